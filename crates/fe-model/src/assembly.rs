@@ -1,0 +1,537 @@
+//! Sparse assembly that keeps every element's contribution separate.
+//!
+//! An [`Assembly`] is the model turned into equations: a [`DofMap`], one
+//! symmetric sparsity [`Pattern`] shared by K, M and every damping matrix, and
+//! one [`Block`] per element, spring and lumped mass. A block holds the local
+//! equation indices and a few [`Term`]s, each a *unit* matrix times a value
+//! that is the product of model quantities:
+//!
+//! ```text
+//! beam  K:  E * f_element * f_group       * K_unit(A, I, L, angle)
+//! beam  M:  rho * f_element * f_group     * M_unit(A, L, angle)   (+ added mass term)
+//! spring:   k_d * f_group                 * [1 -1; -1 1] on direction d
+//! mass:     m * f_group (ux, uy),  j * f_group (rz)
+//! ```
+//!
+//! Any group matrix `K_g`, `M_g`, and the derivative of any of them with
+//! respect to a quantity, is then a sum over a known list of terms. Nothing
+//! here knows about frequencies; `damping` combines the terms into `Z(w)`.
+
+use std::collections::HashMap;
+
+use nalgebra::DMatrix;
+
+use crate::dof::{Dof, DofMap, DofRef, Slot};
+use crate::element::{self, Mat6};
+use crate::error::ModelError;
+use crate::model::{Model, NodeId};
+use crate::quantity::Quantity;
+
+/// Which global matrix a term belongs to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum MatrixKind {
+    /// Stiffness K.
+    Stiffness,
+    /// Mass M.
+    Mass,
+}
+
+/// The model item a block comes from (index into the model's list).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum BlockSource {
+    /// A beam element.
+    Beam(usize),
+    /// A spring.
+    Spring(usize),
+    /// A lumped mass.
+    Mass(usize),
+}
+
+/// One unit matrix of a block, times a value.
+#[derive(Clone, Debug)]
+pub struct Term {
+    /// Stiffness or mass.
+    pub kind: MatrixKind,
+    /// Model quantities whose product is `value`.
+    pub factors: Vec<Quantity>,
+    /// Current product of the factors.
+    pub value: f64,
+    /// Unit matrix over the block's free local DOFs, row-major `n x n`.
+    pub unit: Vec<f64>,
+}
+
+/// The contribution of one element, spring or mass.
+#[derive(Clone, Debug)]
+pub struct Block {
+    /// Where it comes from.
+    pub source: BlockSource,
+    /// Its group index.
+    pub group: usize,
+    /// Equation index of each free local DOF (may repeat when DOFs are tied).
+    pub eqs: Vec<usize>,
+    /// Its terms.
+    pub terms: Vec<Term>,
+    /// For each local pair `(r, c)` (row-major), the index in the pattern's values.
+    pub positions: Vec<usize>,
+}
+
+impl Block {
+    /// Number of free local DOFs.
+    pub fn len(&self) -> usize {
+        self.eqs.len()
+    }
+
+    /// True when every local DOF is fixed.
+    pub fn is_empty(&self) -> bool {
+        self.eqs.is_empty()
+    }
+}
+
+/// Symmetric sparsity pattern in compressed sparse column form (both
+/// triangles stored, rows sorted within each column).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Pattern {
+    /// Matrix dimension.
+    pub n: usize,
+    /// Column pointers, length `n + 1`.
+    pub col_ptr: Vec<usize>,
+    /// Row indices, length `nnz`.
+    pub row_idx: Vec<usize>,
+}
+
+impl Pattern {
+    /// Number of stored entries.
+    pub fn nnz(&self) -> usize {
+        self.row_idx.len()
+    }
+
+    /// Index of entry `(row, col)` in the values array.
+    pub fn position(&self, row: usize, col: usize) -> Option<usize> {
+        let (a, b) = (self.col_ptr[col], self.col_ptr[col + 1]);
+        self.row_idx[a..b].binary_search(&row).ok().map(|k| a + k)
+    }
+
+    /// Index of each diagonal entry.
+    pub fn diagonal_positions(&self) -> Vec<usize> {
+        (0..self.n).map(|i| self.position(i, i).expect("diagonal is always stored")).collect()
+    }
+}
+
+/// A model assembled into equations; see the module docs.
+#[derive(Clone, Debug)]
+pub struct Assembly {
+    /// DOF numbering.
+    pub dofs: DofMap,
+    /// Shared sparsity pattern.
+    pub pattern: Pattern,
+    /// One block per beam, spring and lumped mass.
+    pub blocks: Vec<Block>,
+    /// Blocks of each group.
+    pub group_blocks: Vec<Vec<usize>>,
+    /// For each factor quantity, the `(block, term)` pairs it multiplies.
+    by_quantity: HashMap<Quantity, Vec<(usize, usize)>>,
+}
+
+struct UnionFind(Vec<usize>);
+
+impl UnionFind {
+    fn find(&mut self, mut i: usize) -> usize {
+        while self.0[i] != i {
+            self.0[i] = self.0[self.0[i]];
+            i = self.0[i];
+        }
+        i
+    }
+    fn union(&mut self, a: usize, b: usize) {
+        let (ra, rb) = (self.find(a), self.find(b));
+        if ra != rb {
+            // keep the smaller index as root: equations follow node order
+            let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
+            self.0[hi] = lo;
+        }
+    }
+}
+
+fn build_dof_map(model: &Model) -> DofMap {
+    let n = model.nodes.len();
+    let slot_of = |id: NodeId, d: Dof| 3 * model.node_index[&id] + d.index();
+    let mut uf = UnionFind((0..3 * n).collect());
+    for tie in &model.ties {
+        for &d in &tie.dofs {
+            uf.union(slot_of(tie.nodes[0], d), slot_of(tie.nodes[1], d));
+        }
+    }
+    let mut fixed = vec![false; 3 * n];
+    for s in &model.supports {
+        for &d in &s.dofs {
+            let root = uf.find(slot_of(s.node, d));
+            fixed[root] = true;
+        }
+    }
+    let mut map = DofMap::default();
+    let mut eq_of_root: HashMap<usize, usize> = HashMap::new();
+    for (i, node) in model.nodes.iter().enumerate() {
+        for d in Dof::ALL {
+            let r = DofRef { node: node.id, dof: d };
+            let root = uf.find(3 * i + d.index());
+            if fixed[root] {
+                map.insert_fixed(r);
+            } else if let Some(&eq) = eq_of_root.get(&root) {
+                map.insert_alias(r, eq);
+            } else {
+                let eq = map.insert_free(r);
+                eq_of_root.insert(root, eq);
+            }
+        }
+    }
+    map
+}
+
+/// Local DOFs and terms (full, before removing fixed DOFs) of every block.
+fn raw_blocks(model: &Model) -> Vec<(BlockSource, usize, Vec<DofRef>, Vec<(MatrixKind, Vec<Quantity>, Mat6OrSmall)>)> {
+    let mut out = Vec::new();
+    let node_dofs = |id: NodeId| Dof::ALL.map(|d| DofRef { node: id, dof: d });
+    for (i, b) in model.beams.iter().enumerate() {
+        let (l, c, s) = model.beam_geometry(i);
+        let sec = &model.sections[b.section];
+        let dofs: Vec<DofRef> = node_dofs(b.nodes[0]).into_iter().chain(node_dofs(b.nodes[1])).collect();
+        let g = b.group;
+        let mut terms = vec![
+            (
+                MatrixKind::Stiffness,
+                vec![Quantity::MaterialE(b.material), Quantity::ElementStiffness(i), Quantity::GroupStiffness(g)],
+                Mat6OrSmall::Six(element::frame_stiffness(sec.area, sec.inertia, l, c, s)),
+            ),
+            (
+                MatrixKind::Mass,
+                vec![Quantity::MaterialRho(b.material), Quantity::ElementMass(i), Quantity::GroupMass(g)],
+                Mat6OrSmall::Six(element::frame_mass(sec.area, l, c, s)),
+            ),
+        ];
+        // The added-mass term always exists so that it can be updated from zero.
+        terms.push((
+            MatrixKind::Mass,
+            vec![Quantity::ElementAddedMass(i), Quantity::ElementMass(i), Quantity::GroupMass(g)],
+            Mat6OrSmall::Six(element::transverse_lumped_mass(l, c, s)),
+        ));
+        out.push((BlockSource::Beam(i), g, dofs, terms));
+    }
+    for (i, sp) in model.springs.iter().enumerate() {
+        let mut dofs: Vec<DofRef> = node_dofs(sp.a).to_vec();
+        if let Some(b) = sp.b {
+            dofs.extend(node_dofs(b));
+        }
+        let n = dofs.len();
+        let terms = Dof::ALL
+            .iter()
+            .map(|&d| {
+                let mut u = vec![0.0; n * n];
+                let i0 = d.index();
+                u[i0 * n + i0] = 1.0;
+                if n == 6 {
+                    let i1 = 3 + d.index();
+                    u[i1 * n + i1] = 1.0;
+                    u[i0 * n + i1] = -1.0;
+                    u[i1 * n + i0] = -1.0;
+                }
+                (MatrixKind::Stiffness, vec![Quantity::SpringK(i, d), Quantity::GroupStiffness(sp.group)], Mat6OrSmall::Dense(u))
+            })
+            .collect();
+        out.push((BlockSource::Spring(i), sp.group, dofs, terms));
+    }
+    for (i, m) in model.masses.iter().enumerate() {
+        let dofs = node_dofs(m.node).to_vec();
+        let t = vec![1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0];
+        let r = vec![0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0];
+        let terms = vec![
+            (MatrixKind::Mass, vec![Quantity::MassM(i), Quantity::GroupMass(m.group)], Mat6OrSmall::Dense(t)),
+            (MatrixKind::Mass, vec![Quantity::MassJ(i), Quantity::GroupMass(m.group)], Mat6OrSmall::Dense(r)),
+        ];
+        out.push((BlockSource::Mass(i), m.group, dofs, terms));
+    }
+    out
+}
+
+enum Mat6OrSmall {
+    Six(Mat6),
+    Dense(Vec<f64>),
+}
+
+impl Mat6OrSmall {
+    fn get(&self, n: usize, r: usize, c: usize) -> f64 {
+        match self {
+            Mat6OrSmall::Six(m) => m[(r, c)],
+            Mat6OrSmall::Dense(v) => v[r * n + c],
+        }
+    }
+}
+
+impl Assembly {
+    /// Assembles a model. Fails when no DOF is free, when a node with free
+    /// DOFs touches nothing, or when a free DOF has no stiffness at all.
+    pub fn new(model: &Model) -> Result<Self, ModelError> {
+        let dofs = build_dof_map(model);
+        if dofs.is_empty() {
+            return Err(ModelError::NoFreeDof);
+        }
+        let mut touched = vec![false; model.nodes.len()];
+        let mut blocks = Vec::new();
+        for (source, group, local, terms) in raw_blocks(model) {
+            for r in &local {
+                touched[model.node_index[&r.node]] = true;
+            }
+            let free: Vec<(usize, usize)> = local
+                .iter()
+                .enumerate()
+                .filter_map(|(k, r)| match dofs.slot(*r) {
+                    Some(Slot::Free(eq)) => Some((k, eq)),
+                    _ => None,
+                })
+                .collect();
+            if free.is_empty() {
+                continue;
+            }
+            let n_full = local.len();
+            let n = free.len();
+            let terms = terms
+                .into_iter()
+                .map(|(kind, factors, m)| {
+                    let mut unit = vec![0.0; n * n];
+                    for (r, &(kr, _)) in free.iter().enumerate() {
+                        for (c, &(kc, _)) in free.iter().enumerate() {
+                            unit[r * n + c] = m.get(n_full, kr, kc);
+                        }
+                    }
+                    let value = factors.iter().map(|&q| model.get(q)).product();
+                    Term { kind, factors, value, unit }
+                })
+                .collect();
+            blocks.push(Block {
+                source,
+                group,
+                eqs: free.iter().map(|&(_, eq)| eq).collect(),
+                terms,
+                positions: Vec::new(),
+            });
+        }
+        for (i, node) in model.nodes.iter().enumerate() {
+            let has_free = Dof::ALL.iter().any(|&d| dofs.equation(DofRef { node: node.id, dof: d }).is_some());
+            if !touched[i] && has_free {
+                return Err(ModelError::DanglingNode { id: node.id.0 });
+            }
+        }
+        let pattern = build_pattern(dofs.len(), &blocks);
+        for b in &mut blocks {
+            let n = b.eqs.len();
+            b.positions = (0..n * n)
+                .map(|k| pattern.position(b.eqs[k / n], b.eqs[k % n]).expect("pattern covers every block"))
+                .collect();
+        }
+        let mut group_blocks = vec![Vec::new(); model.groups.len()];
+        let mut by_quantity: HashMap<Quantity, Vec<(usize, usize)>> = HashMap::new();
+        for (bi, b) in blocks.iter().enumerate() {
+            group_blocks[b.group].push(bi);
+            for (ti, t) in b.terms.iter().enumerate() {
+                for &q in &t.factors {
+                    by_quantity.entry(q).or_default().push((bi, ti));
+                }
+            }
+        }
+        let assembly = Assembly { dofs, pattern, blocks, group_blocks, by_quantity };
+        assembly.check_stiffness_diagonal()?;
+        Ok(assembly)
+    }
+
+    /// Every free DOF needs some stiffness: a zero diagonal in K means a DOF
+    /// that nothing restrains (a free rotation at a pin, a spring-less joint).
+    fn check_stiffness_diagonal(&self) -> Result<(), ModelError> {
+        let k = self.real_values(MatrixKind::Stiffness);
+        let diag = self.pattern.diagonal_positions();
+        let scale = diag.iter().map(|&p| k[p].abs()).fold(0.0, f64::max);
+        for (eq, &p) in diag.iter().enumerate() {
+            if k[p] <= 1e-14 * scale {
+                return Err(ModelError::Mechanism { hint: self.dofs.dof_of(eq).to_string() });
+            }
+        }
+        Ok(())
+    }
+
+    /// Recomputes every term value from the model's current quantities.
+    pub fn refresh(&mut self, model: &Model) {
+        for b in &mut self.blocks {
+            for t in &mut b.terms {
+                t.value = t.factors.iter().map(|&q| model.get(q)).product();
+            }
+        }
+    }
+
+    /// Recomputes the values of the terms that quantity `q` multiplies.
+    pub fn refresh_quantity(&mut self, model: &Model, q: Quantity) {
+        if let Some(list) = self.by_quantity.get(&q) {
+            for &(b, t) in list {
+                let term = &mut self.blocks[b].terms[t];
+                term.value = term.factors.iter().map(|&f| model.get(f)).product();
+            }
+        }
+    }
+
+    /// The `(block, term)` pairs that a factor quantity multiplies (empty for
+    /// damping quantities, which act through whole groups).
+    pub fn terms_of(&self, q: Quantity) -> &[(usize, usize)] {
+        self.by_quantity.get(&q).map_or(&[], Vec::as_slice)
+    }
+
+    /// Number of equations.
+    pub fn n(&self) -> usize {
+        self.dofs.len()
+    }
+
+    /// Accumulates `sum over blocks and terms of coef(block, term) * value * unit`
+    /// into `out`, a values array on [`Self::pattern`]. `out` is not cleared.
+    pub fn accumulate<T>(&self, mut coef: impl FnMut(&Block, &Term) -> Option<T>, out: &mut [T])
+    where
+        T: Copy + std::ops::AddAssign + std::ops::Mul<f64, Output = T>,
+    {
+        for b in &self.blocks {
+            for t in &b.terms {
+                if t.value == 0.0 {
+                    continue;
+                }
+                if let Some(c) = coef(b, t) {
+                    for (k, &p) in b.positions.iter().enumerate() {
+                        let u = t.unit[k];
+                        if u != 0.0 {
+                            out[p] += c * (t.value * u);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Values of the whole K or M on the pattern.
+    pub fn real_values(&self, kind: MatrixKind) -> Vec<f64> {
+        let mut v = vec![0.0; self.pattern.nnz()];
+        self.accumulate(|_, t| (t.kind == kind).then_some(1.0), &mut v);
+        v
+    }
+
+    /// Values of `K_g` or `M_g` of one group.
+    pub fn group_values(&self, group: usize, kind: MatrixKind) -> Vec<f64> {
+        let mut v = vec![0.0; self.pattern.nnz()];
+        self.accumulate(|b, t| (b.group == group && t.kind == kind).then_some(1.0), &mut v);
+        v
+    }
+
+    /// A values array on the pattern as a dense matrix (for small models).
+    pub fn to_dense(&self, values: &[f64]) -> DMatrix<f64> {
+        let n = self.n();
+        let mut m = DMatrix::zeros(n, n);
+        for c in 0..n {
+            for p in self.pattern.col_ptr[c]..self.pattern.col_ptr[c + 1] {
+                m[(self.pattern.row_idx[p], c)] = values[p];
+            }
+        }
+        m
+    }
+
+    /// Dense K (for small models and tests).
+    pub fn stiffness_dense(&self) -> DMatrix<f64> {
+        self.to_dense(&self.real_values(MatrixKind::Stiffness))
+    }
+
+    /// Dense M (for small models and tests).
+    pub fn mass_dense(&self) -> DMatrix<f64> {
+        self.to_dense(&self.real_values(MatrixKind::Mass))
+    }
+}
+
+fn build_pattern(n: usize, blocks: &[Block]) -> Pattern {
+    let mut cols: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for i in 0..n {
+        cols[i].push(i);
+    }
+    for b in blocks {
+        for &c in &b.eqs {
+            cols[c].extend_from_slice(&b.eqs);
+        }
+    }
+    let mut col_ptr = Vec::with_capacity(n + 1);
+    let mut row_idx = Vec::new();
+    col_ptr.push(0);
+    for mut rows in cols {
+        rows.sort_unstable();
+        rows.dedup();
+        row_idx.extend(rows);
+        col_ptr.push(row_idx.len());
+    }
+    Pattern { n, col_ptr, row_idx }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::samples;
+    use approx::assert_relative_eq;
+
+    #[test]
+    fn assembled_matrices_are_symmetric_and_pattern_is_symmetric() {
+        let model = samples::frame_with_joint();
+        let a = Assembly::new(&model).unwrap();
+        let k = a.stiffness_dense();
+        let m = a.mass_dense();
+        assert_relative_eq!(k, k.transpose(), epsilon = 1e-6);
+        assert_relative_eq!(m, m.transpose(), epsilon = 1e-12);
+        for c in 0..a.n() {
+            for p in a.pattern.col_ptr[c]..a.pattern.col_ptr[c + 1] {
+                assert!(a.pattern.position(c, a.pattern.row_idx[p]).is_some());
+            }
+        }
+    }
+
+    #[test]
+    fn group_matrices_sum_to_the_whole() {
+        let model = samples::frame_with_joint();
+        let a = Assembly::new(&model).unwrap();
+        let total = a.real_values(MatrixKind::Stiffness);
+        let mut sum = vec![0.0; total.len()];
+        for g in 0..model.groups().len() {
+            for (s, v) in sum.iter_mut().zip(a.group_values(g, MatrixKind::Stiffness)) {
+                *s += v;
+            }
+        }
+        for (s, t) in sum.iter().zip(&total) {
+            assert_relative_eq!(*s, *t, max_relative = 1e-12);
+        }
+    }
+
+    #[test]
+    fn a_pinned_rotation_with_nothing_restraining_it_is_a_mechanism() {
+        let mut m = Model::new("loose");
+        let g = m.add_group(crate::model::Group::new("g")).unwrap();
+        m.add_node(1, 0.0, 0.0).unwrap();
+        m.add_node(2, 1.0, 0.0).unwrap();
+        m.add_node(3, 1.0, 0.0).unwrap();
+        let mat = m.add_material("s", 2e11, 7800.0).unwrap();
+        let sec = m.add_section(crate::model::Section::rectangle("r", 0.05, 0.01)).unwrap();
+        m.add_beam(1, [1, 2], mat, sec, g).unwrap();
+        m.add_spring("j", 2, Some(3), [1e6, 1e6, 0.0], g).unwrap();
+        m.add_mass("tip", 3, 1.0, 0.0, g).unwrap();
+        m.add_support(1, &Dof::ALL).unwrap();
+        let e = Assembly::new(&m).unwrap_err();
+        assert_eq!(e, ModelError::Mechanism { hint: "3:rz".into() });
+    }
+
+    #[test]
+    fn ties_share_equations_and_supports_remove_them() {
+        let model = samples::frame_with_joint();
+        let a = Assembly::new(&model).unwrap();
+        // 4 nodes x 3 dofs, node 1 clamped, nodes 2 and 3 tied in ux, uy
+        assert_eq!(a.n(), 12 - 3 - 2);
+        let e2 = a.dofs.equation(DofRef::new(2, Dof::Ux)).unwrap();
+        let e3 = a.dofs.equation(DofRef::new(3, Dof::Ux)).unwrap();
+        assert_eq!(e2, e3);
+        assert_ne!(a.dofs.equation(DofRef::new(2, Dof::Rz)), a.dofs.equation(DofRef::new(3, Dof::Rz)));
+        assert_eq!(a.dofs.slot(DofRef::new(1, Dof::Rz)), Some(Slot::Fixed));
+    }
+}

@@ -1,0 +1,886 @@
+//! TOML case files: the model, where the measured data comes from, the truth
+//! of a simulated study, and what to update.
+//!
+//! The format is described with an annotated example in `docs/case-files.md`;
+//! every case under `cases/` is a working example. Errors name the file, the
+//! line and the column.
+
+use std::collections::BTreeMap;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+use toml::Spanned;
+
+use crate::dof::{Dof, DofRef};
+use crate::error::{CaseError, ModelError};
+use crate::model::{Group, Model, NodeId, Section};
+use crate::quantity::Quantity;
+
+// ---------------------------------------------------------------- raw schema
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawCase {
+    title: Option<String>,
+    description: Option<String>,
+    #[serde(default)]
+    materials: BTreeMap<String, Spanned<RawMaterial>>,
+    #[serde(default)]
+    sections: BTreeMap<String, Spanned<RawSection>>,
+    #[serde(default)]
+    groups: BTreeMap<String, Spanned<RawGroup>>,
+    #[serde(default)]
+    nodes: Vec<Spanned<(u32, f64, f64)>>,
+    #[serde(default)]
+    lines: Vec<Spanned<RawLine>>,
+    #[serde(default)]
+    beams: Vec<Spanned<RawBeam>>,
+    #[serde(default)]
+    springs: Vec<Spanned<RawSpring>>,
+    #[serde(default)]
+    masses: Vec<Spanned<RawMass>>,
+    #[serde(default)]
+    supports: Vec<Spanned<RawSupport>>,
+    #[serde(default)]
+    ties: Vec<Spanned<RawTie>>,
+    #[serde(default)]
+    set: BTreeMap<String, Spanned<f64>>,
+    measurement: Option<Spanned<RawMeasurement>>,
+    truth: Option<Spanned<RawTruth>>,
+    update: Option<Spanned<RawUpdate>>,
+    paper: Option<Spanned<RawPaper>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawMaterial {
+    #[serde(rename = "E")]
+    e: f64,
+    rho: f64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawSection {
+    #[serde(rename = "A")]
+    area: Option<f64>,
+    #[serde(rename = "I")]
+    inertia: Option<f64>,
+    b: Option<f64>,
+    h: Option<f64>,
+    od: Option<f64>,
+    id: Option<f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawGroup {
+    #[serde(default)]
+    alpha: f64,
+    #[serde(default)]
+    beta: f64,
+    mu: Option<f64>,
+    #[serde(default = "one")]
+    stiffness: f64,
+    #[serde(default = "one")]
+    mass: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawLine {
+    from: Spanned<toml::Value>,
+    to: Spanned<toml::Value>,
+    elements: Spanned<u32>,
+    material: Spanned<String>,
+    section: Spanned<String>,
+    group: Spanned<String>,
+    first_node: Option<u32>,
+    first_element: Option<u32>,
+    #[serde(default)]
+    added_mass: f64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawBeam {
+    id: u32,
+    nodes: [u32; 2],
+    material: Spanned<String>,
+    section: Spanned<String>,
+    group: Spanned<String>,
+    #[serde(default)]
+    added_mass: f64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawSpring {
+    name: String,
+    nodes: Option<[u32; 2]>,
+    node: Option<u32>,
+    #[serde(default)]
+    kx: f64,
+    #[serde(default)]
+    ky: f64,
+    #[serde(default)]
+    kr: f64,
+    group: Spanned<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawMass {
+    name: String,
+    node: u32,
+    #[serde(default)]
+    m: f64,
+    #[serde(default)]
+    j: f64,
+    group: Spanned<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawSupport {
+    node: u32,
+    dofs: Option<Vec<Spanned<String>>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawTie {
+    nodes: [u32; 2],
+    dofs: Vec<Spanned<String>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawMeasurement {
+    frequencies: Spanned<toml::Value>,
+    references: Vec<Spanned<String>>,
+    responses: Vec<Spanned<String>>,
+    data: Option<Spanned<String>>,
+    #[serde(default)]
+    map: Vec<Spanned<RawChannelMap>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawChannelMap {
+    test: Spanned<String>,
+    model: Spanned<String>,
+    #[serde(default = "one")]
+    sign: f64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawTruth {
+    #[serde(default)]
+    noise: f64,
+    #[serde(default)]
+    floor: f64,
+    #[serde(default)]
+    seed: u64,
+    #[serde(default)]
+    set: BTreeMap<String, Spanned<f64>>,
+    #[serde(default)]
+    springs: Vec<Spanned<RawSpring>>,
+    #[serde(default)]
+    masses: Vec<Spanned<RawMass>>,
+    #[serde(default)]
+    groups: BTreeMap<String, Spanned<RawGroup>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawUpdate {
+    parameters: Vec<Spanned<String>>,
+    frequencies: Option<Spanned<toml::Value>>,
+    method: Option<Spanned<String>>,
+    max_iterations: Option<u32>,
+    tolerance: Option<f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawPaper {
+    source: String,
+    #[serde(default)]
+    values: BTreeMap<String, Spanned<f64>>,
+    #[serde(default)]
+    frequencies_hz: Vec<f64>,
+    note: Option<String>,
+}
+
+// ------------------------------------------------------------- public specs
+
+/// Where the measured FRFs come from and which channels they hold.
+#[derive(Clone, Debug)]
+pub struct MeasurementSpec {
+    /// Frequency lines (Hz) of synthesised data.
+    pub frequencies_hz: Vec<f64>,
+    /// Excitation DOFs (columns of the FRF matrix).
+    pub references: Vec<DofRef>,
+    /// Response DOFs (rows).
+    pub responses: Vec<DofRef>,
+    /// Measured data file (resolved relative to the case file), if any.
+    pub data: Option<PathBuf>,
+    /// Test (node, direction) to model DOF mapping for measured files.
+    pub map: Vec<ChannelMap>,
+}
+
+/// Mapping of a test point and direction to a model DOF.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ChannelMap {
+    /// Test point and direction as written in the measurement file, e.g. `101:+Y`.
+    pub test: String,
+    /// Model DOF.
+    pub model: DofRef,
+    /// +1 or -1.
+    pub sign: f64,
+}
+
+/// The truth of a simulated study: the model that generates "measured" data.
+#[derive(Clone, Debug)]
+pub struct TruthSpec {
+    /// The truth model (the case's model with the truth's values and extra items).
+    pub model: Model,
+    /// Quantities set by the truth, in the *case model's* indexing, with values.
+    pub values: Vec<(Quantity, f64)>,
+    /// Relative complex noise level (0.01 = 1 %).
+    pub noise: f64,
+    /// Additive noise floor relative to each channel's RMS magnitude.
+    pub floor: f64,
+    /// Random seed.
+    pub seed: u64,
+}
+
+/// Frequency points for updating.
+#[derive(Clone, Debug, PartialEq)]
+pub enum FrequencyChoice {
+    /// Explicit points (Hz).
+    List(Vec<f64>),
+    /// Choose this many points automatically, away from resonances and anti-resonances.
+    Auto(usize),
+    /// Every measured line.
+    All,
+}
+
+/// What to update and how.
+#[derive(Clone, Debug)]
+pub struct UpdateSpec {
+    /// Parameters to update.
+    pub parameters: Vec<Quantity>,
+    /// Frequency points.
+    pub frequencies: FrequencyChoice,
+    /// Method name as written (checked by the solver crate).
+    pub method: Option<(String, Range<usize>)>,
+    /// Iteration limit.
+    pub max_iterations: Option<u32>,
+    /// Convergence tolerance on the largest relative correction.
+    pub tolerance: Option<f64>,
+}
+
+/// Published values to print beside the tool's (for reproducing a paper).
+#[derive(Clone, Debug)]
+pub struct PaperSpec {
+    /// Which table or figure.
+    pub source: String,
+    /// Published parameter values.
+    pub values: Vec<(Quantity, f64)>,
+    /// Published natural frequencies (Hz).
+    pub frequencies_hz: Vec<f64>,
+    /// A remark printed with the table.
+    pub note: Option<String>,
+}
+
+/// A loaded, validated case file.
+#[derive(Clone, Debug)]
+pub struct CaseFile {
+    /// Path it was read from.
+    pub path: PathBuf,
+    /// Its text.
+    pub source: String,
+    /// Free-text description.
+    pub description: Option<String>,
+    /// The (initial) model.
+    pub model: Model,
+    /// Measurement description.
+    pub measurement: Option<MeasurementSpec>,
+    /// Truth of a simulated study.
+    pub truth: Option<TruthSpec>,
+    /// Updating setup.
+    pub update: Option<UpdateSpec>,
+    /// Published values.
+    pub paper: Option<PaperSpec>,
+}
+
+// ------------------------------------------------------------------ loading
+
+struct Ctx<'a> {
+    path: &'a Path,
+    source: &'a str,
+}
+
+impl Ctx<'_> {
+    fn err(&self, span: Range<usize>, message: impl Into<String>) -> CaseError {
+        CaseError::at(self.path, self.source, Some(span), message.into())
+    }
+    fn model_err(&self, span: Range<usize>, e: ModelError) -> CaseError {
+        self.err(span, e.to_string())
+    }
+}
+
+impl CaseFile {
+    /// Reads and validates a case file.
+    pub fn load(path: impl AsRef<Path>) -> Result<Self, CaseError> {
+        let path = path.as_ref();
+        let source = std::fs::read_to_string(path).map_err(|e| CaseError {
+            file: path.to_path_buf(),
+            location: None,
+            message: format!("cannot read the case file: {e}"),
+            snippet: None,
+        })?;
+        Self::parse(path, &source)
+    }
+
+    /// Parses case-file text; `path` is used in messages and to resolve data files.
+    pub fn parse(path: &Path, source: &str) -> Result<Self, CaseError> {
+        let ctx = Ctx { path, source };
+        let raw: RawCase = toml::from_str(source).map_err(|e| {
+            CaseError::at(path, source, e.span(), e.message().trim_end().to_string())
+        })?;
+        let mut model = Model::new(raw.title.as_deref().unwrap_or("untitled"));
+        build_model(&ctx, &raw, &mut model)?;
+        for (name, v) in &raw.set {
+            let q = model.quantity(name).map_err(|e| ctx.model_err(v.span(), e))?;
+            model.set(q, *v.get_ref()).map_err(|e| ctx.model_err(v.span(), e))?;
+        }
+        // Assemble once so that structural errors are reported at load time.
+        crate::assembly::Assembly::new(&model).map_err(|e| ctx.err(0..0, e.to_string()))?;
+
+        let measurement = raw.measurement.as_ref().map(|m| parse_measurement(&ctx, m, &model)).transpose()?;
+        let truth = raw.truth.as_ref().map(|t| parse_truth(&ctx, t, &model)).transpose()?;
+        let update = raw.update.as_ref().map(|u| parse_update(&ctx, u, &model)).transpose()?;
+        let paper = raw
+            .paper
+            .as_ref()
+            .map(|p| {
+                let p = p.get_ref();
+                let values = resolve_values(&ctx, &p.values, &model)?;
+                Ok::<_, CaseError>(PaperSpec {
+                    source: p.source.clone(),
+                    values,
+                    frequencies_hz: p.frequencies_hz.clone(),
+                    note: p.note.clone(),
+                })
+            })
+            .transpose()?;
+        if let (Some(m), None) = (&measurement, &truth) {
+            if m.data.is_none() {
+                return Err(ctx.err(
+                    raw.measurement.as_ref().unwrap().span(),
+                    "the measurement has no `data` file and the case has no [truth] to synthesise it from",
+                ));
+            }
+        }
+        Ok(CaseFile {
+            path: path.to_path_buf(),
+            source: source.to_string(),
+            description: raw.description,
+            model,
+            measurement,
+            truth,
+            update,
+            paper,
+        })
+    }
+
+    /// A located error about this file (for checks done by higher layers).
+    pub fn error(&self, span: Option<Range<usize>>, message: impl Into<String>) -> CaseError {
+        CaseError::at(&self.path, &self.source, span, message.into())
+    }
+}
+
+fn lookup(ctx: &Ctx<'_>, kind: &str, name: &Spanned<String>, found: Option<usize>, known: Vec<&str>) -> Result<usize, CaseError> {
+    found.ok_or_else(|| {
+        let hint = crate::suggest::closest(name.get_ref(), known.iter().copied())
+            .map(|s| format!("; did you mean `{s}`?"))
+            .unwrap_or_else(|| format!(" (defined: {})", if known.is_empty() { "none".into() } else { known.join(", ") }));
+        ctx.err(name.span(), format!("unknown {kind} `{}`{hint}", name.get_ref()))
+    })
+}
+
+fn group_ref(ctx: &Ctx<'_>, model: &Model, name: &Spanned<String>) -> Result<usize, CaseError> {
+    lookup(ctx, "group", name, model.group_index(name.get_ref()), model.groups.iter().map(|g| g.name.as_str()).collect())
+}
+
+fn raw_group(ctx: &Ctx<'_>, name: &str, g: &Spanned<RawGroup>) -> Result<Group, CaseError> {
+    let r = g.get_ref();
+    if let Some(mu) = r.mu {
+        if !(mu > 0.0) {
+            return Err(ctx.err(g.span(), format!("group `{name}`: mu must be positive (use `inf` or omit it for viscous damping), got {mu}")));
+        }
+    }
+    Ok(Group {
+        name: name.into(),
+        alpha: r.alpha,
+        beta: r.beta,
+        mu: r.mu.filter(|m| m.is_finite()),
+        stiffness: r.stiffness,
+        mass: r.mass,
+    })
+}
+
+fn build_model(ctx: &Ctx<'_>, raw: &RawCase, model: &mut Model) -> Result<(), CaseError> {
+    for (name, m) in &raw.materials {
+        model.add_material(name, m.get_ref().e, m.get_ref().rho).map_err(|e| ctx.model_err(m.span(), e))?;
+    }
+    for (name, s) in &raw.sections {
+        let r = s.get_ref();
+        let section = match (r.area, r.inertia, r.b, r.h, r.od, r.id) {
+            (Some(a), Some(i), None, None, None, None) => Section { name: name.clone(), area: a, inertia: i },
+            (None, None, Some(b), Some(h), None, None) => Section::rectangle(name, b, h),
+            (None, None, None, None, Some(od), id) => {
+                let id = id.unwrap_or(0.0);
+                if !(id >= 0.0 && id < od) {
+                    return Err(ctx.err(s.span(), format!("section `{name}`: need 0 <= id < od, got od = {od}, id = {id}")));
+                }
+                Section::tube(name, od, id)
+            }
+            _ => {
+                return Err(ctx.err(
+                    s.span(),
+                    format!("section `{name}`: give either A and I, or b and h (rectangle), or od and id (tube)"),
+                ));
+            }
+        };
+        model.add_section(section).map_err(|e| ctx.model_err(s.span(), e))?;
+    }
+    for (name, g) in &raw.groups {
+        let group = raw_group(ctx, name, g)?;
+        model.add_group(group).map_err(|e| ctx.model_err(g.span(), e))?;
+    }
+    for n in &raw.nodes {
+        let (id, x, y) = *n.get_ref();
+        model.add_node(id, x, y).map_err(|e| ctx.model_err(n.span(), e))?;
+    }
+    for line in &raw.lines {
+        add_line(ctx, model, line)?;
+    }
+    for b in &raw.beams {
+        let r = b.get_ref();
+        let mat = lookup(ctx, "material", &r.material, model.material_index(r.material.get_ref()), model.materials.iter().map(|m| m.name.as_str()).collect())?;
+        let sec = lookup(ctx, "section", &r.section, model.section_index(r.section.get_ref()), model.sections.iter().map(|m| m.name.as_str()).collect())?;
+        let g = group_ref(ctx, model, &r.group)?;
+        let i = model.add_beam(r.id, r.nodes, mat, sec, g).map_err(|e| ctx.model_err(b.span(), e))?;
+        model.set_added_mass(i, r.added_mass).map_err(|e| ctx.model_err(b.span(), e))?;
+    }
+    for s in &raw.springs {
+        add_spring(ctx, model, s)?;
+    }
+    for m in &raw.masses {
+        add_mass(ctx, model, m)?;
+    }
+    for s in &raw.supports {
+        let r = s.get_ref();
+        let dofs = match &r.dofs {
+            None => Dof::ALL.to_vec(),
+            Some(list) => parse_dofs(ctx, list)?,
+        };
+        model.add_support(r.node, &dofs).map_err(|e| ctx.model_err(s.span(), e))?;
+    }
+    for t in &raw.ties {
+        let r = t.get_ref();
+        let dofs = parse_dofs(ctx, &r.dofs)?;
+        model.add_tie(r.nodes[0], r.nodes[1], &dofs).map_err(|e| ctx.model_err(t.span(), e))?;
+    }
+    if model.beams.is_empty() && model.springs.is_empty() {
+        return Err(ctx.err(0..0, "the case defines no beams, lines or springs"));
+    }
+    Ok(())
+}
+
+fn parse_dofs(ctx: &Ctx<'_>, list: &[Spanned<String>]) -> Result<Vec<Dof>, CaseError> {
+    list.iter()
+        .map(|d| {
+            if d.get_ref() == "all" {
+                return Err(ctx.err(d.span(), "write all DOFs as [\"ux\", \"uy\", \"rz\"] or omit `dofs`"));
+            }
+            d.get_ref().parse::<Dof>().map_err(|e| ctx.err(d.span(), e))
+        })
+        .collect()
+}
+
+fn add_spring(ctx: &Ctx<'_>, model: &mut Model, s: &Spanned<RawSpring>) -> Result<usize, CaseError> {
+    let r = s.get_ref();
+    let (a, b) = match (r.nodes, r.node) {
+        (Some([a, b]), None) => (a, Some(b)),
+        (None, Some(a)) => (a, None),
+        _ => {
+            return Err(ctx.err(
+                s.span(),
+                format!("spring `{}`: give `nodes = [a, b]` (between two nodes) or `node = a` (to ground)", r.name),
+            ));
+        }
+    };
+    let g = group_ref(ctx, model, &r.group)?;
+    model.add_spring(&r.name, a, b, [r.kx, r.ky, r.kr], g).map_err(|e| ctx.model_err(s.span(), e))
+}
+
+fn add_mass(ctx: &Ctx<'_>, model: &mut Model, m: &Spanned<RawMass>) -> Result<usize, CaseError> {
+    let r = m.get_ref();
+    let g = group_ref(ctx, model, &r.group)?;
+    model.add_mass(&r.name, r.node, r.m, r.j, g).map_err(|e| ctx.model_err(m.span(), e))
+}
+
+enum End {
+    Node(u32),
+    Point(f64, f64),
+}
+
+fn parse_end(ctx: &Ctx<'_>, v: &Spanned<toml::Value>) -> Result<End, CaseError> {
+    let bad = || ctx.err(v.span(), "expected an existing node id or a point [x, y]");
+    match v.get_ref() {
+        toml::Value::Integer(i) => u32::try_from(*i).map(End::Node).map_err(|_| bad()),
+        toml::Value::Array(a) if a.len() == 2 => {
+            let num = |x: &toml::Value| match x {
+                toml::Value::Float(f) => Some(*f),
+                toml::Value::Integer(i) => Some(*i as f64),
+                _ => None,
+            };
+            match (num(&a[0]), num(&a[1])) {
+                (Some(x), Some(y)) => Ok(End::Point(x, y)),
+                _ => Err(bad()),
+            }
+        }
+        _ => Err(bad()),
+    }
+}
+
+fn add_line(ctx: &Ctx<'_>, model: &mut Model, line: &Spanned<RawLine>) -> Result<(), CaseError> {
+    let r = line.get_ref();
+    let n = *r.elements.get_ref();
+    if n == 0 {
+        return Err(ctx.err(r.elements.span(), "a line needs at least one element"));
+    }
+    let mat = lookup(ctx, "material", &r.material, model.material_index(r.material.get_ref()), model.materials.iter().map(|m| m.name.as_str()).collect())?;
+    let sec = lookup(ctx, "section", &r.section, model.section_index(r.section.get_ref()), model.sections.iter().map(|m| m.name.as_str()).collect())?;
+    let g = group_ref(ctx, model, &r.group)?;
+    let mut next_node = r.first_node.unwrap_or(model.max_node_id() + 1);
+    let mut next_elem = r.first_element.unwrap_or(model.max_element_id() + 1);
+    let point = |model: &Model, end: &End, span: Range<usize>| -> Result<(f64, f64), CaseError> {
+        match *end {
+            End::Point(x, y) => Ok((x, y)),
+            End::Node(id) => model
+                .node(NodeId(id))
+                .map(|n| (n.x, n.y))
+                .ok_or_else(|| ctx.err(span, format!("node {id} does not exist (define it before this line)"))),
+        }
+    };
+    let from = parse_end(ctx, &r.from)?;
+    let to = parse_end(ctx, &r.to)?;
+    let (x0, y0) = point(model, &from, r.from.span())?;
+    let (x1, y1) = point(model, &to, r.to.span())?;
+    let mut add = |model: &mut Model, x: f64, y: f64| -> Result<u32, CaseError> {
+        let id = next_node;
+        next_node += 1;
+        model.add_node(id, x, y).map_err(|e| ctx.model_err(line.span(), e))?;
+        Ok(id)
+    };
+    let start = match from {
+        End::Node(id) => id,
+        End::Point(x, y) => add(model, x, y)?,
+    };
+    let mut ids = vec![start];
+    for i in 1..n {
+        let t = f64::from(i) / f64::from(n);
+        ids.push(add(model, x0 + t * (x1 - x0), y0 + t * (y1 - y0))?);
+    }
+    ids.push(match to {
+        End::Node(id) => id,
+        End::Point(x, y) => add(model, x, y)?,
+    });
+    for w in ids.windows(2) {
+        let id = next_elem;
+        next_elem += 1;
+        let i = model.add_beam(id, [w[0], w[1]], mat, sec, g).map_err(|e| ctx.model_err(line.span(), e))?;
+        model.set_added_mass(i, r.added_mass).map_err(|e| ctx.model_err(line.span(), e))?;
+    }
+    Ok(())
+}
+
+/// Parses `31:uy` or a range `2..31:uy` (inclusive) into DOF references.
+pub fn parse_dof_list(text: &str) -> Result<Vec<DofRef>, String> {
+    let (nodes, dof) = text
+        .split_once(':')
+        .ok_or_else(|| format!("`{text}` is not of the form node:dof or first..last:dof (for example 2..31:uy)"))?;
+    let dof: Dof = dof.parse()?;
+    if let Some((a, b)) = nodes.split_once("..") {
+        let a: u32 = a.trim().parse().map_err(|_| format!("`{a}` in `{text}` is not a node id"))?;
+        let b: u32 = b.trim().parse().map_err(|_| format!("`{b}` in `{text}` is not a node id"))?;
+        if b < a {
+            return Err(format!("range `{text}` is empty (last node before first)"));
+        }
+        Ok((a..=b).map(|n| DofRef::new(n, dof)).collect())
+    } else {
+        let n: u32 = nodes.trim().parse().map_err(|_| format!("`{nodes}` in `{text}` is not a node id"))?;
+        Ok(vec![DofRef::new(n, dof)])
+    }
+}
+
+/// Parses a frequency specification: a list of numbers, or a table
+/// `{ from, to, step }` / `{ from, to, count }` (Hz).
+fn parse_frequencies(ctx: &Ctx<'_>, v: &Spanned<toml::Value>) -> Result<Vec<f64>, CaseError> {
+    let num = |x: &toml::Value| match x {
+        toml::Value::Float(f) => Some(*f),
+        toml::Value::Integer(i) => Some(*i as f64),
+        _ => None,
+    };
+    let freqs: Vec<f64> = match v.get_ref() {
+        toml::Value::Array(a) => a
+            .iter()
+            .map(|x| num(x).ok_or_else(|| ctx.err(v.span(), "frequencies must be numbers (Hz)")))
+            .collect::<Result<_, _>>()?,
+        toml::Value::Table(t) => {
+            for k in t.keys() {
+                if !["from", "to", "step", "count"].contains(&k.as_str()) {
+                    return Err(ctx.err(v.span(), format!("unknown key `{k}` in a frequency range (use from, to and step or count)")));
+                }
+            }
+            let get = |k: &str| t.get(k).and_then(num);
+            let (from, to) = match (get("from"), get("to")) {
+                (Some(a), Some(b)) => (a, b),
+                _ => return Err(ctx.err(v.span(), "a frequency range needs `from` and `to` (Hz)")),
+            };
+            let count = match (get("step"), t.get("count")) {
+                (Some(step), None) if step > 0.0 => ((to - from) / step + 1e-9).floor() as usize + 1,
+                (None, Some(toml::Value::Integer(c))) if *c >= 2 => *c as usize,
+                _ => return Err(ctx.err(v.span(), "a frequency range needs a positive `step` or an integer `count` >= 2")),
+            };
+            if count > 10_000_000 {
+                return Err(ctx.err(v.span(), format!("{count} frequency lines is more than this tool accepts (10 million)")));
+            }
+            (0..count).map(|i| from + (to - from) * i as f64 / (count - 1).max(1) as f64).collect()
+        }
+        _ => return Err(ctx.err(v.span(), "expected a list of frequencies or a table { from, to, step }")),
+    };
+    if freqs.is_empty() {
+        return Err(ctx.err(v.span(), "no frequencies given"));
+    }
+    for w in freqs.windows(2) {
+        if !(w[1] > w[0]) {
+            return Err(ctx.err(v.span(), format!("frequencies must increase strictly ({} is followed by {})", w[0], w[1])));
+        }
+    }
+    if let Some(f) = freqs.iter().find(|f| !(f.is_finite() && **f > 0.0)) {
+        return Err(ctx.err(v.span(), format!("frequencies must be positive and finite (Hz), got {f}")));
+    }
+    Ok(freqs)
+}
+
+fn parse_dof_refs(ctx: &Ctx<'_>, list: &[Spanned<String>], model: &Model) -> Result<Vec<DofRef>, CaseError> {
+    let mut out = Vec::new();
+    for s in list {
+        let refs = parse_dof_list(s.get_ref()).map_err(|e| ctx.err(s.span(), e))?;
+        for r in refs {
+            if model.node(r.node).is_none() {
+                return Err(ctx.err(s.span(), format!("node {} does not exist in the model", r.node)));
+            }
+            if out.contains(&r) {
+                return Err(ctx.err(s.span(), format!("{r} is listed twice")));
+            }
+            out.push(r);
+        }
+    }
+    Ok(out)
+}
+
+fn parse_measurement(ctx: &Ctx<'_>, m: &Spanned<RawMeasurement>, model: &Model) -> Result<MeasurementSpec, CaseError> {
+    let r = m.get_ref();
+    let frequencies_hz = parse_frequencies(ctx, &r.frequencies)?;
+    let references = parse_dof_refs(ctx, &r.references, model)?;
+    let responses = parse_dof_refs(ctx, &r.responses, model)?;
+    if references.is_empty() || responses.is_empty() {
+        return Err(ctx.err(m.span(), "the measurement needs at least one reference and one response"));
+    }
+    let data = r.data.as_ref().map(|d| {
+        let p = Path::new(d.get_ref());
+        if p.is_absolute() { p.to_path_buf() } else { ctx.path.parent().unwrap_or(Path::new(".")).join(p) }
+    });
+    let map = r
+        .map
+        .iter()
+        .map(|c| {
+            let c = c.get_ref();
+            let model_dof: DofRef = c.model.get_ref().parse().map_err(|e: String| ctx.err(c.model.span(), e))?;
+            if model.node(model_dof.node).is_none() {
+                return Err(ctx.err(c.model.span(), format!("node {} does not exist in the model", model_dof.node)));
+            }
+            if c.sign != 1.0 && c.sign != -1.0 {
+                return Err(ctx.err(c.model.span(), "sign must be 1 or -1"));
+            }
+            Ok(ChannelMap { test: c.test.get_ref().clone(), model: model_dof, sign: c.sign })
+        })
+        .collect::<Result<_, _>>()?;
+    Ok(MeasurementSpec { frequencies_hz, references, responses, data, map })
+}
+
+fn resolve_values(ctx: &Ctx<'_>, values: &BTreeMap<String, Spanned<f64>>, model: &Model) -> Result<Vec<(Quantity, f64)>, CaseError> {
+    values
+        .iter()
+        .map(|(name, v)| {
+            let q = model.quantity(name).map_err(|e| ctx.model_err(v.span(), e))?;
+            Ok((q, *v.get_ref()))
+        })
+        .collect()
+}
+
+fn parse_truth(ctx: &Ctx<'_>, t: &Spanned<RawTruth>, base: &Model) -> Result<TruthSpec, CaseError> {
+    let r = t.get_ref();
+    if !(r.noise >= 0.0 && r.noise.is_finite()) || !(r.floor >= 0.0 && r.floor.is_finite()) {
+        return Err(ctx.err(t.span(), "noise and floor must be zero or positive"));
+    }
+    let mut model = base.clone();
+    for (name, g) in &r.groups {
+        let group = raw_group(ctx, name, g)?;
+        match model.group_index(name) {
+            Some(i) => *model.group_mut(i) = group,
+            None => {
+                model.add_group(group).map_err(|e| ctx.model_err(g.span(), e))?;
+            }
+        }
+    }
+    for s in &r.springs {
+        add_spring(ctx, &mut model, s)?;
+    }
+    for m in &r.masses {
+        add_mass(ctx, &mut model, m)?;
+    }
+    // Values may name items the truth adds, so resolve them on the truth model.
+    for (name, v) in &r.set {
+        let q = model.quantity(name).map_err(|e| ctx.model_err(v.span(), e))?;
+        model.set(q, *v.get_ref()).map_err(|e| ctx.model_err(v.span(), e))?;
+    }
+    crate::assembly::Assembly::new(&model).map_err(|e| ctx.err(t.span(), format!("the truth model: {e}")))?;
+    let values = r
+        .set
+        .iter()
+        .filter_map(|(name, v)| base.quantity(name).ok().map(|q| (q, *v.get_ref())))
+        .collect();
+    Ok(TruthSpec { model, values, noise: r.noise, floor: r.floor, seed: r.seed })
+}
+
+fn parse_update(ctx: &Ctx<'_>, u: &Spanned<RawUpdate>, model: &Model) -> Result<UpdateSpec, CaseError> {
+    let r = u.get_ref();
+    let mut parameters = Vec::new();
+    for p in &r.parameters {
+        let q = model.quantity(p.get_ref()).map_err(|e| ctx.model_err(p.span(), e))?;
+        if parameters.contains(&q) {
+            return Err(ctx.err(p.span(), format!("parameter `{}` is listed twice", p.get_ref())));
+        }
+        let v = model.get(q);
+        if !(v > 0.0 && v.is_finite()) {
+            return Err(ctx.err(
+                p.span(),
+                format!("parameter `{}` starts at {v}; updating works on relative changes and needs a positive, finite starting value", p.get_ref()),
+            ));
+        }
+        parameters.push(q);
+    }
+    if parameters.is_empty() {
+        return Err(ctx.err(u.span(), "no parameters to update"));
+    }
+    let frequencies = match &r.frequencies {
+        None => FrequencyChoice::Auto(2 * parameters.len().max(5)),
+        Some(v) => match v.get_ref() {
+            toml::Value::String(s) if s == "all" => FrequencyChoice::All,
+            toml::Value::Table(t) if t.len() == 1 && t.contains_key("auto") => match t["auto"] {
+                toml::Value::Integer(n) if n > 0 => FrequencyChoice::Auto(n as usize),
+                _ => return Err(ctx.err(v.span(), "`auto` needs a positive number of points")),
+            },
+            _ => FrequencyChoice::List(parse_frequencies(ctx, v)?),
+        },
+    };
+    if let Some(tol) = r.tolerance {
+        if !(tol > 0.0) {
+            return Err(ctx.err(u.span(), "tolerance must be positive"));
+        }
+    }
+    Ok(UpdateSpec {
+        parameters,
+        frequencies,
+        method: r.method.as_ref().map(|m| (m.get_ref().clone(), m.span())),
+        max_iterations: r.max_iterations,
+        tolerance: r.tolerance,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<CaseFile, CaseError> {
+        CaseFile::parse(Path::new("test.toml"), text)
+    }
+
+    const BEAM: &str = r#"
+title = "beam"
+[materials.steel]
+E = 2e11
+rho = 7800
+[sections.bar]
+b = 0.05
+h = 0.01
+[groups.beam]
+alpha = 1e-5
+[[lines]]
+from = [0.0, 0.0]
+to = [1.0, 0.0]
+elements = 4
+material = "steel"
+section = "bar"
+group = "beam"
+[[supports]]
+node = 1
+"#;
+
+    #[test]
+    fn a_line_generates_nodes_and_elements() {
+        let c = parse(BEAM).unwrap();
+        assert_eq!(c.model.nodes().len(), 5);
+        assert_eq!(c.model.beams().len(), 4);
+        assert_eq!(c.model.node(NodeId(5)).unwrap().x, 1.0);
+    }
+
+    #[test]
+    fn unknown_group_is_reported_with_line_column_and_suggestion() {
+        let text = BEAM.replace("group = \"beam\"", "group = \"bean\"");
+        let e = parse(&text).unwrap_err();
+        assert!(e.message.contains("unknown group `bean`; did you mean `beam`?"), "{e}");
+        let loc = e.location.unwrap();
+        assert_eq!(text.lines().nth(loc.line - 1).unwrap().trim(), "group = \"bean\"");
+    }
+
+    #[test]
+    fn toml_syntax_errors_are_located() {
+        let e = parse("title = \n").unwrap_err();
+        assert_eq!(e.location.unwrap().line, 1);
+        assert!(e.to_string().starts_with("test.toml:1:"), "{e}");
+    }
+
+    #[test]
+    fn dof_lists_expand_ranges() {
+        let v = parse_dof_list("2..4:uy").unwrap();
+        assert_eq!(v, vec![DofRef::new(2, Dof::Uy), DofRef::new(3, Dof::Uy), DofRef::new(4, Dof::Uy)]);
+        assert!(parse_dof_list("4..2:uy").is_err());
+        assert!(parse_dof_list("4").is_err());
+    }
+}

@@ -1,0 +1,283 @@
+//! Scalar quantities of a model that can be read, set and updated by name.
+//!
+//! Names are dotted paths, the same in case files, outputs and the API:
+//!
+//! | name | meaning |
+//! |---|---|
+//! | `group.<g>.alpha` / `.beta` / `.mu` | damping of group g (`mu` in rad/s) |
+//! | `group.<g>.stiffness` / `.mass` | factors on `K_g` and `M_g` (nominal 1) |
+//! | `material.<m>.E` / `.rho` | Young's modulus, density |
+//! | `element.<id>.stiffness` / `.mass` | factors on one element (nominal 1) |
+//! | `element.<id>.added_mass` | non-structural transverse mass per length (kg/m) |
+//! | `spring.<name>.kx` / `.ky` / `.kr` | spring stiffnesses |
+//! | `mass.<name>.m` / `.j` | lumped mass and rotary inertia |
+
+use std::fmt;
+
+use crate::dof::Dof;
+use crate::error::ModelError;
+use crate::model::{ElementId, Model};
+
+/// A scalar model quantity (indices refer to the model's lists).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Quantity {
+    /// Stiffness-proportional damping coefficient of a group.
+    GroupAlpha(usize),
+    /// Mass-proportional damping coefficient of a group.
+    GroupBeta(usize),
+    /// Relaxation parameter of a group's kernel.
+    GroupMu(usize),
+    /// Stiffness factor of a group.
+    GroupStiffness(usize),
+    /// Mass factor of a group.
+    GroupMass(usize),
+    /// Young's modulus of a material.
+    MaterialE(usize),
+    /// Density of a material.
+    MaterialRho(usize),
+    /// Stiffness factor of one beam.
+    ElementStiffness(usize),
+    /// Mass factor of one beam.
+    ElementMass(usize),
+    /// Added transverse mass per length of one beam.
+    ElementAddedMass(usize),
+    /// One stiffness of a spring.
+    SpringK(usize, Dof),
+    /// Mass of a lumped mass.
+    MassM(usize),
+    /// Rotary inertia of a lumped mass.
+    MassJ(usize),
+}
+
+/// How a quantity enters the dynamic stiffness.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum QuantityKind {
+    /// Multiplies some stiffness or mass terms (E, rho, k, m, factors).
+    Factor,
+    /// A damping coefficient or relaxation parameter of a group.
+    Damping,
+}
+
+impl Quantity {
+    /// Whether this quantity scales matrix terms or is a damping parameter.
+    pub fn kind(self) -> QuantityKind {
+        match self {
+            Quantity::GroupAlpha(_) | Quantity::GroupBeta(_) | Quantity::GroupMu(_) => {
+                QuantityKind::Damping
+            }
+            _ => QuantityKind::Factor,
+        }
+    }
+}
+
+/// A quantity with the model it belongs to, for display.
+pub struct QuantityName<'a> {
+    model: &'a Model,
+    q: Quantity,
+}
+
+impl fmt::Display for QuantityName<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let m = self.model;
+        match self.q {
+            Quantity::GroupAlpha(g) => write!(f, "group.{}.alpha", m.groups[g].name),
+            Quantity::GroupBeta(g) => write!(f, "group.{}.beta", m.groups[g].name),
+            Quantity::GroupMu(g) => write!(f, "group.{}.mu", m.groups[g].name),
+            Quantity::GroupStiffness(g) => write!(f, "group.{}.stiffness", m.groups[g].name),
+            Quantity::GroupMass(g) => write!(f, "group.{}.mass", m.groups[g].name),
+            Quantity::MaterialE(i) => write!(f, "material.{}.E", m.materials[i].name),
+            Quantity::MaterialRho(i) => write!(f, "material.{}.rho", m.materials[i].name),
+            Quantity::ElementStiffness(i) => write!(f, "element.{}.stiffness", m.beams[i].id),
+            Quantity::ElementMass(i) => write!(f, "element.{}.mass", m.beams[i].id),
+            Quantity::ElementAddedMass(i) => write!(f, "element.{}.added_mass", m.beams[i].id),
+            Quantity::SpringK(i, d) => {
+                let k = match d {
+                    Dof::Ux => "kx",
+                    Dof::Uy => "ky",
+                    Dof::Rz => "kr",
+                };
+                write!(f, "spring.{}.{k}", m.springs[i].name)
+            }
+            Quantity::MassM(i) => write!(f, "mass.{}.m", m.masses[i].name),
+            Quantity::MassJ(i) => write!(f, "mass.{}.j", m.masses[i].name),
+        }
+    }
+}
+
+const FORMS: &str = "group.<name>.{alpha,beta,mu,stiffness,mass}, material.<name>.{E,rho}, \
+                     element.<id>.{stiffness,mass,added_mass}, spring.<name>.{kx,ky,kr}, mass.<name>.{m,j}";
+
+impl Model {
+    /// Resolves a dotted name such as `group.steel.mu` to a quantity.
+    pub fn quantity(&self, name: &str) -> Result<Quantity, ModelError> {
+        let err = |reason: String| ModelError::UnknownQuantity { name: name.into(), reason };
+        let (head, rest) =
+            name.split_once('.').ok_or_else(|| err(format!("expected one of {FORMS}")))?;
+        let (item, field) =
+            rest.rsplit_once('.').ok_or_else(|| err(format!("expected one of {FORMS}")))?;
+        let bad_field = |valid: &str| err(format!("`{field}` is not a field of a {head}; valid: {valid}"));
+        match head {
+            "group" => {
+                let g = self.group_index(item).ok_or_else(|| {
+                    err(format!("no group `{item}` (groups: {})", names(self.groups.iter().map(|g| &g.name))))
+                })?;
+                Ok(match field {
+                    "alpha" => Quantity::GroupAlpha(g),
+                    "beta" => Quantity::GroupBeta(g),
+                    "mu" => Quantity::GroupMu(g),
+                    "stiffness" => Quantity::GroupStiffness(g),
+                    "mass" => Quantity::GroupMass(g),
+                    _ => return Err(bad_field("alpha, beta, mu, stiffness, mass")),
+                })
+            }
+            "material" => {
+                let i = self.material_index(item).ok_or_else(|| {
+                    err(format!(
+                        "no material `{item}` (materials: {})",
+                        names(self.materials.iter().map(|m| &m.name))
+                    ))
+                })?;
+                Ok(match field {
+                    "E" | "e" => Quantity::MaterialE(i),
+                    "rho" => Quantity::MaterialRho(i),
+                    _ => return Err(bad_field("E, rho")),
+                })
+            }
+            "element" => {
+                let id: u32 = item.parse().map_err(|_| err(format!("`{item}` is not an element id")))?;
+                let i = self.beam_index(ElementId(id)).ok_or_else(|| err(format!("no element {id}")))?;
+                Ok(match field {
+                    "stiffness" => Quantity::ElementStiffness(i),
+                    "mass" => Quantity::ElementMass(i),
+                    "added_mass" => Quantity::ElementAddedMass(i),
+                    _ => return Err(bad_field("stiffness, mass, added_mass")),
+                })
+            }
+            "spring" => {
+                let i = self.spring_index(item).ok_or_else(|| {
+                    err(format!("no spring `{item}` (springs: {})", names(self.springs.iter().map(|s| &s.name))))
+                })?;
+                let d = match field {
+                    "kx" => Dof::Ux,
+                    "ky" => Dof::Uy,
+                    "kr" => Dof::Rz,
+                    _ => return Err(bad_field("kx, ky, kr")),
+                };
+                Ok(Quantity::SpringK(i, d))
+            }
+            "mass" => {
+                let i = self.mass_index(item).ok_or_else(|| {
+                    err(format!("no mass `{item}` (masses: {})", names(self.masses.iter().map(|m| &m.name))))
+                })?;
+                Ok(match field {
+                    "m" => Quantity::MassM(i),
+                    "j" => Quantity::MassJ(i),
+                    _ => return Err(bad_field("m, j")),
+                })
+            }
+            _ => Err(err(format!("`{head}` is not a kind of item; expected one of {FORMS}"))),
+        }
+    }
+
+    /// The dotted name of a quantity.
+    pub fn quantity_name(&self, q: Quantity) -> QuantityName<'_> {
+        QuantityName { model: self, q }
+    }
+
+    /// Current value of a quantity (`mu` of a viscous group is infinity).
+    pub fn get(&self, q: Quantity) -> f64 {
+        match q {
+            Quantity::GroupAlpha(g) => self.groups[g].alpha,
+            Quantity::GroupBeta(g) => self.groups[g].beta,
+            Quantity::GroupMu(g) => self.groups[g].mu.unwrap_or(f64::INFINITY),
+            Quantity::GroupStiffness(g) => self.groups[g].stiffness,
+            Quantity::GroupMass(g) => self.groups[g].mass,
+            Quantity::MaterialE(i) => self.materials[i].e,
+            Quantity::MaterialRho(i) => self.materials[i].rho,
+            Quantity::ElementStiffness(i) => self.beams[i].stiffness_factor,
+            Quantity::ElementMass(i) => self.beams[i].mass_factor,
+            Quantity::ElementAddedMass(i) => self.beams[i].added_mass,
+            Quantity::SpringK(i, d) => self.springs[i].k[d.index()],
+            Quantity::MassM(i) => self.masses[i].m,
+            Quantity::MassJ(i) => self.masses[i].j,
+        }
+    }
+
+    /// Sets a quantity. Values must be finite and positive, except damping
+    /// coefficients, added mass, spring stiffnesses and lumped masses that may
+    /// be zero, and `mu` that may be infinite (viscous).
+    pub fn set(&mut self, q: Quantity, value: f64) -> Result<(), ModelError> {
+        let name = self.quantity_name(q).to_string();
+        let may_be_zero = matches!(
+            q,
+            Quantity::GroupAlpha(_)
+                | Quantity::GroupBeta(_)
+                | Quantity::ElementAddedMass(_)
+                | Quantity::SpringK(..)
+                | Quantity::MassM(_)
+                | Quantity::MassJ(_)
+        );
+        let ok = if matches!(q, Quantity::GroupMu(_)) {
+            value > 0.0 && !value.is_nan()
+        } else if may_be_zero {
+            value.is_finite() && value >= 0.0
+        } else {
+            value.is_finite() && value > 0.0
+        };
+        if !ok {
+            return Err(ModelError::Invalid { what: name, reason: format!("cannot be set to {value}") });
+        }
+        match q {
+            Quantity::GroupAlpha(g) => self.groups[g].alpha = value,
+            Quantity::GroupBeta(g) => self.groups[g].beta = value,
+            Quantity::GroupMu(g) => self.groups[g].mu = value.is_finite().then_some(value),
+            Quantity::GroupStiffness(g) => self.groups[g].stiffness = value,
+            Quantity::GroupMass(g) => self.groups[g].mass = value,
+            Quantity::MaterialE(i) => self.materials[i].e = value,
+            Quantity::MaterialRho(i) => self.materials[i].rho = value,
+            Quantity::ElementStiffness(i) => self.beams[i].stiffness_factor = value,
+            Quantity::ElementMass(i) => self.beams[i].mass_factor = value,
+            Quantity::ElementAddedMass(i) => self.beams[i].added_mass = value,
+            Quantity::SpringK(i, d) => self.springs[i].k[d.index()] = value,
+            Quantity::MassM(i) => self.masses[i].m = value,
+            Quantity::MassJ(i) => self.masses[i].j = value,
+        }
+        Ok(())
+    }
+}
+
+fn names<'a>(it: impl Iterator<Item = &'a String>) -> String {
+    let v: Vec<&str> = it.map(String::as_str).collect();
+    if v.is_empty() { "none".into() } else { v.join(", ") }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::samples;
+
+    #[test]
+    fn names_resolve_and_print_back() {
+        let model = samples::frame_with_joint();
+        for name in ["group.joint.mu", "spring.joint.kr", "material.steel.E", "element.1.stiffness"] {
+            let q = model.quantity(name).unwrap();
+            assert_eq!(model.quantity_name(q).to_string(), name);
+        }
+        let e = model.quantity("group.nope.mu").unwrap_err().to_string();
+        assert!(e.contains("no group `nope`"), "{e}");
+        let e = model.quantity("spring.joint.kz").unwrap_err().to_string();
+        assert!(e.contains("kx, ky, kr"), "{e}");
+    }
+
+    #[test]
+    fn set_rejects_non_physical_values() {
+        let mut model = samples::frame_with_joint();
+        let q = model.quantity("material.steel.E").unwrap();
+        assert!(model.set(q, -1.0).is_err());
+        assert!(model.set(q, f64::NAN).is_err());
+        model.set(q, 1e11).unwrap();
+        assert_eq!(model.get(q), 1e11);
+        let mu = model.quantity("group.joint.mu").unwrap();
+        model.set(mu, f64::INFINITY).unwrap();
+        assert_eq!(model.groups()[model.group_index("joint").unwrap()].mu, None);
+    }
+}
