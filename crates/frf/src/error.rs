@@ -1,0 +1,60 @@
+//! Errors of the FRF layer.
+
+use std::path::PathBuf;
+
+use fe_model::DofRef;
+
+/// An FRF computation or data error.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FrfError {
+    /// A channel names a node the model does not have.
+    #[error("{dof} is not a DOF of the model (no such node)")]
+    UnknownDof {
+        /// The DOF.
+        dof: DofRef,
+    },
+    /// A channel is at a supported (fixed) DOF, where the response is zero.
+    #[error("{dof} is held fixed by a support; it cannot be excited or measured")]
+    FixedDof {
+        /// The DOF.
+        dof: DofRef,
+    },
+    /// `Z(w)` is singular at a frequency (an undamped model on a resonance).
+    #[error(
+        "the dynamic stiffness is singular at {freq_hz} Hz (an undamped or very lightly damped model evaluated on a resonance?)"
+    )]
+    Singular {
+        /// The frequency.
+        freq_hz: f64,
+    },
+    /// The sparse factorisation failed for another reason.
+    #[error("sparse factorisation failed: {0}")]
+    Factorization(String),
+    /// A frequency that is not positive and finite.
+    #[error("frequency {freq_hz} Hz is not positive and finite")]
+    BadFrequency {
+        /// The frequency.
+        freq_hz: f64,
+    },
+    /// Reading or writing a file failed.
+    #[error("{}: {message}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+    /// A data file's content is malformed.
+    #[error("{}:{line}: {message}", path.display())]
+    Parse {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line (or byte offset for binary data, see the message).
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// Two FRF sets that should match do not.
+    #[error("{0}")]
+    Mismatch(String),
+}

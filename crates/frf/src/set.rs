@@ -1,0 +1,304 @@
+//! Containers for sets of FRFs, shared by synthesised and measured data.
+
+use std::fmt;
+
+use fe_model::DofRef;
+use num_complex::Complex64 as C64;
+
+use crate::error::FrfError;
+
+/// What an FRF relates: displacement, velocity or acceleration to force.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum FrfKind {
+    /// Displacement / force (m/N), `H`.
+    Receptance,
+    /// Velocity / force (m/s/N), `j w H`.
+    Mobility,
+    /// Acceleration / force (m/s^2/N), `-w^2 H`.
+    Accelerance,
+}
+
+impl FrfKind {
+    /// Factor `(j w)^p` that turns receptance into this kind.
+    pub fn from_receptance_factor(self, omega: f64) -> C64 {
+        match self {
+            FrfKind::Receptance => C64::new(1.0, 0.0),
+            FrfKind::Mobility => C64::new(0.0, omega),
+            FrfKind::Accelerance => C64::new(-omega * omega, 0.0),
+        }
+    }
+
+    /// Lower-case name.
+    pub fn name(self) -> &'static str {
+        match self {
+            FrfKind::Receptance => "receptance",
+            FrfKind::Mobility => "mobility",
+            FrfKind::Accelerance => "accelerance",
+        }
+    }
+
+    /// Parses a name (`receptance`, `mobility`, `accelerance` and common synonyms).
+    pub fn parse(s: &str) -> Option<Self> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "receptance" | "compliance" | "displacement" | "dynamic compliance" => Some(FrfKind::Receptance),
+            "mobility" | "velocity" => Some(FrfKind::Mobility),
+            "accelerance" | "inertance" | "acceleration" => Some(FrfKind::Accelerance),
+            _ => None,
+        }
+    }
+}
+
+impl fmt::Display for FrfKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// One FRF: response DOF over reference (excitation) DOF.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Channel {
+    /// Response DOF (row of the FRF matrix).
+    pub response: DofRef,
+    /// Reference DOF (column).
+    pub reference: DofRef,
+}
+
+impl Channel {
+    /// Shorthand constructor.
+    pub fn new(response: DofRef, reference: DofRef) -> Self {
+        Channel { response, reference }
+    }
+}
+
+impl fmt::Display for Channel {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "H({},{})", self.response, self.reference)
+    }
+}
+
+/// A set of FRFs over common frequency lines.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrfSet {
+    frequencies_hz: Vec<f64>,
+    channels: Vec<Channel>,
+    kind: FrfKind,
+    /// Channel-major values: `data[c * nf + k]`.
+    data: Vec<C64>,
+    /// Optional coherence per channel and line, same layout.
+    coherence: Option<Vec<f64>>,
+}
+
+impl FrfSet {
+    /// A set of zeros. Frequencies must be positive, finite and increasing;
+    /// channels must be distinct.
+    pub fn zeros(frequencies_hz: Vec<f64>, channels: Vec<Channel>, kind: FrfKind) -> Result<Self, FrfError> {
+        check_frequencies(&frequencies_hz)?;
+        for (i, c) in channels.iter().enumerate() {
+            if channels[..i].contains(c) {
+                return Err(FrfError::Mismatch(format!("channel {c} appears twice")));
+            }
+        }
+        let data = vec![C64::new(0.0, 0.0); frequencies_hz.len() * channels.len()];
+        Ok(FrfSet { frequencies_hz, channels, kind, data, coherence: None })
+    }
+
+    /// Frequency lines (Hz).
+    pub fn frequencies_hz(&self) -> &[f64] {
+        &self.frequencies_hz
+    }
+
+    /// Channels.
+    pub fn channels(&self) -> &[Channel] {
+        &self.channels
+    }
+
+    /// What the values relate.
+    pub fn kind(&self) -> FrfKind {
+        self.kind
+    }
+
+    /// Number of frequency lines.
+    pub fn n_freq(&self) -> usize {
+        self.frequencies_hz.len()
+    }
+
+    /// Values of channel `c` over frequency.
+    pub fn channel(&self, c: usize) -> &[C64] {
+        let nf = self.n_freq();
+        &self.data[c * nf..(c + 1) * nf]
+    }
+
+    /// Mutable values of channel `c`.
+    pub fn channel_mut(&mut self, c: usize) -> &mut [C64] {
+        let nf = self.n_freq();
+        &mut self.data[c * nf..(c + 1) * nf]
+    }
+
+    /// Value of channel `c` at line `k`.
+    pub fn get(&self, c: usize, k: usize) -> C64 {
+        self.data[c * self.n_freq() + k]
+    }
+
+    /// Sets the value of channel `c` at line `k`.
+    pub fn set(&mut self, c: usize, k: usize, v: C64) {
+        let nf = self.n_freq();
+        self.data[c * nf + k] = v;
+    }
+
+    /// Index of a channel.
+    pub fn find(&self, channel: Channel) -> Option<usize> {
+        self.channels.iter().position(|&c| c == channel)
+    }
+
+    /// Coherence of channel `c`, when the data carries it.
+    pub fn coherence(&self, c: usize) -> Option<&[f64]> {
+        let nf = self.n_freq();
+        self.coherence.as_ref().map(|v| &v[c * nf..(c + 1) * nf])
+    }
+
+    /// Attaches coherence values (channel-major, same layout as the data).
+    pub fn set_coherence(&mut self, values: Vec<f64>) -> Result<(), FrfError> {
+        if values.len() != self.data.len() {
+            return Err(FrfError::Mismatch(format!(
+                "coherence has {} values, the FRFs {}",
+                values.len(),
+                self.data.len()
+            )));
+        }
+        self.coherence = Some(values);
+        Ok(())
+    }
+
+    /// The same FRFs converted to receptance (dividing by `j w` or `-w^2`).
+    pub fn to_receptance(&self) -> FrfSet {
+        self.converted(FrfKind::Receptance)
+    }
+
+    /// The same FRFs expressed as another kind.
+    pub fn converted(&self, kind: FrfKind) -> FrfSet {
+        let mut out = self.clone();
+        out.kind = kind;
+        let nf = self.n_freq();
+        for (k, &f) in self.frequencies_hz.iter().enumerate() {
+            let w = 2.0 * std::f64::consts::PI * f;
+            let factor = kind.from_receptance_factor(w) / self.kind.from_receptance_factor(w);
+            for c in 0..self.channels.len() {
+                out.data[c * nf + k] = self.data[c * nf + k] * factor;
+            }
+        }
+        out
+    }
+
+    /// The lines nearest to the requested frequencies (must exist within
+    /// 1e-6 relative), as a new set.
+    pub fn at_frequencies(&self, freqs_hz: &[f64]) -> Result<FrfSet, FrfError> {
+        let idx: Vec<usize> = freqs_hz
+            .iter()
+            .map(|&f| {
+                self.line_of(f).ok_or_else(|| {
+                    FrfError::Mismatch(format!("the data has no line at {f} Hz (nearest lines must match to 1e-6)"))
+                })
+            })
+            .collect::<Result<_, _>>()?;
+        self.select_lines(&idx)
+    }
+
+    /// Index of the line at `f` Hz, if there is one within 1e-6 relative.
+    pub fn line_of(&self, f: f64) -> Option<usize> {
+        let k = self.frequencies_hz.partition_point(|&x| x < f);
+        [k.checked_sub(1), Some(k)]
+            .into_iter()
+            .flatten()
+            .filter(|&i| i < self.n_freq())
+            .find(|&i| (self.frequencies_hz[i] - f).abs() <= 1e-6 * f.abs().max(1e-12))
+    }
+
+    /// A new set with the given lines (indices, increasing).
+    pub fn select_lines(&self, idx: &[usize]) -> Result<FrfSet, FrfError> {
+        let freqs: Vec<f64> = idx.iter().map(|&k| self.frequencies_hz[k]).collect();
+        let mut out = FrfSet::zeros(freqs, self.channels.clone(), self.kind)?;
+        for c in 0..self.channels.len() {
+            for (j, &k) in idx.iter().enumerate() {
+                out.set(c, j, self.get(c, k));
+            }
+        }
+        if let Some(coh) = &self.coherence {
+            let nf = self.n_freq();
+            let v = (0..self.channels.len())
+                .flat_map(|c| idx.iter().map(move |&k| coh[c * nf + k]))
+                .collect();
+            out.coherence = Some(v);
+        }
+        Ok(out)
+    }
+
+    /// A new set with the given channels (indices).
+    pub fn select_channels(&self, idx: &[usize]) -> FrfSet {
+        let nf = self.n_freq();
+        let channels = idx.iter().map(|&c| self.channels[c]).collect();
+        let data = idx.iter().flat_map(|&c| self.channel(c).iter().copied()).collect();
+        let coherence = self
+            .coherence
+            .as_ref()
+            .map(|coh| idx.iter().flat_map(|&c| coh[c * nf..(c + 1) * nf].iter().copied()).collect());
+        FrfSet { frequencies_hz: self.frequencies_hz.clone(), channels, kind: self.kind, data, coherence }
+    }
+
+    /// Distinct reference DOFs, in order of first appearance.
+    pub fn references(&self) -> Vec<DofRef> {
+        let mut out: Vec<DofRef> = Vec::new();
+        for c in &self.channels {
+            if !out.contains(&c.reference) {
+                out.push(c.reference);
+            }
+        }
+        out
+    }
+
+    /// All values, channel-major.
+    pub fn values(&self) -> &[C64] {
+        &self.data
+    }
+}
+
+pub(crate) fn check_frequencies(f: &[f64]) -> Result<(), FrfError> {
+    if let Some(&x) = f.iter().find(|x| !(x.is_finite() && **x > 0.0)) {
+        return Err(FrfError::BadFrequency { freq_hz: x });
+    }
+    if let Some(w) = f.windows(2).find(|w| !(w[1] > w[0])) {
+        return Err(FrfError::Mismatch(format!(
+            "frequencies must increase strictly, but {} Hz is followed by {} Hz",
+            w[0], w[1]
+        )));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use fe_model::Dof;
+
+    #[test]
+    fn kind_conversion_round_trips_and_uses_powers_of_jw() {
+        let ch = vec![Channel::new(DofRef::new(2, Dof::Uy), DofRef::new(2, Dof::Uy))];
+        let mut h = FrfSet::zeros(vec![1.0, 10.0], ch, FrfKind::Receptance).unwrap();
+        h.set(0, 0, C64::new(1.0, 2.0));
+        h.set(0, 1, C64::new(-3.0, 0.5));
+        let a = h.converted(FrfKind::Accelerance);
+        let w = 2.0 * std::f64::consts::PI * 10.0;
+        assert!((a.get(0, 1) - C64::new(-3.0, 0.5) * (-w * w)).norm() < 1e-9);
+        let back = a.converted(FrfKind::Mobility).to_receptance();
+        for k in 0..2 {
+            assert!((back.get(0, k) - h.get(0, k)).norm() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn frequencies_must_increase_and_channels_be_distinct() {
+        let c = Channel::new(DofRef::new(2, Dof::Uy), DofRef::new(2, Dof::Uy));
+        assert!(FrfSet::zeros(vec![1.0, 1.0], vec![c], FrfKind::Receptance).is_err());
+        assert!(FrfSet::zeros(vec![0.0, 1.0], vec![c], FrfKind::Receptance).is_err());
+        assert!(FrfSet::zeros(vec![1.0, 2.0], vec![c, c], FrfKind::Receptance).is_err());
+    }
+}

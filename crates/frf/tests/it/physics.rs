@@ -1,0 +1,83 @@
+//! FRF physics against independent truths: reciprocity and the viscous limit.
+
+use damping::DampedSystem;
+use faer::Mat;
+use faer::linalg::solvers::DenseSolveCore;
+use fe_model::{Dof, DofRef, MatrixKind, Quantity, samples};
+use frf::{C64, Channel, synthesize};
+
+fn rel(a: C64, b: C64) -> f64 {
+    (a - b).norm() / b.norm()
+}
+
+#[test]
+fn receptance_is_reciprocal_on_a_non_proportional_non_viscous_frame() {
+    let sys = DampedSystem::new(samples::frame_with_joint()).unwrap();
+    let dofs = [DofRef::new(2, Dof::Ux), DofRef::new(3, Dof::Rz), DofRef::new(4, Dof::Uy), DofRef::new(4, Dof::Rz)];
+    let mut channels = Vec::new();
+    for &a in &dofs {
+        for &b in &dofs {
+            channels.push(Channel::new(a, b));
+        }
+    }
+    let freqs: Vec<f64> = (1..=60).map(|i| 7.3 * f64::from(i)).collect();
+    let h = synthesize(&sys, &channels, &freqs).unwrap();
+    for &a in &dofs {
+        for &b in &dofs {
+            let ab = h.find(Channel::new(a, b)).unwrap();
+            let ba = h.find(Channel::new(b, a)).unwrap();
+            for k in 0..freqs.len() {
+                let e = rel(h.get(ab, k), h.get(ba, k));
+                assert!(e < 1e-9, "H({a},{b}) vs H({b},{a}) at {} Hz: {e:e}", freqs[k]);
+            }
+        }
+    }
+}
+
+/// `(K - w^2 M + j w C)^-1` by dense inversion, `C = sum_g alpha_g K_g + beta_g M_g`.
+fn dense_viscous_receptance(sys: &DampedSystem, omega: f64) -> Mat<C64> {
+    let a = sys.assembly();
+    let n = a.n();
+    let mut z = Mat::<C64>::zeros(n, n);
+    let mut add = |values: &[f64], c: C64| {
+        for col in 0..n {
+            for p in a.pattern.col_ptr[col]..a.pattern.col_ptr[col + 1] {
+                z[(a.pattern.row_idx[p], col)] += c * values[p];
+            }
+        }
+    };
+    add(&a.real_values(MatrixKind::Stiffness), C64::new(1.0, 0.0));
+    add(&a.real_values(MatrixKind::Mass), C64::new(-omega * omega, 0.0));
+    for (g, group) in sys.model().groups().iter().enumerate() {
+        add(&a.group_values(g, MatrixKind::Stiffness), C64::new(0.0, omega * group.alpha));
+        add(&a.group_values(g, MatrixKind::Mass), C64::new(0.0, omega * group.beta));
+    }
+    z.partial_piv_lu().inverse()
+}
+
+#[test]
+fn infinite_mu_is_exactly_viscous_and_large_mu_tends_to_it() {
+    let base = samples::frame_with_joint();
+    let joint = base.group_index("joint").unwrap();
+    let mut viscous = DampedSystem::new(base.clone()).unwrap();
+    viscous.set(Quantity::GroupMu(joint), f64::INFINITY).unwrap();
+    let mut nearly = DampedSystem::new(base).unwrap();
+    nearly.set(Quantity::GroupMu(joint), 1e12).unwrap();
+
+    let dofs: Vec<DofRef> = [(2, Dof::Ux), (3, Dof::Rz), (4, Dof::Uy)].iter().map(|&(n, d)| DofRef::new(n, d)).collect();
+    let channels: Vec<Channel> = dofs.iter().flat_map(|&a| dofs.iter().map(move |&b| Channel::new(a, b))).collect();
+    let freqs = [3.0, 41.0, 157.0, 612.0];
+    let hv = synthesize(&viscous, &channels, &freqs).unwrap();
+    let hn = synthesize(&nearly, &channels, &freqs).unwrap();
+    for (k, &f) in freqs.iter().enumerate() {
+        let r = dense_viscous_receptance(&viscous, 2.0 * std::f64::consts::PI * f);
+        for (c, ch) in channels.iter().enumerate() {
+            let i = frf::equation_of(&viscous, ch.response).unwrap();
+            let j = frf::equation_of(&viscous, ch.reference).unwrap();
+            let e = rel(hv.get(c, k), r[(i, j)]);
+            assert!(e < 1e-10, "mu = inf vs (K - w^2 M + j w C)^-1, {ch} at {f} Hz: {e:e}");
+            let e = rel(hn.get(c, k), hv.get(c, k));
+            assert!(e < 1e-8, "mu = 1e12 vs viscous, {ch} at {f} Hz: {e:e}");
+        }
+    }
+}
