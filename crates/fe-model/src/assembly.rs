@@ -187,8 +187,14 @@ fn build_dof_map(model: &Model) -> DofMap {
     map
 }
 
+/// A term before fixed DOFs are removed: kind, factors, full local matrix.
+type RawTerm = (MatrixKind, Vec<Quantity>, LocalMatrix);
+
+/// A block before fixed DOFs are removed: source, group, local DOFs, terms.
+type RawBlock = (BlockSource, usize, Vec<DofRef>, Vec<RawTerm>);
+
 /// Local DOFs and terms (full, before removing fixed DOFs) of every block.
-fn raw_blocks(model: &Model) -> Vec<(BlockSource, usize, Vec<DofRef>, Vec<(MatrixKind, Vec<Quantity>, Mat6OrSmall)>)> {
+fn raw_blocks(model: &Model) -> Vec<RawBlock> {
     let mut out = Vec::new();
     let node_dofs = |id: NodeId| Dof::ALL.map(|d| DofRef { node: id, dof: d });
     for (i, b) in model.beams.iter().enumerate() {
@@ -200,19 +206,19 @@ fn raw_blocks(model: &Model) -> Vec<(BlockSource, usize, Vec<DofRef>, Vec<(Matri
             (
                 MatrixKind::Stiffness,
                 vec![Quantity::MaterialE(b.material), Quantity::ElementStiffness(i), Quantity::GroupStiffness(g)],
-                Mat6OrSmall::Six(element::frame_stiffness(sec.area, sec.inertia, l, c, s)),
+                LocalMatrix::from6(element::frame_stiffness(sec.area, sec.inertia, l, c, s)),
             ),
             (
                 MatrixKind::Mass,
                 vec![Quantity::MaterialRho(b.material), Quantity::ElementMass(i), Quantity::GroupMass(g)],
-                Mat6OrSmall::Six(element::frame_mass(sec.area, l, c, s)),
+                LocalMatrix::from6(element::frame_mass(sec.area, l, c, s)),
             ),
         ];
         // The added-mass term always exists so that it can be updated from zero.
         terms.push((
             MatrixKind::Mass,
             vec![Quantity::ElementAddedMass(i), Quantity::ElementMass(i), Quantity::GroupMass(g)],
-            Mat6OrSmall::Six(element::transverse_lumped_mass(l, c, s)),
+            LocalMatrix::from6(element::transverse_lumped_mass(l, c, s)),
         ));
         out.push((BlockSource::Beam(i), g, dofs, terms));
     }
@@ -234,7 +240,11 @@ fn raw_blocks(model: &Model) -> Vec<(BlockSource, usize, Vec<DofRef>, Vec<(Matri
                     u[i0 * n + i1] = -1.0;
                     u[i1 * n + i0] = -1.0;
                 }
-                (MatrixKind::Stiffness, vec![Quantity::SpringK(i, d), Quantity::GroupStiffness(sp.group)], Mat6OrSmall::Dense(u))
+                (
+                    MatrixKind::Stiffness,
+                    vec![Quantity::SpringK(i, d), Quantity::GroupStiffness(sp.group)],
+                    LocalMatrix(u),
+                )
             })
             .collect();
         out.push((BlockSource::Spring(i), sp.group, dofs, terms));
@@ -244,25 +254,24 @@ fn raw_blocks(model: &Model) -> Vec<(BlockSource, usize, Vec<DofRef>, Vec<(Matri
         let t = vec![1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0];
         let r = vec![0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0];
         let terms = vec![
-            (MatrixKind::Mass, vec![Quantity::MassM(i), Quantity::GroupMass(m.group)], Mat6OrSmall::Dense(t)),
-            (MatrixKind::Mass, vec![Quantity::MassJ(i), Quantity::GroupMass(m.group)], Mat6OrSmall::Dense(r)),
+            (MatrixKind::Mass, vec![Quantity::MassM(i), Quantity::GroupMass(m.group)], LocalMatrix(t)),
+            (MatrixKind::Mass, vec![Quantity::MassJ(i), Quantity::GroupMass(m.group)], LocalMatrix(r)),
         ];
         out.push((BlockSource::Mass(i), m.group, dofs, terms));
     }
     out
 }
 
-enum Mat6OrSmall {
-    Six(Mat6),
-    Dense(Vec<f64>),
-}
+/// A full local matrix, row-major, of a block's local DOFs.
+struct LocalMatrix(Vec<f64>);
 
-impl Mat6OrSmall {
+impl LocalMatrix {
+    fn from6(m: Mat6) -> Self {
+        LocalMatrix((0..36).map(|k| m[(k / 6, k % 6)]).collect())
+    }
+
     fn get(&self, n: usize, r: usize, c: usize) -> f64 {
-        match self {
-            Mat6OrSmall::Six(m) => m[(r, c)],
-            Mat6OrSmall::Dense(v) => v[r * n + c],
-        }
+        self.0[r * n + c]
     }
 }
 

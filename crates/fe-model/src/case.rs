@@ -354,9 +354,8 @@ impl CaseFile {
     /// Parses case-file text; `path` is used in messages and to resolve data files.
     pub fn parse(path: &Path, source: &str) -> Result<Self, CaseError> {
         let ctx = Ctx { path, source };
-        let raw: RawCase = toml::from_str(source).map_err(|e| {
-            CaseError::at(path, source, e.span(), e.message().trim_end().to_string())
-        })?;
+        let raw: RawCase = toml::from_str(source)
+            .map_err(|e| CaseError::at(path, source, e.span(), e.message().trim_end().to_string()))?;
         let mut model = Model::new(raw.title.as_deref().unwrap_or("untitled"));
         build_model(&ctx, &raw, &mut model)?;
         for (name, v) in &raw.set {
@@ -383,13 +382,13 @@ impl CaseFile {
                 })
             })
             .transpose()?;
-        if let (Some(m), None) = (&measurement, &truth) {
-            if m.data.is_none() {
-                return Err(ctx.err(
-                    raw.measurement.as_ref().unwrap().span(),
-                    "the measurement has no `data` file and the case has no [truth] to synthesise it from",
-                ));
-            }
+        if let (Some(m), None) = (&measurement, &truth)
+            && m.data.is_none()
+        {
+            return Err(ctx.err(
+                raw.measurement.as_ref().unwrap().span(),
+                "the measurement has no `data` file and the case has no [truth] to synthesise it from",
+            ));
         }
         Ok(CaseFile {
             path: path.to_path_buf(),
@@ -409,25 +408,42 @@ impl CaseFile {
     }
 }
 
-fn lookup(ctx: &Ctx<'_>, kind: &str, name: &Spanned<String>, found: Option<usize>, known: Vec<&str>) -> Result<usize, CaseError> {
+fn lookup(
+    ctx: &Ctx<'_>,
+    kind: &str,
+    name: &Spanned<String>,
+    found: Option<usize>,
+    known: Vec<&str>,
+) -> Result<usize, CaseError> {
     found.ok_or_else(|| {
         let hint = crate::suggest::closest(name.get_ref(), known.iter().copied())
             .map(|s| format!("; did you mean `{s}`?"))
-            .unwrap_or_else(|| format!(" (defined: {})", if known.is_empty() { "none".into() } else { known.join(", ") }));
+            .unwrap_or_else(|| {
+                format!(" (defined: {})", if known.is_empty() { "none".into() } else { known.join(", ") })
+            });
         ctx.err(name.span(), format!("unknown {kind} `{}`{hint}", name.get_ref()))
     })
 }
 
 fn group_ref(ctx: &Ctx<'_>, model: &Model, name: &Spanned<String>) -> Result<usize, CaseError> {
-    lookup(ctx, "group", name, model.group_index(name.get_ref()), model.groups.iter().map(|g| g.name.as_str()).collect())
+    lookup(
+        ctx,
+        "group",
+        name,
+        model.group_index(name.get_ref()),
+        model.groups.iter().map(|g| g.name.as_str()).collect(),
+    )
 }
 
 fn raw_group(ctx: &Ctx<'_>, name: &str, g: &Spanned<RawGroup>) -> Result<Group, CaseError> {
     let r = g.get_ref();
-    if let Some(mu) = r.mu {
-        if !(mu > 0.0) {
-            return Err(ctx.err(g.span(), format!("group `{name}`: mu must be positive (use `inf` or omit it for viscous damping), got {mu}")));
-        }
+    if let Some(mu) = r.mu
+        && !(mu > 0.0)
+    {
+        return Err(ctx.err(
+            g.span(),
+            format!("group `{name}`: mu must be positive (use `inf` or omit it for viscous damping), got {mu}"),
+        ));
     }
     Ok(Group {
         name: name.into(),
@@ -451,7 +467,9 @@ fn build_model(ctx: &Ctx<'_>, raw: &RawCase, model: &mut Model) -> Result<(), Ca
             (None, None, None, None, Some(od), id) => {
                 let id = id.unwrap_or(0.0);
                 if !(id >= 0.0 && id < od) {
-                    return Err(ctx.err(s.span(), format!("section `{name}`: need 0 <= id < od, got od = {od}, id = {id}")));
+                    return Err(
+                        ctx.err(s.span(), format!("section `{name}`: need 0 <= id < od, got od = {od}, id = {id}"))
+                    );
                 }
                 Section::tube(name, od, id)
             }
@@ -477,8 +495,20 @@ fn build_model(ctx: &Ctx<'_>, raw: &RawCase, model: &mut Model) -> Result<(), Ca
     }
     for b in &raw.beams {
         let r = b.get_ref();
-        let mat = lookup(ctx, "material", &r.material, model.material_index(r.material.get_ref()), model.materials.iter().map(|m| m.name.as_str()).collect())?;
-        let sec = lookup(ctx, "section", &r.section, model.section_index(r.section.get_ref()), model.sections.iter().map(|m| m.name.as_str()).collect())?;
+        let mat = lookup(
+            ctx,
+            "material",
+            &r.material,
+            model.material_index(r.material.get_ref()),
+            model.materials.iter().map(|m| m.name.as_str()).collect(),
+        )?;
+        let sec = lookup(
+            ctx,
+            "section",
+            &r.section,
+            model.section_index(r.section.get_ref()),
+            model.sections.iter().map(|m| m.name.as_str()).collect(),
+        )?;
         let g = group_ref(ctx, model, &r.group)?;
         let i = model.add_beam(r.id, r.nodes, mat, sec, g).map_err(|e| ctx.model_err(b.span(), e))?;
         model.set_added_mass(i, r.added_mass).map_err(|e| ctx.model_err(b.span(), e))?;
@@ -571,8 +601,20 @@ fn add_line(ctx: &Ctx<'_>, model: &mut Model, line: &Spanned<RawLine>) -> Result
     if n == 0 {
         return Err(ctx.err(r.elements.span(), "a line needs at least one element"));
     }
-    let mat = lookup(ctx, "material", &r.material, model.material_index(r.material.get_ref()), model.materials.iter().map(|m| m.name.as_str()).collect())?;
-    let sec = lookup(ctx, "section", &r.section, model.section_index(r.section.get_ref()), model.sections.iter().map(|m| m.name.as_str()).collect())?;
+    let mat = lookup(
+        ctx,
+        "material",
+        &r.material,
+        model.material_index(r.material.get_ref()),
+        model.materials.iter().map(|m| m.name.as_str()).collect(),
+    )?;
+    let sec = lookup(
+        ctx,
+        "section",
+        &r.section,
+        model.section_index(r.section.get_ref()),
+        model.sections.iter().map(|m| m.name.as_str()).collect(),
+    )?;
     let g = group_ref(ctx, model, &r.group)?;
     let mut next_node = r.first_node.unwrap_or(model.max_node_id() + 1);
     let mut next_elem = r.first_element.unwrap_or(model.max_element_id() + 1);
@@ -652,7 +694,10 @@ fn parse_frequencies(ctx: &Ctx<'_>, v: &Spanned<toml::Value>) -> Result<Vec<f64>
         toml::Value::Table(t) => {
             for k in t.keys() {
                 if !["from", "to", "step", "count"].contains(&k.as_str()) {
-                    return Err(ctx.err(v.span(), format!("unknown key `{k}` in a frequency range (use from, to and step or count)")));
+                    return Err(ctx.err(
+                        v.span(),
+                        format!("unknown key `{k}` in a frequency range (use from, to and step or count)"),
+                    ));
                 }
             }
             let get = |k: &str| t.get(k).and_then(num);
@@ -663,10 +708,16 @@ fn parse_frequencies(ctx: &Ctx<'_>, v: &Spanned<toml::Value>) -> Result<Vec<f64>
             let count = match (get("step"), t.get("count")) {
                 (Some(step), None) if step > 0.0 => ((to - from) / step + 1e-9).floor() as usize + 1,
                 (None, Some(toml::Value::Integer(c))) if *c >= 2 => *c as usize,
-                _ => return Err(ctx.err(v.span(), "a frequency range needs a positive `step` or an integer `count` >= 2")),
+                _ => {
+                    return Err(
+                        ctx.err(v.span(), "a frequency range needs a positive `step` or an integer `count` >= 2")
+                    );
+                }
             };
             if count > 10_000_000 {
-                return Err(ctx.err(v.span(), format!("{count} frequency lines is more than this tool accepts (10 million)")));
+                return Err(
+                    ctx.err(v.span(), format!("{count} frequency lines is more than this tool accepts (10 million)"))
+                );
             }
             (0..count).map(|i| from + (to - from) * i as f64 / (count - 1).max(1) as f64).collect()
         }
@@ -677,7 +728,9 @@ fn parse_frequencies(ctx: &Ctx<'_>, v: &Spanned<toml::Value>) -> Result<Vec<f64>
     }
     for w in freqs.windows(2) {
         if !(w[1] > w[0]) {
-            return Err(ctx.err(v.span(), format!("frequencies must increase strictly ({} is followed by {})", w[0], w[1])));
+            return Err(
+                ctx.err(v.span(), format!("frequencies must increase strictly ({} is followed by {})", w[0], w[1]))
+            );
         }
     }
     if let Some(f) = freqs.iter().find(|f| !(f.is_finite() && **f > 0.0)) {
@@ -733,7 +786,11 @@ fn parse_measurement(ctx: &Ctx<'_>, m: &Spanned<RawMeasurement>, model: &Model) 
     Ok(MeasurementSpec { frequencies_hz, references, responses, data, map })
 }
 
-fn resolve_values(ctx: &Ctx<'_>, values: &BTreeMap<String, Spanned<f64>>, model: &Model) -> Result<Vec<(Quantity, f64)>, CaseError> {
+fn resolve_values(
+    ctx: &Ctx<'_>,
+    values: &BTreeMap<String, Spanned<f64>>,
+    model: &Model,
+) -> Result<Vec<(Quantity, f64)>, CaseError> {
     values
         .iter()
         .map(|(name, v)| {
@@ -745,7 +802,7 @@ fn resolve_values(ctx: &Ctx<'_>, values: &BTreeMap<String, Spanned<f64>>, model:
 
 fn parse_truth(ctx: &Ctx<'_>, t: &Spanned<RawTruth>, base: &Model) -> Result<TruthSpec, CaseError> {
     let r = t.get_ref();
-    if !(r.noise >= 0.0 && r.noise.is_finite()) || !(r.floor >= 0.0 && r.floor.is_finite()) {
+    if !(r.noise >= 0.0 && r.noise.is_finite() && r.floor >= 0.0 && r.floor.is_finite()) {
         return Err(ctx.err(t.span(), "noise and floor must be zero or positive"));
     }
     let mut model = base.clone();
@@ -770,11 +827,7 @@ fn parse_truth(ctx: &Ctx<'_>, t: &Spanned<RawTruth>, base: &Model) -> Result<Tru
         model.set(q, *v.get_ref()).map_err(|e| ctx.model_err(v.span(), e))?;
     }
     crate::assembly::Assembly::new(&model).map_err(|e| ctx.err(t.span(), format!("the truth model: {e}")))?;
-    let values = r
-        .set
-        .iter()
-        .filter_map(|(name, v)| base.quantity(name).ok().map(|q| (q, *v.get_ref())))
-        .collect();
+    let values = r.set.iter().filter_map(|(name, v)| base.quantity(name).ok().map(|q| (q, *v.get_ref()))).collect();
     Ok(TruthSpec { model, values, noise: r.noise, floor: r.floor, seed: r.seed })
 }
 
@@ -809,10 +862,10 @@ fn parse_update(ctx: &Ctx<'_>, u: &Spanned<RawUpdate>, model: &Model) -> Result<
             _ => FrequencyChoice::List(parse_frequencies(ctx, v)?),
         },
     };
-    if let Some(tol) = r.tolerance {
-        if !(tol > 0.0) {
-            return Err(ctx.err(u.span(), "tolerance must be positive"));
-        }
+    if let Some(tol) = r.tolerance
+        && !(tol > 0.0)
+    {
+        return Err(ctx.err(u.span(), "tolerance must be positive"));
     }
     Ok(UpdateSpec {
         parameters,

@@ -94,13 +94,9 @@ impl fmt::Display for DofRef {
 impl FromStr for DofRef {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        let (node, dof) = s
-            .split_once(':')
-            .ok_or_else(|| format!("`{s}` is not of the form node:dof, for example 31:uy"))?;
-        let node: u32 = node
-            .trim()
-            .parse()
-            .map_err(|_| format!("`{node}` in `{s}` is not a node id"))?;
+        let (node, dof) =
+            s.split_once(':').ok_or_else(|| format!("`{s}` is not of the form node:dof, for example 31:uy"))?;
+        let node: u32 = node.trim().parse().map_err(|_| format!("`{node}` in `{s}` is not a node id"))?;
         Ok(DofRef { node: NodeId(node), dof: dof.parse()? })
     }
 }

@@ -127,11 +127,7 @@ mod tests {
         let k = frame_stiffness(0.01, 2e-5, 0.7, c, s);
         let (x1, y1, x2, y2) = (0.0, 0.0, 0.7 * c, 0.7 * s);
         // translations in x and y, and a rotation about the origin
-        let modes = [
-            [1.0, 0.0, 0.0, 1.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0, 0.0, 1.0, 0.0],
-            [-y1, x1, 1.0, -y2, x2, 1.0],
-        ];
+        let modes = [[1.0, 0.0, 0.0, 1.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0, 1.0, 0.0], [-y1, x1, 1.0, -y2, x2, 1.0]];
         for mode in modes {
             let v = nalgebra::SVector::<f64, 6>::from_row_slice(&mode);
             assert!((k * v).norm() < 1e-12 * k.norm(), "rigid mode {mode:?} strains the element");

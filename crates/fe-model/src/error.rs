@@ -133,7 +133,12 @@ pub struct CaseError {
 }
 
 impl CaseError {
-    pub(crate) fn at(file: &std::path::Path, source: &str, span: Option<std::ops::Range<usize>>, message: String) -> Self {
+    pub(crate) fn at(
+        file: &std::path::Path,
+        source: &str,
+        span: Option<std::ops::Range<usize>>,
+        message: String,
+    ) -> Self {
         let location = span.as_ref().map(|s| Location::of(source, s.start));
         let snippet = location.and_then(|l| source.lines().nth(l.line - 1).map(str::to_string));
         CaseError { file: file.to_path_buf(), location, message, snippet }

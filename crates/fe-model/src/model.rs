@@ -489,14 +489,7 @@ impl Model {
     }
 
     /// Adds a lumped mass `m` (kg) with rotary inertia `j` (kg m^2) at a node.
-    pub fn add_mass(
-        &mut self,
-        name: &str,
-        node: u32,
-        m: f64,
-        j: f64,
-        group: usize,
-    ) -> Result<usize, ModelError> {
+    pub fn add_mass(&mut self, name: &str, node: u32, m: f64, j: f64, group: usize) -> Result<usize, ModelError> {
         let ctx = format!("mass `{name}`");
         if self.mass_index(name).is_some() {
             return Err(ModelError::Duplicate { what: ctx });
@@ -524,10 +517,7 @@ impl Model {
         self.require_node(NodeId(a), "tie")?;
         self.require_node(NodeId(b), "tie")?;
         if a == b {
-            return Err(ModelError::Invalid {
-                what: format!("tie {a}-{b}"),
-                reason: "ties a node to itself".into(),
-            });
+            return Err(ModelError::Invalid { what: format!("tie {a}-{b}"), reason: "ties a node to itself".into() });
         }
         self.ties.push(Tie { nodes: [NodeId(a), NodeId(b)], dofs: dofs.to_vec() });
         Ok(())

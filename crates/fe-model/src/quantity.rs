@@ -62,9 +62,7 @@ impl Quantity {
     /// Whether this quantity scales matrix terms or is a damping parameter.
     pub fn kind(self) -> QuantityKind {
         match self {
-            Quantity::GroupAlpha(_) | Quantity::GroupBeta(_) | Quantity::GroupMu(_) => {
-                QuantityKind::Damping
-            }
+            Quantity::GroupAlpha(_) | Quantity::GroupBeta(_) | Quantity::GroupMu(_) => QuantityKind::Damping,
             _ => QuantityKind::Factor,
         }
     }
@@ -111,10 +109,8 @@ impl Model {
     /// Resolves a dotted name such as `group.steel.mu` to a quantity.
     pub fn quantity(&self, name: &str) -> Result<Quantity, ModelError> {
         let err = |reason: String| ModelError::UnknownQuantity { name: name.into(), reason };
-        let (head, rest) =
-            name.split_once('.').ok_or_else(|| err(format!("expected one of {FORMS}")))?;
-        let (item, field) =
-            rest.rsplit_once('.').ok_or_else(|| err(format!("expected one of {FORMS}")))?;
+        let (head, rest) = name.split_once('.').ok_or_else(|| err(format!("expected one of {FORMS}")))?;
+        let (item, field) = rest.rsplit_once('.').ok_or_else(|| err(format!("expected one of {FORMS}")))?;
         let bad_field = |valid: &str| err(format!("`{field}` is not a field of a {head}; valid: {valid}"));
         match head {
             "group" => {
@@ -132,10 +128,7 @@ impl Model {
             }
             "material" => {
                 let i = self.material_index(item).ok_or_else(|| {
-                    err(format!(
-                        "no material `{item}` (materials: {})",
-                        names(self.materials.iter().map(|m| &m.name))
-                    ))
+                    err(format!("no material `{item}` (materials: {})", names(self.materials.iter().map(|m| &m.name))))
                 })?;
                 Ok(match field {
                     "E" | "e" => Quantity::MaterialE(i),

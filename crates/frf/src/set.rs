@@ -224,9 +224,7 @@ impl FrfSet {
         }
         if let Some(coh) = &self.coherence {
             let nf = self.n_freq();
-            let v = (0..self.channels.len())
-                .flat_map(|c| idx.iter().map(move |&k| coh[c * nf + k]))
-                .collect();
+            let v = (0..self.channels.len()).flat_map(|c| idx.iter().map(move |&k| coh[c * nf + k])).collect();
             out.coherence = Some(v);
         }
         Ok(out)

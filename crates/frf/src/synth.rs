@@ -91,10 +91,7 @@ mod tests {
     fn fixed_and_unknown_dofs_are_refused_by_name() {
         let sys = DampedSystem::new(samples::cantilever(4)).unwrap();
         let bad = Channel::new(DofRef::new(1, Dof::Uy), DofRef::new(5, Dof::Uy));
-        assert_eq!(
-            synthesize(&sys, &[bad], &[10.0]).unwrap_err(),
-            FrfError::FixedDof { dof: DofRef::new(1, Dof::Uy) }
-        );
+        assert_eq!(synthesize(&sys, &[bad], &[10.0]).unwrap_err(), FrfError::FixedDof { dof: DofRef::new(1, Dof::Uy) });
         let bad = Channel::new(DofRef::new(9, Dof::Uy), DofRef::new(5, Dof::Uy));
         assert_eq!(
             synthesize(&sys, &[bad], &[10.0]).unwrap_err(),

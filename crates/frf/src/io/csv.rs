@@ -103,18 +103,20 @@ pub fn parse_csv(path: &Path, text: &str) -> Result<FrfSet, FrfError> {
             continue;
         }
         if let Some(comment) = line.strip_prefix('#') {
-            if let Some((k, v)) = comment.split_once('=') {
-                if k.trim() == "kind" {
-                    kind = FrfKind::parse(v)
-                        .ok_or_else(|| err(line_no, format!("unknown kind `{}` (receptance, mobility or accelerance)", v.trim())))?;
-                }
+            if let Some((k, v)) = comment.split_once('=')
+                && k.trim() == "kind"
+            {
+                kind = FrfKind::parse(v).ok_or_else(|| {
+                    err(line_no, format!("unknown kind `{}` (receptance, mobility or accelerance)", v.trim()))
+                })?;
             }
             continue;
         }
         match &header {
             None => {
                 let sep = [';', '\t'].into_iter().find(|&c| line.contains(c)).unwrap_or(',');
-                header = Some((line_no, split_fields(line, sep).into_iter().map(|s| s.trim().to_string()).collect(), sep));
+                header =
+                    Some((line_no, split_fields(line, sep).into_iter().map(|s| s.trim().to_string()).collect(), sep));
             }
             Some((_, cols, sep)) => {
                 let fields: Vec<&str> = line.split(*sep).collect();
@@ -143,22 +145,32 @@ pub fn parse_csv(path: &Path, text: &str) -> Result<FrfSet, FrfError> {
         return Err(err(hline, format!("the first column must be the frequency in Hz, found `{}`", cols[0])));
     }
     if cols.len() < 3 || (cols.len() - 1) % 2 != 0 {
-        return Err(err(hline, "after the frequency column, each channel needs two columns (.re and .im, or .mag and .phase_deg)".into()));
+        return Err(err(
+            hline,
+            "after the frequency column, each channel needs two columns (.re and .im, or .mag and .phase_deg)".into(),
+        ));
     }
     let mut channels = Vec::new();
     let mut pairs = Vec::new();
     for j in (1..cols.len()).step_by(2) {
-        let (c1, p1) = parse_channel(&cols[j])
-            .ok_or_else(|| err(hline, format!("column {} `{}` is not a channel name like H(31:uy,31:uy).re", j + 1, cols[j])))?;
-        let (c2, p2) = parse_channel(&cols[j + 1])
-            .ok_or_else(|| err(hline, format!("column {} `{}` is not a channel name like H(31:uy,31:uy).im", j + 2, cols[j + 1])))?;
+        let (c1, p1) = parse_channel(&cols[j]).ok_or_else(|| {
+            err(hline, format!("column {} `{}` is not a channel name like H(31:uy,31:uy).re", j + 1, cols[j]))
+        })?;
+        let (c2, p2) = parse_channel(&cols[j + 1]).ok_or_else(|| {
+            err(hline, format!("column {} `{}` is not a channel name like H(31:uy,31:uy).im", j + 2, cols[j + 1]))
+        })?;
         if c1 != c2 {
             return Err(err(hline, format!("columns {} and {} belong to different channels", j + 1, j + 2)));
         }
         let pair = match (p1, p2) {
             ("re", "im") => Pair::ReIm,
             ("mag", "phase_deg") => Pair::MagPhase,
-            _ => return Err(err(hline, format!("channel {c1}: expected .re/.im or .mag/.phase_deg columns, found .{p1}/.{p2}"))),
+            _ => {
+                return Err(err(
+                    hline,
+                    format!("channel {c1}: expected .re/.im or .mag/.phase_deg columns, found .{p1}/.{p2}"),
+                ));
+            }
         };
         if channels.contains(&c1) {
             return Err(err(hline, format!("channel {c1} appears twice")));
@@ -171,7 +183,10 @@ pub fn parse_csv(path: &Path, text: &str) -> Result<FrfSet, FrfError> {
     }
     for w in rows.windows(2) {
         if !(w[1].1[0] > w[0].1[0]) {
-            return Err(err(w[1].0, format!("frequency {} Hz does not increase (previous line has {} Hz)", w[1].1[0], w[0].1[0])));
+            return Err(err(
+                w[1].0,
+                format!("frequency {} Hz does not increase (previous line has {} Hz)", w[1].1[0], w[0].1[0]),
+            ));
         }
     }
     if let Some((line, r)) = rows.iter().find(|(_, r)| !(r[0] > 0.0)) {

@@ -55,7 +55,7 @@ mod tests {
         atomic_write(&out, b"one", &[]).unwrap();
         atomic_write(&out, b"two", &[]).unwrap();
         assert_eq!(std::fs::read_to_string(&out).unwrap(), "two");
-        let e = atomic_write(&out, b"three", &[out.clone()]).unwrap_err();
+        let e = atomic_write(&out, b"three", std::slice::from_ref(&out)).unwrap_err();
         assert!(e.to_string().contains("refusing to overwrite an input"), "{e}");
         assert_eq!(std::fs::read_to_string(&out).unwrap(), "two");
         // no temporary files are left behind

@@ -64,7 +64,8 @@ fn infinite_mu_is_exactly_viscous_and_large_mu_tends_to_it() {
     let mut nearly = DampedSystem::new(base).unwrap();
     nearly.set(Quantity::GroupMu(joint), 1e12).unwrap();
 
-    let dofs: Vec<DofRef> = [(2, Dof::Ux), (3, Dof::Rz), (4, Dof::Uy)].iter().map(|&(n, d)| DofRef::new(n, d)).collect();
+    let dofs: Vec<DofRef> =
+        [(2, Dof::Ux), (3, Dof::Rz), (4, Dof::Uy)].iter().map(|&(n, d)| DofRef::new(n, d)).collect();
     let channels: Vec<Channel> = dofs.iter().flat_map(|&a| dofs.iter().map(move |&b| Channel::new(a, b))).collect();
     let freqs = [3.0, 41.0, 157.0, 612.0];
     let hv = synthesize(&viscous, &channels, &freqs).unwrap();
