@@ -1,0 +1,283 @@
+//! The response function method (RFM) extended to exponential damping
+//! (Arora, Adhikari and Vijayan 2023, eqs. 8-21).
+//!
+//! From `Z_EX = Z_FE + dZ` and `Z R = I` for model and structure,
+//! `R_FE dZ R_EX,v = R_FE,v - R_EX,v` for a measured column `v` (eq. 12).
+//! Writing `dZ = sum_i (dZ/dp_i) p_i u_i` with relative corrections
+//! `u_i = dp_i / p_i` (eq. 14) gives, at the measured rows and chosen lines,
+//!
+//! ```text
+//! sum_i u_i [R_FE (dZ/dp_i p_i) R_EX,v]  =  R_FE,v - R_EX,v
+//! ```
+//!
+//! real and imaginary parts stacked into one real least-squares problem
+//! (eqs. 19-21), solved with column scaling and SVD truncation
+//! ([`crate::lstsq`]); then `p_i <- p_i (1 + u_i)` and repeat. Unmeasured
+//! entries of `R_EX,v` take the current model's values at each pass.
+//!
+//! Two safeguards beyond the paper keep the iteration on track when the
+//! model starts far from the data (resonances shifted by more than their
+//! width, parameters acting on unmeasured DOFs), where the linearised step
+//! can be far too long:
+//!
+//! - the step is accepted only if it lowers the FRF misfit at the updating
+//!   lines; otherwise it is damped, Levenberg-Marquardt style (Tikhonov
+//!   regularisation `lambda` in the column-scaled variables, raised tenfold
+//!   per rejection and relaxed tenfold after each success), until it does;
+//! - no parameter changes by more than a factor of 100 in one step (so none
+//!   changes sign); the limit applies per parameter, so that one poorly
+//!   determined parameter asking for a huge change does not stall the others.
+//!
+//! When the full step lowers the misfit, as it does near the solution, the
+//! iteration is exactly the paper's.
+
+use damping::DampedSystem;
+use faer::Mat;
+use fe_model::Quantity;
+use frf::{FrfSet, ZSolver};
+use serde::Serialize;
+
+use crate::error::UpdateError;
+use crate::sensitivity::{self, ChannelPlan, FrequencyBlock, Hybrid};
+
+/// Options of the RFM iteration.
+#[derive(Clone, Debug)]
+pub struct RfmOptions {
+    /// Iteration limit.
+    pub max_iterations: usize,
+    /// Converged when the largest relative correction is below this.
+    pub tolerance: f64,
+    /// Relative singular-value cut-off of the least-squares solve.
+    pub rcond: f64,
+    /// Stalled when this many iterations in a row fail to lower the best
+    /// residual by 1 %.
+    pub stall_iterations: usize,
+}
+
+impl Default for RfmOptions {
+    fn default() -> Self {
+        RfmOptions { max_iterations: 50, tolerance: 1e-6, rcond: 1e-10, stall_iterations: 5 }
+    }
+}
+
+/// One iteration's record.
+#[derive(Clone, Debug, Serialize)]
+pub struct IterationRecord {
+    /// 0 for the initial model.
+    pub iteration: usize,
+    /// `|R_FE - R_EX| / |R_EX|` over the chosen lines and channels, before the step.
+    pub residual: f64,
+    /// Largest `|u_i|` of the step taken (0 for the initial record).
+    pub max_correction: f64,
+    /// Number of corrections limited to a factor of 100 in this step.
+    pub limited: usize,
+    /// Rank of the scaled sensitivity matrix.
+    pub rank: usize,
+    /// Damping `lambda` of the step taken (0 = the plain RFM step).
+    pub lambda: f64,
+    /// Parameter values after the step.
+    pub values: Vec<f64>,
+}
+
+/// How an iteration ended.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Status {
+    /// The largest correction fell below the tolerance.
+    Converged,
+    /// The residual stopped decreasing (numerical floor or noise) before the
+    /// corrections fell below the tolerance; the best iterate is returned.
+    Stalled,
+    /// The iteration limit was reached; the best iterate is returned.
+    MaxIterations,
+    /// The model could not be evaluated any more; the best iterate is returned.
+    Failed(String),
+}
+
+/// Outcome of an RFM run.
+#[derive(Clone, Debug)]
+pub struct RfmResult {
+    /// Records: initial model, then one per iteration.
+    pub history: Vec<IterationRecord>,
+    /// How it ended.
+    pub status: Status,
+    /// Final parameter values (the best iterate unless converged).
+    pub values: Vec<f64>,
+    /// Residual of the final values.
+    pub residual: f64,
+}
+
+/// `|R_FE - R_EX| / |R_EX|` over a set of blocks.
+pub fn relative_residual(blocks: &[FrequencyBlock], measured: &FrfSet) -> f64 {
+    let (mut num, mut den) = (0.0, 0.0);
+    for (k, b) in blocks.iter().enumerate() {
+        for (c, &h) in b.model.iter().enumerate() {
+            let m = measured.get(c, k);
+            num += (h - m).norm_sqr();
+            den += m.norm_sqr();
+        }
+    }
+    (num / den).sqrt()
+}
+
+/// Stacks `S u = R_FE - R_EX` into a real system (real parts, then imaginary).
+fn stack(blocks: &[FrequencyBlock], measured: &FrfSet, n_params: usize) -> (Mat<f64>, Vec<f64>) {
+    let n_ch = measured.channels().len();
+    let rows = blocks.len() * n_ch;
+    let mut a = Mat::<f64>::zeros(2 * rows, n_params);
+    let mut b = vec![0.0; 2 * rows];
+    for (k, blk) in blocks.iter().enumerate() {
+        for c in 0..n_ch {
+            let r = k * n_ch + c;
+            let d = blk.model[c] - measured.get(c, k);
+            b[r] = d.re;
+            b[rows + r] = d.im;
+            for i in 0..n_params {
+                a[(r, i)] = blk.sens[(c, i)].re;
+                a[(rows + r, i)] = blk.sens[(c, i)].im;
+            }
+        }
+    }
+    (a, b)
+}
+
+/// Limits each relative correction so that `1 + u` stays within
+/// `[1/100, 100]`; returns the number of corrections limited.
+fn guard(u: &mut [f64]) -> usize {
+    let mut limited = 0;
+    for x in u.iter_mut() {
+        let clamped = x.clamp(0.01 - 1.0, 100.0 - 1.0);
+        if clamped != *x {
+            limited += 1;
+            *x = clamped;
+        }
+    }
+    limited
+}
+
+fn set_values(sys: &mut DampedSystem, params: &[Quantity], values: &[f64]) -> Result<(), UpdateError> {
+    for (&q, &v) in params.iter().zip(values) {
+        sys.set(q, v)?;
+    }
+    Ok(())
+}
+
+/// Relative FRF misfit of the current model at the measured lines, or
+/// `None` when the model cannot be evaluated (singular at some line).
+fn misfit(sys: &DampedSystem, solver: &ZSolver, measured: &FrfSet) -> Option<f64> {
+    let model = frf::synthesize_with(sys, solver, measured.channels(), measured.frequencies_hz()).ok()?;
+    let (num, den) = model
+        .values()
+        .iter()
+        .zip(measured.values())
+        .fold((0.0, 0.0), |(n, d), (h, m)| (n + (h - m).norm_sqr(), d + m.norm_sqr()));
+    Some((num / den).sqrt()).filter(|r| r.is_finite())
+}
+
+/// Runs the RFM on `sys` (updated in place) against measured receptances at
+/// the lines of `measured`. `on_iteration` sees each record as it is made.
+pub fn run(
+    sys: &mut DampedSystem,
+    params: &[Quantity],
+    measured: &FrfSet,
+    opts: &RfmOptions,
+    mut on_iteration: impl FnMut(&IterationRecord),
+) -> Result<RfmResult, UpdateError> {
+    let solver = ZSolver::new(&sys.assembly().pattern)?;
+    let plan = ChannelPlan::new(sys, measured.channels())?;
+    let freqs = measured.frequencies_hz().to_vec();
+    let values = |sys: &DampedSystem| params.iter().map(|&q| sys.get(q)).collect::<Vec<f64>>();
+    let mut history: Vec<IterationRecord> = Vec::new();
+    let mut best: (f64, Vec<f64>) = (f64::INFINITY, values(sys));
+    let mut status = Status::MaxIterations;
+    let mut since_best = 0;
+    let mut lambda = 0.0;
+    let mut converged = false;
+    // (max |u|, corrections limited, rank, lambda) of the step just taken
+    let mut last_step = (0.0, 0, params.len(), 0.0);
+    for iteration in 0..=opts.max_iterations {
+        let blocks = match sensitivity::assemble(sys, &solver, &plan, params, &freqs, Hybrid::Measured(measured)) {
+            Ok(b) => b,
+            Err(e) => {
+                status = Status::Failed(e.to_string());
+                break;
+            }
+        };
+        let residual = relative_residual(&blocks, measured);
+        let (max_correction, limited, rank, step_lambda) = last_step;
+        let record = IterationRecord {
+            iteration,
+            residual,
+            max_correction,
+            limited,
+            rank,
+            lambda: step_lambda,
+            values: values(sys),
+        };
+        on_iteration(&record);
+        history.push(record);
+        if residual.is_finite() && residual < 0.99 * best.0 {
+            since_best = 0;
+        } else {
+            since_best += 1;
+        }
+        if residual.is_finite() && residual < best.0 {
+            best = (residual, values(sys));
+        }
+        if converged {
+            status = Status::Converged;
+            break;
+        }
+        if since_best >= opts.stall_iterations {
+            status = Status::Stalled;
+            break;
+        }
+        if iteration == opts.max_iterations {
+            break;
+        }
+        let (a, b) = stack(&blocks, measured, params.len());
+        let sol = crate::lstsq::solve(&a, &b, opts.rcond);
+        let current = values(sys);
+        let mut full = sol.x.clone();
+        let full_limited = guard(&mut full);
+        let full_max = full.iter().map(|x| x.abs()).fold(0.0, f64::max);
+        if !full_max.is_finite() {
+            status = Status::Failed("the least-squares step is not finite".into());
+            break;
+        }
+        if full_max < opts.tolerance {
+            // converged: take the (tiny) paper step and stop after recording it
+            let next: Vec<f64> = current.iter().zip(&full).map(|(p, u)| p * (1.0 + u)).collect();
+            set_values(sys, params, &next)?;
+            last_step = (full_max, full_limited, sol.rank, 0.0);
+            converged = true;
+            continue;
+        }
+        let smax2 = sol.largest_singular_value().powi(2);
+        let mut accepted = false;
+        for _ in 0..16 {
+            let mut u = if lambda == 0.0 { sol.x.clone() } else { sol.damped(lambda) };
+            let limited = guard(&mut u);
+            let next: Vec<f64> = current.iter().zip(&u).map(|(p, u)| p * (1.0 + u)).collect();
+            let trial = set_values(sys, params, &next).ok().and_then(|()| misfit(sys, &solver, measured));
+            if trial.is_some_and(|r| r < residual) {
+                last_step = (u.iter().map(|x| x.abs()).fold(0.0, f64::max), limited, sol.rank, lambda);
+                lambda = if lambda <= 1e-9 * smax2 { 0.0 } else { lambda / 10.0 };
+                accepted = true;
+                break;
+            }
+            set_values(sys, params, &current)?;
+            lambda = if lambda == 0.0 { 1e-6 * smax2 } else { lambda * 10.0 };
+        }
+        if !accepted {
+            status = Status::Stalled;
+            break;
+        }
+    }
+    if status != Status::Converged {
+        set_values(sys, params, &best.1)?;
+    }
+    let final_values = values(sys);
+    let residual = if status == Status::Converged { history.last().map_or(f64::NAN, |r| r.residual) } else { best.0 };
+    Ok(RfmResult { history, status, values: final_values, residual })
+}

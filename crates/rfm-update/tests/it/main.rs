@@ -1,0 +1,4 @@
+//! Integration tests of rfm-update.
+
+mod paper_cases;
+mod sensitivity;
