@@ -1,0 +1,69 @@
+//! `rfm`: compare, update and simulate FE models of damped structures against
+//! measured FRFs. Run `rfm --help`.
+
+mod commands;
+mod table;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// FE model updating of damped structures from measured FRFs (response
+/// function method with exponential non-viscous damping).
+#[derive(Parser)]
+#[command(name = "rfm", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Synthesise the model's FRFs (or the truth's) on the case's measurement lines.
+    Simulate {
+        /// Case file.
+        case: PathBuf,
+        /// Output CSV file.
+        #[arg(long)]
+        out: PathBuf,
+        /// Use the case's truth model instead of the initial model.
+        #[arg(long)]
+        truth: bool,
+        /// Relative complex noise level (0.01 = 1 %).
+        #[arg(long, default_value_t = 0.0)]
+        noise: f64,
+        /// Random seed of the noise.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+    },
+    /// Update the model's parameters so that its FRFs match the measured ones.
+    Update {
+        /// Case file.
+        case: PathBuf,
+        /// Folder for results (results.json).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Print machine-readable JSON instead of tables.
+        #[arg(long)]
+        json: bool,
+        /// Updating method.
+        #[arg(long, value_parser = ["rfm"])]
+        method: Option<String>,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Simulate { case, out, truth, noise, seed } => commands::simulate(&case, &out, truth, noise, seed),
+        Command::Update { case, out, json, method } => commands::update(&case, out.as_deref(), json, method.as_deref()),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,84 @@
+//! Each command's output, files and exit codes.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn rfm(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_rfm")).args(args).output().expect("rfm runs")
+}
+
+fn case(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases").join(format!("{name}.toml"))
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+#[test]
+fn update_prints_the_table_and_writes_results_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = rfm(&["update", case("two-material-beam").to_str().unwrap(), "--out", dir.path().to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    assert!(stdout.contains("group.aluminium.mu") && stdout.contains("paper"), "{stdout}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("results.json")).unwrap()).unwrap();
+    assert_eq!(json["status"], "converged");
+    for p in json["parameters"].as_array().unwrap() {
+        for key in ["name", "initial", "updated", "truth"] {
+            assert!(!p[key].is_null(), "results.json parameter lacks {key}: {p}");
+        }
+        let (u, t) = (p["updated"].as_f64().unwrap(), p["truth"].as_f64().unwrap());
+        assert!(((u - t) / t).abs() < 1e-6);
+    }
+    assert!(json["residual"].as_f64().unwrap() < 1e-8);
+}
+
+#[test]
+fn simulate_writes_a_csv_that_reads_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("h.csv");
+    let out = rfm(&[
+        "simulate",
+        case("monopile").to_str().unwrap(),
+        "--out",
+        file.to_str().unwrap(),
+        "--noise",
+        "0.02",
+        "--seed",
+        "3",
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let set = frf::io::csv::read_csv(&file).unwrap();
+    assert_eq!(set.channels().len(), 25);
+    assert_eq!(set.n_freq(), 1200);
+}
+
+#[test]
+fn a_bad_case_file_fails_with_file_line_and_column() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.toml");
+    let text_in =
+        std::fs::read_to_string(case("two-material-beam")).unwrap().replace("group = \"steel\"", "group = \"stel\"");
+    std::fs::write(&bad, &text_in).unwrap();
+    let out = rfm(&["update", bad.to_str().unwrap()]);
+    assert!(!out.status.success());
+    let err = text(&out.stderr);
+    let line = text_in.lines().position(|l| l.contains("\"stel\"")).unwrap() + 1;
+    assert!(err.contains(&format!("bad.toml:{line}:")), "{err}");
+    assert!(err.contains("did you mean `steel`"), "{err}");
+}
+
+#[test]
+fn outputs_never_overwrite_the_case_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let copy = dir.path().join("case.toml");
+    std::fs::copy(case("monopile"), &copy).unwrap();
+    let before = std::fs::read(&copy).unwrap();
+    let out = rfm(&["simulate", copy.to_str().unwrap(), "--out", copy.to_str().unwrap()]);
+    assert!(!out.status.success());
+    assert!(text(&out.stderr).contains("refusing to overwrite an input"), "{}", text(&out.stderr));
+    assert_eq!(std::fs::read(&copy).unwrap(), before);
+    assert!(Path::new(&copy).exists());
+}

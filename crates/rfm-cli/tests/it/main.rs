@@ -1,0 +1,3 @@
+//! End-to-end tests of the `rfm` binary.
+
+mod commands;
