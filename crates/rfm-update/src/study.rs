@@ -126,7 +126,7 @@ impl Study {
         }
         let measured = match (&spec.data, &case.truth, &truth) {
             (Some(path), _, _) => {
-                let set = frf::io::csv::read_csv(path)?.to_receptance();
+                let set = frf::io::read_measured(path, &spec.map)?.to_receptance();
                 for c in &channels {
                     if set.find(*c).is_none() {
                         return Err(UpdateError::Setup(format!(

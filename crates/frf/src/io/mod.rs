@@ -11,7 +11,25 @@ pub mod csv;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use fe_model::case::ChannelMap;
+
 use crate::error::FrfError;
+use crate::set::FrfSet;
+
+/// Reads a measured FRF file, choosing the format from its extension, and
+/// maps its channels to model DOFs. CSV files name model DOFs directly (the
+/// map is not used).
+pub fn read_measured(path: &Path, map: &[ChannelMap]) -> Result<FrfSet, FrfError> {
+    let _ = map;
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    match ext.as_str() {
+        "csv" | "txt" => csv::read_csv(path),
+        _ => Err(FrfError::Io {
+            path: path.to_path_buf(),
+            message: format!("unsupported measured-data format `.{ext}` (supported: .csv)"),
+        }),
+    }
+}
 
 /// Writes `bytes` to `path` atomically (temporary file in the same folder,
 /// flushed and synced, then renamed). Fails if `path` is one of `inputs`.
