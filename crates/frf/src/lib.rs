@@ -16,7 +16,8 @@
 //! [`FrfSet`] holds FRFs over common lines for a list of [`Channel`]s
 //! (response DOF over reference DOF) and is shared by synthesised and
 //! measured data; [`NoiseModel`] adds documented, seeded noise; [`io`] reads
-//! and writes files atomically.
+//! and writes files atomically; [`correlation`] measures how far a model's
+//! FRFs are from measured ones (dB and phase errors, FRAC, per band).
 //!
 //! # Example
 //!
@@ -36,6 +37,7 @@
 //! NoiseModel::relative(0.01, 42).apply(&mut h); // 1 % complex noise, seed 42
 //! ```
 
+pub mod correlation;
 pub mod error;
 pub mod io;
 pub mod noise;
@@ -43,6 +45,7 @@ pub mod set;
 pub mod solver;
 pub mod synth;
 
+pub use correlation::{BandSpec, Correlation, correlate};
 pub use error::FrfError;
 pub use noise::NoiseModel;
 pub use set::{Channel, FrfKind, FrfSet};
