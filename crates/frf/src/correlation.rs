@@ -279,22 +279,28 @@ pub fn frac(measured: &[C64], model: &[C64]) -> f64 {
 
 /// Resonance frequencies (Hz) seen in a set: lines where the magnitude
 /// summed over channels has a local maximum at least 1.5 times the smallest
-/// value within `max(3, n/100)` lines on the lower or the upper side.
+/// value on *both* sides within 5 % of its frequency (at least 3 lines).
+///
+/// The window is relative because a peak's width is: with damping that
+/// grows with frequency, a fixed number of lines would be too narrow to see
+/// the high modes stand out. Requiring the drop on both sides rejects
+/// noise ripples on the flank of a peak.
 pub fn resonances(set: &FrfSet) -> Vec<f64> {
     let f = set.frequencies_hz();
     let nf = f.len();
     if nf < 3 {
         return Vec::new();
     }
-    let reach = (nf / 100).max(3);
     let y: Vec<f64> = (0..nf)
         .map(|k| (0..set.channels().len()).map(|c| set.get(c, k).norm()).filter(|v| v.is_finite()).sum())
         .collect();
     (1..nf - 1)
         .filter(|&k| y[k] >= y[k - 1] && y[k] > y[k + 1])
         .filter(|&k| {
-            let left = y[k.saturating_sub(reach)..k].iter().copied().fold(f64::INFINITY, f64::min);
-            let right = y[k + 1..=(k + reach).min(nf - 1)].iter().copied().fold(f64::INFINITY, f64::min);
+            let lo = f.partition_point(|&x| x < 0.95 * f[k]).min(k.saturating_sub(3));
+            let hi = f.partition_point(|&x| x <= 1.05 * f[k]).max(k + 4).min(nf);
+            let left = y[lo..k].iter().copied().fold(f64::INFINITY, f64::min);
+            let right = y[k + 1..hi].iter().copied().fold(f64::INFINITY, f64::min);
             y[k] >= 1.5 * left.max(right)
         })
         .map(|k| f[k])
