@@ -2,6 +2,7 @@
 //! measured FRFs. Run `rfm --help`.
 
 mod commands;
+mod report;
 mod table;
 
 use std::path::PathBuf;
@@ -37,11 +38,28 @@ enum Command {
         #[arg(long, default_value_t = 0)]
         seed: u64,
     },
+    /// Compare the case's model with the measured FRFs: errors per channel and band, overlays, a report.
+    Compare {
+        /// Case file.
+        case: PathBuf,
+        /// Measured FRF file(s) to use instead of the case's data (channels of several files are joined).
+        #[arg(long, value_name = "FILE")]
+        measured: Vec<PathBuf>,
+        /// Folder for the report (report.html, compare.json, SVG figures).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Print machine-readable JSON instead of tables.
+        #[arg(long)]
+        json: bool,
+        /// Frequency bands: auto, resonances, octave, third-octave, or edges in Hz such as 0,50,120,400.
+        #[arg(long, default_value = "auto")]
+        bands: String,
+    },
     /// Update the model's parameters so that its FRFs match the measured ones.
     Update {
         /// Case file.
         case: PathBuf,
-        /// Folder for results (results.json).
+        /// Folder for results (results.json, report.html and SVG figures).
         #[arg(long)]
         out: Option<PathBuf>,
         /// Print machine-readable JSON instead of tables.
@@ -57,6 +75,9 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Simulate { case, out, truth, noise, seed } => commands::simulate(&case, &out, truth, noise, seed),
+        Command::Compare { case, measured, out, json, bands } => {
+            commands::compare(&case, &measured, out.as_deref(), json, &bands)
+        }
         Command::Update { case, out, json, method } => commands::update(&case, out.as_deref(), json, method.as_deref()),
     };
     match result {

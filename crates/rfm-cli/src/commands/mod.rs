@@ -1,5 +1,6 @@
 //! One module per subcommand. Only this crate prints.
 
+mod compare;
 mod simulate;
 mod update;
 
@@ -7,6 +8,7 @@ use std::path::Path;
 
 use fe_model::CaseFile;
 
+pub(crate) use compare::compare;
 pub(crate) use simulate::simulate;
 pub(crate) use update::update;
 

@@ -100,6 +100,10 @@ pub(crate) fn update(case: &Path, out: Option<&Path>, json: bool, method: Option
         if !json {
             println!("\nwrote {}", path.display());
         }
+        let report = crate::report::update_report::write(&study, &outcome, dir, case)?;
+        if !json {
+            println!("wrote {} (figures beside it)", report.display());
+        }
     }
     Ok(())
 }

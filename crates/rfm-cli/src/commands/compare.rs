@@ -1,0 +1,311 @@
+//! `rfm compare`: the case's model against the measured FRFs, without
+//! updating: FRF-level errors per channel and per band, the worst of them,
+//! overlays and a report.
+//!
+//! The report is a list of sections; the FRF sections come first, and
+//! further comparisons (a mode table, say) are appended as more sections
+//! in [`report_sections`] without changing the others.
+
+use std::path::{Path, PathBuf};
+
+use damping::DampedSystem;
+use fe_model::CaseFile;
+use frf::correlation::{BandSpec, Correlation, correlate};
+use frf::{FrfSet, synthesize};
+use rfm_update::{Study, UpdateError};
+use serde::Serialize;
+
+use super::{Result, load_case};
+use crate::report::html::{Block, Report, Section};
+use crate::report::json::CorrelationJson;
+use crate::report::{self, ModelFrfs, Output, plot, sig, signed};
+use crate::table::Table;
+
+/// Number of overlay figures.
+const OVERLAYS: usize = 4;
+
+/// What `--json` prints and `compare.json` holds.
+#[derive(Serialize)]
+struct CompareJson {
+    case: String,
+    title: String,
+    /// Where the measured data came from.
+    measured: String,
+    /// The model compared (the case's initial model).
+    model: String,
+    /// Band choice (`auto`, `octave`, edges...).
+    bands: String,
+    correlation: CorrelationJson,
+}
+
+/// Parses `--bands`: `auto`, `resonances`, `octave`, `third-octave`, or
+/// comma-separated edges in Hz.
+pub(crate) fn parse_bands(s: &str) -> std::result::Result<BandSpec, String> {
+    match s.trim() {
+        "auto" => Ok(BandSpec::Auto),
+        "resonances" | "modes" => Ok(BandSpec::Resonances),
+        "octave" | "octaves" => Ok(BandSpec::Octave { fraction: 1 }),
+        "third-octave" | "third-octaves" => Ok(BandSpec::Octave { fraction: 3 }),
+        list => list
+            .split(',')
+            .map(|x| x.trim().parse::<f64>().map_err(|_| format!("`{}` is not a frequency in Hz", x.trim())))
+            .collect::<std::result::Result<Vec<f64>, String>>()
+            .map(BandSpec::Edges)
+            .map_err(|e| {
+                format!("{e}; --bands takes auto, resonances, octave, third-octave or edges like 0,50,120,400")
+            }),
+    }
+}
+
+/// The measured FRFs and a description of where they came from.
+fn measured_data(case: CaseFile, files: &[PathBuf]) -> Result<(CaseFile, FrfSet, String)> {
+    if files.is_empty() {
+        let study = Study::from_case(case).map_err(|e| match e {
+            UpdateError::Case(c) => c.render(),
+            other => other.to_string(),
+        })?;
+        let source = match (study.case.measurement.as_ref().and_then(|m| m.data.as_ref()), &study.case.truth) {
+            (Some(p), _) => format!("measured file {} (from the case)", p.display()),
+            (None, Some(t)) if t.noise > 0.0 => format!(
+                "synthesised from the case's truth model ({} % noise, seed {})",
+                report::short(100.0 * t.noise),
+                t.seed
+            ),
+            (None, Some(_)) => "synthesised from the case's truth model (noise-free)".into(),
+            (None, None) => "the case's data".into(),
+        };
+        return Ok((study.case, study.measured, source));
+    }
+    let map = case.measurement.as_ref().map(|m| m.map.clone()).unwrap_or_default();
+    let mut sets = Vec::new();
+    for f in files {
+        sets.push((f.clone(), frf::io::read_measured(f, &map)?));
+    }
+    let names = files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(", ");
+    Ok((case, merge(sets)?, format!("measured file(s) {names}")))
+}
+
+/// Joins the channels of several measured files on the same lines, in the
+/// first file's FRF kind.
+fn merge(sets: Vec<(PathBuf, FrfSet)>) -> Result<FrfSet> {
+    let mut it = sets.into_iter();
+    let Some((first_path, first)) = it.next() else {
+        return Err("no measured file given".into());
+    };
+    let rest: Vec<(PathBuf, FrfSet)> = it.collect();
+    if rest.is_empty() {
+        return Ok(first);
+    }
+    let f = first.frequencies_hz().to_vec();
+    let mut channels = first.channels().to_vec();
+    for (path, set) in &rest {
+        let same = set.n_freq() == f.len()
+            && set.frequencies_hz().iter().zip(&f).all(|(a, b)| (a - b).abs() <= 1e-6 * b.abs());
+        if !same {
+            return Err(format!(
+                "{}: its {} lines differ from the {} lines of {}; files compared together must share their lines",
+                path.display(),
+                set.n_freq(),
+                f.len(),
+                first_path.display()
+            )
+            .into());
+        }
+        for c in set.channels() {
+            if channels.contains(c) {
+                return Err(format!("{}: channel {c} appears in an earlier file too", path.display()).into());
+            }
+            channels.push(*c);
+        }
+    }
+    let mut out = FrfSet::zeros(f, channels, first.kind())?;
+    let mut c_out = 0;
+    for set in std::iter::once(&first).chain(rest.iter().map(|(_, s)| s)) {
+        let set = set.converted(first.kind());
+        for c in 0..set.channels().len() {
+            out.channel_mut(c_out).copy_from_slice(set.channel(c));
+            c_out += 1;
+        }
+    }
+    Ok(out)
+}
+
+pub(crate) fn compare(
+    case_path: &Path,
+    measured_files: &[PathBuf],
+    out: Option<&Path>,
+    json: bool,
+    bands: &str,
+) -> Result<()> {
+    let spec = parse_bands(bands)?;
+    let case = load_case(case_path)?;
+    let (case, measured, source) = measured_data(case, measured_files)?;
+    let system = DampedSystem::new(case.model.clone())?;
+    let frfs = synthesize(&system, measured.channels(), measured.frequencies_hz())?;
+    let correlation = correlate(&measured, &frfs, &spec)?;
+    let doc = CompareJson {
+        case: case_path.display().to_string(),
+        title: case.model.title.clone(),
+        measured: source.clone(),
+        model: "the case's model (initial values)".into(),
+        bands: bands.to_string(),
+        correlation: CorrelationJson::from(&correlation),
+    };
+    if json {
+        println!("{}", serde_json::to_string_pretty(&doc)?);
+    } else {
+        print_tables(&case, &measured, &source, &correlation);
+    }
+    if let Some(dir) = out {
+        let mut inputs = vec![case_path.to_path_buf()];
+        inputs.extend(measured_files.iter().cloned());
+        let mut output = Output::new(dir, inputs);
+        let path = output.write("compare.json", serde_json::to_string_pretty(&doc)?.as_bytes())?;
+        let model = ModelFrfs { label: "model".into(), colour: plot::UPDATED, frfs, correlation };
+        let mut report = Report::new(format!("{}: model against measurement", case.model.title));
+        report.subtitle = Some(format!("rfm compare, case file {}", case_path.display()));
+        report.sections = report_sections(&case, &measured, &source, &model, &mut output)?;
+        let html = output.write("report.html", report.render().as_bytes())?;
+        if !json {
+            println!("\nwrote {}, {} and {} figures", path.display(), html.display(), output.written().len() - 2);
+        }
+    }
+    Ok(())
+}
+
+/// The report's sections, in order. A modal comparison goes in before the
+/// definitions.
+fn report_sections(
+    case: &CaseFile,
+    measured: &FrfSet,
+    source: &str,
+    model: &ModelFrfs,
+    out: &mut Output,
+) -> Result<Vec<Section>> {
+    let c = &model.correlation;
+    let mut sections = vec![summary(case, measured, source, c)];
+    let notes = vec!["The case's model with its initial parameter values against the measured FRFs.".to_string()];
+    sections.push(report::correlation_section(measured, std::slice::from_ref(model), out, notes)?);
+    let worst = report::notable_channels(c, 2);
+    let picks = report::representative_channels(measured, &worst, OVERLAYS);
+    sections.push(report::overlay_section(measured, std::slice::from_ref(model), &picks, &worst, &[], out)?);
+    sections.push(report::definitions_section());
+    Ok(sections)
+}
+
+fn summary(case: &CaseFile, measured: &FrfSet, source: &str, c: &Correlation) -> Section {
+    let f = measured.frequencies_hz();
+    let t = &c.total;
+    let mut s = Section::new("Summary");
+    s.push(Block::Facts(vec![
+        ("case".into(), case.path.display().to_string()),
+        ("data".into(), source.to_string()),
+        (
+            "measurement".into(),
+            format!(
+                "{} channels x {} lines, {} to {} Hz, {}",
+                measured.channels().len(),
+                f.len(),
+                report::short(f.first().copied().unwrap_or(0.0)),
+                report::short(f.last().copied().unwrap_or(0.0)),
+                measured.kind()
+            ),
+        ),
+        ("RMS magnitude error".into(), format!("{} dB (mean {} dB)", sig(t.rms_db, 3), signed(t.mean_db, 3))),
+        ("RMS phase error".into(), format!("{} deg", sig(t.rms_phase_deg, 3))),
+        ("FRAC".into(), format!("mean {:.4}, lowest {:.4}", t.mean_frac, t.min_frac)),
+        ("complex-log misfit".into(), sig(t.log_misfit, 3)),
+    ]));
+    let bands: Vec<String> = report::notable_bands(c, 3)
+        .into_iter()
+        .map(|i| format!("{} ({} of the misfit)", c.bands[i].band.label(), report::percent(c.bands[i].share)))
+        .collect();
+    let channels: Vec<String> = report::notable_channels(c, 3)
+        .into_iter()
+        .map(|i| {
+            format!("{} ({} dB, FRAC {:.3})", c.channels[i].channel, sig(c.channels[i].rms_db, 3), c.channels[i].frac)
+        })
+        .collect();
+    if bands.is_empty() && channels.is_empty() {
+        s.push(Block::Text(format!(
+            "The model matches the measured FRFs in every band and channel (complex-log misfit below {}).",
+            report::NOTABLE_MISFIT
+        )));
+    }
+    if !bands.is_empty() {
+        s.push(Block::Text(format!("Worst bands: {}.", bands.join("; "))));
+    }
+    if !channels.is_empty() {
+        s.push(Block::Text(format!("Worst channels: {}.", channels.join("; "))));
+    }
+    s
+}
+
+fn print_tables(case: &CaseFile, measured: &FrfSet, source: &str, c: &Correlation) {
+    let f = measured.frequencies_hz();
+    let t = &c.total;
+    println!("{}", case.model.title);
+    println!(
+        "model against {source}: {} channels x {} lines, {} to {} Hz, {}",
+        measured.channels().len(),
+        f.len(),
+        report::short(f.first().copied().unwrap_or(0.0)),
+        report::short(f.last().copied().unwrap_or(0.0)),
+        measured.kind()
+    );
+    println!(
+        "overall: RMS {} dB (mean {} dB), RMS phase {} deg, FRAC mean {:.4} / lowest {:.4}, complex-log misfit {}",
+        sig(t.rms_db, 3),
+        signed(t.mean_db, 3),
+        sig(t.rms_phase_deg, 3),
+        t.mean_frac,
+        t.min_frac,
+        sig(t.log_misfit, 3)
+    );
+    if t.lines_excluded > 0 {
+        println!("({} values left out: zero or not finite)", t.lines_excluded);
+    }
+    let worst = c.worst_channels(3);
+    let mut table = Table::new(&["channel", "RMS dB", "mean dB", "max |dB| at Hz", "RMS phase", "FRAC", "share", ""]);
+    for (i, ch) in c.channels.iter().enumerate() {
+        table.row(vec![
+            ch.channel.to_string(),
+            sig(ch.rms_db, 3),
+            signed(ch.mean_db, 3),
+            format!("{} @ {}", sig(ch.max_abs_db.0, 3), report::short(ch.max_abs_db.1)),
+            sig(ch.rms_phase_deg, 3),
+            format!("{:.4}", ch.frac),
+            report::percent(ch.share),
+            if worst.contains(&i) { "<- worst".into() } else { String::new() },
+        ]);
+    }
+    println!("\nper channel\n{}", table.render());
+    let worst = c.worst_bands(3);
+    let mut table = Table::new(&["band", "lines", "RMS dB", "mean dB", "RMS phase", "share", ""]);
+    for (i, b) in c.bands.iter().enumerate() {
+        table.row(vec![
+            format!("{}: {}", i + 1, b.band.label()),
+            b.lines.to_string(),
+            sig(b.rms_db, 3),
+            signed(b.mean_db, 3),
+            sig(b.rms_phase_deg, 3),
+            report::percent(b.share),
+            if worst.contains(&i) { "<- worst".into() } else { String::new() },
+        ]);
+    }
+    println!("\nper band\n{}", table.render());
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn band_options_parse_and_bad_ones_say_what_is_accepted() {
+        assert_eq!(parse_bands("auto").unwrap(), BandSpec::Auto);
+        assert_eq!(parse_bands("third-octave").unwrap(), BandSpec::Octave { fraction: 3 });
+        assert_eq!(parse_bands("0, 50,120.5").unwrap(), BandSpec::Edges(vec![0.0, 50.0, 120.5]));
+        let e = parse_bands("0,fifty").unwrap_err();
+        assert!(e.contains("`fifty`") && e.contains("third-octave"), "{e}");
+    }
+}

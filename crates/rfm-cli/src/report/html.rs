@@ -1,0 +1,296 @@
+//! A self-contained HTML report: one file with inline CSS and inline SVG
+//! figures, no scripts and no external resources, so that it opens offline
+//! and can be mailed or archived as it is.
+//!
+//! A [`Report`] is a title and a list of [`Section`]s, each a list of
+//! [`Block`]s; commands build the sections they need (a later section, such
+//! as a mode table, is appended without touching the others).
+
+/// A report: title, optional subtitle, sections in order.
+pub(crate) struct Report {
+    /// Title (the case's title and what was done).
+    pub(crate) title: String,
+    /// A line under the title.
+    pub(crate) subtitle: Option<String>,
+    /// Sections.
+    pub(crate) sections: Vec<Section>,
+}
+
+/// A titled section.
+pub(crate) struct Section {
+    /// Heading.
+    pub(crate) heading: String,
+    /// Content.
+    pub(crate) blocks: Vec<Block>,
+}
+
+impl Section {
+    /// An empty section.
+    pub(crate) fn new(heading: impl Into<String>) -> Self {
+        Section { heading: heading.into(), blocks: Vec::new() }
+    }
+
+    /// Appends a block.
+    pub(crate) fn push(&mut self, block: Block) -> &mut Self {
+        self.blocks.push(block);
+        self
+    }
+}
+
+/// Content of a section.
+pub(crate) enum Block {
+    /// A paragraph of plain text (escaped).
+    Text(String),
+    /// Label-value pairs shown as a compact list.
+    Facts(Vec<(String, String)>),
+    /// A table.
+    Table(Table),
+    /// An SVG figure with a caption.
+    Figure(Figure),
+}
+
+/// A table cell's emphasis.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Tone {
+    /// Plain.
+    Plain,
+    /// Highlighted as a problem (the worst entries).
+    Bad,
+    /// Highlighted as good.
+    Good,
+}
+
+/// A table with a header; cells other than the first column are right-aligned numbers.
+pub(crate) struct Table {
+    /// Caption above the table.
+    pub(crate) caption: Option<String>,
+    /// Column headings.
+    pub(crate) header: Vec<String>,
+    /// Rows of (text, tone).
+    pub(crate) rows: Vec<Vec<(String, Tone)>>,
+}
+
+impl Table {
+    /// A table with the given headings.
+    pub(crate) fn new(header: &[&str]) -> Self {
+        Table { caption: None, header: header.iter().map(|s| s.to_string()).collect(), rows: Vec::new() }
+    }
+
+    /// Sets the caption.
+    pub(crate) fn caption(mut self, text: impl Into<String>) -> Self {
+        self.caption = Some(text.into());
+        self
+    }
+
+    /// Appends a row of plain cells.
+    pub(crate) fn row(&mut self, cells: Vec<String>) {
+        self.rows.push(cells.into_iter().map(|c| (c, Tone::Plain)).collect());
+    }
+
+    /// Appends a row with tones.
+    pub(crate) fn row_toned(&mut self, cells: Vec<(String, Tone)>) {
+        self.rows.push(cells);
+    }
+}
+
+/// An inline SVG figure.
+pub(crate) struct Figure {
+    /// The SVG document (as plotters writes it).
+    pub(crate) svg: String,
+    /// Caption under the figure.
+    pub(crate) caption: String,
+}
+
+/// Escapes text for HTML element content and attribute values.
+pub(crate) fn escape(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&#39;"),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// Makes a plotters SVG scale with the page: the fixed `width`/`height` of
+/// its root element are replaced by a relative width (the `viewBox` keeps
+/// the aspect ratio), and an accessible name is added.
+fn responsive(svg: &str, label: &str) -> String {
+    let Some(start) = svg.find("<svg") else {
+        return svg.to_string();
+    };
+    let end = start + svg[start..].find('>').unwrap_or(0);
+    let open = &svg[start..end];
+    let mut attrs = String::new();
+    let mut rest = open.trim_start_matches("<svg");
+    // keep every attribute but width and height
+    while let Some(eq) = rest.find("=\"") {
+        let name = rest[..eq].trim();
+        let after = &rest[eq + 2..];
+        let Some(close) = after.find('"') else { break };
+        let value = &after[..close];
+        if name != "width" && name != "height" {
+            attrs.push_str(&format!(" {name}=\"{value}\""));
+        }
+        rest = &after[close + 1..];
+    }
+    format!(
+        "{}<svg{attrs} role=\"img\" aria-label=\"{}\" class=\"figure\">{}",
+        &svg[..start],
+        escape(label),
+        &svg[end + 1..]
+    )
+}
+
+const CSS: &str = r#"
+:root { --ink: #1d1d1f; --muted: #5f6368; --rule: #d9d9de; --zebra: #f6f6f8; --accent: #0072b2;
+        --bad: #fde8e1; --bad-ink: #8a2b06; --good: #e3f4ec; --good-ink: #04593e; }
+* { box-sizing: border-box; }
+body { margin: 0; color: var(--ink); background: #fff;
+       font: 15px/1.5 system-ui, -apple-system, "Segoe UI", Roboto, "Helvetica Neue", Arial, sans-serif; }
+main { max-width: 1180px; margin: 0 auto; padding: 24px 28px 64px; }
+header { border-bottom: 3px solid var(--accent); margin-bottom: 20px; padding-bottom: 10px; }
+h1 { font-size: 26px; margin: 0 0 4px; }
+.subtitle { color: var(--muted); margin: 0; }
+h2 { font-size: 20px; margin: 36px 0 10px; padding-bottom: 4px; border-bottom: 1px solid var(--rule); }
+nav ol { margin: 6px 0 0; padding-left: 22px; columns: 2; }
+nav a { color: var(--accent); text-decoration: none; }
+dl.facts { display: grid; grid-template-columns: max-content 1fr; gap: 3px 18px; margin: 10px 0; }
+dl.facts dt { color: var(--muted); }
+dl.facts dd { margin: 0; font-variant-numeric: tabular-nums; }
+table { border-collapse: collapse; margin: 10px 0 18px; font-size: 13.5px; font-variant-numeric: tabular-nums; }
+caption { text-align: left; color: var(--muted); padding-bottom: 4px; caption-side: top; }
+th, td { padding: 4px 9px; border-bottom: 1px solid var(--rule); }
+th { text-align: right; vertical-align: bottom; background: #eef0f4; font-weight: 600; min-width: 4.5em; }
+td { text-align: right; white-space: nowrap; }
+th:first-child, td:first-child { text-align: left; }
+tbody tr:nth-child(even) { background: var(--zebra); }
+td.bad { background: var(--bad); color: var(--bad-ink); font-weight: 600; }
+td.good { background: var(--good); color: var(--good-ink); }
+.scroll { overflow-x: auto; }
+figure { margin: 14px 0 26px; }
+svg.figure { width: 100%; height: auto; display: block; border: 1px solid var(--rule); }
+figcaption { color: var(--muted); font-size: 14px; margin-top: 6px; }
+footer { margin-top: 48px; color: var(--muted); font-size: 13px; border-top: 1px solid var(--rule); padding-top: 8px; }
+@media print { main { max-width: none; padding: 0; } figure, table { break-inside: avoid; } nav { display: none; } }
+"#;
+
+impl Report {
+    /// A report without sections.
+    pub(crate) fn new(title: impl Into<String>) -> Self {
+        Report { title: title.into(), subtitle: None, sections: Vec::new() }
+    }
+
+    /// The whole HTML document.
+    pub(crate) fn render(&self) -> String {
+        let mut h = String::new();
+        h.push_str("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n");
+        h.push_str("<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n");
+        h.push_str(&format!("<title>{}</title>\n<style>{CSS}</style>\n</head>\n<body>\n<main>\n", escape(&self.title)));
+        h.push_str(&format!("<header>\n<h1>{}</h1>\n", escape(&self.title)));
+        if let Some(s) = &self.subtitle {
+            h.push_str(&format!("<p class=\"subtitle\">{}</p>\n", escape(s)));
+        }
+        h.push_str("</header>\n");
+        if self.sections.len() > 2 {
+            h.push_str("<nav><strong>Contents</strong><ol>\n");
+            for (i, s) in self.sections.iter().enumerate() {
+                h.push_str(&format!("<li><a href=\"#s{}\">{}</a></li>\n", i + 1, escape(&s.heading)));
+            }
+            h.push_str("</ol></nav>\n");
+        }
+        let mut figure_no = 0;
+        for (i, s) in self.sections.iter().enumerate() {
+            h.push_str(&format!("<section id=\"s{}\">\n<h2>{}</h2>\n", i + 1, escape(&s.heading)));
+            for b in &s.blocks {
+                match b {
+                    Block::Text(t) => h.push_str(&format!("<p>{}</p>\n", escape(t))),
+                    Block::Facts(items) => {
+                        h.push_str("<dl class=\"facts\">\n");
+                        for (k, v) in items {
+                            h.push_str(&format!("<dt>{}</dt><dd>{}</dd>\n", escape(k), escape(v)));
+                        }
+                        h.push_str("</dl>\n");
+                    }
+                    Block::Table(t) => render_table(&mut h, t),
+                    Block::Figure(f) => {
+                        figure_no += 1;
+                        h.push_str("<figure>\n");
+                        h.push_str(&responsive(&f.svg, &f.caption));
+                        h.push_str(&format!(
+                            "<figcaption><strong>Figure {figure_no}.</strong> {}</figcaption>\n</figure>\n",
+                            escape(&f.caption)
+                        ));
+                    }
+                }
+            }
+            h.push_str("</section>\n");
+        }
+        h.push_str(&format!(
+            "<footer>Written by rfm {} (FRF-based model updating with exponential non-viscous damping, after \
+             Arora, Adhikari and Vijayan, J. Sound Vib. 2023). This file is self-contained: figures are inline \
+             SVG and it loads nothing from elsewhere.</footer>\n",
+            env!("CARGO_PKG_VERSION")
+        ));
+        h.push_str("</main>\n</body>\n</html>\n");
+        h
+    }
+}
+
+fn render_table(h: &mut String, t: &Table) {
+    h.push_str("<div class=\"scroll\"><table>\n");
+    if let Some(c) = &t.caption {
+        h.push_str(&format!("<caption>{}</caption>\n", escape(c)));
+    }
+    h.push_str("<thead><tr>");
+    for c in &t.header {
+        h.push_str(&format!("<th>{}</th>", escape(c)));
+    }
+    h.push_str("</tr></thead>\n<tbody>\n");
+    for r in &t.rows {
+        h.push_str("<tr>");
+        for (text, tone) in r {
+            let class = match tone {
+                Tone::Plain => "",
+                Tone::Bad => " class=\"bad\"",
+                Tone::Good => " class=\"good\"",
+            };
+            h.push_str(&format!("<td{class}>{}</td>", escape(text)));
+        }
+        h.push_str("</tr>\n");
+    }
+    h.push_str("</tbody>\n</table></div>\n");
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn text_is_escaped_and_svgs_scale_with_the_page() {
+        let mut r = Report::new("a <b> & c");
+        let mut s = Section::new("one");
+        let mut t = Table::new(&["x", "y"]);
+        t.row_toned(vec![("<1>".into(), Tone::Plain), ("2".into(), Tone::Bad)]);
+        s.push(Block::Table(t));
+        s.push(Block::Figure(Figure {
+            svg: "<svg width=\"960\" height=\"400\" viewBox=\"0 0 960 400\" xmlns=\"http://www.w3.org/2000/svg\">\n<rect/>\n</svg>"
+                .into(),
+            caption: "cap \"q\"".into(),
+        }));
+        r.sections.push(s);
+        let html = r.render();
+        assert!(html.contains("<h1>a &lt;b&gt; &amp; c</h1>"));
+        assert!(html.contains("<td>&lt;1&gt;</td><td class=\"bad\">2</td>"));
+        assert!(html.contains(
+            "<svg viewBox=\"0 0 960 400\" xmlns=\"http://www.w3.org/2000/svg\" role=\"img\" aria-label=\"cap &quot;q&quot;\" class=\"figure\">\n<rect/>"
+        ));
+        assert!(!html.contains("width=\"960\""));
+        assert!(!html.contains("<script"));
+    }
+}

@@ -1,0 +1,317 @@
+//! The report of an updating run (`rfm update --out DIR`): before/after FRF
+//! overlays of representative channels, error against frequency and per
+//! channel, misfit and parameter values per iteration, the parameter table
+//! (also as `parameters.csv`) and `report.html` with all of it.
+
+use std::path::{Path, PathBuf};
+
+use frf::correlation::{BandSpec, correlate};
+use frf::{FrfSet, synthesize};
+use rfm_update::rfm::Status;
+use rfm_update::{Study, UpdateOutcome};
+
+use super::html::{Block, Report, Section, Table, Tone};
+use super::{ModelFrfs, Output, Result, plot, sig};
+use crate::table::num;
+
+/// At most this many iterations are re-evaluated over all lines for the
+/// convergence plot (evenly spread, first and last included).
+const MAX_ITERATIONS_EVALUATED: usize = 30;
+
+/// Number of overlay figures.
+const OVERLAYS: usize = 4;
+
+/// Writes the report files of an updating run into `dir` and returns the
+/// path of `report.html`. `case_path` is protected from being overwritten.
+pub(crate) fn write(study: &Study, outcome: &UpdateOutcome, dir: &Path, case_path: &Path) -> Result<PathBuf> {
+    let mut out = Output::new(dir, vec![case_path.to_path_buf()]);
+    let measured = &study.measured;
+    let channels = measured.channels();
+    let freqs = measured.frequencies_hz();
+    let model = |label: &str, colour, sys: &damping::DampedSystem| -> Result<ModelFrfs> {
+        let frfs = synthesize(sys, channels, freqs)?;
+        let correlation = correlate(measured, &frfs, &BandSpec::Auto)?;
+        Ok(ModelFrfs { label: label.into(), colour, frfs, correlation })
+    };
+    let models = [
+        model("initial model", plot::INITIAL, &study.system)?,
+        model("updated model", plot::UPDATED, &outcome.system)?,
+    ];
+    let all_lines_db = misfit_per_iteration(study, outcome, measured);
+
+    let mut report = Report::new(format!("{}: model updating", study.case.model.title));
+    report.subtitle =
+        Some(format!("rfm update, {} method, case file {}", method_name(&outcome.method), case_path.display()));
+    report.sections.push(summary(study, outcome, &models));
+
+    let mut conv = Section::new("Convergence");
+    let residuals: Vec<f64> = outcome.history.iter().map(|r| r.residual).collect();
+    conv.push(out.figure(
+        "convergence",
+        plot::convergence(&residuals, Some(&all_lines_db))?,
+        "Top: the updating method's relative residual |R_FE - R_EX| / |R_EX| at the updating lines, per \
+         iteration (iteration 0 is the initial model). Bottom: the RMS magnitude error over all measured lines \
+         and channels of the model at each iteration, which shows whether fitting the updating lines improved \
+         the whole band.",
+    )?);
+    let traces: Vec<plot::ParameterTrace> = outcome
+        .parameters
+        .iter()
+        .enumerate()
+        .map(|(i, p)| plot::ParameterTrace {
+            name: p.name.clone(),
+            ratios: outcome.history.iter().map(|r| r.values.get(i).copied().unwrap_or(f64::NAN) / p.initial).collect(),
+            truth_ratio: p.truth.map(|t| t / p.initial),
+        })
+        .collect();
+    conv.push(out.figure(
+        "parameters",
+        plot::parameter_history(&traces)?,
+        "Each parameter divided by its initial value, per iteration (logarithmic axis). A parameter that \
+         wanders far or keeps changing after the misfit has levelled off is poorly determined by the data.",
+    )?);
+    conv.push(Block::Table(iteration_table(outcome, &all_lines_db)));
+    report.sections.push(conv);
+
+    let (params, csv) = parameter_table(outcome);
+    out.write("parameters.csv", csv.as_bytes())?;
+    let mut ps = Section::new("Parameters");
+    ps.push(Block::Table(params));
+    ps.push(Block::Table(frequency_table(outcome)));
+    report.sections.push(ps);
+
+    let notes = vec![format!(
+        "The initial and the updated model against the measured FRFs over all {} lines, not only the {} \
+         updating lines.",
+        freqs.len(),
+        outcome.frequencies_hz.len()
+    )];
+    report.sections.push(super::correlation_section(measured, &models, &mut out, notes)?);
+
+    let worst = super::notable_channels(&models[1].correlation, 2);
+    let picks = super::representative_channels(measured, &worst, OVERLAYS);
+    report.sections.push(super::overlay_section(measured, &models, &picks, &worst, &outcome.frequencies_hz, &mut out)?);
+    report.sections.push(super::definitions_section());
+    out.write("report.html", report.render().as_bytes())
+}
+
+fn method_name(m: &str) -> String {
+    match m {
+        "rfm" => "response function".into(),
+        other => other.to_string(),
+    }
+}
+
+fn status_text(s: &Status) -> String {
+    match s {
+        Status::Converged => "converged".into(),
+        Status::Stalled => "stalled (the misfit stopped falling; the best iterate is reported)".into(),
+        Status::MaxIterations => "iteration limit reached (the best iterate is reported)".into(),
+        Status::Failed(why) => format!("failed ({why}); the best iterate is reported"),
+    }
+}
+
+/// RMS magnitude error over all lines of the model at each iteration, NaN
+/// for the iterations not evaluated (see [`MAX_ITERATIONS_EVALUATED`]).
+fn misfit_per_iteration(study: &Study, outcome: &UpdateOutcome, measured: &FrfSet) -> Vec<f64> {
+    let n = outcome.history.len();
+    let chosen: Vec<usize> = if n <= MAX_ITERATIONS_EVALUATED {
+        (0..n).collect()
+    } else {
+        let m = MAX_ITERATIONS_EVALUATED;
+        let mut v: Vec<usize> = (0..m).map(|j| j * (n - 1) / (m - 1)).collect();
+        v.dedup();
+        v
+    };
+    let mut out = vec![f64::NAN; n];
+    let f = measured.frequencies_hz();
+    let whole = BandSpec::Edges(vec![f[0], f[f.len() - 1]]);
+    for k in chosen {
+        let mut sys = study.system.clone();
+        let ok = study.parameters.iter().zip(&outcome.history[k].values).all(|(&q, &v)| sys.set(q, v).is_ok());
+        if !ok {
+            continue;
+        }
+        // an iterate the model cannot evaluate (singular) is simply not plotted
+        if let Ok(frfs) = synthesize(&sys, measured.channels(), measured.frequencies_hz())
+            && let Ok(c) = correlate(measured, &frfs, &whole)
+        {
+            out[k] = c.total.rms_db;
+        }
+    }
+    out
+}
+
+fn summary(study: &Study, outcome: &UpdateOutcome, models: &[ModelFrfs; 2]) -> Section {
+    let (a, b) = (&models[0].correlation, &models[1].correlation);
+    let measured = &study.measured;
+    let f = measured.frequencies_hz();
+    let source = match (&study.case.measurement.as_ref().and_then(|m| m.data.clone()), &study.case.truth) {
+        (Some(path), _) => format!("measured file {}", path.display()),
+        (None, Some(t)) if t.noise > 0.0 => {
+            format!(
+                "synthesised from the case's truth model with {} % noise (seed {})",
+                super::short(100.0 * t.noise),
+                t.seed
+            )
+        }
+        (None, Some(_)) => "synthesised from the case's truth model, noise-free".into(),
+        (None, None) => "-".into(),
+    };
+    let iterations = outcome.history.last().map_or(0, |r| r.iteration);
+    let first = outcome.history.first().map_or(f64::NAN, |r| r.residual);
+    let mut s = Section::new("Summary");
+    s.push(Block::Facts(vec![
+        ("case".into(), study.case.path.display().to_string()),
+        ("data".into(), source),
+        (
+            "measurement".into(),
+            format!(
+                "{} channels x {} lines, {} to {} Hz, {}",
+                measured.channels().len(),
+                f.len(),
+                super::short(f.first().copied().unwrap_or(0.0)),
+                super::short(f.last().copied().unwrap_or(0.0)),
+                measured.kind()
+            ),
+        ),
+        ("method".into(), method_name(&outcome.method)),
+        ("parameters".into(), outcome.parameters.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join(", ")),
+        (
+            "updating lines (Hz)".into(),
+            outcome.frequencies_hz.iter().map(|&v| super::short(v)).collect::<Vec<_>>().join(", "),
+        ),
+        ("status".into(), format!("{} after {iterations} iterations", status_text(&outcome.status))),
+        ("residual at updating lines".into(), format!("{} -> {}", sig(first, 3), sig(outcome.residual, 3))),
+        (
+            "RMS magnitude error, all lines".into(),
+            format!("{} dB -> {} dB", sig(a.total.rms_db, 3), sig(b.total.rms_db, 3)),
+        ),
+        (
+            "RMS phase error, all lines".into(),
+            format!("{} deg -> {} deg", sig(a.total.rms_phase_deg, 3), sig(b.total.rms_phase_deg, 3)),
+        ),
+        ("mean FRAC".into(), format!("{:.4} -> {:.4}", a.total.mean_frac, b.total.mean_frac)),
+    ]));
+    let band = super::notable_bands(b, 1).first().map(|&i| &b.bands[i]);
+    let channel = super::notable_channels(b, 1).first().map(|&i| &b.channels[i]);
+    if b.total.log_misfit < super::NOTABLE_MISFIT {
+        s.push(Block::Text(format!(
+            "The updated model matches the measured FRFs over the whole band: RMS {} dB and {} deg.",
+            sig(b.total.rms_db, 2),
+            sig(b.total.rms_phase_deg, 2)
+        )));
+    } else if let (Some(band), Some(ch)) = (band, channel) {
+        s.push(Block::Text(format!(
+            "Where the updated model still misses most: the band {} ({} of the remaining misfit, RMS {} dB) \
+             and channel {} (RMS {} dB, FRAC {:.3}).",
+            band.band.label(),
+            super::percent(band.share),
+            sig(band.rms_db, 3),
+            ch.channel,
+            sig(ch.rms_db, 3),
+            ch.frac
+        )));
+    }
+    s
+}
+
+fn iteration_table(outcome: &UpdateOutcome, all_lines_db: &[f64]) -> Table {
+    let mut t = Table::new(&[
+        "iteration",
+        "residual at updating lines",
+        "max |du/u| of the step",
+        "limited",
+        "rank",
+        "damping lambda",
+        "RMS dB, all lines",
+    ])
+    .caption("The iteration history (each row is the model after the step that led to it).");
+    for (r, db) in outcome.history.iter().zip(all_lines_db) {
+        t.row(vec![
+            r.iteration.to_string(),
+            sig(r.residual, 4),
+            sig(r.max_correction, 3),
+            r.limited.to_string(),
+            r.rank.to_string(),
+            sig(r.lambda, 3),
+            sig(*db, 3),
+        ]);
+    }
+    t
+}
+
+/// The parameter table for the report and as CSV.
+fn parameter_table(outcome: &UpdateOutcome) -> (Table, String) {
+    let has_truth = outcome.parameters.iter().any(|p| p.truth.is_some());
+    let has_paper = outcome.parameters.iter().any(|p| p.paper.is_some());
+    let mut header = vec!["parameter", "initial", "updated", "updated / initial"];
+    if has_truth {
+        header.extend(["truth", "error vs truth"]);
+    }
+    if has_paper {
+        header.push("paper");
+    }
+    let mut t = Table::new(&header).caption("Parameter values before and after updating.");
+    let mut csv = header.join(",");
+    csv.push('\n');
+    for p in &outcome.parameters {
+        let mut row = vec![
+            (p.name.clone(), Tone::Plain),
+            (num(p.initial), Tone::Plain),
+            (num(p.updated), Tone::Plain),
+            (sig(p.updated / p.initial, 4), Tone::Plain),
+        ];
+        let mut line = vec![
+            p.name.clone(),
+            format!("{:e}", p.initial),
+            format!("{:e}", p.updated),
+            format!("{:e}", p.updated / p.initial),
+        ];
+        if has_truth {
+            let err = p.relative_error();
+            let tone = match err {
+                Some(e) if e > 0.05 => Tone::Bad,
+                Some(e) if e < 1e-3 => Tone::Good,
+                _ => Tone::Plain,
+            };
+            row.push((p.truth.map(num).unwrap_or_default(), Tone::Plain));
+            row.push((err.map(|e| super::trimmed(sig(e, 2))).unwrap_or_default(), tone));
+            line.push(p.truth.map(|v| format!("{v:e}")).unwrap_or_default());
+            line.push(err.map(|v| format!("{v:e}")).unwrap_or_default());
+        }
+        if has_paper {
+            row.push((p.paper.map(num).unwrap_or_default(), Tone::Plain));
+            line.push(p.paper.map(|v| format!("{v:e}")).unwrap_or_default());
+        }
+        t.row_toned(row);
+        csv.push_str(&line.join(","));
+        csv.push('\n');
+    }
+    (t, csv)
+}
+
+fn frequency_table(outcome: &UpdateOutcome) -> Table {
+    let nf = &outcome.natural_frequencies_hz;
+    let mut header = vec!["mode", "initial (Hz)", "updated (Hz)"];
+    if nf.truth.is_some() {
+        header.push("truth (Hz)");
+    }
+    if nf.paper.is_some() {
+        header.push("paper (Hz)");
+    }
+    let mut t = Table::new(&header).caption("Undamped natural frequencies in the measured band.");
+    let rows = nf.initial.len().max(nf.updated.len()).max(nf.paper.as_ref().map_or(0, Vec::len));
+    let cell = |v: Option<&f64>| v.map(|f| format!("{f:.2}")).unwrap_or_default();
+    for k in 0..rows {
+        let mut row = vec![format!("{}", k + 1), cell(nf.initial.get(k)), cell(nf.updated.get(k))];
+        if let Some(tr) = &nf.truth {
+            row.push(cell(tr.get(k)));
+        }
+        if let Some(p) = &nf.paper {
+            row.push(cell(p.get(k)));
+        }
+        t.row(row);
+    }
+    t
+}
