@@ -1,0 +1,294 @@
+//! Reports of `rfm update --out` and `rfm compare`: the files exist, the
+//! SVG figures are well-formed XML with the expected content, the HTML is
+//! self-contained, and the numbers agree with the library's.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use damping::DampedSystem;
+use frf::correlation::{BandSpec, correlate};
+use rfm_update::Study;
+
+fn rfm(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_rfm")).args(args).output().expect("rfm runs")
+}
+
+fn case(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases").join(format!("{name}.toml"))
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+fn read(path: &Path) -> String {
+    std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// Checks that `doc` is a well-formed XML document with root `root`: every
+/// tag closed in order, quoted attributes, only entity-escaped `&` in text.
+/// Returns the element names in document order.
+fn check_xml(doc: &str, root: &str) -> Result<Vec<String>, String> {
+    let mut stack: Vec<String> = Vec::new();
+    let mut names = Vec::new();
+    let mut rest = doc;
+    let mut seen_root = false;
+    while let Some(lt) = rest.find('<') {
+        let between = &rest[..lt];
+        if stack.is_empty() && !between.trim().is_empty() {
+            return Err(format!("text outside the root element: {between:?}"));
+        }
+        check_text(between)?;
+        let after = &rest[lt..];
+        if let Some(comment) = after.strip_prefix("<!--") {
+            let end = comment.find("-->").ok_or("unterminated comment")?;
+            rest = &comment[end + 3..];
+            continue;
+        }
+        let gt = after.find('>').ok_or("unterminated tag")?;
+        let tag = &after[1..gt];
+        rest = &after[gt + 1..];
+        if tag.starts_with('?') {
+            continue;
+        }
+        if !tag.matches('"').count().is_multiple_of(2) {
+            return Err(format!("unbalanced quotes in <{tag}>"));
+        }
+        if let Some(name) = tag.strip_prefix('/') {
+            let open = stack.pop().ok_or_else(|| format!("</{name}> closes nothing"))?;
+            if open != name.trim() {
+                return Err(format!("</{name}> closes <{open}>"));
+            }
+            continue;
+        }
+        let name: String = tag.chars().take_while(|c| !c.is_whitespace() && *c != '/').collect();
+        if name.is_empty() {
+            return Err(format!("a tag without a name: <{tag}>"));
+        }
+        if stack.is_empty() {
+            if seen_root {
+                return Err(format!("a second root element <{name}>"));
+            }
+            if name != root {
+                return Err(format!("the root is <{name}>, not <{root}>"));
+            }
+            seen_root = true;
+        }
+        names.push(name.clone());
+        if !tag.ends_with('/') {
+            stack.push(name);
+        }
+    }
+    if !rest.trim().is_empty() {
+        return Err(format!("text after the root element: {rest:?}"));
+    }
+    if let Some(open) = stack.pop() {
+        return Err(format!("<{open}> is never closed"));
+    }
+    if !seen_root {
+        return Err("no root element".into());
+    }
+    Ok(names)
+}
+
+fn check_text(t: &str) -> Result<(), String> {
+    for (i, _) in t.match_indices('&') {
+        let entity: String = t[i + 1..].chars().take_while(|c| *c != ';').collect();
+        let known = ["amp", "lt", "gt", "quot", "apos"].contains(&entity.as_str()) || entity.starts_with('#');
+        if !known || entity.len() > 8 {
+            return Err(format!("an unescaped `&` in {t:?}"));
+        }
+    }
+    Ok(())
+}
+
+/// Checks an SVG figure and returns its text.
+fn check_svg(path: &Path, must_contain: &[&str]) -> String {
+    let svg = read(path);
+    let names = check_xml(&svg, "svg").unwrap_or_else(|e| panic!("{} is not well-formed: {e}", path.display()));
+    assert!(names.iter().any(|n| n == "polyline"), "{} draws no curve", path.display());
+    assert!(names.iter().filter(|n| *n == "text").count() >= 5, "{} has too few labels", path.display());
+    for s in must_contain {
+        assert!(svg.contains(s), "{} lacks {s:?}", path.display());
+    }
+    svg
+}
+
+/// Fails if the HTML loads anything from elsewhere or runs scripts.
+fn check_self_contained(html: &str) {
+    let lower = html.to_ascii_lowercase();
+    for bad in ["<script", "<link", "@import", "url(", "<iframe", "<img", "src="] {
+        assert!(!lower.contains(bad), "report.html contains `{bad}`");
+    }
+    for (i, _) in lower.match_indices("href=\"") {
+        let target = &lower[i + 6..];
+        assert!(target.starts_with('#'), "report.html links outside itself: {}", &target[..target.len().min(60)]);
+    }
+    // the SVG namespace is an identifier, not a resource; nothing else names a URL
+    let urls = lower.matches("http://").count() + lower.matches("https://").count();
+    assert_eq!(urls, lower.matches("xmlns=\"http://www.w3.org/2000/svg\"").count(), "report.html names a URL");
+}
+
+#[test]
+fn update_out_writes_figures_parameters_and_a_self_contained_report() {
+    let dir = tempfile::tempdir().unwrap();
+    let case_file = case("cantilever-flexible-clamp");
+    let out = rfm(&["update", case_file.to_str().unwrap(), "--out", dir.path().to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(text(&out.stdout).contains("report.html"), "{}", text(&out.stdout));
+
+    let d = dir.path();
+    check_svg(&d.join("convergence.svg"), &["Iteration", "Relative residual", "RMS error, all lines (dB)"]);
+    check_svg(&d.join("parameters.svg"), &["Value / initial value", "spring.clamp_r.kr", "group.clamp_x.alpha"]);
+    check_svg(&d.join("error-vs-frequency.svg"), &["Frequency (Hz)", "RMS phase error (deg)", "initial model"]);
+    check_svg(&d.join("channel-errors.svg"), &["FRAC", "3:uy", "7:uy"]);
+    // the driving point (tip over tip) is always among the overlays
+    let overlays: Vec<PathBuf> = std::fs::read_dir(d)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.file_name().unwrap().to_str().unwrap().starts_with("frf-"))
+        .collect();
+    assert!(overlays.len() >= 3 && overlays.len() <= 4, "{overlays:?}");
+    assert!(d.join("frf-7uy-7uy.svg").exists());
+    for p in &overlays {
+        check_svg(p, &["Frequency (Hz)", "Phase (deg)", "dB re 1 m/N", "measured", "initial model", "updated model"]);
+    }
+
+    let html = read(&d.join("report.html"));
+    check_self_contained(&html);
+    let svg_files = std::fs::read_dir(d).unwrap().filter(|e| e.as_ref().unwrap().path().extension().unwrap() == "svg");
+    assert_eq!(html.matches("<svg").count(), svg_files.count(), "every figure is inline in the report");
+    for heading in ["Summary", "Convergence", "Parameters", "FRF correlation", "FRF overlays"] {
+        assert!(html.contains(&format!("<h2>{heading}</h2>")), "report.html lacks the section {heading}");
+    }
+    // the HTML is well-formed apart from the void elements of its head
+    let body = &html[html.find("<body>").unwrap()..html.find("</html>").unwrap()];
+    check_xml(body, "body").unwrap_or_else(|e| panic!("report.html body: {e}"));
+
+    // parameters.csv holds the values of results.json
+    let json: serde_json::Value = serde_json::from_str(&read(&d.join("results.json"))).unwrap();
+    let params = json["parameters"].as_array().unwrap();
+    let csv = read(&d.join("parameters.csv"));
+    let lines: Vec<&str> = csv.lines().collect();
+    assert_eq!(lines.len(), params.len() + 1);
+    assert!(lines[0].starts_with("parameter,initial,updated"));
+    for (line, p) in lines[1..].iter().zip(params) {
+        let cells: Vec<&str> = line.split(',').collect();
+        assert_eq!(cells[0], p["name"].as_str().unwrap());
+        let updated: f64 = cells[2].parse().unwrap();
+        let expect = p["updated"].as_f64().unwrap();
+        assert!(((updated - expect) / expect).abs() < 1e-12, "{line}");
+        assert!(html.contains(&format!("<td>{}</td>", cells[0])));
+    }
+}
+
+#[test]
+fn compare_json_agrees_with_the_library() {
+    let case_file = case("two-material-beam");
+    let out = rfm(&["compare", case_file.to_str().unwrap(), "--json"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let json: serde_json::Value = serde_json::from_str(&text(&out.stdout)).unwrap();
+    let c = &json["correlation"];
+
+    let study = Study::load(&case_file).unwrap();
+    let model = DampedSystem::new(study.case.model.clone()).unwrap();
+    let frfs = frf::synthesize(&model, study.measured.channels(), study.measured.frequencies_hz()).unwrap();
+    let lib = correlate(&study.measured, &frfs, &BandSpec::Auto).unwrap();
+
+    let close = |a: &serde_json::Value, b: f64| {
+        let a = a.as_f64().unwrap_or_else(|| panic!("not a number: {a}"));
+        (a - b).abs() <= 1e-12 * b.abs().max(1e-12)
+    };
+    assert!(close(&c["total"]["rms_db"], lib.total.rms_db));
+    assert!(close(&c["total"]["rms_phase_deg"], lib.total.rms_phase_deg));
+    assert!(close(&c["total"]["mean_frac"], lib.total.mean_frac));
+    assert!(close(&c["total"]["log_misfit"], lib.total.log_misfit));
+    let channels = c["channels"].as_array().unwrap();
+    assert_eq!(channels.len(), lib.channels.len());
+    for (j, l) in channels.iter().zip(&lib.channels) {
+        assert_eq!(j["channel"], l.channel.to_string());
+        assert!(close(&j["rms_db"], l.rms_db) && close(&j["frac"], l.frac) && close(&j["share"], l.share));
+    }
+    let bands = c["bands"].as_array().unwrap();
+    assert_eq!(bands.len(), lib.bands.len());
+    assert!(bands.len() >= 4, "one band per resonance of the beam in 0-400 Hz");
+    for (j, l) in bands.iter().zip(&lib.bands) {
+        assert!(close(&j["lo_hz"], l.band.lo_hz) && close(&j["rms_db"], l.rms_db));
+    }
+    let worst = lib.worst_channels(1)[0];
+    assert_eq!(c["worst_channels"][0], lib.channels[worst].channel.to_string());
+    // the paper's initial damping errors show: a measurable but not gross misfit
+    assert!(lib.total.rms_db > 0.5 && lib.total.rms_db < 5.0, "{}", lib.total.rms_db);
+}
+
+#[test]
+fn compare_reads_a_measured_file_and_writes_a_report_with_given_bands() {
+    let dir = tempfile::tempdir().unwrap();
+    let case_file = case("cantilever-flexible-clamp");
+    let data = dir.path().join("measured.csv");
+    let sim = rfm(&[
+        "simulate",
+        case_file.to_str().unwrap(),
+        "--truth",
+        "--noise",
+        "0.02",
+        "--seed",
+        "9",
+        "--out",
+        data.to_str().unwrap(),
+    ]);
+    assert!(sim.status.success(), "{}", text(&sim.stderr));
+    let report_dir = dir.path().join("report");
+    let out = rfm(&[
+        "compare",
+        case_file.to_str().unwrap(),
+        "--measured",
+        data.to_str().unwrap(),
+        "--bands",
+        "1,100,300,1000",
+        "--out",
+        report_dir.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    assert!(stdout.contains("per channel") && stdout.contains("per band") && stdout.contains("<- worst"), "{stdout}");
+
+    let json: serde_json::Value = serde_json::from_str(&read(&report_dir.join("compare.json"))).unwrap();
+    assert!(json["measured"].as_str().unwrap().contains("measured.csv"));
+    let bands = json["correlation"]["bands"].as_array().unwrap();
+    assert_eq!(bands.len(), 3);
+    assert_eq!(bands.iter().map(|b| b["lines"].as_u64().unwrap()).sum::<u64>(), 1000);
+    assert_eq!(json["correlation"]["channels"].as_array().unwrap().len(), 5);
+
+    check_svg(&report_dir.join("error-vs-frequency.svg"), &["RMS magnitude error (dB)"]);
+    check_svg(&report_dir.join("channel-errors.svg"), &["Channel (response DOF)"]);
+    check_svg(&report_dir.join("frf-7uy-7uy.svg"), &["measured", "model", "Phase (deg)"]);
+    let html = read(&report_dir.join("report.html"));
+    check_self_contained(&html);
+    assert!(html.contains("<h2>FRF correlation</h2>") && html.contains("measured.csv"));
+    assert!(html.contains("1-100 Hz") && html.contains("300-1000 Hz"), "the given band edges label the table");
+}
+
+#[test]
+fn compare_refuses_bad_bands_and_missing_files_with_a_message() {
+    let case_file = case("cantilever-flexible-clamp");
+    let out = rfm(&["compare", case_file.to_str().unwrap(), "--bands", "0,fifty"]);
+    assert!(!out.status.success());
+    assert!(text(&out.stderr).contains("`fifty` is not a frequency"), "{}", text(&out.stderr));
+    let out = rfm(&["compare", case_file.to_str().unwrap(), "--bands", "2000,3000"]);
+    assert!(!out.status.success());
+    assert!(text(&out.stderr).contains("no measured line"), "{}", text(&out.stderr));
+    let out = rfm(&["compare", case_file.to_str().unwrap(), "--measured", "/nonexistent/h.csv"]);
+    assert!(!out.status.success());
+    assert!(text(&out.stderr).contains("/nonexistent/h.csv"), "{}", text(&out.stderr));
+}
+
+#[test]
+fn the_xml_check_rejects_what_it_should() {
+    assert!(check_xml("<svg><g><text>a &amp; b</text></g></svg>", "svg").is_ok());
+    assert!(check_xml("<svg><g></svg>", "svg").is_err());
+    assert!(check_xml("<svg><text>a & b</text></svg>", "svg").is_err());
+    assert!(check_xml("<svg a=\"1></svg>", "svg").is_err());
+    assert!(check_xml("<html></html>", "svg").is_err());
+    assert!(check_xml("<svg/><svg/>", "svg").is_err());
+}
