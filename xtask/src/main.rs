@@ -95,6 +95,13 @@ fn reproduce(cases: &[String]) -> Result<(), String> {
             .fold(0.0, f64::max);
         println!("{name:<32} {status:>10} {residual:>12.3e} {max_err:>22.2e}");
     }
+    println!("\nreports (self-contained HTML with the figures; open in a browser):");
+    for (name, _) in &summary {
+        let report = root().join("target/reproduce").join(name).join("report.html");
+        if report.exists() {
+            println!("  {}", report.display());
+        }
+    }
     println!("\nresults: {}", root().join("target/reproduce").display());
     Ok(())
 }
