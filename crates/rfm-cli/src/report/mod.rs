@@ -104,7 +104,7 @@ pub(crate) fn representative_channels(set: &FrfSet, priority: &[usize], n: usize
     out
 }
 
-/// Relative position of a channel in the list, described for a caption.
+/// Why a channel was picked for an overlay, for its caption.
 fn role(set: &FrfSet, c: usize, priority: &[usize]) -> &'static str {
     let ch = set.channels()[c];
     if ch.response == ch.reference {

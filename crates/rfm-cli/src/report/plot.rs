@@ -93,7 +93,8 @@ pub(crate) struct LegendEntry {
 
 const LEGEND_ROW: u32 = 22;
 
-/// Rows of legend entries that fit the width (about 0.58 em per character).
+/// Rows of legend entries that fit the width (text estimated at 7.6 px per
+/// character of the 14 px legend font).
 fn legend_layout(entries: &[LegendEntry]) -> Vec<Vec<(usize, i32)>> {
     let mut rows: Vec<Vec<(usize, i32)>> = vec![Vec::new()];
     let mut x = 0;
@@ -605,14 +606,14 @@ pub(crate) fn convergence(residual: &[f64], all_lines_db: Option<&[f64]>) -> Res
     }];
     if all_lines_db.is_some() {
         legend.push(LegendEntry {
-            label: "RMS magnitude error over all lines".into(),
+            label: "RMS magnitude error over the measured band".into(),
             colour: INITIAL,
             mark: Mark::Line(2),
         });
     }
     let n = residual.len().max(all_lines_db.map_or(0, <[f64]>::len)).max(2);
     let panels: Vec<(&str, RGBColor, &[f64])> = std::iter::once(("Relative residual", UPDATED, residual))
-        .chain(all_lines_db.map(|d| ("RMS error, all lines (dB)", INITIAL, d)))
+        .chain(all_lines_db.map(|d| ("RMS error over the band (dB)", INITIAL, d)))
         .collect();
     let height = if panels.len() == 2 { 600 } else { 380 };
     svg(title, height, |root| {

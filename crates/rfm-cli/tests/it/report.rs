@@ -138,7 +138,7 @@ fn update_out_writes_figures_parameters_and_a_self_contained_report() {
     assert!(text(&out.stdout).contains("report.html"), "{}", text(&out.stdout));
 
     let d = dir.path();
-    check_svg(&d.join("convergence.svg"), &["Iteration", "Relative residual", "RMS error, all lines (dB)"]);
+    check_svg(&d.join("convergence.svg"), &["Iteration", "Relative residual", "RMS error over the band (dB)"]);
     check_svg(&d.join("parameters.svg"), &["Value / initial value", "spring.clamp_r.kr", "group.clamp_x.alpha"]);
     check_svg(&d.join("error-vs-frequency.svg"), &["Frequency (Hz)", "RMS phase error (deg)", "initial model"]);
     check_svg(&d.join("channel-errors.svg"), &["FRAC", "3:uy", "7:uy"]);
