@@ -164,7 +164,8 @@ dl.facts { display: grid; grid-template-columns: max-content 1fr; gap: 3px 18px;
 dl.facts dt { color: var(--muted); }
 dl.facts dd { margin: 0; font-variant-numeric: tabular-nums; }
 table { border-collapse: collapse; margin: 10px 0 18px; font-size: 13.5px; font-variant-numeric: tabular-nums; }
-caption { text-align: left; color: var(--muted); padding-bottom: 4px; caption-side: top; }
+p.table-caption { color: var(--muted); margin: 14px 0 0; font-size: 14px; }
+p.table-caption + .scroll table { margin-top: 6px; }
 th, td { padding: 4px 9px; border-bottom: 1px solid var(--rule); }
 th { text-align: right; vertical-align: bottom; background: #eef0f4; font-weight: 600; min-width: 4.5em; }
 td { text-align: right; white-space: nowrap; }
@@ -243,10 +244,12 @@ impl Report {
 }
 
 fn render_table(h: &mut String, t: &Table) {
-    h.push_str("<div class=\"scroll\"><table>\n");
+    // the caption is a paragraph above the table rather than a <caption>,
+    // which browsers squeeze to the width of a narrow table
     if let Some(c) = &t.caption {
-        h.push_str(&format!("<caption>{}</caption>\n", escape(c)));
+        h.push_str(&format!("<p class=\"table-caption\">{}</p>\n", escape(c)));
     }
+    h.push_str("<div class=\"scroll\"><table>\n");
     h.push_str("<thead><tr>");
     for c in &t.header {
         h.push_str(&format!("<th>{}</th>", escape(c)));
