@@ -41,15 +41,21 @@ enum Command {
     Update {
         /// Case file.
         case: PathBuf,
-        /// Folder for results (results.json).
+        /// Folder for results (results.json, updated.toml).
         #[arg(long)]
         out: Option<PathBuf>,
         /// Print machine-readable JSON instead of tables.
         #[arg(long)]
         json: bool,
-        /// Updating method.
-        #[arg(long, value_parser = ["rfm"])]
+        /// Updating method (default: the case's, else rfm).
+        #[arg(long, value_parser = ["rfm", "output-error"])]
         method: Option<String>,
+        /// Fit this many measured lines spread over the band (overrides the case).
+        #[arg(long)]
+        lines: Option<usize>,
+        /// Iteration limit (overrides the case).
+        #[arg(long)]
+        iterations: Option<usize>,
     },
 }
 
@@ -57,7 +63,12 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Simulate { case, out, truth, noise, seed } => commands::simulate(&case, &out, truth, noise, seed),
-        Command::Update { case, out, json, method } => commands::update(&case, out.as_deref(), json, method.as_deref()),
+        Command::Update { case, out, json, method, lines, iterations } => commands::update(
+            &case,
+            out.as_deref(),
+            json,
+            &commands::UpdateOverrides { method, lines, max_iterations: iterations },
+        ),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

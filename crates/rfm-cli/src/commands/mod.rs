@@ -8,7 +8,7 @@ use std::path::Path;
 use fe_model::CaseFile;
 
 pub(crate) use simulate::simulate;
-pub(crate) use update::update;
+pub(crate) use update::{Overrides as UpdateOverrides, update};
 
 pub(crate) type Result<T> = std::result::Result<T, Box<dyn std::error::Error>>;
 
