@@ -219,6 +219,8 @@ struct RawTruth {
     #[serde(default)]
     masses: Vec<Spanned<RawMass>>,
     #[serde(default)]
+    joints: Vec<Spanned<RawJoint>>,
+    #[serde(default)]
     groups: BTreeMap<String, Spanned<RawGroup>>,
 }
 
@@ -520,6 +522,78 @@ impl CaseFile {
             }
         }
         Ok(out)
+    }
+
+    /// The case text without the `[[supports]]` entries of `node` (to replace
+    /// a rigid support by springs). Fails if the node has no such entry or
+    /// the result does not load.
+    pub fn without_supports_at(&self, node: u32) -> Result<String, CaseError> {
+        let lines: Vec<&str> = self.source.lines().collect();
+        let mut out: Vec<&str> = Vec::new();
+        let mut removed = 0;
+        let mut i = 0;
+        while i < lines.len() {
+            let header = lines[i].split('#').next().unwrap_or("").trim();
+            if header == "[[supports]]" {
+                let mut j = i + 1;
+                while j < lines.len() && !lines[j].trim_start().starts_with('[') {
+                    j += 1;
+                }
+                let holds_node = lines[i + 1..j].iter().any(|l| {
+                    let code = l.split('#').next().unwrap_or("");
+                    code.split_once('=').is_some_and(|(k, v)| k.trim() == "node" && v.trim() == node.to_string())
+                });
+                if holds_node {
+                    removed += 1;
+                    i = j;
+                    continue;
+                }
+            }
+            out.push(lines[i]);
+            i += 1;
+        }
+        if removed == 0 {
+            return Err(self.error(None, format!("no [[supports]] entry for node {node} to replace")));
+        }
+        let text = out.join("\n") + "\n";
+        CaseFile::parse(&self.path, &text)?;
+        Ok(text)
+    }
+
+    /// `text` (this case's source, possibly edited) made valid at `target`:
+    /// a relative measured-data path is rewritten so that it still names the
+    /// same file from the new case file's folder.
+    pub fn relocate(&self, text: &str, target: &Path) -> String {
+        let Some(data) = self.measurement.as_ref().and_then(|m| m.data.as_ref()) else {
+            return text.to_string();
+        };
+        let here = self.path.parent().map(Path::to_path_buf).unwrap_or_default();
+        let there = target.parent().map(Path::to_path_buf).unwrap_or_default();
+        let same_dir = match (here.canonicalize(), there.canonicalize()) {
+            (Ok(a), Ok(b)) => a == b,
+            _ => here == there,
+        };
+        if same_dir {
+            return text.to_string();
+        }
+        let absolute = data.canonicalize().unwrap_or_else(|_| data.clone());
+        let mut out = String::with_capacity(text.len());
+        let mut in_measurement = false;
+        for line in text.lines() {
+            let t = line.trim_start();
+            if t.starts_with('[') {
+                in_measurement = t.split('#').next().unwrap_or("").trim() == "[measurement]";
+            }
+            let is_data = in_measurement && t.split_once('=').is_some_and(|(k, _)| k.trim() == "data");
+            if is_data {
+                let escaped = absolute.display().to_string().replace('\\', "\\\\").replace('"', "\\\"");
+                out.push_str(&format!("data = \"{escaped}\"   # relocated by rfm"));
+            } else {
+                out.push_str(line);
+            }
+            out.push('\n');
+        }
+        out
     }
 
     /// A located error about this file (for checks done by higher layers).
@@ -983,6 +1057,9 @@ fn parse_truth(ctx: &Ctx<'_>, t: &Spanned<RawTruth>, base: &Model) -> Result<Tru
     for m in &r.masses {
         add_mass(ctx, &mut model, m)?;
     }
+    for j in &r.joints {
+        add_joint(ctx, &mut model, j)?;
+    }
     // Values may name items the truth adds, so resolve them on the truth model.
     for (name, v) in &r.set {
         let q = model.quantity(name).map_err(|e| ctx.model_err(v.span(), e))?;
@@ -1201,6 +1278,16 @@ node = 1
         assert_eq!(back.model.get(a), 3.141592653589793e-5);
         assert_eq!(back.model.get(b), 0.5);
         assert!(out.contains("# updated\n[set]"));
+    }
+
+    #[test]
+    fn without_supports_at_removes_only_that_nodes_entry() {
+        let text = BEAM.replace("[[supports]]\nnode = 1\n", "[[supports]]\nnode = 1\n[[springs]]\nname = \"s\"\nnode = 1\nkr = 1e4\nkx = 1e9\nky = 1e9\ngroup = \"beam\"\n");
+        let c = parse(&text).unwrap();
+        let out = c.without_supports_at(1).unwrap();
+        assert!(!out.contains("[[supports]]"));
+        assert!(parse(&out).unwrap().model.supports().is_empty());
+        assert!(c.without_supports_at(3).is_err());
     }
 
     #[test]
