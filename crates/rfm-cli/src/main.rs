@@ -37,6 +37,26 @@ enum Command {
         #[arg(long, default_value_t = 0)]
         seed: u64,
     },
+    /// Find which physical effect is missing: fit every candidate effect and rank them.
+    Diagnose {
+        /// Case file.
+        case: PathBuf,
+        /// Measured FRFs (default: the case's data or truth).
+        #[arg(long)]
+        measured: Option<PathBuf>,
+        /// Print machine-readable JSON instead of tables.
+        #[arg(long)]
+        json: bool,
+        /// Write the case with the effect of this rank added (needs --out).
+        #[arg(long)]
+        apply: Option<usize>,
+        /// New case file for --apply.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Rows of the ranking to print.
+        #[arg(long, default_value_t = 10)]
+        top: usize,
+    },
     /// Update the model's parameters so that its FRFs match the measured ones.
     Update {
         /// Case file.
@@ -63,6 +83,14 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Simulate { case, out, truth, noise, seed } => commands::simulate(&case, &out, truth, noise, seed),
+        Command::Diagnose { case, measured, json, apply, out, top } => commands::diagnose(&commands::DiagnoseArgs {
+            case: &case,
+            measured: measured.as_deref(),
+            json,
+            apply,
+            out: out.as_deref(),
+            top,
+        }),
         Command::Update { case, out, json, method, lines, iterations } => commands::update(
             &case,
             out.as_deref(),

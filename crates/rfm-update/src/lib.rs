@@ -48,6 +48,7 @@
 //! assert!((result.values[1] / 1e-5 - 1.0).abs() < 1e-8);
 //! ```
 
+pub mod diagnose;
 pub mod error;
 pub mod freqsel;
 pub mod lstsq;

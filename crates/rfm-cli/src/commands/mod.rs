@@ -1,5 +1,6 @@
 //! One module per subcommand. Only this crate prints.
 
+mod diagnose;
 mod simulate;
 mod update;
 
@@ -7,6 +8,7 @@ use std::path::Path;
 
 use fe_model::CaseFile;
 
+pub(crate) use diagnose::{DiagnoseArgs, diagnose};
 pub(crate) use simulate::simulate;
 pub(crate) use update::{Overrides as UpdateOverrides, update};
 

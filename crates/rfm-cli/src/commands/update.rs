@@ -137,6 +137,7 @@ fn write_updated_model(
     );
     let text = study.case.with_values(&values, &comment).map_err(|e| e.render())?;
     let path = dir.join("updated.toml");
+    let text = study.case.relocate(&text, &path);
     frf::io::atomic_write(&path, text.as_bytes(), inputs)?;
     Ok(path)
 }

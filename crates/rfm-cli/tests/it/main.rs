@@ -1,3 +1,4 @@
 //! End-to-end tests of the `rfm` binary.
 
 mod commands;
+mod diagnose;

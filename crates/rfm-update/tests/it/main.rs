@@ -1,4 +1,5 @@
 //! Integration tests of rfm-update.
 
+mod hidden_effects;
 mod paper_cases;
 mod sensitivity;
