@@ -15,7 +15,7 @@ use toml::Spanned;
 use crate::dof::{Dof, DofRef};
 use crate::error::{CaseError, ModelError};
 use crate::model::{Group, Model, NodeId, Section};
-use crate::quantity::Quantity;
+use crate::quantity::{Parameter, Quantity};
 
 // ---------------------------------------------------------------- raw schema
 
@@ -44,6 +44,10 @@ struct RawCase {
     supports: Vec<Spanned<RawSupport>>,
     #[serde(default)]
     ties: Vec<Spanned<RawTie>>,
+    #[serde(default)]
+    joints: Vec<Spanned<RawJoint>>,
+    #[serde(default)]
+    assign: Vec<Spanned<RawAssign>>,
     #[serde(default)]
     set: BTreeMap<String, Spanned<f64>>,
     measurement: Option<Spanned<RawMeasurement>>,
@@ -161,6 +165,26 @@ struct RawTie {
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
+struct RawAssign {
+    elements: Spanned<String>,
+    group: Spanned<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawJoint {
+    name: String,
+    node: u32,
+    elements: Vec<u32>,
+    new_node: Option<u32>,
+    kx: Option<f64>,
+    ky: Option<f64>,
+    kr: f64,
+    group: Spanned<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
 struct RawMeasurement {
     frequencies: Spanned<toml::Value>,
     references: Vec<Spanned<String>>,
@@ -195,6 +219,8 @@ struct RawTruth {
     #[serde(default)]
     masses: Vec<Spanned<RawMass>>,
     #[serde(default)]
+    joints: Vec<Spanned<RawJoint>>,
+    #[serde(default)]
     groups: BTreeMap<String, Spanned<RawGroup>>,
 }
 
@@ -206,6 +232,24 @@ struct RawUpdate {
     method: Option<Spanned<String>>,
     max_iterations: Option<u32>,
     tolerance: Option<f64>,
+    #[serde(default)]
+    bounds: BTreeMap<String, Spanned<[f64; 2]>>,
+    regularization: Option<Spanned<f64>>,
+    #[serde(default)]
+    gains: bool,
+    misfit: Option<Spanned<String>>,
+    #[serde(default)]
+    coherence: bool,
+    #[serde(default)]
+    weights: Vec<Spanned<RawBandWeight>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawBandWeight {
+    from: f64,
+    to: f64,
+    weight: f64,
 }
 
 #[derive(Deserialize)]
@@ -265,6 +309,8 @@ pub struct TruthSpec {
 /// Frequency points for updating.
 #[derive(Clone, Debug, PartialEq)]
 pub enum FrequencyChoice {
+    /// This many lines spread evenly over the measured band.
+    Lines(usize),
     /// Explicit points (Hz).
     List(Vec<f64>),
     /// Choose this many points automatically, away from resonances and anti-resonances.
@@ -273,19 +319,42 @@ pub enum FrequencyChoice {
     All,
 }
 
+/// A weight on the measured lines of a frequency band (0 masks the band).
+#[derive(Clone, Debug, PartialEq)]
+pub struct BandWeight {
+    /// Lower edge (Hz).
+    pub from: f64,
+    /// Upper edge (Hz).
+    pub to: f64,
+    /// Weight of the band's lines (1 is neutral).
+    pub weight: f64,
+}
+
 /// What to update and how.
 #[derive(Clone, Debug)]
 pub struct UpdateSpec {
     /// Parameters to update.
-    pub parameters: Vec<Quantity>,
-    /// Frequency points.
-    pub frequencies: FrequencyChoice,
+    pub parameters: Vec<Parameter>,
+    /// Optional bounds per parameter (same order), in physical units.
+    pub bounds: Vec<Option<(f64, f64)>>,
+    /// Frequency points (`None`: the method's default).
+    pub frequencies: Option<FrequencyChoice>,
     /// Method name as written (checked by the solver crate).
     pub method: Option<(String, Range<usize>)>,
     /// Iteration limit.
     pub max_iterations: Option<u32>,
     /// Convergence tolerance on the largest relative correction.
     pub tolerance: Option<f64>,
+    /// Tikhonov regularisation weight on the log-parameter changes.
+    pub regularization: Option<f64>,
+    /// Estimate an unknown complex gain per reference.
+    pub gains: bool,
+    /// Misfit form as written (`relative` or `log`), checked by the solver crate.
+    pub misfit: Option<(String, Range<usize>)>,
+    /// Weight lines by the measured coherence.
+    pub coherence: bool,
+    /// Weights per frequency band.
+    pub weights: Vec<BandWeight>,
 }
 
 /// Published values to print beside the tool's (for reproducing a paper).
@@ -400,6 +469,131 @@ impl CaseFile {
             update,
             paper,
         })
+    }
+
+    /// The case text with its top-level `[set]` table replaced by one that
+    /// holds the existing entries overridden by `values` (quantity names and
+    /// values), for writing an updated model as a new case file. The result
+    /// is re-parsed and checked to carry every value exactly.
+    pub fn with_values(&self, values: &[(String, f64)], comment: &str) -> Result<String, CaseError> {
+        let mut merged: BTreeMap<String, f64> = BTreeMap::new();
+        if let Ok(table) = self.source.parse::<toml::Table>()
+            && let Some(toml::Value::Table(set)) = table.get("set")
+        {
+            for (k, v) in set {
+                if let Some(x) = v.as_float().or_else(|| v.as_integer().map(|i| i as f64)) {
+                    merged.insert(k.clone(), x);
+                }
+            }
+        }
+        for (k, v) in values {
+            merged.insert(k.clone(), *v);
+        }
+        let mut out = String::new();
+        let mut skipping = false;
+        for line in self.source.lines() {
+            let t = line.trim_start();
+            if t.starts_with('[') {
+                let header = t.split('#').next().unwrap_or("").trim();
+                skipping = header == "[set]";
+            }
+            if !skipping {
+                out.push_str(line);
+                out.push('\n');
+            }
+        }
+        while out.ends_with("\n\n") {
+            out.pop();
+        }
+        out.push('\n');
+        for c in comment.lines() {
+            out.push_str(&format!("# {c}\n"));
+        }
+        out.push_str("[set]\n");
+        for (k, v) in &merged {
+            out.push_str(&format!("\"{k}\" = {v:e}\n"));
+        }
+        let reparsed = CaseFile::parse(&self.path, &out)?;
+        for (k, v) in &merged {
+            let q = reparsed.model.quantity(k).map_err(|e| self.error(None, e.to_string()))?;
+            let got = reparsed.model.get(q);
+            if got != *v {
+                return Err(self.error(None, format!("writing {k} = {v} gave {got} when read back")));
+            }
+        }
+        Ok(out)
+    }
+
+    /// The case text without the `[[supports]]` entries of `node` (to replace
+    /// a rigid support by springs). Fails if the node has no such entry or
+    /// the result does not load.
+    pub fn without_supports_at(&self, node: u32) -> Result<String, CaseError> {
+        let lines: Vec<&str> = self.source.lines().collect();
+        let mut out: Vec<&str> = Vec::new();
+        let mut removed = 0;
+        let mut i = 0;
+        while i < lines.len() {
+            let header = lines[i].split('#').next().unwrap_or("").trim();
+            if header == "[[supports]]" {
+                let mut j = i + 1;
+                while j < lines.len() && !lines[j].trim_start().starts_with('[') {
+                    j += 1;
+                }
+                let holds_node = lines[i + 1..j].iter().any(|l| {
+                    let code = l.split('#').next().unwrap_or("");
+                    code.split_once('=').is_some_and(|(k, v)| k.trim() == "node" && v.trim() == node.to_string())
+                });
+                if holds_node {
+                    removed += 1;
+                    i = j;
+                    continue;
+                }
+            }
+            out.push(lines[i]);
+            i += 1;
+        }
+        if removed == 0 {
+            return Err(self.error(None, format!("no [[supports]] entry for node {node} to replace")));
+        }
+        let text = out.join("\n") + "\n";
+        CaseFile::parse(&self.path, &text)?;
+        Ok(text)
+    }
+
+    /// `text` (this case's source, possibly edited) made valid at `target`:
+    /// a relative measured-data path is rewritten so that it still names the
+    /// same file from the new case file's folder.
+    pub fn relocate(&self, text: &str, target: &Path) -> String {
+        let Some(data) = self.measurement.as_ref().and_then(|m| m.data.as_ref()) else {
+            return text.to_string();
+        };
+        let here = self.path.parent().map(Path::to_path_buf).unwrap_or_default();
+        let there = target.parent().map(Path::to_path_buf).unwrap_or_default();
+        let same_dir = match (here.canonicalize(), there.canonicalize()) {
+            (Ok(a), Ok(b)) => a == b,
+            _ => here == there,
+        };
+        if same_dir {
+            return text.to_string();
+        }
+        let absolute = data.canonicalize().unwrap_or_else(|_| data.clone());
+        let mut out = String::with_capacity(text.len());
+        let mut in_measurement = false;
+        for line in text.lines() {
+            let t = line.trim_start();
+            if t.starts_with('[') {
+                in_measurement = t.split('#').next().unwrap_or("").trim() == "[measurement]";
+            }
+            let is_data = in_measurement && t.split_once('=').is_some_and(|(k, _)| k.trim() == "data");
+            if is_data {
+                let escaped = absolute.display().to_string().replace('\\', "\\\\").replace('"', "\\\"");
+                out.push_str(&format!("data = \"{escaped}\"   # relocated by rfm"));
+            } else {
+                out.push_str(line);
+            }
+            out.push('\n');
+        }
+        out
     }
 
     /// A located error about this file (for checks done by higher layers).
@@ -532,6 +726,30 @@ fn build_model(ctx: &Ctx<'_>, raw: &RawCase, model: &mut Model) -> Result<(), Ca
         let dofs = parse_dofs(ctx, &r.dofs)?;
         model.add_tie(r.nodes[0], r.nodes[1], &dofs).map_err(|e| ctx.model_err(t.span(), e))?;
     }
+    for j in &raw.joints {
+        add_joint(ctx, model, j)?;
+    }
+    for a in &raw.assign {
+        let r = a.get_ref();
+        let g = group_ref(ctx, model, &r.group)?;
+        let text = r.elements.get_ref();
+        let (first, last) = match text.split_once("..") {
+            Some((x, y)) => (x.trim().parse::<u32>(), y.trim().parse::<u32>()),
+            None => (text.trim().parse::<u32>(), text.trim().parse::<u32>()),
+        };
+        let (Ok(first), Ok(last)) = (first, last) else {
+            return Err(ctx.err(r.elements.span(), format!("`{text}` is not an element id or a range first..last")));
+        };
+        if last < first {
+            return Err(ctx.err(r.elements.span(), format!("the range `{text}` is empty")));
+        }
+        for id in first..=last {
+            let i = model
+                .beam_index(crate::model::ElementId(id))
+                .ok_or_else(|| ctx.err(r.elements.span(), format!("element {id} does not exist")))?;
+            model.set_beam_group(i, g).map_err(|e| ctx.model_err(a.span(), e))?;
+        }
+    }
     if model.beams.is_empty() && model.springs.is_empty() {
         return Err(ctx.err(0..0, "the case defines no beams, lines or springs"));
     }
@@ -563,6 +781,24 @@ fn add_spring(ctx: &Ctx<'_>, model: &mut Model, s: &Spanned<RawSpring>) -> Resul
     };
     let g = group_ref(ctx, model, &r.group)?;
     model.add_spring(&r.name, a, b, [r.kx, r.ky, r.kr], g).map_err(|e| ctx.model_err(s.span(), e))
+}
+
+/// A joint: the node is split, the listed elements move to a new coincident
+/// node, the translations without a spring are tied and a spring (always kr,
+/// and kx, ky when given) joins the pair.
+fn add_joint(ctx: &Ctx<'_>, model: &mut Model, j: &Spanned<RawJoint>) -> Result<(), CaseError> {
+    let r = j.get_ref();
+    let g = group_ref(ctx, model, &r.group)?;
+    let new_id = r.new_node.unwrap_or(model.max_node_id() + 1);
+    model.split_node(r.node, &r.elements, new_id).map_err(|e| ctx.model_err(j.span(), e))?;
+    let tied: Vec<Dof> =
+        [(Dof::Ux, r.kx), (Dof::Uy, r.ky)].iter().filter(|(_, k)| k.is_none()).map(|(d, _)| *d).collect();
+    if !tied.is_empty() {
+        model.add_tie(r.node, new_id, &tied).map_err(|e| ctx.model_err(j.span(), e))?;
+    }
+    let k = [r.kx.unwrap_or(0.0), r.ky.unwrap_or(0.0), r.kr];
+    model.add_spring(&r.name, r.node, Some(new_id), k, g).map_err(|e| ctx.model_err(j.span(), e))?;
+    Ok(())
 }
 
 fn add_mass(ctx: &Ctx<'_>, model: &mut Model, m: &Spanned<RawMass>) -> Result<usize, CaseError> {
@@ -821,6 +1057,9 @@ fn parse_truth(ctx: &Ctx<'_>, t: &Spanned<RawTruth>, base: &Model) -> Result<Tru
     for m in &r.masses {
         add_mass(ctx, &mut model, m)?;
     }
+    for j in &r.joints {
+        add_joint(ctx, &mut model, j)?;
+    }
     // Values may name items the truth adds, so resolve them on the truth model.
     for (name, v) in &r.set {
         let q = model.quantity(name).map_err(|e| ctx.model_err(v.span(), e))?;
@@ -833,46 +1072,102 @@ fn parse_truth(ctx: &Ctx<'_>, t: &Spanned<RawTruth>, base: &Model) -> Result<Tru
 
 fn parse_update(ctx: &Ctx<'_>, u: &Spanned<RawUpdate>, model: &Model) -> Result<UpdateSpec, CaseError> {
     let r = u.get_ref();
-    let mut parameters = Vec::new();
+    let mut parameters: Vec<Parameter> = Vec::new();
     for p in &r.parameters {
-        let q = model.quantity(p.get_ref()).map_err(|e| ctx.model_err(p.span(), e))?;
-        if parameters.contains(&q) {
-            return Err(ctx.err(p.span(), format!("parameter `{}` is listed twice", p.get_ref())));
-        }
-        let v = model.get(q);
-        if !(v > 0.0 && v.is_finite()) {
+        let param = model.parameter(p.get_ref()).map_err(|e| ctx.model_err(p.span(), e))?;
+        if let Some(q) = param.quantities.iter().find(|q| parameters.iter().any(|o| o.quantities.contains(q))) {
             return Err(ctx.err(
                 p.span(),
-                format!("parameter `{}` starts at {v}; updating works on relative changes and needs a positive, finite starting value", p.get_ref()),
+                format!("`{}` is already updated by another parameter in the list", model.quantity_name(*q)),
             ));
         }
-        parameters.push(q);
+        for &q in &param.quantities {
+            let v = model.get(q);
+            if !(v > 0.0 && v.is_finite()) {
+                return Err(ctx.err(
+                    p.span(),
+                    format!(
+                        "`{}` starts at {v}; updating works on relative changes and needs a positive, finite starting value",
+                        model.quantity_name(q)
+                    ),
+                ));
+            }
+        }
+        parameters.push(param);
     }
     if parameters.is_empty() {
         return Err(ctx.err(u.span(), "no parameters to update"));
     }
+    let mut bounds = vec![None; parameters.len()];
+    for (name, b) in &r.bounds {
+        let i = parameters.iter().position(|p| &p.name == name).ok_or_else(|| {
+            ctx.err(b.span(), format!("bounds given for `{name}`, which is not in the parameters list"))
+        })?;
+        let [lo, hi] = *b.get_ref();
+        if !(lo > 0.0 && hi > lo && hi.is_finite()) {
+            return Err(
+                ctx.err(b.span(), format!("bounds of `{name}` must satisfy 0 < lower < upper < inf, got [{lo}, {hi}]"))
+            );
+        }
+        let v = model.get(parameters[i].quantities[0]);
+        if !(lo <= v && v <= hi) {
+            return Err(ctx.err(b.span(), format!("`{name}` starts at {v}, outside its bounds [{lo}, {hi}]")));
+        }
+        bounds[i] = Some((lo, hi));
+    }
     let frequencies = match &r.frequencies {
-        None => FrequencyChoice::Auto(2 * parameters.len().max(5)),
-        Some(v) => match v.get_ref() {
+        None => None,
+        Some(v) => Some(match v.get_ref() {
             toml::Value::String(s) if s == "all" => FrequencyChoice::All,
-            toml::Value::Table(t) if t.len() == 1 && t.contains_key("auto") => match t["auto"] {
-                toml::Value::Integer(n) if n > 0 => FrequencyChoice::Auto(n as usize),
-                _ => return Err(ctx.err(v.span(), "`auto` needs a positive number of points")),
-            },
+            toml::Value::Table(t) if t.len() == 1 && (t.contains_key("auto") || t.contains_key("lines")) => {
+                let (key, n) = t.iter().next().expect("one entry");
+                match n {
+                    toml::Value::Integer(n) if *n > 0 => {
+                        if key == "auto" {
+                            FrequencyChoice::Auto(*n as usize)
+                        } else {
+                            FrequencyChoice::Lines(*n as usize)
+                        }
+                    }
+                    _ => return Err(ctx.err(v.span(), format!("`{key}` needs a positive number of lines"))),
+                }
+            }
             _ => FrequencyChoice::List(parse_frequencies(ctx, v)?),
-        },
+        }),
     };
     if let Some(tol) = r.tolerance
         && !(tol > 0.0)
     {
         return Err(ctx.err(u.span(), "tolerance must be positive"));
     }
+    if let Some(reg) = &r.regularization
+        && !(*reg.get_ref() >= 0.0 && reg.get_ref().is_finite())
+    {
+        return Err(ctx.err(reg.span(), "regularization must be zero or positive"));
+    }
+    let weights = r
+        .weights
+        .iter()
+        .map(|w| {
+            let b = w.get_ref();
+            if !(b.to > b.from && b.weight >= 0.0 && b.weight.is_finite()) {
+                return Err(ctx.err(w.span(), "a band weight needs from < to and a weight >= 0"));
+            }
+            Ok(BandWeight { from: b.from, to: b.to, weight: b.weight })
+        })
+        .collect::<Result<_, _>>()?;
     Ok(UpdateSpec {
         parameters,
+        bounds,
         frequencies,
         method: r.method.as_ref().map(|m| (m.get_ref().clone(), m.span())),
         max_iterations: r.max_iterations,
         tolerance: r.tolerance,
+        regularization: r.regularization.as_ref().map(|r| *r.get_ref()),
+        gains: r.gains,
+        misfit: r.misfit.as_ref().map(|m| (m.get_ref().clone(), m.span())),
+        coherence: r.coherence,
+        weights,
     })
 }
 
@@ -927,6 +1222,72 @@ node = 1
         let e = parse("title = \n").unwrap_err();
         assert_eq!(e.location.unwrap().line, 1);
         assert!(e.to_string().starts_with("test.toml:1:"), "{e}");
+    }
+
+    #[test]
+    fn a_joint_splits_a_node_ties_translations_and_adds_a_rotational_spring() {
+        let text = format!(
+            "{BEAM}\n[groups.j]\nalpha = 1e-3\n[[joints]]\nname = \"j3\"\nnode = 3\nelements = [3]\nkr = 5e3\ngroup = \"j\"\n"
+        );
+        let c = parse(&text).unwrap();
+        assert_eq!(c.model.nodes().len(), 6);
+        let e3 = &c.model.beams()[c.model.beam_index(crate::model::ElementId(3)).unwrap()];
+        assert_eq!(e3.nodes[0], NodeId(6));
+        assert_eq!(c.model.springs()[0].k, [0.0, 0.0, 5e3]);
+        assert_eq!(c.model.ties()[0].dofs, vec![Dof::Ux, Dof::Uy]);
+        let bad = text.replace("elements = [3]", "elements = [1]");
+        assert!(parse(&bad).unwrap_err().message.contains("does not end at node 3"));
+    }
+
+    #[test]
+    fn assign_moves_a_range_of_elements_to_a_group() {
+        let text =
+            format!("{BEAM}\n[groups.patch]\nalpha = 1e-3\n[[assign]]\nelements = \"2..3\"\ngroup = \"patch\"\n");
+        let c = parse(&text).unwrap();
+        let g = c.model.group_index("patch").unwrap();
+        let groups: Vec<usize> = c.model.beams().iter().map(|b| b.group).collect();
+        assert_eq!(groups, vec![0, g, g, 0]);
+        let e = parse(&text.replace("2..3", "3..9")).unwrap_err();
+        assert!(e.message.contains("element 5 does not exist"), "{e}");
+    }
+
+    #[test]
+    fn update_bounds_must_hold_the_start_and_name_a_parameter() {
+        let text = format!(
+            "{BEAM}\n[measurement]\nfrequencies = [10.0, 20.0]\nreferences = [\"5:uy\"]\nresponses = [\"2..5:uy\"]\n[truth]\n[update]\nparameters = [\"group.beam.alpha\", \"element.1..2.stiffness\"]\nbounds = {{ \"group.beam.alpha\" = [1e-6, 1e-4] }}\n"
+        );
+        let c = parse(&text).unwrap();
+        let u = c.update.unwrap();
+        assert_eq!(u.bounds, vec![Some((1e-6, 1e-4)), None]);
+        assert_eq!(u.parameters[1].quantities.len(), 2);
+        let e = parse(&text.replace("[1e-6, 1e-4]", "[1e-4, 1e-3]")).unwrap_err();
+        assert!(e.message.contains("outside its bounds"), "{e}");
+        let e = parse(&text.replace("bounds = { \"group.beam.alpha\"", "bounds = { \"group.beam.beta\"")).unwrap_err();
+        assert!(e.message.contains("not in the parameters list"), "{e}");
+    }
+
+    #[test]
+    fn with_values_replaces_the_set_table_and_reads_back() {
+        let text = format!("{BEAM}\n[set]\n\"group.beam.beta\" = 0.5\n\"group.beam.alpha\" = 2e-5\n");
+        let c = parse(&text).unwrap();
+        let out = c.with_values(&[("group.beam.alpha".into(), 3.141592653589793e-5)], "updated").unwrap();
+        assert_eq!(out.matches("[set]").count(), 1);
+        let back = parse(&out).unwrap();
+        let a = back.model.quantity("group.beam.alpha").unwrap();
+        let b = back.model.quantity("group.beam.beta").unwrap();
+        assert_eq!(back.model.get(a), 3.141592653589793e-5);
+        assert_eq!(back.model.get(b), 0.5);
+        assert!(out.contains("# updated\n[set]"));
+    }
+
+    #[test]
+    fn without_supports_at_removes_only_that_nodes_entry() {
+        let text = BEAM.replace("[[supports]]\nnode = 1\n", "[[supports]]\nnode = 1\n[[springs]]\nname = \"s\"\nnode = 1\nkr = 1e4\nkx = 1e9\nky = 1e9\ngroup = \"beam\"\n");
+        let c = parse(&text).unwrap();
+        let out = c.without_supports_at(1).unwrap();
+        assert!(!out.contains("[[supports]]"));
+        assert!(parse(&out).unwrap().model.supports().is_empty());
+        assert!(c.without_supports_at(3).is_err());
     }
 
     #[test]

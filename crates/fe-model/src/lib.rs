@@ -63,4 +63,4 @@ pub use case::CaseFile;
 pub use dof::{Dof, DofMap, DofRef, Slot};
 pub use error::{CaseError, Location, ModelError};
 pub use model::{Beam, ElementId, Group, LumpedMass, Material, Model, Node, NodeId, Section, Spring};
-pub use quantity::{Quantity, QuantityKind};
+pub use quantity::{Parameter, Quantity, QuantityKind};

@@ -523,6 +523,86 @@ impl Model {
         Ok(())
     }
 
+    /// Splits `node` in two: a new coincident node `new_id` takes over the
+    /// ends of the listed elements. Used to insert a joint where members meet
+    /// (the caller then ties and springs the pair). Returns the new node id.
+    pub fn split_node(&mut self, node: u32, elements: &[u32], new_id: u32) -> Result<u32, ModelError> {
+        let ctx = format!("joint at node {node}");
+        self.require_node(NodeId(node), &ctx)?;
+        if elements.is_empty() {
+            return Err(ModelError::Invalid { what: ctx, reason: "lists no elements to detach".into() });
+        }
+        let mut idx = Vec::new();
+        for &e in elements {
+            let i = self.beam_index(ElementId(e)).ok_or_else(|| ModelError::Invalid {
+                what: ctx.clone(),
+                reason: format!("element {e} does not exist"),
+            })?;
+            if !self.beams[i].nodes.contains(&NodeId(node)) {
+                return Err(ModelError::Invalid {
+                    what: ctx,
+                    reason: format!("element {e} does not end at node {node}"),
+                });
+            }
+            idx.push(i);
+        }
+        let attached = self.beams.iter().filter(|b| b.nodes.contains(&NodeId(node))).count();
+        if attached <= idx.len() {
+            return Err(ModelError::Invalid {
+                what: ctx,
+                reason: "would detach every element at the node; leave at least one on each side".into(),
+            });
+        }
+        let (x, y) = {
+            let n = self.node(NodeId(node)).expect("checked above");
+            (n.x, n.y)
+        };
+        self.add_node(new_id, x, y)?;
+        for i in idx {
+            for end in &mut self.beams[i].nodes {
+                if *end == NodeId(node) {
+                    *end = NodeId(new_id);
+                }
+            }
+        }
+        Ok(new_id)
+    }
+
+    /// Removes the supports of a node; returns the DOFs that were fixed.
+    pub fn remove_support(&mut self, node: u32) -> Vec<Dof> {
+        let mut dofs = Vec::new();
+        self.supports.retain(|s| {
+            if s.node == NodeId(node) {
+                dofs.extend(s.dofs.iter().copied());
+                false
+            } else {
+                true
+            }
+        });
+        dofs.sort();
+        dofs.dedup();
+        dofs
+    }
+
+    /// Moves a beam (by index) to another group.
+    pub fn set_beam_group(&mut self, beam: usize, group: usize) -> Result<(), ModelError> {
+        self.require_group(group, &format!("element {}", self.beams[beam].id))?;
+        self.beams[beam].group = group;
+        Ok(())
+    }
+
+    /// Moves a spring (by index) to another group.
+    pub fn set_spring_group(&mut self, spring: usize, group: usize) -> Result<(), ModelError> {
+        self.require_group(group, &format!("spring `{}`", self.springs[spring].name))?;
+        self.springs[spring].group = group;
+        Ok(())
+    }
+
+    /// Indices of the beams with an end at `node`.
+    pub fn beams_at(&self, node: NodeId) -> Vec<usize> {
+        self.beams.iter().enumerate().filter(|(_, b)| b.nodes.contains(&node)).map(|(i, _)| i).collect()
+    }
+
     /// Length and direction cosines (c, s) of a beam.
     pub fn beam_geometry(&self, beam: usize) -> (f64, f64, f64) {
         let b = &self.beams[beam];

@@ -11,6 +11,10 @@
 //! | `element.<id>.added_mass` | non-structural transverse mass per length (kg/m) |
 //! | `spring.<name>.kx` / `.ky` / `.kr` | spring stiffnesses |
 //! | `mass.<name>.m` / `.j` | lumped mass and rotary inertia |
+//!
+//! An updating [`Parameter`] is one quantity, or several scaled together:
+//! `element.<first>..<last>.<field>` links the field of every element with an
+//! id in the inclusive range (a region's stiffness or mass factor).
 
 use std::fmt;
 
@@ -102,6 +106,25 @@ impl fmt::Display for QuantityName<'_> {
     }
 }
 
+/// An updating parameter: one or several quantities scaled by a common factor.
+///
+/// Its value is the value of its first quantity; changing it by a factor
+/// changes every quantity by that factor.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Parameter {
+    /// Name as written (`group.steel.mu`, `element.5..8.stiffness`).
+    pub name: String,
+    /// The quantities it scales (at least one).
+    pub quantities: Vec<Quantity>,
+}
+
+impl Parameter {
+    /// A parameter of a single quantity, named after it.
+    pub fn single(model: &Model, q: Quantity) -> Self {
+        Parameter { name: model.quantity_name(q).to_string(), quantities: vec![q] }
+    }
+}
+
 const FORMS: &str = "group.<name>.{alpha,beta,mu,stiffness,mass}, material.<name>.{E,rho}, \
                      element.<id>.{stiffness,mass,added_mass}, spring.<name>.{kx,ky,kr}, mass.<name>.{m,j}";
 
@@ -170,6 +193,28 @@ impl Model {
             }
             _ => Err(err(format!("`{head}` is not a kind of item; expected one of {FORMS}"))),
         }
+    }
+
+    /// Resolves an updating parameter name: a quantity name, or
+    /// `element.<first>..<last>.<field>` for a range of elements.
+    pub fn parameter(&self, name: &str) -> Result<Parameter, ModelError> {
+        let err = |reason: String| ModelError::UnknownQuantity { name: name.into(), reason };
+        if let Some(rest) = name.strip_prefix("element.")
+            && let Some((range, field)) = rest.rsplit_once('.')
+            && let Some((a, b)) = range.split_once("..")
+        {
+            let a: u32 = a.parse().map_err(|_| err(format!("`{a}` is not an element id")))?;
+            let b: u32 = b.parse().map_err(|_| err(format!("`{b}` is not an element id")))?;
+            if b < a {
+                return Err(err(format!("the range {a}..{b} is empty")));
+            }
+            let quantities = (a..=b)
+                .map(|id| self.quantity(&format!("element.{id}.{field}")))
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(|e| err(e.to_string()))?;
+            return Ok(Parameter { name: name.into(), quantities });
+        }
+        Ok(Parameter { name: name.into(), quantities: vec![self.quantity(name)?] })
     }
 
     /// The dotted name of a quantity.
@@ -259,6 +304,17 @@ mod tests {
         assert!(e.contains("no group `nope`"), "{e}");
         let e = model.quantity("spring.joint.kz").unwrap_err().to_string();
         assert!(e.contains("kx, ky, kr"), "{e}");
+    }
+
+    #[test]
+    fn element_ranges_link_quantities() {
+        let model = samples::cantilever(6);
+        let p = model.parameter("element.2..4.stiffness").unwrap();
+        assert_eq!(p.quantities.len(), 3);
+        assert_eq!(model.quantity_name(p.quantities[2]).to_string(), "element.4.stiffness");
+        assert!(model.parameter("element.5..9.mass").unwrap_err().to_string().contains("no element 7"));
+        assert!(model.parameter("element.4..2.mass").is_err());
+        assert_eq!(model.parameter("group.beam.alpha").unwrap().quantities.len(), 1);
     }
 
     #[test]

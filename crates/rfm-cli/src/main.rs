@@ -55,19 +55,45 @@ enum Command {
         #[arg(long, default_value = "auto")]
         bands: String,
     },
+    /// Find which physical effect is missing: fit every candidate effect and rank them.
+    Diagnose {
+        /// Case file.
+        case: PathBuf,
+        /// Measured FRFs (default: the case's data or truth).
+        #[arg(long)]
+        measured: Option<PathBuf>,
+        /// Print machine-readable JSON instead of tables.
+        #[arg(long)]
+        json: bool,
+        /// Write the case with the effect of this rank added (needs --out).
+        #[arg(long)]
+        apply: Option<usize>,
+        /// New case file for --apply.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Rows of the ranking to print.
+        #[arg(long, default_value_t = 10)]
+        top: usize,
+    },
     /// Update the model's parameters so that its FRFs match the measured ones.
     Update {
         /// Case file.
         case: PathBuf,
-        /// Folder for results (results.json, report.html and SVG figures).
+        /// Folder for results (results.json, updated.toml, report.html and SVG figures).
         #[arg(long)]
         out: Option<PathBuf>,
         /// Print machine-readable JSON instead of tables.
         #[arg(long)]
         json: bool,
-        /// Updating method.
-        #[arg(long, value_parser = ["rfm"])]
+        /// Updating method (default: the case's, else rfm).
+        #[arg(long, value_parser = ["rfm", "output-error"])]
         method: Option<String>,
+        /// Fit this many measured lines spread over the band (overrides the case).
+        #[arg(long)]
+        lines: Option<usize>,
+        /// Iteration limit (overrides the case).
+        #[arg(long)]
+        iterations: Option<usize>,
     },
 }
 
@@ -78,7 +104,20 @@ fn main() -> ExitCode {
         Command::Compare { case, measured, out, json, bands } => {
             commands::compare(&case, &measured, out.as_deref(), json, &bands)
         }
-        Command::Update { case, out, json, method } => commands::update(&case, out.as_deref(), json, method.as_deref()),
+        Command::Diagnose { case, measured, json, apply, out, top } => commands::diagnose(&commands::DiagnoseArgs {
+            case: &case,
+            measured: measured.as_deref(),
+            json,
+            apply,
+            out: out.as_deref(),
+            top,
+        }),
+        Command::Update { case, out, json, method, lines, iterations } => commands::update(
+            &case,
+            out.as_deref(),
+            json,
+            &commands::UpdateOverrides { method, lines, max_iterations: iterations },
+        ),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -26,6 +26,7 @@
 //! use damping::DampedSystem;
 //! use fe_model::{Dof, DofRef, samples};
 //! use frf::{Channel, synthesize};
+//! use rfm_update::params::ParameterSet;
 //! use rfm_update::rfm::{self, RfmOptions};
 //!
 //! // truth: the paper's two-material beam; model: steel group's mu and alpha off
@@ -41,17 +42,27 @@
 //! let lines = [13.0, 27.0, 61.0, 95.0, 140.0, 190.0];
 //! let measured = synthesize(&truth, &channels, &lines).unwrap();
 //!
-//! let result = rfm::run(&mut model, &[mu, alpha], &measured, &RfmOptions::default(), |_| {}).unwrap();
+//! let params = ParameterSet::of_quantities(&model, &[mu, alpha]);
+//! let result = rfm::run(&mut model, &params, &measured, &RfmOptions::default(), |_| {}).unwrap();
 //! assert!((result.values[0] / 631.12 - 1.0).abs() < 1e-8);
 //! assert!((result.values[1] / 1e-5 - 1.0).abs() < 1e-8);
 //! ```
 
+pub mod diagnose;
 pub mod error;
 pub mod freqsel;
 pub mod lstsq;
+pub mod oe;
+pub mod params;
 pub mod rfm;
 pub mod sensitivity;
 pub mod study;
+pub mod uncertainty;
 
 pub use error::UpdateError;
-pub use study::{ParameterReport, Study, UpdateOutcome};
+
+/// Serialises a value through its `Display` form (DOF names such as `31:uy`).
+pub(crate) fn serialize_display<T: std::fmt::Display, S: serde::Serializer>(v: &T, s: S) -> Result<S::Ok, S::Error> {
+    s.collect_str(v)
+}
+pub use study::{Method, ParameterReport, Study, UpdateOutcome};

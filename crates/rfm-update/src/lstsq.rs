@@ -45,6 +45,12 @@ impl LstsqSolution {
         xs.iter().zip(&self.column_norms).map(|(x, c)| x / c).collect()
     }
 
+    /// How much the undamped solution lowers `|A x - b|^2` (that is `|P b|^2`,
+    /// the squared norm of `b`'s projection on the kept directions).
+    pub fn predicted_reduction(&self) -> f64 {
+        self.keep.iter().map(|&i| self.utb[i] * self.utb[i]).sum()
+    }
+
     /// Largest kept singular value (0 when none is kept).
     pub fn largest_singular_value(&self) -> f64 {
         self.singular_values.first().copied().unwrap_or(0.0)

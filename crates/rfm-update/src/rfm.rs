@@ -33,11 +33,11 @@
 
 use damping::DampedSystem;
 use faer::Mat;
-use fe_model::Quantity;
 use frf::{FrfSet, ZSolver};
 use serde::Serialize;
 
 use crate::error::UpdateError;
+use crate::params::ParameterSet;
 use crate::sensitivity::{self, ChannelPlan, FrequencyBlock, Hybrid};
 
 /// Options of the RFM iteration.
@@ -121,20 +121,22 @@ pub fn relative_residual(blocks: &[FrequencyBlock], measured: &FrfSet) -> f64 {
 }
 
 /// Stacks `S u = R_FE - R_EX` into a real system (real parts, then imaginary).
-fn stack(blocks: &[FrequencyBlock], measured: &FrfSet, n_params: usize) -> (Mat<f64>, Vec<f64>) {
+fn stack(blocks: &[FrequencyBlock], measured: &FrfSet, params: &ParameterSet) -> (Mat<f64>, Vec<f64>) {
+    let n_params = params.len();
     let n_ch = measured.channels().len();
     let rows = blocks.len() * n_ch;
     let mut a = Mat::<f64>::zeros(2 * rows, n_params);
     let mut b = vec![0.0; 2 * rows];
     for (k, blk) in blocks.iter().enumerate() {
+        let sens = params.combine(blk);
         for c in 0..n_ch {
             let r = k * n_ch + c;
             let d = blk.model[c] - measured.get(c, k);
             b[r] = d.re;
             b[rows + r] = d.im;
             for i in 0..n_params {
-                a[(r, i)] = blk.sens[(c, i)].re;
-                a[(rows + r, i)] = blk.sens[(c, i)].im;
+                a[(r, i)] = sens[(c, i)].re;
+                a[(rows + r, i)] = sens[(c, i)].im;
             }
         }
     }
@@ -155,13 +157,6 @@ fn guard(u: &mut [f64]) -> usize {
     limited
 }
 
-fn set_values(sys: &mut DampedSystem, params: &[Quantity], values: &[f64]) -> Result<(), UpdateError> {
-    for (&q, &v) in params.iter().zip(values) {
-        sys.set(q, v)?;
-    }
-    Ok(())
-}
-
 /// Relative FRF misfit of the current model at the measured lines, or
 /// `None` when the model cannot be evaluated (singular at some line).
 fn misfit(sys: &DampedSystem, solver: &ZSolver, measured: &FrfSet) -> Option<f64> {
@@ -178,7 +173,7 @@ fn misfit(sys: &DampedSystem, solver: &ZSolver, measured: &FrfSet) -> Option<f64
 /// the lines of `measured`. `on_iteration` sees each record as it is made.
 pub fn run(
     sys: &mut DampedSystem,
-    params: &[Quantity],
+    params: &ParameterSet,
     measured: &FrfSet,
     opts: &RfmOptions,
     mut on_iteration: impl FnMut(&IterationRecord),
@@ -186,7 +181,7 @@ pub fn run(
     let solver = ZSolver::new(&sys.assembly().pattern)?;
     let plan = ChannelPlan::new(sys, measured.channels())?;
     let freqs = measured.frequencies_hz().to_vec();
-    let values = |sys: &DampedSystem| params.iter().map(|&q| sys.get(q)).collect::<Vec<f64>>();
+    let values = |sys: &DampedSystem| params.values(sys);
     let mut history: Vec<IterationRecord> = Vec::new();
     let mut best: (f64, Vec<f64>) = (f64::INFINITY, values(sys));
     let mut status = Status::MaxIterations;
@@ -196,13 +191,14 @@ pub fn run(
     // (max |u|, corrections limited, rank, lambda) of the step just taken
     let mut last_step = (0.0, 0, params.len(), 0.0);
     for iteration in 0..=opts.max_iterations {
-        let blocks = match sensitivity::assemble(sys, &solver, &plan, params, &freqs, Hybrid::Measured(measured)) {
-            Ok(b) => b,
-            Err(e) => {
-                status = Status::Failed(e.to_string());
-                break;
-            }
-        };
+        let blocks =
+            match sensitivity::assemble(sys, &solver, &plan, params.quantities(), &freqs, Hybrid::Measured(measured)) {
+                Ok(b) => b,
+                Err(e) => {
+                    status = Status::Failed(e.to_string());
+                    break;
+                }
+            };
         let residual = relative_residual(&blocks, measured);
         let (max_correction, limited, rank, step_lambda) = last_step;
         let record = IterationRecord {
@@ -235,7 +231,7 @@ pub fn run(
         if iteration == opts.max_iterations {
             break;
         }
-        let (a, b) = stack(&blocks, measured, params.len());
+        let (a, b) = stack(&blocks, measured, params);
         let sol = crate::lstsq::solve(&a, &b, opts.rcond);
         let current = values(sys);
         let mut full = sol.x.clone();
@@ -248,7 +244,7 @@ pub fn run(
         if full_max < opts.tolerance {
             // converged: take the (tiny) paper step and stop after recording it
             let next: Vec<f64> = current.iter().zip(&full).map(|(p, u)| p * (1.0 + u)).collect();
-            set_values(sys, params, &next)?;
+            params.set_values(sys, &next)?;
             last_step = (full_max, full_limited, sol.rank, 0.0);
             converged = true;
             continue;
@@ -259,14 +255,14 @@ pub fn run(
             let mut u = if lambda == 0.0 { sol.x.clone() } else { sol.damped(lambda) };
             let limited = guard(&mut u);
             let next: Vec<f64> = current.iter().zip(&u).map(|(p, u)| p * (1.0 + u)).collect();
-            let trial = set_values(sys, params, &next).ok().and_then(|()| misfit(sys, &solver, measured));
+            let trial = params.set_values(sys, &next).ok().and_then(|()| misfit(sys, &solver, measured));
             if trial.is_some_and(|r| r < residual) {
                 last_step = (u.iter().map(|x| x.abs()).fold(0.0, f64::max), limited, sol.rank, lambda);
                 lambda = if lambda <= 1e-9 * smax2 { 0.0 } else { lambda / 10.0 };
                 accepted = true;
                 break;
             }
-            set_values(sys, params, &current)?;
+            params.set_values(sys, &current)?;
             lambda = if lambda == 0.0 { 1e-6 * smax2 } else { lambda * 10.0 };
         }
         if !accepted {
@@ -275,7 +271,7 @@ pub fn run(
         }
     }
     if status != Status::Converged {
-        set_values(sys, params, &best.1)?;
+        params.set_values(sys, &best.1)?;
     }
     let final_values = values(sys);
     let residual = if status == Status::Converged { history.last().map_or(f64::NAN, |r| r.residual) } else { best.0 };

@@ -3,13 +3,45 @@
 
 use damping::DampedSystem;
 use fe_model::case::{FrequencyChoice, MeasurementSpec};
-use fe_model::{CaseFile, Quantity};
+use fe_model::{CaseFile, Parameter};
 use frf::{Channel, FrfSet, NoiseModel};
 use serde::Serialize;
 
 use crate::error::UpdateError;
 use crate::freqsel;
+use crate::oe::{self, Gain, Misfit, OeData, OeOptions};
+use crate::params::ParameterSet;
 use crate::rfm::{self, IterationRecord, RfmOptions, Status};
+use crate::uncertainty::{self, UncertaintyReport};
+
+/// An updating method.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Method {
+    /// The response function method (the paper's).
+    Rfm,
+    /// Output-error Levenberg-Marquardt with uncertainty.
+    OutputError,
+}
+
+impl Method {
+    /// Parses `rfm` or `output-error`.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "rfm" => Some(Method::Rfm),
+            "output-error" | "oe" => Some(Method::OutputError),
+            _ => None,
+        }
+    }
+
+    /// The name used in case files and outputs.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Rfm => "rfm",
+            Method::OutputError => "output-error",
+        }
+    }
+}
 
 /// A case made ready for updating.
 #[derive(Clone, Debug)]
@@ -23,7 +55,7 @@ pub struct Study {
     /// Measured receptances on the measurement lines.
     pub measured: FrfSet,
     /// Parameters to update (empty when the case has no `[update]`).
-    pub parameters: Vec<Quantity>,
+    pub parameters: Vec<Parameter>,
     /// Lines used for updating (Hz).
     pub update_frequencies_hz: Vec<f64>,
 }
@@ -89,6 +121,10 @@ pub struct UpdateOutcome {
     pub frequencies_hz: Vec<f64>,
     /// Natural frequencies before and after.
     pub natural_frequencies_hz: FrequencyTable,
+    /// Parameter uncertainty and identifiability (output-error method).
+    pub uncertainty: Option<UncertaintyReport>,
+    /// Fitted gain per reference, when requested.
+    pub gains: Vec<Gain>,
     /// The updated model.
     #[serde(skip)]
     pub system: DampedSystem,
@@ -118,7 +154,7 @@ impl Study {
         let mut grid = spec.frequencies_hz.clone();
         if let (Some(update), None) = (&case.update, &spec.data) {
             // synthesised data: make sure the chosen points are lines of it
-            if let FrequencyChoice::List(points) = &update.frequencies {
+            if let Some(FrequencyChoice::List(points)) = &update.frequencies {
                 grid.extend(points.iter().copied());
                 grid.sort_by(f64::total_cmp);
                 grid.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * b.abs());
@@ -146,12 +182,66 @@ impl Study {
             _ => unreachable!("the case loader requires data or a truth"),
         };
         let parameters = case.update.as_ref().map(|u| u.parameters.clone()).unwrap_or_default();
-        let update_frequencies_hz = match case.update.as_ref().map(|u| &u.frequencies) {
-            None => Vec::new(),
-            Some(FrequencyChoice::All) => measured.frequencies_hz().to_vec(),
-            Some(FrequencyChoice::List(points)) => {
+        let mut study = Study { case, system, truth, measured, parameters, update_frequencies_hz: Vec::new() };
+        if study.case.update.is_some() {
+            study.update_frequencies_hz = study.lines_for(study.method())?;
+        }
+        Ok(study)
+    }
+
+    /// The updating method the case asks for (`rfm` when it does not say).
+    pub fn method(&self) -> Method {
+        match self.case.update.as_ref().and_then(|u| u.method.as_ref()).map(|m| m.0.as_str()) {
+            Some("output-error") => Method::OutputError,
+            _ => Method::Rfm,
+        }
+    }
+
+    /// Checks the case's method name; returns it parsed.
+    pub fn checked_method(&self) -> Result<Method, UpdateError> {
+        match self.case.update.as_ref().and_then(|u| u.method.as_ref()) {
+            None => Ok(Method::Rfm),
+            Some((m, span)) => Method::parse(m).ok_or_else(|| {
+                UpdateError::Case(
+                    self.case.error(Some(span.clone()), format!("unknown method `{m}` (available: rfm, output-error)")),
+                )
+            }),
+        }
+    }
+
+    /// Updating lines for a method: the case's choice, else the method's
+    /// default (RFM: points away from resonances, two per parameter and at
+    /// least ten; output-error: 200 lines spread over the band).
+    pub fn lines_for(&self, method: Method) -> Result<Vec<f64>, UpdateError> {
+        let given = self.case.update.as_ref().and_then(|u| u.frequencies.clone());
+        let choice = given.unwrap_or(match method {
+            Method::Rfm => FrequencyChoice::Auto(2 * self.parameters.len().max(5)),
+            Method::OutputError => FrequencyChoice::Lines(200),
+        });
+        self.choose_lines(&choice)
+    }
+
+    /// The measured lines a frequency choice designates.
+    pub fn choose_lines(&self, choice: &FrequencyChoice) -> Result<Vec<f64>, UpdateError> {
+        let lines = self.measured.frequencies_hz();
+        Ok(match choice {
+            FrequencyChoice::All => lines.to_vec(),
+            FrequencyChoice::Lines(n) => {
+                let n = (*n).min(lines.len());
+                if n == lines.len() {
+                    lines.to_vec()
+                } else {
+                    // evenly spread, first and last included
+                    let mut idx: Vec<usize> = (0..n)
+                        .map(|i| (i as f64 * (lines.len() - 1) as f64 / (n - 1).max(1) as f64).round() as usize)
+                        .collect();
+                    idx.dedup();
+                    idx.iter().map(|&k| lines[k]).collect()
+                }
+            }
+            FrequencyChoice::List(points) => {
                 for &p in points {
-                    if measured.line_of(p).is_none() {
+                    if self.measured.line_of(p).is_none() {
                         return Err(UpdateError::Setup(format!(
                             "updating point {p} Hz is not a line of the measured data"
                         )));
@@ -159,19 +249,23 @@ impl Study {
                 }
                 points.clone()
             }
-            Some(FrequencyChoice::Auto(n)) => {
-                let model = frf::synthesize(&system, &channels, measured.frequencies_hz())?;
+            FrequencyChoice::Auto(n) => {
+                let model = frf::synthesize(&self.system, self.measured.channels(), lines)?;
                 let mut avoid = freqsel::features(&model);
-                avoid.extend(freqsel::features(&measured));
-                freqsel::choose(measured.frequencies_hz(), &avoid, *n)
+                avoid.extend(freqsel::features(&self.measured));
+                freqsel::choose(lines, &avoid, *n)
             }
-        };
-        Ok(Study { case, system, truth, measured, parameters, update_frequencies_hz })
+        })
     }
 
     /// Parameter names.
     pub fn parameter_names(&self) -> Vec<String> {
-        self.parameters.iter().map(|&q| self.system.model().quantity_name(q).to_string()).collect()
+        self.parameters.iter().map(|p| p.name.clone()).collect()
+    }
+
+    /// The parameters as a set for the solvers.
+    pub fn parameter_set(&self) -> ParameterSet {
+        ParameterSet::new(self.parameters.clone())
     }
 
     /// The measured data at the updating lines.
@@ -188,20 +282,111 @@ impl Study {
         if self.parameters.is_empty() {
             return Err(UpdateError::Setup("the case has no [update] parameters".into()));
         }
-        let measured = self.measured_at_update_lines()?;
+        let lines = self.lines_for(Method::Rfm)?;
+        let measured = self.measured.at_frequencies(&lines)?;
         let mut sys = self.system.clone();
-        let result = rfm::run(&mut sys, &self.parameters, &measured, opts, on_iteration)?;
+        let result = rfm::run(&mut sys, &self.parameter_set(), &measured, opts, on_iteration)?;
         let natural_frequencies_hz = self.frequency_table(&sys);
         Ok(UpdateOutcome {
             natural_frequencies_hz,
+            uncertainty: None,
+            gains: Vec::new(),
             method: "rfm".into(),
             status: result.status,
             parameters: self.reports(&result.values),
             history: result.history,
             residual: result.residual,
-            frequencies_hz: self.update_frequencies_hz.clone(),
+            frequencies_hz: lines,
             system: sys,
         })
+    }
+
+    /// Line weights for the measured data at `lines` (band weights and
+    /// coherence from the case's `[update]`), channel-major; `None` when all are 1.
+    pub fn weights(&self, measured: &FrfSet) -> Result<Option<Vec<f64>>, UpdateError> {
+        let Some(spec) = self.case.update.as_ref() else { return Ok(None) };
+        if spec.weights.is_empty() && !spec.coherence {
+            return Ok(None);
+        }
+        let nf = measured.n_freq();
+        let mut w = vec![1.0; nf * measured.channels().len()];
+        for (c, chunk) in w.chunks_mut(nf).enumerate() {
+            for (k, wk) in chunk.iter_mut().enumerate() {
+                let f = measured.frequencies_hz()[k];
+                for b in spec.weights.iter().filter(|b| b.from <= f && f <= b.to) {
+                    *wk *= b.weight;
+                }
+                if spec.coherence {
+                    let coh = measured.coherence(c).ok_or_else(|| {
+                        UpdateError::Setup(
+                            "coherence weighting is requested but the measured data carry no coherence".into(),
+                        )
+                    })?;
+                    // inverse of the relative standard deviation of an FRF estimate, up to a constant
+                    let g = coh[k].clamp(0.0, 0.999);
+                    *wk *= (g / (1.0 - g)).sqrt().min(30.0) / 30.0;
+                }
+            }
+        }
+        Ok(Some(w))
+    }
+
+    /// Runs the output-error estimator from the initial model, with the
+    /// case's options (bounds, regularisation, gains, weights, misfit form).
+    pub fn run_output_error(
+        &self,
+        opts: &OeOptions,
+        on_iteration: impl FnMut(&IterationRecord),
+    ) -> Result<UpdateOutcome, UpdateError> {
+        if self.parameters.is_empty() {
+            return Err(UpdateError::Setup("the case has no [update] parameters".into()));
+        }
+        let lines = self.lines_for(Method::OutputError)?;
+        let measured = self.measured.at_frequencies(&lines)?;
+        let weights = self.weights(&measured)?;
+        let params = self.parameter_set();
+        let mut sys = self.system.clone();
+        let data = OeData { measured: &measured, weights: weights.as_deref() };
+        let result = oe::run(&mut sys, &params, &data, opts, on_iteration)?;
+        let band = (lines[0], lines[lines.len() - 1]);
+        let report = uncertainty::analyse(&params, &result, band);
+        let natural_frequencies_hz = self.frequency_table(&sys);
+        Ok(UpdateOutcome {
+            method: "output-error".into(),
+            status: result.status.clone(),
+            parameters: self.reports(&result.values),
+            residual: result.history.last().map_or(f64::NAN, |r| r.residual),
+            history: result.history,
+            frequencies_hz: lines,
+            natural_frequencies_hz,
+            uncertainty: Some(report),
+            gains: result.gains,
+            system: sys,
+        })
+    }
+
+    /// Output-error options from the case's `[update]` section.
+    pub fn output_error_options(&self) -> Result<OeOptions, UpdateError> {
+        let mut opts = OeOptions::default();
+        if let Some(spec) = self.case.update.as_ref() {
+            if let Some(n) = spec.max_iterations {
+                opts.max_iterations = n as usize;
+            }
+            if let Some(t) = spec.tolerance {
+                opts.tolerance = t;
+            }
+            opts.regularization = spec.regularization.unwrap_or(0.0);
+            opts.bounds = spec.bounds.clone();
+            opts.gains = spec.gains;
+            if let Some((m, span)) = &spec.misfit {
+                opts.misfit = Misfit::parse(m).ok_or_else(|| {
+                    UpdateError::Case(
+                        self.case.error(Some(span.clone()), format!("unknown misfit `{m}` (relative or log)")),
+                    )
+                })?;
+            }
+        }
+        Ok(opts)
     }
 
     /// Natural frequencies of the initial, given and truth models in the measured band.
@@ -221,12 +406,15 @@ impl Study {
         self.parameters
             .iter()
             .zip(updated)
-            .map(|(&q, &u)| ParameterReport {
-                name: self.system.model().quantity_name(q).to_string(),
-                initial: self.system.get(q),
-                updated: u,
-                truth: self.truth.as_ref().map(|t| t.get(q)),
-                paper: paper.and_then(|p| p.values.iter().find(|(pq, _)| *pq == q).map(|&(_, v)| v)),
+            .map(|(p, &u)| {
+                let q = p.quantities[0];
+                ParameterReport {
+                    name: p.name.clone(),
+                    initial: self.system.get(q),
+                    updated: u,
+                    truth: self.truth.as_ref().map(|t| t.get(q)),
+                    paper: paper.and_then(|pp| pp.values.iter().find(|(pq, _)| *pq == q).map(|&(_, v)| v)),
+                }
             })
             .collect()
     }

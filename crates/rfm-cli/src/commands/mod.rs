@@ -1,6 +1,7 @@
 //! One module per subcommand. Only this crate prints.
 
 mod compare;
+mod diagnose;
 mod simulate;
 mod update;
 
@@ -9,8 +10,9 @@ use std::path::Path;
 use fe_model::CaseFile;
 
 pub(crate) use compare::compare;
+pub(crate) use diagnose::{DiagnoseArgs, diagnose};
 pub(crate) use simulate::simulate;
-pub(crate) use update::update;
+pub(crate) use update::{Overrides as UpdateOverrides, update};
 
 pub(crate) type Result<T> = std::result::Result<T, Box<dyn std::error::Error>>;
 

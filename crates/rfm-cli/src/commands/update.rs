@@ -2,103 +2,114 @@
 
 use std::path::Path;
 
-use rfm_update::rfm::RfmOptions;
-use rfm_update::{Study, UpdateError};
+use indicatif::{ProgressBar, ProgressStyle};
+use rfm_update::rfm::{IterationRecord, RfmOptions, Status};
+use rfm_update::{Method, Study, UpdateError, UpdateOutcome};
 
 use super::Result;
 use crate::table::{Table, num};
 
-pub(crate) fn update(case: &Path, out: Option<&Path>, json: bool, method: Option<&str>) -> Result<()> {
-    let study = Study::load(case).map_err(|e| match e {
-        UpdateError::Case(c) => c.render(),
-        other => other.to_string(),
-    })?;
+fn db(x: f64) -> f64 {
+    20.0 * x.log10()
+}
+
+fn load_study(case: &Path) -> Result<Study> {
+    Study::load(case).map_err(|e| match e {
+        UpdateError::Case(c) => c.render().into(),
+        other => other.to_string().into(),
+    })
+}
+
+/// Command-line overrides of the case's `[update]` settings.
+#[derive(Default)]
+pub(crate) struct Overrides {
+    /// Method name.
+    pub(crate) method: Option<String>,
+    /// Fit this many lines spread over the band.
+    pub(crate) lines: Option<usize>,
+    /// Iteration limit.
+    pub(crate) max_iterations: Option<usize>,
+}
+
+pub(crate) fn update(case: &Path, out: Option<&Path>, json: bool, over: &Overrides) -> Result<()> {
+    let mut study = load_study(case)?;
+    if let Some(n) = over.lines
+        && let Some(u) = study.case.update.as_mut()
+    {
+        u.frequencies = Some(fe_model::case::FrequencyChoice::Lines(n));
+    }
+    let method = over.method.as_deref();
     let spec = study.case.update.as_ref().ok_or("the case has no [update] section")?;
-    let method =
-        method.map(str::to_string).or_else(|| spec.method.as_ref().map(|m| m.0.clone())).unwrap_or("rfm".into());
-    if method != "rfm" {
-        return Err(study
-            .case
-            .error(spec.method.as_ref().map(|m| m.1.clone()), format!("unknown method `{method}` (available: rfm)"))
-            .render()
-            .into());
-    }
-    let mut opts = RfmOptions::default();
-    if let Some(n) = spec.max_iterations {
-        opts.max_iterations = n as usize;
-    }
-    if let Some(t) = spec.tolerance {
-        opts.tolerance = t;
-    }
+    let method = match method {
+        Some(m) => Method::parse(m).ok_or_else(|| format!("unknown method `{m}` (available: rfm, output-error)"))?,
+        None => study.checked_method().map_err(|e| e.to_string())?,
+    };
+    let lines = study.lines_for(method)?;
+    let max_iterations = over.max_iterations.unwrap_or(match method {
+        Method::Rfm => spec.max_iterations.map_or(RfmOptions::default().max_iterations, |n| n as usize),
+        Method::OutputError => study.output_error_options()?.max_iterations,
+    });
     if !json {
         println!("{}", study.case.model.title);
+        let what = match method {
+            Method::Rfm => "the response function method",
+            Method::OutputError => "output-error Levenberg-Marquardt",
+        };
         println!(
-            "updating {} parameters with the response function method at {} lines: {}",
+            "updating {} parameters with {what} at {} lines ({} to {} Hz)",
             study.parameters.len(),
-            study.update_frequencies_hz.len(),
-            study.update_frequencies_hz.iter().map(|f| num(*f)).collect::<Vec<_>>().join(", ")
+            lines.len(),
+            num(lines[0]),
+            num(lines[lines.len() - 1])
         );
-        println!("{:>5}  {:>12}  {:>12}", "iter", "residual", "max |du/u|");
+        println!("{:>5}  {:>11}  {:>9}  {:>11}", "iter", "misfit", "(dB)", "max step");
     }
-    let outcome = study.run_rfm(&opts, |r| {
+    let bar = if json { ProgressBar::hidden() } else { ProgressBar::new(max_iterations as u64) };
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} iteration {pos}/{len} {msg}").unwrap_or(ProgressStyle::default_bar()),
+    );
+    let on_iteration = |r: &IterationRecord| {
         if !json {
-            println!("{:>5}  {:>12.4e}  {:>12.4e}", r.iteration, r.residual, r.max_correction);
+            let line = format!(
+                "{:>5}  {:>11.4e}  {:>9.2}  {:>11.3e}",
+                r.iteration,
+                r.residual,
+                db(r.residual),
+                r.max_correction
+            );
+            // a hidden bar (output not a terminal) swallows println
+            if bar.is_hidden() { println!("{line}") } else { bar.println(line) }
         }
-    })?;
+        bar.set_position(r.iteration as u64);
+        bar.set_message(format!("misfit {:.3e}", r.residual));
+    };
+    let outcome = match method {
+        Method::Rfm => {
+            let mut opts = RfmOptions { max_iterations, ..Default::default() };
+            if let Some(t) = spec.tolerance {
+                opts.tolerance = t;
+            }
+            study.run_rfm(&opts, on_iteration)?
+        }
+        Method::OutputError => {
+            let mut opts = study.output_error_options()?;
+            opts.max_iterations = max_iterations;
+            study.run_output_error(&opts, on_iteration)?
+        }
+    };
+    bar.finish_and_clear();
     if json {
         println!("{}", serde_json::to_string_pretty(&outcome)?);
     } else {
-        println!("status: {:?}, final residual {:.3e}\n", outcome.status, outcome.residual);
-        let has_truth = outcome.parameters.iter().any(|p| p.truth.is_some());
-        let has_paper = outcome.parameters.iter().any(|p| p.paper.is_some());
-        let mut header = vec!["parameter", "initial", "updated"];
-        if has_truth {
-            header.extend(["truth", "error"]);
-        }
-        if has_paper {
-            header.push("paper");
-        }
-        let mut t = Table::new(&header);
-        for p in &outcome.parameters {
-            let mut row = vec![p.name.clone(), num(p.initial), num(p.updated)];
-            if has_truth {
-                row.push(p.truth.map(num).unwrap_or_default());
-                row.push(p.relative_error().map(|e| format!("{e:.1e}")).unwrap_or_default());
-            }
-            if has_paper {
-                row.push(p.paper.map(num).unwrap_or_default());
-            }
-            t.row(row);
-        }
-        println!("{}", t.render());
-        let nf = &outcome.natural_frequencies_hz;
-        let mut header = vec!["mode", "initial (Hz)", "updated (Hz)"];
-        if nf.truth.is_some() {
-            header.push("truth (Hz)");
-        }
-        if nf.paper.is_some() {
-            header.push("paper (Hz)");
-        }
-        let mut t = Table::new(&header);
-        let rows = nf.initial.len().max(nf.updated.len()).max(nf.paper.as_ref().map_or(0, Vec::len));
-        let cell = |v: Option<&f64>| v.map(|f| format!("{f:.2}")).unwrap_or_default();
-        for k in 0..rows {
-            let mut row = vec![format!("{}", k + 1), cell(nf.initial.get(k)), cell(nf.updated.get(k))];
-            if let Some(tr) = &nf.truth {
-                row.push(cell(tr.get(k)));
-            }
-            if let Some(p) = &nf.paper {
-                row.push(cell(p.get(k)));
-            }
-            t.row(row);
-        }
-        println!("\nundamped natural frequencies in the measured band\n{}", t.render());
+        print_outcome(&outcome);
     }
     if let Some(dir) = out {
+        let inputs = [case.to_path_buf()];
         let path = dir.join("results.json");
-        frf::io::atomic_write(&path, serde_json::to_string_pretty(&outcome)?.as_bytes(), &[case.to_path_buf()])?;
+        frf::io::atomic_write(&path, serde_json::to_string_pretty(&outcome)?.as_bytes(), &inputs)?;
+        let updated = write_updated_model(&study, &outcome, dir, &inputs)?;
         if !json {
-            println!("\nwrote {}", path.display());
+            println!("\nwrote {} and {}", path.display(), updated.display());
         }
         let report = crate::report::update_report::write(&study, &outcome, dir, case)?;
         if !json {
@@ -106,4 +117,134 @@ pub(crate) fn update(case: &Path, out: Option<&Path>, json: bool, method: Option
         }
     }
     Ok(())
+}
+
+/// Writes the case with the updated values as `DIR/updated.toml`.
+fn write_updated_model(
+    study: &Study,
+    outcome: &UpdateOutcome,
+    dir: &Path,
+    inputs: &[std::path::PathBuf],
+) -> Result<std::path::PathBuf> {
+    let model = outcome.system.model();
+    let values: Vec<(String, f64)> = study
+        .parameters
+        .iter()
+        .flat_map(|p| p.quantities.iter().map(|&q| (model.quantity_name(q).to_string(), model.get(q))))
+        .collect();
+    let comment = format!(
+        "Updated by rfm ({}, status {:?}, misfit {:.3e}) from {}",
+        outcome.method,
+        outcome.status,
+        outcome.residual,
+        study.case.path.display()
+    );
+    let text = study.case.with_values(&values, &comment).map_err(|e| e.render())?;
+    let path = dir.join("updated.toml");
+    let text = study.case.relocate(&text, &path);
+    frf::io::atomic_write(&path, text.as_bytes(), inputs)?;
+    Ok(path)
+}
+
+fn print_outcome(outcome: &UpdateOutcome) {
+    let status = match &outcome.status {
+        Status::Converged => "converged".to_string(),
+        Status::Stalled => "stalled: no step lowers the misfit further (best iterate kept)".to_string(),
+        Status::MaxIterations => "iteration limit reached (best iterate kept)".to_string(),
+        Status::Failed(e) => format!("failed: {e} (best iterate kept)"),
+    };
+    let first = outcome.history.first().map_or(f64::NAN, |r| r.residual);
+    println!(
+        "{status} after {} iterations; misfit {:.3e} -> {:.3e} ({:+.1} dB)\n",
+        outcome.history.len().saturating_sub(1),
+        first,
+        outcome.residual,
+        db(outcome.residual) - db(first)
+    );
+    let unc = outcome.uncertainty.as_ref();
+    let has_truth = outcome.parameters.iter().any(|p| p.truth.is_some());
+    let has_paper = outcome.parameters.iter().any(|p| p.paper.is_some());
+    let mut header = vec!["parameter", "initial", "updated"];
+    if unc.is_some() {
+        header.extend(["+-1 sd", "95 % interval"]);
+    }
+    if has_truth {
+        header.extend(["truth", "error"]);
+        if unc.is_some() {
+            header.push("error/sd");
+        }
+    }
+    if has_paper {
+        header.push("paper");
+    }
+    header.push("");
+    let mut t = Table::new(&header);
+    for (i, p) in outcome.parameters.iter().enumerate() {
+        let u = unc.map(|u| &u.parameters[i]);
+        let mut row = vec![p.name.clone(), num(p.initial), num(p.updated)];
+        if let Some(u) = u {
+            if u.relative_std > 10.0 {
+                row.push("unbounded".into());
+                row.push("-".into());
+            } else {
+                row.push(num(u.std));
+                row.push(format!("{} .. {}", num(u.interval95.0), num(u.interval95.1)));
+            }
+        }
+        if has_truth {
+            row.push(p.truth.map(num).unwrap_or_default());
+            row.push(p.relative_error().map(|e| format!("{e:.1e}")).unwrap_or_default());
+            if let Some(u) = u {
+                // in log space, consistent with the asymmetric interval
+                let z = p.truth.map(|t| (p.updated / t).ln().abs() / u.relative_std.max(1e-300));
+                row.push(z.map(|z| format!("{z:.2}")).unwrap_or_default());
+            }
+        }
+        if has_paper {
+            row.push(p.paper.map(num).unwrap_or_default());
+        }
+        row.push(if u.is_some_and(|u| !u.well_determined) { "weakly determined".into() } else { String::new() });
+        t.row(row);
+    }
+    println!("{}", t.render());
+    if let Some(u) = unc {
+        let notes: Vec<String> = u
+            .parameters
+            .iter()
+            .flat_map(|p| p.warnings.iter().map(move |w| format!("{}: {w}", p.name)))
+            .chain(u.warnings.iter().cloned())
+            .collect();
+        if !notes.is_empty() {
+            println!("\nwhat the data determine only weakly:");
+            for n in notes {
+                println!("  - {n}");
+            }
+        }
+        println!("\nresidual RMS per value {:.3e} (the noise level the fit leaves)", u.residual_rms);
+    }
+    for g in &outcome.gains {
+        println!("gain of reference {}: {:.4} at {:+.2} deg", g.reference, g.magnitude, g.phase_deg);
+    }
+    let nf = &outcome.natural_frequencies_hz;
+    let mut header = vec!["mode", "initial (Hz)", "updated (Hz)"];
+    if nf.truth.is_some() {
+        header.push("truth (Hz)");
+    }
+    if nf.paper.is_some() {
+        header.push("paper (Hz)");
+    }
+    let mut t = Table::new(&header);
+    let rows = nf.initial.len().max(nf.updated.len()).max(nf.paper.as_ref().map_or(0, Vec::len));
+    let cell = |v: Option<&f64>| v.map(|f| format!("{f:.2}")).unwrap_or_default();
+    for k in 0..rows {
+        let mut row = vec![format!("{}", k + 1), cell(nf.initial.get(k)), cell(nf.updated.get(k))];
+        if let Some(tr) = &nf.truth {
+            row.push(cell(tr.get(k)));
+        }
+        if let Some(p) = &nf.paper {
+            row.push(cell(p.get(k)));
+        }
+        t.row(row);
+    }
+    println!("\nundamped natural frequencies in the measured band\n{}", t.render());
 }

@@ -397,8 +397,10 @@ impl Ranged for LogAxis {
         let decades = (self.hi / self.lo).log10();
         let light = hint.weight().allow_light_points();
         let all = &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0];
-        let mantissas: &[f64] = if decades <= 1.0 || (light && decades <= 3.0) {
+        let mantissas: &[f64] = if decades <= 0.5 || (light && decades <= 3.0) {
             all
+        } else if decades <= 1.2 {
+            &[1.0, 2.0, 3.0, 5.0]
         } else if decades <= 2.5 {
             &[1.0, 2.0, 5.0]
         } else {
@@ -597,10 +599,14 @@ pub(crate) fn channel_errors(title: &str, names: &[String], series: &[ChannelSer
 
 /// Misfit per iteration: the updating method's residual at its lines and,
 /// when given, the RMS dB error over all measured lines; logarithmic axes.
-pub(crate) fn convergence(residual: &[f64], all_lines_db: Option<&[f64]>) -> Result<String, PlotError> {
+pub(crate) fn convergence(
+    residual_label: &str,
+    residual: &[f64],
+    all_lines_db: Option<&[f64]>,
+) -> Result<String, PlotError> {
     let title = "Misfit per iteration";
     let mut legend = vec![LegendEntry {
-        label: "relative residual at the updating lines".into(),
+        label: format!("{residual_label} at the updating lines"),
         colour: UPDATED,
         mark: Mark::Line(2),
     }];
@@ -612,7 +618,7 @@ pub(crate) fn convergence(residual: &[f64], all_lines_db: Option<&[f64]>) -> Res
         });
     }
     let n = residual.len().max(all_lines_db.map_or(0, <[f64]>::len)).max(2);
-    let panels: Vec<(&str, RGBColor, &[f64])> = std::iter::once(("Relative residual", UPDATED, residual))
+    let panels: Vec<(&str, RGBColor, &[f64])> = std::iter::once((residual_label, UPDATED, residual))
         .chain(all_lines_db.map(|d| ("RMS error over the band (dB)", INITIAL, d)))
         .collect();
     let height = if panels.len() == 2 { 600 } else { 380 };

@@ -5,8 +5,10 @@
 
 use std::path::{Path, PathBuf};
 
+use frf::C64;
 use frf::correlation::{BandSpec, correlate};
 use frf::{FrfSet, synthesize};
+use rfm_update::oe::Gain;
 use rfm_update::rfm::Status;
 use rfm_update::{Study, UpdateOutcome};
 
@@ -28,21 +30,27 @@ pub(crate) fn write(study: &Study, outcome: &UpdateOutcome, dir: &Path, case_pat
     let measured = &study.measured;
     let channels = measured.channels();
     let freqs = measured.frequencies_hz();
-    let model = |label: &str, colour, sys: &damping::DampedSystem| -> Result<ModelFrfs> {
-        let frfs = synthesize(sys, channels, freqs)?;
+    let model = |label: &str, colour, sys: &damping::DampedSystem, gains: &[Gain]| -> Result<ModelFrfs> {
+        let mut frfs = synthesize(sys, channels, freqs)?;
+        apply_gains(&mut frfs, gains);
         let correlation = correlate(measured, &frfs, &BandSpec::Auto)?;
         Ok(ModelFrfs { label: label.into(), colour, frfs, correlation })
     };
+    let updated_label = if outcome.gains.is_empty() { "updated model" } else { "updated model (with fitted gains)" };
     let models = [
-        model("initial model", plot::INITIAL, &study.system)?,
-        model("updated model", plot::UPDATED, &outcome.system)?,
+        model("initial model", plot::INITIAL, &study.system, &[])?,
+        model(updated_label, plot::UPDATED, &outcome.system, &outcome.gains)?,
     ];
     let (all_lines_db, stride) = misfit_per_iteration(study, outcome, measured);
-    let which_lines = if stride == 1 {
+    let mut which_lines = if stride == 1 {
         "all measured lines".to_string()
     } else {
         format!("every {stride}th measured line (thinned to keep the report quick on a large model)")
     };
+    if !outcome.gains.is_empty() {
+        // the history records parameter values only, not the gains of each step
+        which_lines.push_str(", without the fitted gains");
+    }
 
     let mut report = Report::new(format!("{}: model updating", study.case.model.title));
     report.subtitle =
@@ -51,14 +59,14 @@ pub(crate) fn write(study: &Study, outcome: &UpdateOutcome, dir: &Path, case_pat
 
     let mut conv = Section::new("Convergence");
     let residuals: Vec<f64> = outcome.history.iter().map(|r| r.residual).collect();
+    let (residual_label, residual_text) = residual_names(&outcome.method);
     conv.push(out.figure(
         "convergence",
-        plot::convergence(&residuals, Some(&all_lines_db))?,
+        plot::convergence(residual_label, &residuals, Some(&all_lines_db))?,
         format!(
-            "Top: the updating method's relative residual |R_FE - R_EX| / |R_EX| at the updating lines, per \
-             iteration (iteration 0 is the initial model). Bottom: the RMS magnitude error of the model at each \
-             iteration over {which_lines} and all channels, which shows whether fitting the updating lines \
-             improved the whole band."
+            "Top: the updating method's own misfit, {residual_text}, per iteration (iteration 0 is the initial \
+             model). Bottom: the RMS magnitude error of the model at each iteration over {which_lines} and all \
+             channels, which shows whether fitting the updating lines improved the whole band."
         ),
     )?);
     let traces: Vec<plot::ParameterTrace> = outcome
@@ -84,6 +92,22 @@ pub(crate) fn write(study: &Study, outcome: &UpdateOutcome, dir: &Path, case_pat
     out.write("parameters.csv", csv.as_bytes())?;
     let mut ps = Section::new("Parameters");
     ps.push(Block::Table(params));
+    if let Some(u) = &outcome.uncertainty {
+        for w in u.parameters.iter().flat_map(|p| p.warnings.iter().map(move |w| format!("{}: {w}.", p.name))) {
+            ps.push(Block::Text(w));
+        }
+        for w in &u.warnings {
+            ps.push(Block::Text(format!("{w}.")));
+        }
+    }
+    if !outcome.gains.is_empty() {
+        let mut t = Table::new(&["reference", "gain magnitude", "gain phase (deg)"])
+            .caption("Fitted gain per reference (the model FRFs are multiplied by it before comparison).");
+        for g in &outcome.gains {
+            t.row(vec![g.reference.to_string(), sig(g.magnitude, 4), sig(g.phase_deg, 3)]);
+        }
+        ps.push(Block::Table(t));
+    }
     ps.push(Block::Table(frequency_table(outcome)));
     report.sections.push(ps);
 
@@ -106,6 +130,28 @@ fn method_name(m: &str) -> String {
     match m {
         "rfm" => "response function".into(),
         other => other.to_string(),
+    }
+}
+
+/// Axis label and caption wording of a method's own misfit.
+fn residual_names(method: &str) -> (&'static str, &'static str) {
+    match method {
+        "rfm" => ("Relative residual", "the relative residual |R_FE - R_EX| / |R_EX| at the updating lines"),
+        _ => ("RMS weighted residual", "the RMS of the weighted residual at the fitted lines"),
+    }
+}
+
+/// Multiplies each channel by the fitted gain of its reference.
+fn apply_gains(frfs: &mut FrfSet, gains: &[Gain]) {
+    for g in gains {
+        let factor = C64::from_polar(g.magnitude, g.phase_deg.to_radians());
+        for c in 0..frfs.channels().len() {
+            if frfs.channels()[c].reference == g.reference {
+                for v in frfs.channel_mut(c) {
+                    *v *= factor;
+                }
+            }
+        }
     }
 }
 
@@ -152,10 +198,10 @@ fn misfit_per_iteration(study: &Study, outcome: &UpdateOutcome, measured: &FrfSe
     };
     let f = measured.frequencies_hz();
     let whole = BandSpec::Edges(vec![f[0], f[f.len() - 1]]);
+    let params = study.parameter_set();
     for k in chosen {
         let mut sys = study.system.clone();
-        let ok = study.parameters.iter().zip(&outcome.history[k].values).all(|(&q, &v)| sys.set(q, v).is_ok());
-        if !ok {
+        if params.set_values(&mut sys, &outcome.history[k].values).is_err() {
             continue;
         }
         // an iterate the model cannot evaluate (singular) is simply not plotted
@@ -271,15 +317,35 @@ fn iteration_table(outcome: &UpdateOutcome, all_lines_db: &[f64]) -> Table {
 fn parameter_table(outcome: &UpdateOutcome) -> (Table, String) {
     let has_truth = outcome.parameters.iter().any(|p| p.truth.is_some());
     let has_paper = outcome.parameters.iter().any(|p| p.paper.is_some());
+    let unc = outcome.uncertainty.as_ref();
     let mut header = vec!["parameter", "initial", "updated", "updated / initial"];
+    if unc.is_some() {
+        header.extend(["std (%)", "95 % interval", "determined"]);
+    }
     if has_truth {
         header.extend(["truth", "error vs truth"]);
     }
     if has_paper {
         header.push("paper");
     }
-    let mut t = Table::new(&header).caption("Parameter values before and after updating.");
-    let mut csv = header.join(",");
+    let mut t = Table::new(&header).caption(if unc.is_some() {
+        "Parameter values before and after updating, with the relative standard deviation and 95 % interval \
+         of the fit; `weakly` marks a parameter the data do not determine well (reasons below)."
+    } else {
+        "Parameter values before and after updating."
+    });
+    // the CSV has one value per cell and plain names
+    let mut csv_header = vec!["parameter", "initial", "updated", "updated/initial"];
+    if unc.is_some() {
+        csv_header.extend(["relative_std", "interval95_low", "interval95_high", "well_determined"]);
+    }
+    if has_truth {
+        csv_header.extend(["truth", "relative_error"]);
+    }
+    if has_paper {
+        csv_header.push("paper");
+    }
+    let mut csv = csv_header.join(",");
     csv.push('\n');
     for p in &outcome.parameters {
         let mut row = vec![
@@ -294,6 +360,20 @@ fn parameter_table(outcome: &UpdateOutcome) -> (Table, String) {
             format!("{:e}", p.updated),
             format!("{:e}", p.updated / p.initial),
         ];
+        if let Some(u) = unc.and_then(|u| u.parameters.iter().find(|u| u.name == p.name)) {
+            let tone = if u.well_determined { Tone::Good } else { Tone::Bad };
+            row.push((sig(100.0 * u.relative_std, 2), Tone::Plain));
+            let (lo, hi) = u.interval95;
+            row.push((format!("{} .. {}", super::trimmed(sig(lo, 3)), super::trimmed(sig(hi, 3))), Tone::Plain));
+            row.push((if u.well_determined { "yes" } else { "weakly" }.to_string(), tone));
+            line.push(format!("{:e}", u.relative_std));
+            line.push(format!("{:e}", u.interval95.0));
+            line.push(format!("{:e}", u.interval95.1));
+            line.push(u.well_determined.to_string());
+        } else if unc.is_some() {
+            row.extend(std::iter::repeat_n((String::new(), Tone::Plain), 3));
+            line.extend(std::iter::repeat_n(String::new(), 4));
+        }
         if has_truth {
             let err = p.relative_error();
             let tone = match err {

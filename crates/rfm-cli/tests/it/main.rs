@@ -1,4 +1,5 @@
 //! End-to-end tests of the `rfm` binary.
 
 mod commands;
+mod diagnose;
 mod report;

@@ -183,6 +183,37 @@ fn update_out_writes_figures_parameters_and_a_self_contained_report() {
 }
 
 #[test]
+fn an_output_error_report_shows_the_uncertainty_of_each_parameter() {
+    let dir = tempfile::tempdir().unwrap();
+    let case_file = case("cantilever-flexible-clamp");
+    let out = rfm(&[
+        "update",
+        case_file.to_str().unwrap(),
+        "--method",
+        "output-error",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let json: serde_json::Value = serde_json::from_str(&read(&dir.path().join("results.json"))).unwrap();
+    let unc = json["uncertainty"]["parameters"].as_array().expect("output-error reports uncertainty");
+    let csv = read(&dir.path().join("parameters.csv"));
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("no column {name}"));
+    for (line, u) in csv.lines().skip(1).zip(unc) {
+        let cells: Vec<&str> = line.split(',').collect();
+        let s: f64 = cells[col("relative_std")].parse().unwrap();
+        let expect = u["relative_std"].as_f64().unwrap();
+        assert!((s - expect).abs() <= 1e-12 * expect.abs().max(1e-300), "{line}");
+        assert_eq!(cells[col("well_determined")], u["well_determined"].as_bool().unwrap().to_string());
+    }
+    let html = read(&dir.path().join("report.html"));
+    check_self_contained(&html);
+    assert!(html.contains("<th>95 % interval</th>") && html.contains("<th>determined</th>"));
+    check_svg(&dir.path().join("convergence.svg"), &["RMS weighted residual"]);
+}
+
+#[test]
 fn compare_json_agrees_with_the_library() {
     let case_file = case("two-material-beam");
     let out = rfm(&["compare", case_file.to_str().unwrap(), "--json"]);

@@ -1,0 +1,117 @@
+//! `rfm diagnose`: which physical effect is missing from the model.
+
+use std::path::Path;
+
+use rfm_update::diagnose::{DiagnoseOptions, Diagnosis, diagnose as run_diagnosis};
+use rfm_update::{Study, UpdateError};
+
+use super::Result;
+use crate::table::{Table, num, percent};
+
+/// Options of the diagnose command.
+pub(crate) struct DiagnoseArgs<'a> {
+    pub(crate) case: &'a Path,
+    pub(crate) measured: Option<&'a Path>,
+    pub(crate) json: bool,
+    pub(crate) apply: Option<usize>,
+    pub(crate) out: Option<&'a Path>,
+    pub(crate) top: usize,
+}
+
+pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<()> {
+    let study = Study::load(args.case).map_err(|e| match e {
+        UpdateError::Case(c) => c.render(),
+        other => other.to_string(),
+    })?;
+    let measured = match args.measured {
+        Some(path) => {
+            let map = study.case.measurement.as_ref().map(|m| m.map.clone()).unwrap_or_default();
+            frf::io::read_measured(path, &map)?.to_receptance()
+        }
+        None => study.measured.clone(),
+    };
+    if !args.json {
+        println!("{}", study.case.model.title);
+        println!(
+            "fitting every candidate effect to {} channels x {} lines ({} to {} Hz) ...",
+            measured.channels().len(),
+            measured.n_freq(),
+            num(measured.frequencies_hz()[0]),
+            num(*measured.frequencies_hz().last().expect("lines"))
+        );
+    }
+    let d = run_diagnosis(&study.case.model, &measured, &DiagnoseOptions::default())?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&d)?);
+    } else {
+        print_diagnosis(&d, args.top);
+    }
+    if let Some(rank) = args.apply {
+        let out = args.out.ok_or("--apply needs --out FILE for the new case file")?;
+        let text =
+            d.case_text(&study.case, rank.checked_sub(1).ok_or("ranks start at 1")?).map_err(|e| e.to_string())?;
+        let text = study.case.relocate(&text, out);
+        frf::io::atomic_write(out, text.as_bytes(), &[args.case.to_path_buf()])?;
+        if !args.json {
+            println!("\nwrote {} with effect {rank} added", out.display());
+        }
+    }
+    Ok(())
+}
+
+fn print_diagnosis(d: &Diagnosis, top: usize) {
+    println!(
+        "noise level estimated from the data: {:.2} %; nominal model misfit: {:.2} % (RMS relative)\n",
+        100.0 * d.noise,
+        100.0 * d.nominal_misfit
+    );
+    let mut t = Table::new(&["rank", "effect", "explained", "dBIC", "significant", "fitted values", ""]);
+    for (i, r) in d.ranking.iter().enumerate().take(top) {
+        let values = r
+            .parameters
+            .iter()
+            .map(|p| format!("{} = {} (+-{})", p.name, num(p.value), percent(p.relative_std)))
+            .collect::<Vec<_>>()
+            .join(", ");
+        let note = match (&r.implausible_reason, r.fully_fitted) {
+            (Some(why), _) => format!("implausible: {why}"),
+            (None, false) => "screened only".into(),
+            (None, true) => String::new(),
+        };
+        t.row(vec![
+            format!("{}", i + 1),
+            r.description.clone(),
+            format!("{:.1} %", 100.0 * r.explained),
+            format!("{:.1}", r.delta_bic),
+            if r.significant { "yes".into() } else { "no".into() },
+            values,
+            note,
+        ]);
+    }
+    println!("{}", t.render());
+    println!("\n(dBIC: change of the Bayesian information criterion; below -10 the evidence is very strong)");
+    match d.leader() {
+        None if d.consistent() => {
+            println!("\nNo candidate explains the misfit beyond the noise: the model is consistent with the data.")
+        }
+        None => println!(
+            "\nSome effects are significant, but none at plausible values: the missing effect may not be among the candidates."
+        ),
+        Some(leader) => {
+            let rank = d.ranking.iter().position(|r| std::ptr::eq(r, leader)).expect("from the ranking");
+            println!("\nMost likely missing: {}.", leader.description);
+            let (text, set) = d.proposal(rank);
+            println!("Add it to the case file with these lines:\n");
+            for l in text.lines() {
+                println!("    {l}");
+            }
+            if !set.is_empty() {
+                println!("    [set]    # merge into the case's [set] table");
+                for (k, v) in &set {
+                    println!("    \"{k}\" = {v:e}");
+                }
+            }
+            println!("\nor let rfm write the new case: rfm diagnose CASE --apply {} --out NEW.toml", rank + 1);
+        }
+    }
+}

@@ -1,0 +1,356 @@
+//! Diagnosis: which physical effect is missing from the model.
+//!
+//! Every candidate effect ([`candidates`]) is fitted to the measured FRFs by
+//! the output-error estimator on the complex-log misfit `ln(H / M)`, which
+//! stays well behaved when a resonance is shifted by more than its width
+//! (one linearised step from the nominal model does not: it ranks a 40 %
+//! stiffness loss behind unrelated masses). Candidates are compared by the
+//! Bayesian information criterion with the noise variance estimated from the
+//! data themselves:
+//!
+//! ```text
+//! dBIC_c = (cost_c - cost_0) / s^2 + k_c ln(n)
+//! ```
+//!
+//! `cost` is the sum of squared real residuals (`cost_0` for the nominal
+//! model), `k_c` the candidate's number of parameters, `n` the number of real
+//! residuals, `s^2` the noise variance per real residual. An effect is
+//! *significant* when `dBIC < -10` (very strong evidence); when none is, the
+//! model is consistent with the data.
+//!
+//! The noise level comes from the roughness of the measured FRFs: on a line
+//! grid fine enough to resolve the structure's response, the second
+//! difference of `ln M` across adjacent lines is noise plus a small smooth
+//! part, and its median (robust to the few lines at sharp resonances) gives
+//! the variance ([`estimate_noise`]).
+//!
+//! To stay fast with many candidates, all are first fitted briefly on a
+//! coarse subset of lines (screening), and the leaders are then fitted fully
+//! on the updating lines; the final ranking rests on the full fits only.
+
+pub mod candidates;
+
+use damping::DampedSystem;
+use frf::FrfSet;
+use rayon::prelude::*;
+use serde::Serialize;
+
+pub use candidates::{Candidate, CandidateOptions, EffectKind};
+
+use crate::error::UpdateError;
+use crate::oe::{self, Misfit, OeData, OeOptions};
+use crate::params::ParameterSet;
+
+/// Relative noise level of measured FRFs (RMS of the relative error per
+/// complex value), from the roughness of `ln M` over adjacent lines; see the
+/// module docs. `None` when there are too few lines.
+pub fn estimate_noise(measured: &FrfSet) -> Option<f64> {
+    let mut d2 = Vec::new();
+    for c in 0..measured.channels().len() {
+        let h = measured.channel(c);
+        for k in 1..h.len().saturating_sub(1) {
+            if h[k - 1].norm() == 0.0 || h[k].norm() == 0.0 || h[k + 1].norm() == 0.0 {
+                continue;
+            }
+            let d = (h[k + 1] / h[k]).ln() - (h[k] / h[k - 1]).ln();
+            if d.re.is_finite() && d.im.is_finite() {
+                d2.push(d.norm_sqr());
+            }
+        }
+    }
+    if d2.len() < 10 {
+        return None;
+    }
+    d2.sort_by(f64::total_cmp);
+    let median = d2[d2.len() / 2];
+    // d = e(k+1) - 2 e(k) + e(k-1): E|d|^2 = 6 s^2, and the median of an
+    // exponential variable is its mean times ln 2
+    Some((median / (6.0 * std::f64::consts::LN_2)).sqrt())
+}
+
+/// Options of the diagnosis.
+#[derive(Clone, Debug)]
+pub struct DiagnoseOptions {
+    /// Lines for the full fits.
+    pub lines: usize,
+    /// Lines for the screening fits.
+    pub screen_lines: usize,
+    /// Iterations of a screening fit.
+    pub screen_iterations: usize,
+    /// Candidates fitted fully after screening.
+    pub keep: usize,
+    /// Iterations of a full fit.
+    pub iterations: usize,
+    /// `dBIC` below which an effect is significant.
+    pub significance: f64,
+    /// Candidate generation options (the band is taken from the data).
+    pub candidates: CandidateOptions,
+}
+
+impl Default for DiagnoseOptions {
+    fn default() -> Self {
+        DiagnoseOptions {
+            lines: 200,
+            screen_lines: 60,
+            screen_iterations: 6,
+            keep: 8,
+            iterations: 40,
+            significance: -10.0,
+            candidates: CandidateOptions::default(),
+        }
+    }
+}
+
+/// A fitted parameter of a candidate.
+#[derive(Clone, Debug, Serialize)]
+pub struct FittedParameter {
+    /// Name (in the candidate's model).
+    pub name: String,
+    /// Fitted value.
+    pub value: f64,
+    /// Relative standard deviation from the fit.
+    pub relative_std: f64,
+}
+
+/// One ranked candidate.
+#[derive(Clone, Debug, Serialize)]
+pub struct Ranked {
+    /// Kind.
+    pub kind: EffectKind,
+    /// Plain-language description with location.
+    pub description: String,
+    /// Nodes where it acts.
+    pub nodes: Vec<u32>,
+    /// Elements where it acts.
+    pub elements: Vec<u32>,
+    /// DOFs it acts on (names).
+    pub dof: Vec<String>,
+    /// Fraction of the nominal misfit it explains (`1 - cost_c / cost_0`).
+    pub explained: f64,
+    /// Change of the information criterion (negative is better).
+    pub delta_bic: f64,
+    /// `delta_bic` below the significance threshold.
+    pub significant: bool,
+    /// Fitted values within their plausible ranges.
+    pub plausible: bool,
+    /// Why not, when not plausible.
+    pub implausible_reason: Option<String>,
+    /// Fitted parameters.
+    pub parameters: Vec<FittedParameter>,
+    /// Fitted on the full line set (false: screening only).
+    pub fully_fitted: bool,
+    /// Index of the candidate in [`Diagnosis::candidates`].
+    #[serde(skip)]
+    pub candidate: usize,
+}
+
+/// The outcome of a diagnosis.
+#[derive(Clone, Debug, Serialize)]
+pub struct Diagnosis {
+    /// Estimated relative noise of the data (RMS per complex value).
+    pub noise: f64,
+    /// RMS residual of the nominal model on the fitted lines.
+    pub nominal_misfit: f64,
+    /// Number of real residuals of the full fits.
+    pub n_residuals: usize,
+    /// Candidates ranked: full fits by `delta_bic`, then screening-only ones.
+    pub ranking: Vec<Ranked>,
+    /// The candidates (same indices as [`Ranked::candidate`]).
+    #[serde(skip)]
+    pub candidates: Vec<Candidate>,
+}
+
+impl Diagnosis {
+    /// The case-file lines that add ranked effect `rank`: the text to append
+    /// and the `[set]` entries to merge.
+    pub fn proposal(&self, rank: usize) -> (String, Vec<(String, f64)>) {
+        let r = &self.ranking[rank];
+        let values: Vec<f64> = r.parameters.iter().map(|p| p.value).collect();
+        self.candidates[r.candidate].case_lines(&values)
+    }
+
+    /// The case text with ranked effect `rank` added at its fitted values.
+    /// When the case has no `[update]` section, one is appended that updates
+    /// the effect's parameters by output error. The result is reloaded and
+    /// checked to carry the fitted values.
+    pub fn case_text(&self, case: &fe_model::CaseFile, rank: usize) -> Result<String, UpdateError> {
+        let r = self.ranking.get(rank).ok_or_else(|| UpdateError::Setup(format!("there is no rank {}", rank + 1)))?;
+        let c = &self.candidates[r.candidate];
+        let (snippet, set) = self.proposal(rank);
+        let mut text = match &c.edit {
+            candidates::Edit::Support { node, .. } => case.without_supports_at(*node)?,
+            _ => case.source.clone(),
+        };
+        if !snippet.is_empty() {
+            text.push_str(&format!(
+                "\n# Added by rfm diagnose: {} (explains {:.1} % of the misfit)\n",
+                r.description,
+                100.0 * r.explained
+            ));
+            text.push_str(&snippet);
+        }
+        if case.update.is_none() {
+            let names: Vec<String> = r.parameters.iter().map(|p| format!("\"{}\"", p.name)).collect();
+            text.push_str(&format!("\n[update]\nparameters = [{}]\nmethod = \"output-error\"\n", names.join(", ")));
+        }
+        let mut reparsed = fe_model::CaseFile::parse(&case.path, &text)?;
+        if !set.is_empty() {
+            text = reparsed.with_values(&set, &format!("{} (rfm diagnose)", r.description))?;
+            reparsed = fe_model::CaseFile::parse(&case.path, &text)?;
+        }
+        for p in &r.parameters {
+            let param = reparsed.model.parameter(&p.name)?;
+            let got = reparsed.model.get(param.quantities[0]);
+            if (got - p.value).abs() > 1e-12 * p.value.abs() {
+                return Err(UpdateError::Setup(format!("{} reads back as {got}, not {}", p.name, p.value)));
+            }
+        }
+        Ok(text)
+    }
+
+    /// The best significant, plausible candidate, if any.
+    pub fn leader(&self) -> Option<&Ranked> {
+        self.ranking.iter().find(|r| r.fully_fitted && r.significant && r.plausible)
+    }
+
+    /// True when no candidate is significant: the model is consistent with the data.
+    pub fn consistent(&self) -> bool {
+        !self.ranking.iter().any(|r| r.fully_fitted && r.significant)
+    }
+}
+
+fn spread(lines: &[f64], n: usize) -> Vec<f64> {
+    if n >= lines.len() {
+        return lines.to_vec();
+    }
+    let mut idx: Vec<usize> =
+        (0..n).map(|i| (i as f64 * (lines.len() - 1) as f64 / (n - 1).max(1) as f64).round() as usize).collect();
+    idx.dedup();
+    idx.into_iter().map(|k| lines[k]).collect()
+}
+
+struct Fit {
+    values: Vec<f64>,
+    cost: f64,
+    n: usize,
+    relative_std: Vec<f64>,
+}
+
+fn fit(candidate: &Candidate, measured: &FrfSet, iterations: usize, start: Option<&[f64]>) -> Option<Fit> {
+    let mut sys = DampedSystem::new(candidate.model.clone()).ok()?;
+    let params = ParameterSet::new(candidate.parameters.clone());
+    if let Some(v) = start {
+        params.set_values(&mut sys, v).ok()?;
+    }
+    // bounds must hold the start
+    let now = params.values(&sys);
+    let bounds = candidate.bounds.iter().zip(&now).map(|(b, &v)| b.map(|(lo, hi)| (lo.min(v), hi.max(v)))).collect();
+    let opts =
+        OeOptions { misfit: Misfit::Log, max_iterations: iterations, tolerance: 1e-6, bounds, ..OeOptions::default() };
+    let data = OeData { measured, weights: None };
+    let r = oe::run(&mut sys, &params, &data, &opts, |_| {}).ok()?;
+    let relative_std = (0..params.len()).map(|i| r.covariance[(i, i)].max(0.0).sqrt()).collect();
+    Some(Fit { values: r.values, cost: r.cost, n: r.n_data, relative_std })
+}
+
+fn nominal_cost(sys: &DampedSystem, measured: &FrfSet) -> Result<(f64, usize), UpdateError> {
+    let model = frf::synthesize(sys, measured.channels(), measured.frequencies_hz())?;
+    let (mut cost, mut n) = (0.0, 0);
+    for (h, m) in model.values().iter().zip(measured.values()) {
+        if m.norm() > 0.0 {
+            cost += (h / m).ln().norm_sqr();
+            n += 2;
+        }
+    }
+    Ok((cost, n))
+}
+
+/// Diagnoses a model against measured receptances (all measured lines; the
+/// fits use subsets of them). Candidates are fitted in parallel.
+pub fn diagnose(model: &fe_model::Model, measured: &FrfSet, opts: &DiagnoseOptions) -> Result<Diagnosis, UpdateError> {
+    let lines = measured.frequencies_hz();
+    if lines.len() < 10 {
+        return Err(UpdateError::Setup("diagnosis needs at least 10 measured lines".into()));
+    }
+    let noise = estimate_noise(measured)
+        .ok_or_else(|| UpdateError::Setup("too few usable measured values to estimate the noise level".into()))?;
+    // a noise floor for noise-free data keeps the criterion finite
+    let s2 = (noise * noise / 2.0).max(1e-20);
+    let full = measured.at_frequencies(&spread(lines, opts.lines))?;
+    let coarse = measured.at_frequencies(&spread(lines, opts.screen_lines))?;
+    let nominal = DampedSystem::new(model.clone())?;
+    let (cost0_full, n_full) = nominal_cost(&nominal, &full)?;
+    let (cost0_coarse, n_coarse) = nominal_cost(&nominal, &coarse)?;
+    let mut copts = opts.candidates.clone();
+    copts.band_hz = (lines[0], lines[lines.len() - 1]);
+    let candidates = candidates::generate(model, &copts);
+    let bic = |cost: f64, cost0: f64, n: usize, k: usize| (cost - cost0) / s2 + k as f64 * (n as f64).ln();
+
+    // screening
+    let screened: Vec<Option<Fit>> =
+        candidates.par_iter().map(|c| fit(c, &coarse, opts.screen_iterations, None)).collect();
+    let mut order: Vec<usize> = (0..candidates.len()).filter(|&i| screened[i].is_some()).collect();
+    let score = |i: usize| {
+        let f = screened[i].as_ref().expect("filtered");
+        bic(f.cost, cost0_coarse, n_coarse, candidates[i].parameters.len())
+    };
+    order.sort_by(|&a, &b| score(a).total_cmp(&score(b)));
+    let keep: Vec<usize> = order.iter().copied().take(opts.keep).collect();
+
+    // full fits of the leaders, warm-started from screening
+    let full_fits: Vec<(usize, Option<Fit>)> = keep
+        .par_iter()
+        .map(|&i| {
+            let start = screened[i].as_ref().map(|f| f.values.as_slice());
+            let f = fit(&candidates[i], &full, opts.iterations, start)
+                .or_else(|| fit(&candidates[i], &full, opts.iterations, None));
+            (i, f)
+        })
+        .collect();
+
+    let ranked = |i: usize, f: &Fit, cost0: f64, n: usize, fully: bool| {
+        let c = &candidates[i];
+        let delta_bic = bic(f.cost, cost0, n, c.parameters.len());
+        let implausible_reason = c.implausible(&f.values);
+        Ranked {
+            kind: c.kind,
+            description: c.description.clone(),
+            nodes: c.nodes.clone(),
+            elements: c.elements.clone(),
+            dof: c.dofs.iter().map(|d| d.to_string()).collect(),
+            explained: (1.0 - f.cost / cost0).max(0.0),
+            delta_bic,
+            significant: delta_bic < opts.significance,
+            plausible: implausible_reason.is_none(),
+            implausible_reason,
+            parameters: c
+                .parameters
+                .iter()
+                .zip(&f.values)
+                .zip(&f.relative_std)
+                .map(|((p, &value), &relative_std)| FittedParameter { name: p.name.clone(), value, relative_std })
+                .collect(),
+            fully_fitted: fully,
+            candidate: i,
+        }
+    };
+    let mut ranking: Vec<Ranked> = full_fits
+        .iter()
+        .filter_map(|(i, f)| f.as_ref().map(|f| ranked(*i, f, cost0_full, n_full.max(f.n), true)))
+        .collect();
+    ranking.sort_by(|a, b| a.delta_bic.total_cmp(&b.delta_bic));
+    let fitted: Vec<usize> = ranking.iter().map(|r| r.candidate).collect();
+    ranking.extend(
+        order
+            .iter()
+            .filter(|i| !fitted.contains(i))
+            .map(|&i| ranked(i, screened[i].as_ref().expect("filtered"), cost0_coarse, n_coarse, false)),
+    );
+    Ok(Diagnosis {
+        noise,
+        nominal_misfit: (cost0_full / (n_full as f64 / 2.0)).sqrt(),
+        n_residuals: n_full,
+        ranking,
+        candidates,
+    })
+}

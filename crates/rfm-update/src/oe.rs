@@ -1,0 +1,462 @@
+//! Output-error estimation: Levenberg-Marquardt on the FRF residual.
+//!
+//! The response function method's equation error has measured data on both
+//! sides, which biases it when the data are noisy. The output-error
+//! estimator instead minimises the misfit between model and measured FRFs
+//! directly, over log-parameters `theta_i = ln(p_i / p_i0)` (so physical
+//! parameters stay positive):
+//!
+//! ```text
+//! cost(theta) = sum_{lines k, channels c} |rho_kc|^2  +  tau sum_i theta_i^2
+//! rho_kc = w_kc (g_v H_kc - M_kc) / |M_kc|        (misfit "relative")
+//! rho_kc = w_kc ln(g_v H_kc / M_kc)               (misfit "log": log-magnitude and phase)
+//! ```
+//!
+//! with `H` the model receptance, `M` the measured one, `w_kc >= 0` line
+//! weights (band weights, coherence; 0 masks a line) and `g_v = exp(a_v + j b_v)`
+//! an optional unknown complex gain per reference `v` (FRFs referenced to a
+//! shaker amplifier's voltage carry one). For multiplicative noise of
+//! relative level `s`, both forms give residuals of standard deviation about
+//! `s` per complex value, so the weighting is the maximum-likelihood one.
+//!
+//! The Jacobian comes from the shared sensitivity assembly: `(dH/dp) p = -S`
+//! with the model's own column ([`crate::sensitivity::Hybrid::Model`]). Each
+//! iteration solves the column-scaled, Tikhonov-damped Gauss-Newton system by
+//! SVD; a step is taken only if it lowers the cost, with the damping raised
+//! tenfold after each rejection and relaxed after each success. Bounds are
+//! enforced by projecting the step. Convergence is declared when the
+//! Gauss-Newton step would lower the cost by less than a relative 1e-10, or
+//! when steps no longer change any parameter by more than the tolerance.
+//!
+//! At the solution the covariance of `theta` is `s^2 (J^T J)^+` with `s^2` the
+//! residual variance estimated from the fit; see [`crate::uncertainty`].
+
+use damping::DampedSystem;
+use faer::Mat;
+use fe_model::DofRef;
+use frf::{FrfSet, ZSolver};
+use num_complex::Complex64 as C64;
+use serde::Serialize;
+
+use crate::error::UpdateError;
+use crate::lstsq;
+use crate::params::ParameterSet;
+use crate::rfm::{IterationRecord, Status};
+use crate::sensitivity::{self, ChannelPlan, Hybrid};
+
+/// Form of the residual; see the module docs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Misfit {
+    /// `(H - M) / |M|`.
+    Relative,
+    /// `ln(H / M)`.
+    Log,
+}
+
+impl Misfit {
+    /// Parses `relative` or `log`.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "relative" => Some(Misfit::Relative),
+            "log" => Some(Misfit::Log),
+            _ => None,
+        }
+    }
+}
+
+/// Options of the output-error estimator.
+#[derive(Clone, Debug)]
+pub struct OeOptions {
+    /// Residual form.
+    pub misfit: Misfit,
+    /// Iteration limit.
+    pub max_iterations: usize,
+    /// Converged when no parameter changes by more than this (relative) in a step.
+    pub tolerance: f64,
+    /// Tikhonov weight `tau` on `theta_i^2`.
+    pub regularization: f64,
+    /// Bounds per parameter in physical units (`None`: unbounded).
+    pub bounds: Vec<Option<(f64, f64)>>,
+    /// Estimate a complex gain per reference.
+    pub gains: bool,
+    /// Relative singular-value cut-off.
+    pub rcond: f64,
+}
+
+impl Default for OeOptions {
+    fn default() -> Self {
+        OeOptions {
+            misfit: Misfit::Relative,
+            max_iterations: 100,
+            tolerance: 1e-8,
+            regularization: 0.0,
+            bounds: Vec::new(),
+            gains: false,
+            rcond: 1e-12,
+        }
+    }
+}
+
+/// A fitted gain of one reference.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct Gain {
+    /// The reference DOF.
+    #[serde(serialize_with = "crate::serialize_display")]
+    pub reference: DofRef,
+    /// Magnitude of the gain.
+    pub magnitude: f64,
+    /// Phase of the gain (degrees).
+    pub phase_deg: f64,
+}
+
+/// Outcome of an output-error fit.
+#[derive(Clone, Debug)]
+pub struct OeResult {
+    /// How the iteration ended.
+    pub status: Status,
+    /// Fitted parameter values.
+    pub values: Vec<f64>,
+    /// Fitted gains (empty unless requested).
+    pub gains: Vec<Gain>,
+    /// Iteration records (`residual` is the RMS weighted residual).
+    pub history: Vec<IterationRecord>,
+    /// Final data cost (weighted sum of squares, without regularisation).
+    pub cost: f64,
+    /// Number of real residuals that carry weight.
+    pub n_data: usize,
+    /// Covariance of `(theta, gain parameters)` at the solution.
+    pub covariance: Mat<f64>,
+    /// Estimated residual variance per real residual.
+    pub sigma2: f64,
+    /// Singular values of the column-scaled Jacobian at the solution.
+    pub singular_values: Vec<f64>,
+    /// Right singular vectors of the scaled Jacobian (columns), to name
+    /// parameter combinations the data cannot determine.
+    pub v: Mat<f64>,
+    /// Parameters that ended on a bound.
+    pub at_bound: Vec<bool>,
+}
+
+/// The data of a fit: measured receptances at the fitted lines and weights.
+#[derive(Clone, Debug)]
+pub struct OeData<'a> {
+    /// Measured receptance (its lines are the fitted lines).
+    pub measured: &'a FrfSet,
+    /// Weights, channel-major like the data (`None`: all 1).
+    pub weights: Option<&'a [f64]>,
+}
+
+struct Evaluator<'a> {
+    params: &'a ParameterSet,
+    data: &'a OeData<'a>,
+    opts: &'a OeOptions,
+    solver: ZSolver,
+    plan: ChannelPlan,
+    /// Reference index of each channel.
+    ref_of: Vec<usize>,
+    refs: Vec<DofRef>,
+    p0: Vec<f64>,
+}
+
+struct Point {
+    residual: Vec<f64>,
+    cost_data: f64,
+    cost: f64,
+    jacobian: Option<Mat<f64>>,
+}
+
+impl Evaluator<'_> {
+    fn n_params(&self) -> usize {
+        self.params.len()
+    }
+
+    fn n_gain(&self) -> usize {
+        if self.opts.gains { 2 * self.refs.len() } else { 0 }
+    }
+
+    fn weight(&self, c: usize, k: usize) -> f64 {
+        let nf = self.data.measured.n_freq();
+        let w = self.data.weights.map_or(1.0, |w| w[c * nf + k]);
+        let m = self.data.measured.get(c, k);
+        if m.norm() > 0.0 && m.norm().is_finite() { w } else { 0.0 }
+    }
+
+    fn n_data(&self) -> usize {
+        let nf = self.data.measured.n_freq();
+        let nc = self.data.measured.channels().len();
+        2 * (0..nc).flat_map(|c| (0..nf).map(move |k| (c, k))).filter(|&(c, k)| self.weight(c, k) > 0.0).count()
+    }
+
+    /// Sets the system to `theta` (structural part of `x`).
+    fn apply(&self, sys: &mut DampedSystem, x: &[f64]) -> Result<(), UpdateError> {
+        let values: Vec<f64> = self.p0.iter().zip(x).map(|(p, t)| p * t.exp()).collect();
+        self.params.set_values(sys, &values)
+    }
+
+    fn gain(&self, x: &[f64], v: usize) -> C64 {
+        if self.opts.gains {
+            let n = self.n_params();
+            C64::new(x[n + 2 * v], x[n + 2 * v + 1]).exp()
+        } else {
+            C64::new(1.0, 0.0)
+        }
+    }
+
+    /// Residuals (and optionally the Jacobian) at `x`; `None` when the model
+    /// cannot be evaluated there.
+    fn eval(&self, sys: &mut DampedSystem, x: &[f64], jacobian: bool) -> Option<Point> {
+        self.apply(sys, x).ok()?;
+        let m = self.data.measured;
+        let lines = m.frequencies_hz();
+        let (nf, nc, n) = (lines.len(), m.channels().len(), self.n_params());
+        let ncol = n + self.n_gain();
+        // model FRFs [line][channel] and per-parameter sensitivities
+        let (model, sens): (Vec<Vec<C64>>, Option<Vec<Mat<C64>>>) = if jacobian {
+            let blocks =
+                sensitivity::assemble(sys, &self.solver, &self.plan, self.params.quantities(), lines, Hybrid::Model)
+                    .ok()?;
+            let sens = blocks.iter().map(|b| self.params.combine(b)).collect();
+            (blocks.into_iter().map(|b| b.model).collect(), Some(sens))
+        } else {
+            let set = frf::synthesize_with(sys, &self.solver, m.channels(), lines).ok()?;
+            ((0..nf).map(|k| (0..nc).map(|c| set.get(c, k)).collect()).collect(), None)
+        };
+        let n_reg = if self.opts.regularization > 0.0 { n } else { 0 };
+        let rows = nf * nc;
+        let mut residual = vec![0.0; 2 * rows + n_reg];
+        let mut jac = jacobian.then(|| Mat::<f64>::zeros(2 * rows + n_reg, ncol));
+        let mut cost_data = 0.0;
+        for k in 0..nf {
+            for c in 0..nc {
+                let w = self.weight(c, k);
+                if w == 0.0 {
+                    continue;
+                }
+                let r = k * nc + c;
+                let v = self.ref_of[c];
+                let g = self.gain(x, v);
+                let h = model[k][c];
+                let meas = m.get(c, k);
+                let rho = match self.opts.misfit {
+                    Misfit::Relative => w * (g * h - meas) / meas.norm(),
+                    Misfit::Log => w * (g * h / meas).ln(),
+                };
+                if !(rho.re.is_finite() && rho.im.is_finite()) {
+                    return None;
+                }
+                residual[r] = rho.re;
+                residual[rows + r] = rho.im;
+                cost_data += rho.norm_sqr();
+                if let (Some(j), Some(s)) = (jac.as_mut(), sens.as_ref()) {
+                    for i in 0..n {
+                        let d = match self.opts.misfit {
+                            Misfit::Relative => -w * g * s[k][(c, i)] / meas.norm(),
+                            Misfit::Log => -w * s[k][(c, i)] / h,
+                        };
+                        j[(r, i)] = d.re;
+                        j[(rows + r, i)] = d.im;
+                    }
+                    if self.opts.gains {
+                        let da = match self.opts.misfit {
+                            Misfit::Relative => w * g * h / meas.norm(),
+                            Misfit::Log => C64::new(w, 0.0),
+                        };
+                        let db = da * C64::new(0.0, 1.0);
+                        j[(r, n + 2 * v)] = da.re;
+                        j[(rows + r, n + 2 * v)] = da.im;
+                        j[(r, n + 2 * v + 1)] = db.re;
+                        j[(rows + r, n + 2 * v + 1)] = db.im;
+                    }
+                }
+            }
+        }
+        let mut cost = cost_data;
+        if n_reg > 0 {
+            let s = self.opts.regularization.sqrt();
+            for i in 0..n {
+                residual[2 * rows + i] = s * x[i];
+                cost += (s * x[i]).powi(2);
+                if let Some(j) = jac.as_mut() {
+                    j[(2 * rows + i, i)] = s;
+                }
+            }
+        }
+        Some(Point { residual, cost_data, cost, jacobian: jac })
+    }
+}
+
+fn project(x: &mut [f64], lo: &[f64], hi: &[f64]) {
+    for ((v, l), h) in x.iter_mut().zip(lo).zip(hi) {
+        *v = v.clamp(*l, *h);
+    }
+}
+
+/// Fits `params` of `sys` (updated in place) to the measured data; see the
+/// module docs. `on_iteration` sees each record as it is made.
+pub fn run(
+    sys: &mut DampedSystem,
+    params: &ParameterSet,
+    data: &OeData<'_>,
+    opts: &OeOptions,
+    mut on_iteration: impl FnMut(&IterationRecord),
+) -> Result<OeResult, UpdateError> {
+    let measured = data.measured;
+    if let Some(w) = data.weights
+        && w.len() != measured.values().len()
+    {
+        return Err(UpdateError::Setup(format!("{} weights for {} data values", w.len(), measured.values().len())));
+    }
+    let refs = measured.references();
+    let ref_of = measured.channels().iter().map(|c| refs.iter().position(|&r| r == c.reference).unwrap()).collect();
+    let ev = Evaluator {
+        params,
+        data,
+        opts,
+        solver: ZSolver::new(&sys.assembly().pattern)?,
+        plan: ChannelPlan::new(sys, measured.channels())?,
+        ref_of,
+        refs,
+        p0: params.values(sys),
+    };
+    let (n, ng) = (ev.n_params(), ev.n_gain());
+    let n_data = ev.n_data();
+    if n_data == 0 {
+        return Err(UpdateError::Setup("every measured value has zero weight".into()));
+    }
+    // bounds in theta; gains are unbounded
+    let mut lo = vec![f64::NEG_INFINITY; n + ng];
+    let mut hi = vec![f64::INFINITY; n + ng];
+    for (i, b) in opts.bounds.iter().enumerate().take(n) {
+        if let Some((l, h)) = b {
+            lo[i] = (l / ev.p0[i]).ln();
+            hi[i] = (h / ev.p0[i]).ln();
+        }
+    }
+    let mut x = vec![0.0; n + ng];
+    if opts.gains {
+        // start each gain at its least-squares value for the initial model
+        let model = frf::synthesize_with(sys, &ev.solver, measured.channels(), measured.frequencies_hz())?;
+        for v in 0..ev.refs.len() {
+            let (mut num, mut den) = (C64::new(0.0, 0.0), 0.0);
+            for c in (0..measured.channels().len()).filter(|&c| ev.ref_of[c] == v) {
+                for k in 0..measured.n_freq() {
+                    let (h, m) = (model.get(c, k), measured.get(c, k));
+                    let w = ev.weight(c, k) / m.norm().max(1e-300);
+                    num += h.conj() * m * w * w;
+                    den += h.norm_sqr() * w * w;
+                }
+            }
+            if den > 0.0 && num.norm() > 0.0 {
+                let g = (num / den).ln();
+                x[n + 2 * v] = g.re;
+                x[n + 2 * v + 1] = g.im;
+            }
+        }
+    }
+    let mut point =
+        ev.eval(sys, &x, true).ok_or_else(|| UpdateError::Setup("the initial model cannot be evaluated".into()))?;
+    let record = |iteration: usize, p: &Point, x: &[f64], max_step: f64, lambda: f64, rank: usize| IterationRecord {
+        iteration,
+        residual: (p.cost_data / (n_data as f64 / 2.0)).sqrt(),
+        max_correction: max_step,
+        limited: 0,
+        rank,
+        lambda,
+        values: ev.p0.iter().zip(x).map(|(p, t)| p * t.exp()).collect(),
+    };
+    let mut history = vec![record(0, &point, &x, 0.0, 0.0, n + ng)];
+    on_iteration(&history[0]);
+    let mut lambda = 0.0;
+    let mut status = Status::MaxIterations;
+    for iteration in 1..=opts.max_iterations {
+        let jac = point.jacobian.as_ref().expect("points kept have a Jacobian");
+        let minus_r: Vec<f64> = point.residual.iter().map(|v| -v).collect();
+        let sol = lstsq::solve(jac, &minus_r, opts.rcond);
+        // first-order optimality: the Gauss-Newton step would gain almost nothing
+        let predicted = sol.predicted_reduction();
+        if predicted <= 1e-10 * point.cost {
+            status = Status::Converged;
+            break;
+        }
+        let smax2 = sol.largest_singular_value().powi(2);
+        let mut accepted = None;
+        for _ in 0..20 {
+            let mut step = if lambda == 0.0 { sol.x.clone() } else { sol.damped(lambda) };
+            // at most a factor of 100 per step in any parameter
+            for s in step.iter_mut().take(n) {
+                *s = s.clamp(-(100f64.ln()), 100f64.ln());
+            }
+            let mut trial: Vec<f64> = x.iter().zip(&step).map(|(a, b)| a + b).collect();
+            project(&mut trial, &lo, &hi);
+            if let Some(p) = ev.eval(sys, &trial, false)
+                && p.cost < point.cost
+            {
+                accepted = Some((trial, p.cost));
+                lambda = if lambda <= 1e-9 * smax2 { 0.0 } else { lambda / 10.0 };
+                break;
+            }
+            lambda = if lambda == 0.0 { 1e-4 * smax2 } else { lambda * 10.0 };
+        }
+        let Some((trial, trial_cost)) = accepted else {
+            // no step lowers the cost: at the optimum to working precision
+            status = if predicted <= 1e-6 * point.cost { Status::Converged } else { Status::Stalled };
+            break;
+        };
+        let max_step = trial.iter().zip(&x).take(n).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+        let relative_gain = (point.cost - trial_cost) / point.cost;
+        x = trial;
+        point = match ev.eval(sys, &x, true) {
+            Some(p) => p,
+            None => {
+                status = Status::Failed("the model cannot be evaluated at the accepted step".into());
+                break;
+            }
+        };
+        let rec = record(iteration, &point, &x, max_step, lambda, sol.rank);
+        on_iteration(&rec);
+        history.push(rec);
+        if max_step < opts.tolerance || relative_gain < 1e-12 {
+            status = Status::Converged;
+            break;
+        }
+    }
+    // leave the system at the final point and analyse it
+    let final_point = match point.jacobian {
+        Some(_) => point,
+        None => {
+            ev.eval(sys, &x, true).ok_or_else(|| UpdateError::Setup("the final model cannot be evaluated".into()))?
+        }
+    };
+    ev.apply(sys, &x)?;
+    let at_bound: Vec<bool> = (0..n).map(|i| (x[i] - lo[i]).abs() < 1e-9 || (x[i] - hi[i]).abs() < 1e-9).collect();
+    let jac = final_point.jacobian.as_ref().expect("final point has a Jacobian");
+    let sol = lstsq::solve(jac, &vec![0.0; jac.nrows()], opts.rcond);
+    let free = (0..n).filter(|&i| !at_bound[i]).count() + ng;
+    let dof = (n_data as f64 - free as f64).max(1.0);
+    let sigma2 = final_point.cost_data / dof;
+    let m = n + ng;
+    let covariance = Mat::from_fn(m, m, |i, j| {
+        sigma2 * sol.scaled_inverse_normal[(i, j)] / (sol.column_norms[i] * sol.column_norms[j])
+    });
+    let gains = (0..ev.refs.len())
+        .filter(|_| opts.gains)
+        .map(|v| {
+            let g = ev.gain(&x, v);
+            Gain { reference: ev.refs[v], magnitude: g.norm(), phase_deg: g.arg().to_degrees() }
+        })
+        .collect();
+    Ok(OeResult {
+        status,
+        values: ev.p0.iter().zip(&x).map(|(p, t)| p * t.exp()).collect(),
+        gains,
+        history,
+        cost: final_point.cost_data,
+        n_data,
+        covariance,
+        sigma2,
+        singular_values: sol.singular_values.clone(),
+        v: sol.v.clone(),
+        at_bound,
+    })
+}

@@ -1,0 +1,100 @@
+//! The output-error estimator's options against known truths.
+
+use damping::DampedSystem;
+use fe_model::{Dof, DofRef, samples};
+use frf::{C64, Channel, FrfSet, NoiseModel, synthesize};
+use rfm_update::oe::{self, Misfit, OeData, OeOptions};
+use rfm_update::params::ParameterSet;
+use rfm_update::rfm::Status;
+
+fn beam_data(truth: &DampedSystem, noise: f64) -> FrfSet {
+    let tip = DofRef::new(31, Dof::Uy);
+    let channels: Vec<Channel> = (4..=31).step_by(3).map(|n| Channel::new(DofRef::new(n, Dof::Uy), tip)).collect();
+    let lines: Vec<f64> = (1..=200).map(|i| 2.0 * f64::from(i)).collect();
+    let mut set = synthesize(truth, &channels, &lines).unwrap();
+    NoiseModel::relative(noise, 17).apply(&mut set);
+    set
+}
+
+/// Starts the steel group's damping away from the truth.
+fn perturbed(truth: &DampedSystem) -> (DampedSystem, ParameterSet) {
+    let mut model = truth.clone();
+    let names = ["group.steel.mu", "group.steel.alpha", "group.aluminium.alpha"];
+    let qs: Vec<_> = names.iter().map(|n| model.model().quantity(n).unwrap()).collect();
+    for &q in &qs {
+        let v = model.get(q);
+        model.set(q, 0.5 * v).unwrap();
+    }
+    let params = ParameterSet::of_quantities(&model, &qs);
+    (model, params)
+}
+
+#[test]
+fn an_unknown_complex_gain_per_reference_is_estimated_with_the_parameters() {
+    let truth = DampedSystem::new(samples::two_material_cantilever()).unwrap();
+    let mut data = beam_data(&truth, 0.0);
+    let gain = C64::from_polar(0.37, 0.4);
+    for c in 0..data.channels().len() {
+        for v in data.channel_mut(c) {
+            *v *= gain;
+        }
+    }
+    let (mut model, params) = perturbed(&truth);
+    let opts = OeOptions { gains: true, ..OeOptions::default() };
+    let r = oe::run(&mut model, &params, &OeData { measured: &data, weights: None }, &opts, |_| {}).unwrap();
+    assert_eq!(r.status, Status::Converged);
+    assert!((r.gains[0].magnitude / 0.37 - 1.0).abs() < 1e-8, "{:?}", r.gains);
+    assert!((r.gains[0].phase_deg - 0.4f64.to_degrees()).abs() < 1e-6, "{:?}", r.gains);
+    for (&v, q) in r.values.iter().zip(params.quantities()) {
+        let t = truth.get(*q);
+        assert!((v / t - 1.0).abs() < 1e-7, "{v} vs {t}");
+    }
+    // without the gain the same data cannot be fitted
+    let (mut model, params) = perturbed(&truth);
+    let r = oe::run(&mut model, &params, &OeData { measured: &data, weights: None }, &OeOptions::default(), |_| {})
+        .unwrap();
+    assert!(r.history.last().unwrap().residual > 0.3);
+}
+
+#[test]
+fn an_active_bound_holds_and_is_reported() {
+    let truth = DampedSystem::new(samples::two_material_cantilever()).unwrap();
+    let data = beam_data(&truth, 0.005);
+    let (mut model, params) = perturbed(&truth);
+    // the steel mu is 631 in truth; keep it below 400
+    let start = params.values(&model);
+    let opts = OeOptions { bounds: vec![Some((1.0, 400.0)), None, None], ..OeOptions::default() };
+    let r = oe::run(&mut model, &params, &OeData { measured: &data, weights: None }, &opts, |_| {}).unwrap();
+    assert!(start[0] <= 400.0);
+    assert!((r.values[0] - 400.0).abs() < 1e-9, "{}", r.values[0]);
+    assert_eq!(r.at_bound, vec![true, false, false]);
+}
+
+#[test]
+fn band_weights_of_zero_mask_corrupted_lines() {
+    let truth = DampedSystem::new(samples::two_material_cantilever()).unwrap();
+    let mut data = beam_data(&truth, 0.0);
+    // corrupt the lines above 300 Hz (a broken sensor band)
+    let nf = data.n_freq();
+    let bad: Vec<usize> = (0..nf).filter(|&k| data.frequencies_hz()[k] > 300.0).collect();
+    for c in 0..data.channels().len() {
+        for &k in &bad {
+            let v = data.get(c, k);
+            data.set(c, k, v * 3.0);
+        }
+    }
+    let mut weights = vec![1.0; data.values().len()];
+    for c in 0..data.channels().len() {
+        for &k in &bad {
+            weights[c * nf + k] = 0.0;
+        }
+    }
+    let (mut model, params) = perturbed(&truth);
+    let opts = OeOptions { misfit: Misfit::Log, ..OeOptions::default() };
+    let r = oe::run(&mut model, &params, &OeData { measured: &data, weights: Some(&weights) }, &opts, |_| {}).unwrap();
+    for (&v, q) in r.values.iter().zip(params.quantities()) {
+        let t = truth.get(*q);
+        assert!((v / t - 1.0).abs() < 1e-6, "{v} vs {t}");
+    }
+    assert_eq!(r.n_data, 2 * data.channels().len() * (nf - bad.len()));
+}
