@@ -312,11 +312,12 @@ pub fn complex_modes(sys: &DampedSystem) -> Result<ComplexModes, ModalError> {
     let ops = Operators::new(sys);
     let n = ops.n();
     // internal variables: (mu, d_i, r_i)
+    if 2 * n > MAX_STATE_DIMENSION {
+        // no need to factorise the damping matrices of a model this large
+        return Err(ModalError::TooLarge { dofs: n, state_dimension: 2 * n, max: MAX_STATE_DIMENSION });
+    }
     let mut internal: Vec<(f64, f64, Vec<f64>)> = Vec::new();
     for (g, mu, c) in &ops.relaxing {
-        if 2 * n + internal.len() > MAX_STATE_DIMENSION {
-            break;
-        }
         for (d, r) in internal_directions(&ops, *g, c)? {
             internal.push((*mu, d, r));
         }
@@ -558,8 +559,10 @@ fn solve_pencil(ops: &Operators<'_>, internal: &[(f64, f64, Vec<f64>)]) -> Resul
 
 fn oscillatory_mode(ops: &Operators<'_>, s: C64, mut phi: Vec<C64>) -> ComplexMode {
     let a = ops.bilinear(&ops.dz_values(s), &phi);
-    let mut scale = 1.0 / a.sqrt();
     let big = phi.iter().copied().max_by(|x, y| x.norm().total_cmp(&y.norm())).unwrap_or_default();
+    // a vanishing phi^T Z' phi would mean a defective eigenvalue, where no
+    // residue scaling exists: the largest component is then set to 1
+    let mut scale = if a.norm() > 0.0 && a.re.is_finite() && a.im.is_finite() { 1.0 / a.sqrt() } else { 1.0 / big };
     if (big * scale).re < 0.0 {
         scale = -scale;
     }

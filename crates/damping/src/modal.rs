@@ -28,7 +28,8 @@ pub enum ModalError {
     TooLarge {
         /// Number of equations of the model.
         dofs: usize,
-        /// `2 n +` the number of internal variables.
+        /// `2 n +` the number of internal variables (just `2 n` when that
+        /// alone exceeds the limit).
         state_dimension: usize,
         /// The limit.
         max: usize,

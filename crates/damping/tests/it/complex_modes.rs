@@ -304,10 +304,20 @@ fn a_large_viscous_mu_gives_the_viscous_modes() {
 
 #[test]
 fn models_beyond_the_dense_limit_are_refused_with_their_size() {
+    let max = damping::complex_modes::MAX_STATE_DIMENSION;
     let sys = DampedSystem::new(samples::cantilever(300)).unwrap();
     let e = complex_modes(&sys).unwrap_err();
-    assert_eq!(
-        e,
-        ModalError::TooLarge { dofs: 900, state_dimension: 1800, max: damping::complex_modes::MAX_STATE_DIMENSION }
-    );
+    assert_eq!(e, ModalError::TooLarge { dofs: 900, state_dimension: 1800, max });
+    // 699 DOFs fit as a viscous model but not with an exponential kernel on
+    // every element: the internal variables push the state past the limit
+    let mut model = samples::cantilever(233);
+    model.group_mut(0).mu = Some(500.0);
+    let sys = DampedSystem::new(model).unwrap();
+    match complex_modes(&sys).unwrap_err() {
+        ModalError::TooLarge { dofs, state_dimension, max: m } => {
+            assert_eq!((dofs, m), (699, max));
+            assert!(state_dimension > max && state_dimension <= 3 * 699, "{state_dimension}");
+        }
+        other => panic!("expected TooLarge, got {other:?}"),
+    }
 }
