@@ -278,7 +278,8 @@ pub struct ModalEstimate {
     pub upper_residuals: Vec<C64>,
     /// Lower residual `LR` of each channel (`LR / (j w)^2`).
     pub lower_residuals: Vec<C64>,
-    /// Relative LSFD misfit of each channel, `|H - H_fit| / |H|` over the band.
+    /// Relative LSFD misfit of each channel, `|H - H_fit| / |H|` over the
+    /// band (absolute for a channel of zeros).
     pub fit_error: Vec<f64>,
 }
 
@@ -295,7 +296,7 @@ impl ModalEstimate {
     }
 }
 
-/// The data of the band arranged per response: `h[o][f][i]` (reference `i`).
+/// The lines of the band and, per response, the channel of each reference.
 struct Arranged {
     omega: Vec<f64>,
     /// Channel index of (response, reference).
@@ -320,8 +321,8 @@ fn arrange(set: &FrfSet, opts: &LscfOptions) -> Result<Arranged, LscfError> {
             responses.push(c.response);
         }
     }
-    // unknowns per response: (p + 1) (m + ...) ; ask for at least twice as
-    // many complex equations as polynomial coefficients of one row
+    // at least twice as many lines as denominator coefficients per column
+    // (m (p + 1)), so that every order's normal equations are well posed
     let needed = 2 * (max_order + 1) * references.len().max(1);
     if !(lo < hi) || lines.len() < needed {
         return Err(LscfError::Band { lo_hz: lo, hi_hz: hi, lines: lines.len(), needed });
@@ -367,9 +368,11 @@ fn lag_sums(set: &FrfSet, arr: &Arranged, o: usize, dt: f64, p: usize, weighting
     let rms = (rows.iter().flatten().map(|v| v.norm_sqr()).sum::<f64>() / rows.len() as f64).sqrt();
     for (f, row) in rows.iter().enumerate() {
         let mag = row.iter().map(|v| v.norm_sqr()).sum::<f64>().sqrt();
+        // a line (or response) of zeros carries no information: weight 0
         let w2 = match weighting {
-            Weighting::InverseMagnitude => 1.0 / (mag * mag).max(1e-300),
-            Weighting::PerResponse => 1.0 / (rms * rms).max(1e-300),
+            Weighting::InverseMagnitude if mag > 0.0 => 1.0 / (mag * mag),
+            Weighting::PerResponse if rms > 0.0 => 1.0 / (rms * rms),
+            _ => 0.0,
         };
         let theta = arr.omega[f] * dt;
         for (li, d) in (-(p as i64)..=(p as i64)).enumerate() {
@@ -553,8 +556,11 @@ pub fn lscf(set: &FrfSet, opts: &LscfOptions) -> Result<ModalEstimate, LscfError
     let f_first = set.frequencies_hz()[arr.lines[0]];
     let f_last = set.frequencies_hz()[*arr.lines.last().unwrap()];
     let dt = 1.0 / (2.0 * f_last);
-    let sums: Vec<LagSums> =
-        (0..arr.responses.len()).map(|o| lag_sums(set, &arr, o, dt, pmax, opts.weighting)).collect();
+    // responses without any signal add nothing (and would make R_o singular)
+    let sums: Vec<LagSums> = (0..arr.responses.len())
+        .map(|o| lag_sums(set, &arr, o, dt, pmax, opts.weighting))
+        .filter(|ls| ls.r[pmax].re > 0.0)
+        .collect();
 
     let two_pi = 2.0 * std::f64::consts::PI;
     let mut stabilisation: Vec<OrderPoles> = Vec::new();
@@ -754,7 +760,7 @@ fn lsfd(
                 num += (h - out.synthesize(c, set.frequencies_hz()[k])).norm_sqr();
                 den += h.norm_sqr();
             }
-            (num / den).sqrt()
+            if den > 0.0 { (num / den).sqrt() } else { num.sqrt() }
         })
         .collect();
     Ok(out)

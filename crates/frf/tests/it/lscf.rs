@@ -251,6 +251,15 @@ fn unusable_input_is_refused_with_a_reason() {
         lscf(&nan, &opts).unwrap_err(),
         LscfError::NotFinite { channel: nan.channels()[2], freq_hz: nan.frequencies_hz()[10] }
     );
+    // a response without signal (a dead sensor) is ignored, not fatal
+    let mut dead = h.clone();
+    dead.channel_mut(1).fill(C64::new(0.0, 0.0));
+    let mut o = opts.clone();
+    o.orders = 2..=30;
+    let est = lscf(&dead, &o).unwrap();
+    assert_eq!(est.modes.len(), 3);
+    assert_eq!(est.fit_error[1], 0.0);
+    assert!(est.fit_error.iter().all(|e| e.is_finite()));
     // an empty FrfSet of the right kind but no lines in the band
     let empty = FrfSet::zeros(vec![1.0, 2.0], grid(&[tip], &[tip]), FrfKind::Receptance).unwrap();
     assert!(matches!(lscf(&empty, &opts).unwrap_err(), LscfError::Band { lines: 0, .. }));
