@@ -1,3 +1,5 @@
 //! Integration tests of the frf crate.
 
+mod lscf;
+mod modal;
 mod physics;
