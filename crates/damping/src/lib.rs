@@ -28,6 +28,27 @@
 //! group's matrices that the quantity multiplies. Every row is checked
 //! against central finite differences in the tests.
 //!
+//! # Modes
+//!
+//! [`normal_modes`] gives the undamped modes (`K phi = w^2 M phi`).
+//! [`complex_modes()`] gives the exact complex modes of the damped model, the
+//! roots of `Z(s) phi = 0` with
+//!
+//! ```text
+//! Z(s) = K + s^2 M + s sum_g mu_g / (mu_g + s) C_g        (s = j w on the frequency axis)
+//! ```
+//!
+//! through a state-space expansion with one internal variable per retained
+//! direction of each exponential group's `C_g` (`C_g = sum_i d_i r_i r_i^T`,
+//! rank-revealing on the group's DOFs):
+//! `s q_i = mu_g (r_i^T s x - q_i)`, `s^2 M x + s C_v x + K x + sum_i d_i r_i q_i = 0`.
+//! Oscillatory modes ([`ComplexMode`]: eigenvalue, natural frequency
+//! `|s| / 2 pi`, damping ratio `-Re s / |s|`, shape scaled to
+//! `phi^T Z'(s) phi = 1` so that the receptance residue is `phi phi^T`) and
+//! real non-oscillatory modes ([`RealMode`]: the kernels' relaxation modes and
+//! overdamped modes) are reported separately. Dense: a few hundred DOFs; see
+//! [`complex_modes`](mod@complex_modes) for the formulation and limits.
+//!
 //! # Example
 //!
 //! ```
@@ -43,12 +64,19 @@
 //! let mu = sys.model().quantity("group.steel.mu").unwrap();
 //! let d = sys.derivative(mu, omega);
 //! assert!(!d.is_zero());
+//!
+//! // the complex modes: the first bending mode near 7.9 Hz, lightly damped
+//! let modes = damping::complex_modes(&sys).unwrap();
+//! let first = &modes.oscillatory[0];
+//! assert!((first.frequency_hz - 7.88).abs() < 0.01 && first.damping_ratio < 0.01);
 //! ```
 
+pub mod complex_modes;
 pub mod kernel;
 pub mod modal;
 pub mod system;
 
+pub use complex_modes::{ComplexMode, ComplexModes, RealMode, complex_modes};
 pub use kernel::{GroupCoefficients, relaxation_factor};
 pub use modal::{ModalError, NormalModes, normal_modes};
 pub use system::{DampedSystem, Derivative};

@@ -21,6 +21,22 @@ pub enum ModalError {
     /// The eigensolver did not converge.
     #[error("the eigenvalue solver did not converge")]
     NoConvergence,
+    /// The dense state-space problem would be too large.
+    #[error(
+        "the model is too large for dense complex modal analysis: {dofs} DOFs give a state space of dimension {state_dimension} (at most {max})"
+    )]
+    TooLarge {
+        /// Number of equations of the model.
+        dofs: usize,
+        /// `2 n +` the number of internal variables (just `2 n` when that
+        /// alone exceeds the limit).
+        state_dimension: usize,
+        /// The limit.
+        max: usize,
+    },
+    /// The eigensolver returned NaN or infinity (ill-posed input).
+    #[error("the eigenvalue solver returned a non-finite result (are the model's matrices finite?)")]
+    NotFinite,
 }
 
 /// Undamped natural frequencies and mass-normalised mode shapes.

@@ -19,6 +19,20 @@
 //! and writes files atomically; [`correlation`] measures how far a model's
 //! FRFs are from measured ones (dB and phase errors, FRAC, per band).
 //!
+//! # Modal parameters and correlation
+//!
+//! [`lscf()`] estimates the modes in a band from receptances: the
+//! (poly-reference) least-squares complex frequency-domain estimator fits
+//! `H_o(w) ~ B_o(z) A(z)^-1` with `z = exp(j w dt)` and real matrix
+//! coefficients, over model orders `p`; poles `s = ln(z) / dt` that stay
+//! stable in frequency, damping and participation over consecutive orders
+//! are kept (the whole stabilisation diagram is returned), then residues and
+//! shapes come from a least-squares fit of
+//! `H(w) = sum_k [R_k / (j w - s_k) + conj(R_k) / (j w - conj(s_k))] + UR + LR / (j w)^2`.
+//! [`modal`] compares model modes ([`model_modes`], from
+//! [`damping::complex_modes()`]) with measured ones ([`measured_modes`]) by
+//! the MAC, `|a^H b|^2 / ((a^H a)(b^H b))`, and pairs them ([`pair_modes`]).
+//!
 //! # Example
 //!
 //! ```
@@ -36,10 +50,35 @@
 //!
 //! NoiseModel::relative(0.01, 42).apply(&mut h); // 1 % complex noise, seed 42
 //! ```
+//!
+//! Modes from FRFs, paired with the model's:
+//!
+//! ```
+//! use damping::DampedSystem;
+//! use fe_model::{Dof, DofRef, samples};
+//! use frf::{Channel, LscfOptions, lscf, measured_modes, model_modes, pair_modes, synthesize};
+//!
+//! let sys = DampedSystem::new(samples::frame_with_joint()).unwrap();
+//! let tip = DofRef::new(4, Dof::Uy);
+//! let dofs = [DofRef::new(2, Dof::Ux), DofRef::new(4, Dof::Ux), tip];
+//! let channels: Vec<Channel> = dofs.iter().map(|&d| Channel::new(d, tip)).collect();
+//! let freqs: Vec<f64> = (0..=1920).map(|k| 40.0 + 0.5 * f64::from(k)).collect();
+//! let h = synthesize(&sys, &channels, &freqs).unwrap();
+//!
+//! let estimate = lscf(&h, &LscfOptions::new(40.0, 1000.0)).unwrap();
+//! let model = model_modes(&sys, &dofs, 1000.0).unwrap();
+//! let pairing = pair_modes(&model, &measured_modes(&estimate), 0.9);
+//! assert_eq!(pairing.pairs.len(), 3); // 120, 274 and 663 Hz
+//! for p in &pairing.pairs {
+//!     assert!(p.frequency_error_pct.abs() < 1e-3 && p.mac > 0.99);
+//! }
+//! ```
 
 pub mod correlation;
 pub mod error;
 pub mod io;
+pub mod lscf;
+pub mod modal;
 pub mod noise;
 pub mod set;
 pub mod solver;
@@ -47,6 +86,8 @@ pub mod synth;
 
 pub use correlation::{BandSpec, Correlation, correlate};
 pub use error::FrfError;
+pub use lscf::{EstimatedMode, LscfError, LscfOptions, ModalEstimate, PoleStatus, lscf};
+pub use modal::{Mode, ModeError, ModePair, Pairing, mac, mac_matrix, measured_modes, model_modes, pair_modes};
 pub use noise::NoiseModel;
 pub use set::{Channel, FrfKind, FrfSet};
 pub use solver::{Workspace, ZSolver};

@@ -1,4 +1,6 @@
 //! Integration tests of the frf crate.
 
 mod correlation;
+mod lscf;
+mod modal;
 mod physics;

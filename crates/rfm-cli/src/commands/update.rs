@@ -246,5 +246,5 @@ fn print_outcome(outcome: &UpdateOutcome) {
         }
         t.row(row);
     }
-    println!("\nundamped natural frequencies in the measured band\n{}", t.render());
+    println!("\n{} natural frequencies in the measured band\n{}", nf.kind, t.render());
 }
