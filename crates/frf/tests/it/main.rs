@@ -3,3 +3,4 @@
 mod lscf;
 mod modal;
 mod physics;
+mod uff;
