@@ -1,6 +1,7 @@
 //! One module per subcommand. Only this crate prints.
 
 mod diagnose;
+mod inspect;
 mod simulate;
 mod update;
 
@@ -9,6 +10,7 @@ use std::path::Path;
 use fe_model::CaseFile;
 
 pub(crate) use diagnose::{DiagnoseArgs, diagnose};
+pub(crate) use inspect::inspect;
 pub(crate) use simulate::simulate;
 pub(crate) use update::{Overrides as UpdateOverrides, update};
 
