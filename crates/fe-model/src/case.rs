@@ -280,7 +280,14 @@ pub struct MeasurementSpec {
     pub map: Vec<ChannelMap>,
 }
 
-/// Mapping of a test point and direction to a model DOF.
+/// Mapping of a test point and direction to a model DOF: the unit vector of
+/// the test direction `test` equals `sign` times the model DOF `model`.
+///
+/// A measured FRF whose response or reference is at `test` is multiplied by
+/// the direction's sign (`-Z` counts -1) and by `sign`, once for the response
+/// and once for the reference. Without an entry, measurement readers map
+/// `X`, `Y`, `RZ` to `ux`, `uy`, `rz` of the same node (see
+/// `docs/measured-data.md`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct ChannelMap {
     /// Test point and direction as written in the measurement file, e.g. `101:+Y`.
@@ -289,6 +296,48 @@ pub struct ChannelMap {
     pub model: DofRef,
     /// +1 or -1.
     pub sign: f64,
+}
+
+impl ChannelMap {
+    /// Parses a test point `node:direction` into the node and a signed
+    /// direction code: `X`, `Y`, `Z`, `RX`, `RY`, `RZ` are 1 to 6 (the codes
+    /// of UFF dataset 58), negative with a leading `-`; `S` (scalar) is 0.
+    /// Letters are case-insensitive, `+` is optional, and the numeric codes
+    /// themselves (`101:-3`) are accepted.
+    pub fn parse_test_point(s: &str) -> Result<(i64, i8), String> {
+        let bad = || {
+            format!(
+                "`{s}` is not a test point; write node:direction, e.g. `101:+Z` \
+                 (directions X, Y, Z, RX, RY, RZ with an optional sign, or S for scalar)"
+            )
+        };
+        let (node, dir) = s.trim().split_once(':').ok_or_else(bad)?;
+        let node: i64 = node.trim().parse().map_err(|_| bad())?;
+        let dir = dir.trim().to_ascii_uppercase();
+        let (sign, axis) = match dir.strip_prefix('-') {
+            Some(rest) => (-1, rest),
+            None => (1, dir.strip_prefix('+').unwrap_or(&dir)),
+        };
+        let code: i8 = match axis {
+            "X" => 1,
+            "Y" => 2,
+            "Z" => 3,
+            "RX" => 4,
+            "RY" => 5,
+            "RZ" => 6,
+            "S" | "SCALAR" => 0,
+            digits => match digits.parse::<i8>() {
+                Ok(c) if (0..=6).contains(&c) => c,
+                _ => return Err(bad()),
+            },
+        };
+        Ok((node, sign * code))
+    }
+
+    /// The node and signed direction code of `test` (see [`ChannelMap::parse_test_point`]).
+    pub fn test_point(&self) -> Result<(i64, i8), String> {
+        Self::parse_test_point(&self.test)
+    }
 }
 
 /// The truth of a simulated study: the model that generates "measured" data.
@@ -1004,21 +1053,26 @@ fn parse_measurement(ctx: &Ctx<'_>, m: &Spanned<RawMeasurement>, model: &Model) 
         let p = Path::new(d.get_ref());
         if p.is_absolute() { p.to_path_buf() } else { ctx.path.parent().unwrap_or(Path::new(".")).join(p) }
     });
-    let map = r
-        .map
-        .iter()
-        .map(|c| {
-            let c = c.get_ref();
-            let model_dof: DofRef = c.model.get_ref().parse().map_err(|e: String| ctx.err(c.model.span(), e))?;
-            if model.node(model_dof.node).is_none() {
-                return Err(ctx.err(c.model.span(), format!("node {} does not exist in the model", model_dof.node)));
-            }
-            if c.sign != 1.0 && c.sign != -1.0 {
-                return Err(ctx.err(c.model.span(), "sign must be 1 or -1"));
-            }
-            Ok(ChannelMap { test: c.test.get_ref().clone(), model: model_dof, sign: c.sign })
-        })
-        .collect::<Result<_, _>>()?;
+    let mut map: Vec<ChannelMap> = Vec::new();
+    for entry in &r.map {
+        let c = entry.get_ref();
+        let (node, dir) = ChannelMap::parse_test_point(c.test.get_ref()).map_err(|e| ctx.err(c.test.span(), e))?;
+        // One entry per test node and axis: `101:+Z` and `101:-Z` describe the same sensor axis.
+        if let Some(prev) = map.iter().find(|m| m.test_point().is_ok_and(|(n, d)| n == node && d.abs() == dir.abs())) {
+            return Err(ctx.err(
+                c.test.span(),
+                format!("test point `{}` is already mapped by `{}`", c.test.get_ref(), prev.test),
+            ));
+        }
+        let model_dof: DofRef = c.model.get_ref().parse().map_err(|e: String| ctx.err(c.model.span(), e))?;
+        if model.node(model_dof.node).is_none() {
+            return Err(ctx.err(c.model.span(), format!("node {} does not exist in the model", model_dof.node)));
+        }
+        if c.sign != 1.0 && c.sign != -1.0 {
+            return Err(ctx.err(entry.span(), "sign must be 1 or -1"));
+        }
+        map.push(ChannelMap { test: c.test.get_ref().clone(), model: model_dof, sign: c.sign });
+    }
     Ok(MeasurementSpec { frequencies_hz, references, responses, data, map })
 }
 
@@ -1288,6 +1342,42 @@ node = 1
         assert!(!out.contains("[[supports]]"));
         assert!(parse(&out).unwrap().model.supports().is_empty());
         assert!(c.without_supports_at(3).is_err());
+    }
+
+    #[test]
+    fn test_points_parse_with_signs_and_codes() {
+        assert_eq!(ChannelMap::parse_test_point("101:+Z"), Ok((101, 3)));
+        assert_eq!(ChannelMap::parse_test_point(" 7 : -rz "), Ok((7, -6)));
+        assert_eq!(ChannelMap::parse_test_point("5:Y"), Ok((5, 2)));
+        assert_eq!(ChannelMap::parse_test_point("5:-4"), Ok((5, -4)));
+        assert_eq!(ChannelMap::parse_test_point("-1:S"), Ok((-1, 0)));
+        for bad in ["101", "101:W", "x:+Z", "101:7", "101:+-Z"] {
+            assert!(ChannelMap::parse_test_point(bad).unwrap_err().contains("is not a test point"), "{bad}");
+        }
+    }
+
+    #[test]
+    fn measurement_map_errors_are_located() {
+        let base = format!(
+            "{BEAM}[measurement]\nfrequencies = [10.0]\nreferences = [\"5:uy\"]\nresponses = [\"5:uy\"]\ndata = \"m.uff\"\n"
+        );
+        let ok = format!("{base}[[measurement.map]]\ntest = \"105:-Z\"\nmodel = \"5:uy\"\nsign = -1\n");
+        let c = parse(&ok).unwrap();
+        let m = &c.measurement.unwrap().map[0];
+        assert_eq!((m.test_point(), m.model, m.sign), (Ok((105, -3)), DofRef::new(5, Dof::Uy), -1.0));
+
+        let text = format!("{base}[[measurement.map]]\ntest = \"105:Q\"\nmodel = \"5:uy\"\n");
+        let e = parse(&text).unwrap_err();
+        assert!(e.message.contains("`105:Q` is not a test point"), "{e}");
+        assert_eq!(text.lines().nth(e.location.unwrap().line - 1).unwrap(), "test = \"105:Q\"");
+
+        let text = format!(
+            "{base}[[measurement.map]]\ntest = \"105:+Z\"\nmodel = \"5:uy\"\n\
+             [[measurement.map]]\ntest = \"105:-z\"\nmodel = \"4:uy\"\n"
+        );
+        let e = parse(&text).unwrap_err();
+        assert!(e.message.contains("`105:-z` is already mapped by `105:+Z`"), "{e}");
+        assert_eq!(text.lines().nth(e.location.unwrap().line - 1).unwrap(), "test = \"105:-z\"");
     }
 
     #[test]

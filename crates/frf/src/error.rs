@@ -54,6 +54,15 @@ pub enum FrfError {
         /// What is wrong.
         message: String,
     },
+    /// Data that cannot be written in the requested format (a number too
+    /// wide for its fixed-width field, complex FRFs as a real type, ...).
+    #[error("cannot write {format}: {message}")]
+    Unwritable {
+        /// The format (`UFF dataset 58`).
+        format: &'static str,
+        /// Why.
+        message: String,
+    },
     /// Two FRF sets that should match do not.
     #[error("{0}")]
     Mismatch(String),

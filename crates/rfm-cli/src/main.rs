@@ -75,6 +75,15 @@ enum Command {
         #[arg(long, default_value_t = 10)]
         top: usize,
     },
+    /// List what a measurement file holds (UFF dataset 58 or CSV): channels,
+    /// function types, units, frequency lines, data types; skipped datasets.
+    Inspect {
+        /// Measurement file (.uff, .unv, .58, .csv, ...).
+        file: PathBuf,
+        /// Print machine-readable JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
     /// Update the model's parameters so that its FRFs match the measured ones.
     Update {
         /// Case file.
@@ -112,6 +121,7 @@ fn main() -> ExitCode {
             out: out.as_deref(),
             top,
         }),
+        Command::Inspect { file, json } => commands::inspect(&file, json),
         Command::Update { case, out, json, method, lines, iterations } => commands::update(
             &case,
             out.as_deref(),

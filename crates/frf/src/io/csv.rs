@@ -115,8 +115,16 @@ pub fn parse_csv(path: &Path, text: &str) -> Result<FrfSet, FrfError> {
         match &header {
             None => {
                 let sep = [';', '\t'].into_iter().find(|&c| line.contains(c)).unwrap_or(',');
-                header =
-                    Some((line_no, split_fields(line, sep).into_iter().map(|s| s.trim().to_string()).collect(), sep));
+                let cols: Vec<String> = split_fields(line, sep).into_iter().map(|s| s.trim().to_string()).collect();
+                // checked here, before any data row, so that a file in another layout is
+                // refused at its first line rather than at a row it cannot parse
+                if !cols[0].to_ascii_lowercase().contains("freq") {
+                    return Err(err(
+                        line_no,
+                        format!("the first column must be the frequency in Hz, found `{}`", cols[0]),
+                    ));
+                }
+                header = Some((line_no, cols, sep));
             }
             Some((_, cols, sep)) => {
                 let fields: Vec<&str> = line.split(*sep).collect();
@@ -141,9 +149,6 @@ pub fn parse_csv(path: &Path, text: &str) -> Result<FrfSet, FrfError> {
         }
     }
     let (hline, cols, _) = header.ok_or_else(|| err(1, "no header line".into()))?;
-    if !cols[0].to_ascii_lowercase().contains("freq") {
-        return Err(err(hline, format!("the first column must be the frequency in Hz, found `{}`", cols[0])));
-    }
     if cols.len() < 3 || (cols.len() - 1) % 2 != 0 {
         return Err(err(
             hline,

@@ -1,12 +1,17 @@
 //! File input and output of FRF sets. This module is the only place in the
 //! crate that touches the file system.
 //!
+//! Measured data comes as UFF dataset 58 ([`uff`]: ASCII or binary, test
+//! nodes and directions mapped to model DOFs) or CSV ([`csv`]: model DOFs);
+//! [`read_measured`] picks the reader by extension or content.
+//!
 //! Every writer goes through [`atomic_write`]: the data is written to a
 //! temporary file beside the target and renamed over it, so an interrupted
 //! run never leaves a half-written file, and [`atomic_write`] refuses to
 //! replace a file the caller marks as an input.
 
 pub mod csv;
+pub mod uff;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -16,19 +21,84 @@ use fe_model::case::ChannelMap;
 use crate::error::FrfError;
 use crate::set::FrfSet;
 
-/// Reads a measured FRF file, choosing the format from its extension, and
-/// maps its channels to model DOFs. CSV files name model DOFs directly (the
-/// map is not used).
-pub fn read_measured(path: &Path, map: &[ChannelMap]) -> Result<FrfSet, FrfError> {
-    let _ = map;
+/// A measured-data file format.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MeasuredFormat {
+    /// Plain CSV whose channel names are model DOFs ([`csv`]).
+    Csv,
+    /// Universal file, dataset 58 or 58b ([`uff`]).
+    Uff,
+}
+
+/// File extensions read as universal files.
+pub const UFF_EXTENSIONS: [&str; 4] = ["uff", "unv", "58", "uff58"];
+
+/// The format of a measured-data file: by extension (`.csv`/`.txt` CSV,
+/// `.uff`/`.unv`/`.58`/`.uff58` universal file), otherwise by content (a
+/// universal file starts with a `-1` line; a CSV file has a header line
+/// naming a frequency column).
+pub fn detect_format(path: &Path) -> Result<MeasuredFormat, FrfError> {
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
-    match ext.as_str() {
-        "csv" | "txt" => csv::read_csv(path),
-        _ => Err(FrfError::Io {
-            path: path.to_path_buf(),
-            message: format!("unsupported measured-data format `.{ext}` (supported: .csv)"),
-        }),
+    if ext == "csv" || ext == "txt" {
+        return Ok(MeasuredFormat::Csv);
     }
+    if UFF_EXTENSIONS.contains(&ext.as_str()) {
+        return Ok(MeasuredFormat::Uff);
+    }
+    let bytes = uff::read_bytes(path)?;
+    if uff::looks_like_uff(&bytes) {
+        return Ok(MeasuredFormat::Uff);
+    }
+    let looks_csv = String::from_utf8_lossy(bytes.get(..4096).unwrap_or(&bytes))
+        .lines()
+        .map(str::trim)
+        .find(|l| !l.is_empty() && !l.starts_with('#'))
+        .is_some_and(|l| l.to_ascii_lowercase().starts_with("freq"));
+    if looks_csv {
+        return Ok(MeasuredFormat::Csv);
+    }
+    Err(FrfError::Io {
+        path: path.to_path_buf(),
+        message: format!(
+            "cannot tell the format of this file{}: it is neither a universal file (dataset 58, first line `-1`) \
+             nor CSV (a header line starting with the frequency column); supported: .csv, .txt, {}",
+            if ext.is_empty() { String::new() } else { format!(" (extension `.{ext}`)") },
+            UFF_EXTENSIONS.map(|e| format!(".{e}")).join(", ")
+        ),
+    })
+}
+
+/// Measured FRFs and what reading them involved.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Measured {
+    /// The FRFs on model DOFs, in the file's kind (call
+    /// [`FrfSet::to_receptance`] to compare with receptances).
+    pub set: FrfSet,
+    /// The format read.
+    pub format: MeasuredFormat,
+    /// Notes for the user (skipped datasets, dropped lines, conversions).
+    pub notes: Vec<String>,
+}
+
+/// Reads a measured FRF file (see [`detect_format`]) and maps its channels
+/// to model DOFs. CSV files name model DOFs directly (the map is not used);
+/// universal files name test nodes and directions, mapped through `map`
+/// (see [`uff::map_test_dof`] and `docs/measured-data.md`).
+pub fn load_measured(path: &Path, map: &[ChannelMap]) -> Result<Measured, FrfError> {
+    match detect_format(path)? {
+        MeasuredFormat::Csv => {
+            Ok(Measured { set: csv::read_csv(path)?, format: MeasuredFormat::Csv, notes: Vec::new() })
+        }
+        MeasuredFormat::Uff => {
+            let u = uff::read_uff_frfs(path, map)?;
+            Ok(Measured { set: u.set, format: MeasuredFormat::Uff, notes: u.notes })
+        }
+    }
+}
+
+/// Reads a measured FRF file like [`load_measured`], keeping only the FRFs.
+pub fn read_measured(path: &Path, map: &[ChannelMap]) -> Result<FrfSet, FrfError> {
+    load_measured(path, map).map(|m| m.set)
 }
 
 /// Writes `bytes` to `path` atomically (temporary file in the same folder,

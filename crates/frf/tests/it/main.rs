@@ -4,3 +4,4 @@ mod correlation;
 mod lscf;
 mod modal;
 mod physics;
+mod uff;

@@ -2,6 +2,7 @@
 
 mod compare;
 mod diagnose;
+mod inspect;
 mod simulate;
 mod update;
 
@@ -11,6 +12,7 @@ use fe_model::CaseFile;
 
 pub(crate) use compare::compare;
 pub(crate) use diagnose::{DiagnoseArgs, diagnose};
+pub(crate) use inspect::inspect;
 pub(crate) use simulate::simulate;
 pub(crate) use update::{Overrides as UpdateOverrides, update};
 

@@ -2,4 +2,5 @@
 
 mod commands;
 mod diagnose;
+mod inspect;
 mod report;

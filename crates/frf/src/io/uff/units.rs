@@ -1,0 +1,383 @@
+//! What an FRF record relates, from its units labels (records 9 and 10) or,
+//! when those are absent, from its specific data types; and the factor to SI.
+//!
+//! Units labels are parsed as products and quotients of known units with
+//! integer powers (`m/s^2`, `(1/N)*(m/s²)`, `g/lbf`, `m s-2 N-1`, `1/kg`)
+//! into exponents of length, force and time plus a scale to metres, newtons
+//! and seconds. The time exponent decides the kind: 0 receptance, -1
+//! mobility, -2 accelerance. `g` is the standard gravity (9.80665 m/s^2), as
+//! in accelerometer units, never the gram.
+
+use std::f64::consts::PI;
+
+use super::{Direction, Header58, specific_data_type_name};
+use crate::set::FrfKind;
+
+/// The kind of an FRF record and the factor that brings its values to SI.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrfUnits {
+    /// Receptance, mobility or accelerance.
+    pub kind: FrfKind,
+    /// Multiply the file's values by this to get m, m/s or m/s^2 per N (rad for rotations, N m for moments).
+    pub scale: f64,
+    /// How it was decided, for messages (`units "g" / "N"`, or the data types).
+    pub basis: String,
+    /// Whether SI units were assumed because the file states none.
+    pub assumed_si: bool,
+}
+
+/// Decides what an FRF record relates from its header. Units labels win;
+/// without them the specific data types decide (SI assumed). When both are
+/// given and disagree, or neither is usable, it is an error (returned as a
+/// message to be prefixed with the record).
+pub fn frf_units(h: &Header58) -> Result<FrfUnits, String> {
+    let by_units = units_kind(h)?;
+    let by_types = types_kind(h)?;
+    match (by_units, by_types) {
+        (Some(u), Some((k, names))) if u.kind != k => Err(format!(
+            "the units {} say {}, but the data types ({names}) say {k}; correct one of them in the file",
+            u.basis, u.kind
+        )),
+        (Some(u), _) => Ok(u),
+        (None, Some((kind, names))) => {
+            Ok(FrfUnits { kind, scale: 1.0, basis: format!("data types {names}, SI assumed"), assumed_si: true })
+        }
+        (None, None) => Err(format!(
+            "cannot tell whether the FRF is a receptance, mobility or accelerance: the ordinate units are `{}` over \
+             `{}` and the data types {} over {}; the file should give units such as `m/s^2` over `N` (records 9 and \
+             10)",
+            h.numerator.units, h.denominator.units, h.numerator.specific_type, h.denominator.specific_type
+        )),
+    }
+}
+
+/// The factor from the abscissa's units to hertz, and whether Hz was assumed
+/// because the file does not say.
+pub(super) fn abscissa_to_hz(h: &Header58) -> Result<(f64, bool), String> {
+    let units = h.abscissa_axis.units.trim();
+    let t = h.abscissa_axis.specific_type;
+    match units.to_ascii_lowercase().replace(' ', "").as_str() {
+        "hz" | "1/s" | "cycles/s" => Ok((1.0, false)),
+        "khz" => Ok((1e3, false)),
+        "rad/s" | "rad/sec" => Ok((1.0 / (2.0 * PI), false)),
+        "" | "none" if t == 0 || t == 18 => Ok((1.0, true)),
+        _ if t == 17 => Err(format!("the abscissa is time (`{units}`), not frequency")),
+        "s" | "sec" | "ms" => Err(format!("the abscissa is time (`{units}`), not frequency")),
+        _ => Err(format!(
+            "the abscissa units `{units}` (data type {t}, {}) are not a frequency (Hz, kHz or rad/s)",
+            specific_data_type_name(t)
+        )),
+    }
+}
+
+fn is_none(s: &str) -> bool {
+    let s = s.trim();
+    s.is_empty() || s.eq_ignore_ascii_case("none")
+}
+
+fn units_kind(h: &Header58) -> Result<Option<FrfUnits>, String> {
+    let (num, den) = (h.numerator.units.trim(), h.denominator.units.trim());
+    if is_none(num) {
+        return Ok(None);
+    }
+    let Some(n) = parse_units(num) else { return Ok(None) };
+    // numerator units of a response alone (`m/s^2`) with no denominator units: per newton
+    // (per newton metre for a moment), stated by a force data type or else assumed
+    let per_force_assumed = is_none(den) && n.f == 0;
+    let assumed_si = per_force_assumed && !matches!(h.denominator.specific_type, 9 | 13);
+    let d = if per_force_assumed {
+        Some(Dim {
+            l: i32::from(matches!(h.reference.direction.axis_name(), "RX" | "RY" | "RZ")),
+            f: 1,
+            t: 0,
+            scale: 1.0,
+        })
+    } else if is_none(den) {
+        Some(Dim::ONE)
+    } else {
+        parse_units(den)
+    };
+    let Some(d) = d else { return Ok(None) };
+    let dim = n.div(d);
+    let basis = match (is_none(den), assumed_si) {
+        (true, true) => format!("`{num}` (per N assumed)"),
+        (true, false) if per_force_assumed => {
+            format!("`{num}` / {}", specific_data_type_name(h.denominator.specific_type))
+        }
+        (true, false) => format!("`{num}`"),
+        _ => format!("`{num}` / `{den}`"),
+    };
+    // a rotation in the response has no length; a moment as reference has one more
+    let rot = |dir: Direction| matches!(dir.axis_name(), "RX" | "RY" | "RZ");
+    let want_l = i32::from(!rot(h.response.direction)) - i32::from(rot(h.reference.direction));
+    let kind = match dim.t {
+        0 => FrfKind::Receptance,
+        -1 => FrfKind::Mobility,
+        -2 => FrfKind::Accelerance,
+        _ => {
+            return Err(format!(
+                "the units {basis} are not those of an FRF (displacement, velocity or acceleration per force)"
+            ));
+        }
+    };
+    if dim.f != -1 || dim.l != want_l {
+        return Err(format!(
+            "the units {basis} are not those of an FRF from {} to {} (expected displacement, velocity or \
+             acceleration per {})",
+            h.reference.direction,
+            h.response.direction,
+            if rot(h.reference.direction) { "moment" } else { "force" }
+        ));
+    }
+    Ok(Some(FrfUnits { kind, scale: dim.scale, basis, assumed_si }))
+}
+
+fn types_kind(h: &Header58) -> Result<Option<(FrfKind, String)>, String> {
+    let (n, d) = (h.numerator.specific_type, h.denominator.specific_type);
+    let kind = match n {
+        8 => FrfKind::Receptance,
+        11 => FrfKind::Mobility,
+        12 => FrfKind::Accelerance,
+        _ => return Ok(None),
+    };
+    let names = format!("{} / {}", specific_data_type_name(n), specific_data_type_name(d));
+    match d {
+        0 | 1 | 9 | 13 => Ok(Some((kind, names))),
+        _ => Err(format!("the data types ({names}) are not a response over a force")),
+    }
+}
+
+/// Exponents of length, force and time, and the factor to SI.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Dim {
+    l: i32,
+    f: i32,
+    t: i32,
+    scale: f64,
+}
+
+impl Dim {
+    const ONE: Dim = Dim { l: 0, f: 0, t: 0, scale: 1.0 };
+
+    // saturating: a label like `((m^99)^99)^99` must not overflow
+    fn mul(self, o: Dim) -> Dim {
+        Dim {
+            l: self.l.saturating_add(o.l),
+            f: self.f.saturating_add(o.f),
+            t: self.t.saturating_add(o.t),
+            scale: self.scale * o.scale,
+        }
+    }
+
+    fn div(self, o: Dim) -> Dim {
+        self.mul(o.pow(-1))
+    }
+
+    fn pow(self, p: i32) -> Dim {
+        Dim {
+            l: self.l.saturating_mul(p),
+            f: self.f.saturating_mul(p),
+            t: self.t.saturating_mul(p),
+            scale: self.scale.powi(p),
+        }
+    }
+}
+
+const G0: f64 = 9.80665;
+const LBF: f64 = 4.448_221_615_260_5;
+
+fn unit(name: &str) -> Option<Dim> {
+    let d = |l, f, t, scale| Some(Dim { l, f, t, scale });
+    match name.to_lowercase().as_str() {
+        "m" => d(1, 0, 0, 1.0),
+        "mm" => d(1, 0, 0, 1e-3),
+        "cm" => d(1, 0, 0, 1e-2),
+        "um" | "µm" | "μm" | "micron" => d(1, 0, 0, 1e-6),
+        "in" | "inch" => d(1, 0, 0, 0.0254),
+        "ft" => d(1, 0, 0, 0.3048),
+        "s" | "sec" => d(0, 0, 1, 1.0),
+        "ms" => d(0, 0, 1, 1e-3),
+        "n" => d(0, 1, 0, 1.0),
+        "kn" => d(0, 1, 0, 1e3),
+        "mn" => d(0, 1, 0, 1e-3),
+        "lbf" | "lb" | "lbs" => d(0, 1, 0, LBF),
+        "kgf" => d(0, 1, 0, G0),
+        "kg" => d(-1, 1, 2, 1.0),
+        "g" | "gn" => d(1, 0, -2, G0),
+        "rad" => d(0, 0, 0, 1.0),
+        "deg" => d(0, 0, 0, PI / 180.0),
+        "hz" => d(0, 0, -1, 1.0),
+        _ => None,
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+enum Tok {
+    Unit(String, i32),
+    One,
+    Mul,
+    Div,
+    Pow(i32),
+    Open,
+    Close,
+}
+
+fn lex(s: &str) -> Option<Vec<Tok>> {
+    let s = s
+        .replace("**", "^")
+        .replace('²', "^2")
+        .replace('³', "^3")
+        .replace("⁻¹", "^-1")
+        .replace("⁻²", "^-2")
+        .replace(['·', '×'], "*")
+        .replace('[', "(")
+        .replace(']', ")");
+    let c: Vec<char> = s.chars().collect();
+    let mut out = Vec::new();
+    let mut i = 0;
+    let int_at = |i: &mut usize| -> Option<i32> {
+        let start = *i;
+        if matches!(c.get(*i), Some('-' | '+')) {
+            *i += 1;
+        }
+        let digits = *i;
+        while c.get(*i).is_some_and(|d| d.is_ascii_digit()) {
+            *i += 1;
+        }
+        if *i == digits || *i - digits > 2 {
+            return None;
+        }
+        c.get(start..*i)?.iter().collect::<String>().parse().ok()
+    };
+    while let Some(&ch) = c.get(i) {
+        match ch {
+            ' ' | '\t' => i += 1,
+            '*' | '.' => {
+                out.push(Tok::Mul);
+                i += 1;
+            }
+            '/' => {
+                out.push(Tok::Div);
+                i += 1;
+            }
+            '(' => {
+                out.push(Tok::Open);
+                i += 1;
+            }
+            ')' => {
+                out.push(Tok::Close);
+                i += 1;
+            }
+            '^' => {
+                i += 1;
+                out.push(Tok::Pow(int_at(&mut i)?));
+            }
+            '1' if !c.get(i + 1).is_some_and(|d| d.is_ascii_digit()) => {
+                out.push(Tok::One);
+                i += 1;
+            }
+            ch if ch.is_alphabetic() => {
+                let start = i;
+                while c.get(i).is_some_and(|d| d.is_alphabetic()) {
+                    i += 1;
+                }
+                let name: String = c.get(start..i)?.iter().collect();
+                // `s2`, `s-2`: an exponent written right after the unit
+                let p = if c.get(i).is_some_and(|d| d.is_ascii_digit() || *d == '-') { int_at(&mut i)? } else { 1 };
+                out.push(Tok::Unit(name, p));
+            }
+            _ => return None,
+        }
+    }
+    Some(out)
+}
+
+/// Parses a units label into dimensions, or `None` when it is not understood.
+fn parse_units(s: &str) -> Option<Dim> {
+    let toks = lex(s)?;
+    let mut pos = 0;
+    let d = expr(&toks, &mut pos, 0)?;
+    (pos == toks.len()).then_some(d)
+}
+
+fn expr(t: &[Tok], pos: &mut usize, depth: usize) -> Option<Dim> {
+    if depth > 16 {
+        return None;
+    }
+    let mut acc = term(t, pos, depth)?;
+    loop {
+        match t.get(*pos) {
+            Some(Tok::Mul) => {
+                *pos += 1;
+                acc = acc.mul(term(t, pos, depth)?);
+            }
+            Some(Tok::Div) => {
+                *pos += 1;
+                acc = acc.div(term(t, pos, depth)?);
+            }
+            // implicit product: `N m`, `m s-2`
+            Some(Tok::Unit(..) | Tok::Open | Tok::One) => acc = acc.mul(term(t, pos, depth)?),
+            _ => return Some(acc),
+        }
+    }
+}
+
+fn term(t: &[Tok], pos: &mut usize, depth: usize) -> Option<Dim> {
+    let base = match t.get(*pos)? {
+        Tok::Unit(name, p) => {
+            *pos += 1;
+            unit(name)?.pow(*p)
+        }
+        Tok::One => {
+            *pos += 1;
+            Dim::ONE
+        }
+        Tok::Open => {
+            *pos += 1;
+            let d = expr(t, pos, depth + 1)?;
+            if t.get(*pos) != Some(&Tok::Close) {
+                return None;
+            }
+            *pos += 1;
+            d
+        }
+        _ => return None,
+    };
+    if let Some(Tok::Pow(p)) = t.get(*pos) {
+        *pos += 1;
+        return Some(base.pow(*p));
+    }
+    Some(base)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn dims(s: &str) -> Option<(i32, i32, i32, f64)> {
+        parse_units(s).map(|d| (d.l, d.f, d.t, d.scale))
+    }
+
+    #[test]
+    fn units_labels_parse_to_dimensions_and_scales() {
+        assert_eq!(dims("m/s^2"), Some((1, 0, -2, 1.0)));
+        assert_eq!(dims("m/s2"), Some((1, 0, -2, 1.0)));
+        assert_eq!(dims("m/s²"), Some((1, 0, -2, 1.0)));
+        assert_eq!(dims("(1/N)*(m/s²)"), Some((1, -1, -2, 1.0)));
+        assert_eq!(dims("[m/s^2]/[N]"), Some((1, -1, -2, 1.0)));
+        assert_eq!(dims("m s-2 N-1"), Some((1, -1, -2, 1.0)));
+        assert_eq!(dims("m/s/N"), Some((1, -1, -1, 1.0)));
+        assert_eq!(dims("mm/N"), Some((1, -1, 0, 1e-3)));
+        assert_eq!(dims("g/N"), Some((1, -1, -2, G0)));
+        assert_eq!(dims("1/kg"), Some((1, -1, -2, 1.0)));
+        assert_eq!(dims("N*m"), Some((1, 1, 0, 1.0)));
+        let (l, f, t, s) = dims("in/s/lbf").unwrap();
+        assert_eq!((l, f, t), (1, -1, -1));
+        assert!((s - 0.0254 / LBF).abs() < 1e-15);
+        for bad in ["Pa", "m/", "(m/s", "m^", "NONE", "m/s^999", "m))"] {
+            assert_eq!(dims(bad), None, "{bad}");
+        }
+        let deep = format!("{}m{}", "(".repeat(16), "^99)".repeat(16));
+        assert_eq!(dims(&deep).map(|d| d.0), Some(i32::MAX));
+    }
+}

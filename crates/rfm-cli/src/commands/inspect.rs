@@ -1,0 +1,203 @@
+//! `rfm inspect`: what a measurement file holds, before any case uses it.
+
+use std::path::Path;
+
+use frf::io::MeasuredFormat;
+use frf::io::uff::{self, Record58};
+use serde_json::{Value, json};
+
+use super::Result;
+use crate::table::{Table, num};
+
+pub(crate) fn inspect(file: &Path, json: bool) -> Result<()> {
+    let report = match frf::io::detect_format(file)? {
+        MeasuredFormat::Uff => uff_report(file)?,
+        MeasuredFormat::Csv => csv_report(file)?,
+    };
+    if json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print_report(&report);
+    }
+    Ok(())
+}
+
+fn uff_report(file: &Path) -> Result<Value> {
+    let u = uff::read_uff(file)?;
+    let records: Vec<Value> = u.records.iter().map(record_json).collect();
+    let skipped: Vec<Value> = u
+        .skipped
+        .iter()
+        .map(|d| json!({ "dataset": d.number, "line": d.line, "description": d.description() }))
+        .collect();
+    Ok(json!({
+        "file": file.display().to_string(),
+        "format": "uff",
+        "records": records,
+        "skipped": skipped,
+        "notes": u.notes,
+    }))
+}
+
+fn record_json(r: &Record58) -> Value {
+    let f = &r.function;
+    let h = &f.header;
+    let x = f.abscissa_values();
+    let kind = (h.function_type == uff::FUNCTION_FRF).then(|| uff::frf_units(h).ok()).flatten();
+    let dof = |d: uff::TestDof, entity: &str| json!({ "node": d.node, "direction": d.direction.to_string(), "entity": entity });
+    json!({
+        "record": r.index,
+        "line": r.line,
+        "response": dof(h.response, &h.response_entity),
+        "reference": dof(h.reference, &h.reference_entity),
+        "function_type": h.function_type,
+        "function": uff::function_type_name(h.function_type),
+        "kind": kind.map(|k| k.kind.name()),
+        "units": { "numerator": h.numerator.units, "denominator": h.denominator.units },
+        "abscissa": {
+            "units": h.abscissa_axis.units,
+            "min": x.first(),
+            "max": x.last(),
+            "count": f.len(),
+            "spacing": if f.is_even() { "even" } else { "uneven" },
+        },
+        "data_type": { "code": h.ordinate_type.code(), "name": h.ordinate_type.name() },
+        "encoding": r.encoding.name(),
+    })
+}
+
+fn csv_report(file: &Path) -> Result<Value> {
+    let set = frf::io::csv::read_csv(file)?;
+    let f = set.frequencies_hz();
+    let records: Vec<Value> = set
+        .channels()
+        .iter()
+        .enumerate()
+        .map(|(c, ch)| {
+            json!({
+                "record": c + 1,
+                "line": Value::Null,
+                "response": { "dof": ch.response.to_string() },
+                "reference": { "dof": ch.reference.to_string() },
+                "function_type": uff::FUNCTION_FRF,
+                "function": uff::function_type_name(uff::FUNCTION_FRF),
+                "kind": set.kind().name(),
+                "units": Value::Null,
+                "abscissa": {
+                    "units": "Hz",
+                    "min": f.first(),
+                    "max": f.last(),
+                    "count": f.len(),
+                    "spacing": "listed",
+                },
+                "data_type": { "code": Value::Null, "name": "complex (decimal text)" },
+                "encoding": "CSV",
+            })
+        })
+        .collect();
+    Ok(json!({
+        "file": file.display().to_string(),
+        "format": "csv",
+        "records": records,
+        "skipped": [],
+        "notes": [],
+    }))
+}
+
+fn print_report(report: &Value) {
+    let records = report["records"].as_array().map(Vec::as_slice).unwrap_or_default();
+    let skipped = report["skipped"].as_array().map(Vec::as_slice).unwrap_or_default();
+    let csv = report["format"] == "csv";
+    let count = |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
+    println!(
+        "{}: {}, {}{}",
+        report["file"].as_str().unwrap_or_default(),
+        if csv { "CSV (channels name model DOFs)" } else { "universal file" },
+        if csv {
+            count(records.len(), "channel", "channels")
+        } else {
+            count(records.len(), "dataset 58", "datasets 58")
+        },
+        if skipped.is_empty() {
+            String::new()
+        } else {
+            format!(", {} skipped", count(skipped.len(), "other dataset", "other datasets"))
+        }
+    );
+    if !records.is_empty() {
+        let mut t = Table::new(&[
+            "record",
+            "line",
+            "response",
+            "reference",
+            "function",
+            "units",
+            "abscissa",
+            "values",
+            "data type",
+            "encoding",
+        ]);
+        for r in records {
+            t.row(vec![
+                r["record"].to_string(),
+                r["line"].as_u64().map_or("-".into(), |l| l.to_string()),
+                dof_text(&r["response"]),
+                dof_text(&r["reference"]),
+                function_text(r),
+                units_text(&r["units"]),
+                abscissa_text(&r["abscissa"]),
+                r["abscissa"]["count"].to_string(),
+                r["data_type"]["name"].as_str().unwrap_or_default().to_string(),
+                r["encoding"].as_str().unwrap_or_default().to_string(),
+            ]);
+        }
+        println!("{}", t.render());
+    }
+    for n in report["notes"].as_array().map(Vec::as_slice).unwrap_or_default() {
+        println!("note: {}", n.as_str().unwrap_or_default());
+    }
+    for d in skipped {
+        println!(
+            "skipped dataset {} ({}) at line {}",
+            d["dataset"],
+            d["description"].as_str().unwrap_or_default(),
+            d["line"]
+        );
+    }
+}
+
+fn dof_text(v: &Value) -> String {
+    if let Some(d) = v["dof"].as_str() {
+        return d.to_string();
+    }
+    let entity = v["entity"].as_str().unwrap_or_default();
+    let base = format!("{}:{}", v["node"], v["direction"].as_str().unwrap_or_default());
+    if entity.is_empty() || entity.eq_ignore_ascii_case("none") { base } else { format!("{base} ({entity})") }
+}
+
+fn function_text(r: &Value) -> String {
+    let name = match r["function_type"].as_i64() {
+        Some(4) => "FRF".to_string(),
+        _ => r["function"].as_str().unwrap_or_default().to_string(),
+    };
+    match r["kind"].as_str() {
+        Some(k) => format!("{} {name} ({k})", r["function_type"]),
+        None => format!("{} {name}", r["function_type"]),
+    }
+}
+
+fn units_text(u: &Value) -> String {
+    let (n, d) = (u["numerator"].as_str().unwrap_or("-"), u["denominator"].as_str().unwrap_or("NONE"));
+    if d.is_empty() || d.eq_ignore_ascii_case("none") { n.to_string() } else { format!("{n} / {d}") }
+}
+
+fn abscissa_text(a: &Value) -> String {
+    match (a["min"].as_f64(), a["max"].as_f64()) {
+        (Some(lo), Some(hi)) => {
+            let units = a["units"].as_str().unwrap_or_default();
+            let units = if units.eq_ignore_ascii_case("none") { "" } else { units };
+            format!("{} .. {} {units} ({})", num(lo), num(hi), a["spacing"].as_str().unwrap_or_default())
+        }
+        _ => "-".into(),
+    }
+}
