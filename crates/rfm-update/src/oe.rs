@@ -24,9 +24,13 @@
 //! iteration solves the column-scaled, Tikhonov-damped Gauss-Newton system by
 //! SVD; a step is taken only if it lowers the cost, with the damping raised
 //! tenfold after each rejection and relaxed after each success. Bounds are
-//! enforced by projecting the step. Convergence is declared when the
-//! Gauss-Newton step would lower the cost by less than a relative 1e-10, or
-//! when steps no longer change any parameter by more than the tolerance.
+//! enforced by projecting the step; without user bounds each parameter stays
+//! within a factor of 1e6 of its start, so that one the data do not
+//! determine cannot wander off to zero or infinity (it ends on that bound,
+//! and is reported there). Convergence is declared when the Gauss-Newton
+//! step would lower the cost by less than a relative 1e-10, when an accepted
+//! step gains less than a relative 1e-9, or when steps no longer change any
+//! parameter by more than the tolerance.
 //!
 //! At the solution the covariance of `theta` is `s^2 (J^T J)^+` with `s^2` the
 //! residual variance estimated from the fit; see [`crate::uncertainty`].
@@ -327,10 +331,16 @@ pub fn run(
     // bounds in theta; gains are unbounded
     let mut lo = vec![f64::NEG_INFINITY; n + ng];
     let mut hi = vec![f64::INFINITY; n + ng];
-    for (i, b) in opts.bounds.iter().enumerate().take(n) {
-        if let Some((l, h)) = b {
-            lo[i] = (l / ev.p0[i]).ln();
-            hi[i] = (h / ev.p0[i]).ln();
+    for i in 0..n {
+        match opts.bounds.get(i).copied().flatten() {
+            Some((l, h)) => {
+                lo[i] = (l / ev.p0[i]).ln();
+                hi[i] = (h / ev.p0[i]).ln();
+            }
+            None => {
+                lo[i] = -(1e6f64.ln());
+                hi[i] = 1e6f64.ln();
+            }
         }
     }
     let mut x = vec![0.0; n + ng];
@@ -416,7 +426,7 @@ pub fn run(
         let rec = record(iteration, &point, &x, max_step, lambda, sol.rank);
         on_iteration(&rec);
         history.push(rec);
-        if max_step < opts.tolerance || relative_gain < 1e-12 {
+        if max_step < opts.tolerance || relative_gain < 1e-9 {
             status = Status::Converged;
             break;
         }
