@@ -323,6 +323,14 @@ impl Assembly {
                 positions: Vec::new(),
             });
         }
+        if let Some(b) =
+            blocks.iter().find(|b| b.terms.iter().any(|t| !t.unit.iter().all(|u| (u * t.value).is_finite())))
+        {
+            return Err(ModelError::Invalid {
+                what: describe_source(model, b.source),
+                reason: "has a stiffness or mass that is not finite (values or geometry too large)".into(),
+            });
+        }
         for (i, node) in model.nodes.iter().enumerate() {
             let has_free = Dof::ALL.iter().any(|&d| dofs.equation(DofRef { node: node.id, dof: d }).is_some());
             if !touched[i] && has_free {
@@ -347,6 +355,7 @@ impl Assembly {
             }
         }
         let assembly = Assembly { dofs, pattern, blocks, group_blocks, by_quantity };
+        crate::kinematics::check(model)?;
         assembly.check_stiffness_diagonal()?;
         Ok(assembly)
     }
@@ -359,7 +368,11 @@ impl Assembly {
         let scale = diag.iter().map(|&p| k[p].abs()).fold(0.0, f64::max);
         for (eq, &p) in diag.iter().enumerate() {
             if k[p] <= 1e-14 * scale {
-                return Err(ModelError::Mechanism { hint: self.dofs.dof_of(eq).to_string() });
+                let dof = self.dofs.dof_of(eq);
+                let mut nodes: Vec<u32> = self.dofs.dofs_of(eq).iter().map(|r| r.node.0).collect();
+                nodes.sort_unstable();
+                nodes.dedup();
+                return Err(ModelError::Mechanism { hint: dof.to_string(), modes: 1, nodes });
             }
         }
         Ok(())
@@ -455,6 +468,15 @@ impl Assembly {
     }
 }
 
+/// `element 3`, `spring `clamp``, `mass `sensor``: a block's model item, for messages.
+fn describe_source(model: &Model, source: BlockSource) -> String {
+    match source {
+        BlockSource::Beam(i) => format!("element {}", model.beams[i].id),
+        BlockSource::Spring(i) => format!("spring `{}`", model.springs[i].name),
+        BlockSource::Mass(i) => format!("mass `{}`", model.masses[i].name),
+    }
+}
+
 fn build_pattern(n: usize, blocks: &[Block]) -> Pattern {
     let mut cols: Vec<Vec<usize>> = vec![Vec::new(); n];
     for i in 0..n {
@@ -528,7 +550,7 @@ mod tests {
         m.add_mass("tip", 3, 1.0, 0.0, g).unwrap();
         m.add_support(1, &Dof::ALL).unwrap();
         let e = Assembly::new(&m).unwrap_err();
-        assert_eq!(e, ModelError::Mechanism { hint: "3:rz".into() });
+        assert_eq!(e, ModelError::Mechanism { hint: "3:rz".into(), modes: 1, nodes: vec![3] });
     }
 
     #[test]
