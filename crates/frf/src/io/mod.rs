@@ -11,12 +11,16 @@
 //! replace a file the caller marks as an input.
 
 pub mod csv;
+pub mod mask;
 pub mod uff;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use fe_model::case::ChannelMap;
+use fe_model::DofMap;
+use fe_model::case::{ChannelMap, MaskRule};
+
+pub use mask::{Masked, Origin, check_channels};
 
 use crate::error::FrfError;
 use crate::set::FrfSet;
@@ -78,20 +82,54 @@ pub struct Measured {
     pub format: MeasuredFormat,
     /// Notes for the user (skipped datasets, dropped lines, conversions).
     pub notes: Vec<String>,
+    /// Where each channel of `set` comes from in the file, in the same order.
+    pub origins: Vec<Origin>,
+    /// What the case's mask rules left out (empty without rules).
+    pub masked: Vec<Masked>,
+}
+
+impl Measured {
+    /// Checks the channels against a model's DOFs (see [`check_channels`]):
+    /// a channel at a node the model lacks or at a supported DOF is refused,
+    /// naming the file, its record or columns and the DOF, or left out when
+    /// `rules` hold [`MaskRule::UnmodelledChannels`].
+    pub fn check_channels(self, path: &Path, dofs: &DofMap, rules: &[MaskRule]) -> Result<Measured, FrfError> {
+        let (set, origins, masked) = check_channels(path, self.set, &self.origins, dofs, rules)?;
+        let mut all = self.masked;
+        all.extend(masked);
+        Ok(Measured { set, format: self.format, notes: self.notes, origins, masked: all })
+    }
 }
 
 /// Reads a measured FRF file (see [`detect_format`]) and maps its channels
 /// to model DOFs. CSV files name model DOFs directly (the map is not used);
 /// universal files name test nodes and directions, mapped through `map`
-/// (see [`uff::map_test_dof`] and `docs/measured-data.md`).
+/// (see [`uff::map_test_dof`] and `docs/measured-data.md`). Defects are
+/// refused; see [`load_measured_with`] to leave some out.
 pub fn load_measured(path: &Path, map: &[ChannelMap]) -> Result<Measured, FrfError> {
+    load_measured_with(path, map, &[])
+}
+
+/// Reads a measured FRF file like [`load_measured`], leaving out what the
+/// mask rules allow (non-finite values, repeated lines) instead of refusing
+/// the file; [`Measured::masked`] lists what was left out. Channel rules
+/// need the model: see [`Measured::check_channels`].
+pub fn load_measured_with(path: &Path, map: &[ChannelMap], rules: &[MaskRule]) -> Result<Measured, FrfError> {
     match detect_format(path)? {
         MeasuredFormat::Csv => {
-            Ok(Measured { set: csv::read_csv(path)?, format: MeasuredFormat::Csv, notes: Vec::new() })
+            let c = csv::read_csv_with(path, rules)?;
+            Ok(Measured {
+                set: c.set,
+                format: MeasuredFormat::Csv,
+                notes: Vec::new(),
+                origins: c.origins,
+                masked: c.masked,
+            })
         }
         MeasuredFormat::Uff => {
-            let u = uff::read_uff_frfs(path, map)?;
-            Ok(Measured { set: u.set, format: MeasuredFormat::Uff, notes: u.notes })
+            let u = uff::read_uff_frfs_with(path, map, rules)?;
+            let origins = u.origins();
+            Ok(Measured { set: u.set, format: MeasuredFormat::Uff, notes: u.notes, origins, masked: u.masked })
         }
     }
 }
