@@ -87,7 +87,9 @@ pub mod synth;
 pub use correlation::{BandSpec, Correlation, correlate};
 pub use error::FrfError;
 pub use lscf::{EstimatedMode, LscfError, LscfOptions, ModalEstimate, PoleStatus, lscf};
-pub use modal::{Mode, ModeError, ModePair, Pairing, mac, mac_matrix, measured_modes, model_modes, pair_modes};
+pub use modal::{
+    Mode, ModeError, ModePair, Pairing, Symptom, mac, mac_matrix, measured_modes, model_modes, pair_modes, symptom,
+};
 pub use noise::NoiseModel;
 pub use set::{Channel, FrfKind, FrfSet};
 pub use solver::{Workspace, ZSolver};
