@@ -1,3 +1,4 @@
 //! Integration tests of the frf crate.
 
 mod physics;
+mod solver;
