@@ -42,6 +42,26 @@ pub(crate) const PIVOT_TOLERANCE: f64 = 1e-8;
 
 const ZERO: C64 = C64 { re: 0.0, im: 0.0 };
 
+/// Solution values smaller than this in magnitude are set to zero as each
+/// row is finalised. Responses can decay by hundreds of orders of magnitude
+/// across a large model (a long periodic structure in a stop band), and
+/// arithmetic on subnormal numbers (below about 2.2e-308) is some hundred
+/// times slower; values this small are far below anything physical.
+const FLUSH_BELOW: f64 = 1e-200;
+
+/// Sets parts of `row` smaller than [`FLUSH_BELOW`] to zero.
+#[inline(always)]
+fn flush_tiny(row: &mut [C64]) {
+    for v in row {
+        if v.re.abs() < FLUSH_BELOW {
+            v.re = 0.0;
+        }
+        if v.im.abs() < FLUSH_BELOW {
+            v.im = 0.0;
+        }
+    }
+}
+
 /// `|re| + |im|`: a cheap norm within a factor sqrt(2) of the modulus.
 #[inline(always)]
 fn l1(z: C64) -> f64 {
@@ -403,6 +423,7 @@ impl<V: FnMut(usize, &[C64])> WithSimd for Substitution<'_, V> {
                 let i = i as usize * k;
                 mul_add(simd, xr, -l_val[pos], &head[i..i + k]);
             }
+            flush_tiny(xr);
         }
         // D^-1 and backward, L^T x = D^-1 y: column j of L is row j of L^T,
         // so row j gathers the rows below it, which are final
@@ -416,6 +437,7 @@ impl<V: FnMut(usize, &[C64])> WithSimd for Substitution<'_, V> {
                 let off = (r as usize - j - 1) * k;
                 mul_add(simd, xj, -l, &tail[off..off + k]);
             }
+            flush_tiny(xj);
             finite &= xj.iter().all(|v| v.re.is_finite() && v.im.is_finite());
             visit(j, &x[j * k..]);
         }
