@@ -41,6 +41,14 @@
 //!   the solution are final in the backward substitution, while they are in
 //!   cache, instead of in another pass over the `N x (measured + references)`
 //!   block.
+//! - **Class sums when they are fewer.** By symmetry of `R`, step 4 can also
+//!   be taken the other way round: `R[m, :] w = (Z^-1 w)[m]`, so each class
+//!   sum `w = sum value U x` (built in the sweep that solves for `x`) is
+//!   solved for once and read at the measured rows. That is
+//!   `references x (1 + classes)` solves instead of
+//!   `references + measured`; each line uses whichever is fewer (class sums
+//!   for the paper's beam: 4 classes against 30 measured DOFs; measured rows
+//!   for a diagnosis with a thousand element parameters).
 //! - **Prepared once per call.** The term table (blocks bucketed by solver
 //!   row, distinct unit matrices stored once) and a streamable copy of
 //!   `Z(w)`'s contributions that gives bitwise the values of
@@ -48,10 +56,10 @@
 //!   shared by the threads, which take the lines in parallel, each with its
 //!   own [`Scratch`].
 //!
-//! Per line the cost is one factorisation, `(measured + references)` solves
-//! and `O(measured)` work per used term; the memory per thread is the factor,
-//! the `N x (measured + references)` solutions and the per-class sums; the
-//! result is `channels x parameters` per line.
+//! Per line the cost is one factorisation, `min(measured + references,
+//! references x (1 + classes))` solves and `O(measured)` work per used term;
+//! the memory per thread is the factor, the `N x` (that many) solutions and
+//! the per-class sums; the result is `channels x parameters` per line.
 //!
 //! [`naive`] is the dense textbook formulation, a reference for tests and
 //! benchmarks.
@@ -151,6 +159,8 @@ pub struct Scratch {
     coef: Vec<C64>,
     /// `references x classes x responses` sums of step 4.
     acc: Vec<C64>,
+    /// Class sums as right-hand sides (the class-sum strategy).
+    w: Vec<C64>,
     /// Per solver row: index of its measured values in `measured`, or `NONE`.
     measured_at: Vec<u32>,
     /// Measured values per replaced row and reference (`None`: no channel).
@@ -167,6 +177,7 @@ impl Scratch {
             sol: Vec::new(),
             coef: Vec::new(),
             acc: Vec::new(),
+            w: Vec::new(),
             measured_at: Vec::new(),
             measured: Vec::new(),
         }
@@ -177,63 +188,94 @@ const NONE: u32 = u32::MAX;
 
 /// `Z(w)` laid out for fast evaluation at many frequencies.
 ///
-/// [`DampedSystem::z_values_into`] walks every element's terms and unit
-/// matrices (scattered in memory) at each frequency. Here each entry of the
-/// pattern keeps its own list of contributions `(group and kind, value x
-/// unit entry)`, in the order in which the system adds them, so that
-/// evaluating `Z(w)` is one stream through memory and gives *bitwise* the
-/// same values: model FRFs from the sensitivity assembly and from
-/// [`frf::synthesize_with`] then agree exactly, which the response function
-/// method's step control relies on near convergence. Made once per
-/// [`assemble`] call (the parameters may have changed since the last).
+/// [`DampedSystem::z_values_into`] walks every element's terms, unit
+/// matrices and positions, each in its own heap allocation, at every
+/// frequency. This is the same walk over compact arrays (positions as `u32`,
+/// each distinct unit matrix stored once), with the same operations in the
+/// same order, so it gives *bitwise* the same values: model FRFs from the
+/// sensitivity assembly and from [`frf::synthesize_with`] then agree exactly,
+/// which the response function method's step control relies on near
+/// convergence. Made once per [`assemble`] call (the parameters may have
+/// changed since the last).
 struct ZCache {
-    /// Per pattern entry: its contributions are `start[p]..start[p + 1]`.
-    start: Vec<usize>,
-    /// `2 g` for group `g`'s stiffness terms, `2 g + 1` for its mass terms.
-    slot: Vec<u32>,
-    value: Vec<f64>,
+    /// Per block: `(first position, number of local entries, first term, end of terms)`.
+    blocks: Vec<(u32, u32, u32, u32)>,
+    positions: Vec<u32>,
+    /// Per non-zero term: `(slot, value, unit offset)`; the slot is `2 g` for
+    /// group `g`'s stiffness terms and `2 g + 1` for its mass terms.
+    terms: Vec<(u32, f64, u32)>,
+    units: Vec<f64>,
 }
 
 impl ZCache {
     fn new(sys: &DampedSystem) -> Self {
         let a = sys.assembly();
-        let nnz = a.pattern.nnz();
-        // the order of Assembly::accumulate: blocks, terms, local entries
-        let each = |visit: &mut dyn FnMut(usize, u32, f64)| {
-            for b in &a.blocks {
-                for t in b.terms.iter().filter(|t| t.value != 0.0) {
-                    let slot = 2 * b.group as u32 + u32::from(t.kind == MatrixKind::Mass);
-                    for (&p, &u) in b.positions.iter().zip(&t.unit) {
-                        if u != 0.0 {
-                            visit(p, slot, t.value * u);
-                        }
+        let mut units = UnitStore::default();
+        let (mut blocks, mut positions, mut terms) = (Vec::with_capacity(a.blocks.len()), Vec::new(), Vec::new());
+        for b in &a.blocks {
+            let p0 = positions.len() as u32;
+            positions.extend(b.positions.iter().map(|&p| p as u32));
+            let t0 = terms.len() as u32;
+            // Assembly::accumulate skips terms whose value is zero
+            for t in b.terms.iter().filter(|t| t.value != 0.0) {
+                let slot = 2 * b.group as u32 + u32::from(t.kind == MatrixKind::Mass);
+                terms.push((slot, t.value, units.offset_of(&t.unit)));
+            }
+            blocks.push((p0, b.positions.len() as u32, t0, terms.len() as u32));
+        }
+        ZCache { blocks, positions, terms, units: units.values }
+    }
+
+    /// `Z(w)` into `out`, given each group's coefficients at `w`: the loop of
+    /// `Assembly::accumulate` with the coefficients of `z_values_into`.
+    fn values_into(&self, coefs: &[GroupCoefficients], out: &mut [C64]) {
+        let by_slot: Vec<C64> = coefs.iter().flat_map(|c| [c.stiffness, c.mass]).collect();
+        out.fill(ZERO);
+        for &(p0, len, t0, t1) in &self.blocks {
+            let positions = &self.positions[p0 as usize..(p0 + len) as usize];
+            for &(slot, value, unit) in &self.terms[t0 as usize..t1 as usize] {
+                let c = by_slot[slot as usize];
+                let unit = &self.units[unit as usize..unit as usize + positions.len()];
+                for (&p, &u) in positions.iter().zip(unit) {
+                    if u != 0.0 {
+                        out[p as usize] += c * (value * u);
                     }
                 }
             }
-        };
-        let mut start = vec![0usize; nnz + 1];
-        each(&mut |p, _, _| start[p + 1] += 1);
-        for p in 0..nnz {
-            start[p + 1] += start[p];
         }
-        let mut next = start[..nnz].to_vec();
-        let mut slot = vec![0u32; start[nnz]];
-        let mut value = vec![0.0; start[nnz]];
-        each(&mut |p, s, v| {
-            slot[next[p]] = s;
-            value[next[p]] = v;
-            next[p] += 1;
-        });
-        ZCache { start, slot, value }
     }
+}
 
-    /// `Z(w)` into `out`, given each group's coefficients at `w`.
-    fn values_into(&self, coefs: &[GroupCoefficients], out: &mut [C64]) {
-        let by_slot: Vec<C64> = coefs.iter().flat_map(|c| [c.stiffness, c.mass]).collect();
-        for (p, z) in out.iter_mut().enumerate() {
-            let (a, b) = (self.start[p], self.start[p + 1]);
-            *z = self.slot[a..b].iter().zip(&self.value[a..b]).fold(ZERO, |s, (&q, &v)| s + by_slot[q as usize] * v);
+/// Unit matrices stored once each: identical elements (the common case in
+/// a mesh) share one copy, so that the hot loops read them from cache.
+#[derive(Default)]
+struct UnitStore {
+    values: Vec<f64>,
+    /// Hash of a matrix's bits to the offset of the last one stored with it.
+    by_hash: FxMap<u64, u32>,
+}
+
+impl UnitStore {
+    /// Offset in `values` of a matrix equal to `unit` (bit for bit), stored
+    /// now if there is none.
+    fn offset_of(&mut self, unit: &[f64]) -> u32 {
+        // a sample of the entries is enough for a key: equality is checked
+        let mut h = FxHasher::default();
+        h.write_usize(unit.len());
+        for u in unit.iter().step_by(5) {
+            h.write_u64(u.to_bits());
         }
+        let key = h.finish();
+        if let Some(&at) = self.by_hash.get(&key) {
+            let stored = &self.values[at as usize..at as usize + unit.len()];
+            if stored.iter().zip(unit).all(|(a, b)| a.to_bits() == b.to_bits()) {
+                return at;
+            }
+        }
+        let at = self.values.len() as u32;
+        self.values.extend_from_slice(unit);
+        self.by_hash.insert(key, at);
+        at
     }
 }
 
@@ -436,9 +478,11 @@ impl TermTable {
         // by (group, kind, users) under the rules, else one per term
         let mut items = Vec::with_capacity(order.len());
         let mut terms = Vec::new();
-        let mut units = Vec::new();
-        let mut unit_of: FxMap<Vec<u64>, u32> = FxMap::default();
-        let mut class_of: FxMap<(usize, bool, Vec<u32>), u32> = FxMap::default();
+        let mut units = UnitStore::default();
+        // classes by hash of (group, kind, users), checked against the first
+        // term of the class: (group, kind, its users' range in `users`)
+        let mut class_of: FxMap<u64, u32> = FxMap::default();
+        let mut classes: Vec<(usize, MatrixKind, usize)> = Vec::new();
         let mut class_of_term = vec![NONE; total];
         let mut pairs: Vec<(u32, u32)> = Vec::new();
         let mut pair_rules = Vec::new();
@@ -456,14 +500,10 @@ impl TermTable {
                 if !used(f) {
                     continue;
                 }
-                let key: Vec<u64> = term.unit.iter().map(|u| u.to_bits()).collect();
-                let unit = *unit_of.entry(key).or_insert_with(|| {
-                    units.extend_from_slice(&term.unit);
-                    (units.len() - term.unit.len()) as u32
-                });
+                let unit = units.offset_of(&term.unit);
                 let who = &users[users_ptr[f] as usize..users_ptr[f + 1] as usize];
                 let mut new_class = || {
-                    let class = class_of.len() as u32 + u32::from(!rules_hold) * terms.len() as u32;
+                    let class = if rules_hold { classes.len() } else { terms.len() } as u32;
                     for &i in who {
                         pairs.push((i, class));
                         let q = params[i as usize];
@@ -472,11 +512,23 @@ impl TermTable {
                     class
                 };
                 let class = if rules_hold {
-                    let key = (block.group, term.kind == MatrixKind::Mass, who.to_vec());
-                    match class_of.get(&key) {
-                        Some(&c) => c,
+                    let mut h = FxHasher::default();
+                    h.write_usize(block.group);
+                    h.write_u32(u32::from(term.kind == MatrixKind::Mass));
+                    for &i in who {
+                        h.write_u32(i);
+                    }
+                    let key = h.finish();
+                    let same = |c: u32| {
+                        let (g, kind, f0) = classes[c as usize];
+                        let them = &users[users_ptr[f0] as usize..users_ptr[f0 + 1] as usize];
+                        g == block.group && kind == term.kind && them == who
+                    };
+                    match class_of.get(&key).copied().filter(|&c| same(c)) {
+                        Some(c) => c,
                         None => {
                             let c = new_class();
+                            classes.push((block.group, term.kind, f));
                             class_of.insert(key, c);
                             c
                         }
@@ -489,7 +541,7 @@ impl TermTable {
             }
             items.push(Item { rows, nb: nb as u32, t0, t1: terms.len() as u32 });
         }
-        let n_classes = if rules_hold { class_of.len() } else { terms.len() };
+        let n_classes = if rules_hold { classes.len() } else { terms.len() };
         let coefficients = if rules_hold {
             Coefficients::Rules(pair_rules)
         } else {
@@ -514,7 +566,7 @@ impl TermTable {
                     .collect(),
             )
         };
-        TermTable { bucket, items, terms, units, n_classes, pairs, coefficients }
+        TermTable { bucket, items, terms, units: units.values, n_classes, pairs, coefficients }
     }
 
     /// Each pair's coefficient at `omega` into `coef`. `None` when the
@@ -557,6 +609,19 @@ fn rule_group(q: Quantity, term_group: usize) -> usize {
     }
 }
 
+/// How step 4 reaches the measured rows (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Strategy {
+    /// Whichever needs fewer right-hand sides.
+    Auto,
+    /// Unit solves at the measured DOFs, products taken in the sweep.
+    #[cfg_attr(not(test), allow(dead_code))] // forced in tests
+    MeasuredRows,
+    /// Solves with the class sums `sum value U x` as right-hand sides.
+    #[cfg_attr(not(test), allow(dead_code))] // forced in tests
+    ClassSums,
+}
+
 /// Model FRFs and sensitivities at one line; see the module docs.
 pub fn assemble_one(
     sys: &DampedSystem,
@@ -568,7 +633,7 @@ pub fn assemble_one(
     line: usize,
     scratch: &mut Scratch,
 ) -> Result<FrequencyBlock, UpdateError> {
-    assemble_line(sys, None, None, solver, plan, params, freq_hz, hybrid, line, scratch)
+    assemble_line(sys, None, None, Strategy::Auto, solver, plan, params, freq_hz, hybrid, line, scratch)
 }
 
 /// [`assemble_one`] with optional prepared parts: a Z cache, and a term
@@ -577,6 +642,7 @@ fn assemble_line(
     sys: &DampedSystem,
     cache: Option<&ZCache>,
     table: Option<&TermTable>,
+    strategy: Strategy,
     solver: &ZSolver,
     plan: &ChannelPlan,
     params: &[Quantity],
@@ -587,7 +653,6 @@ fn assemble_line(
 ) -> Result<FrequencyBlock, UpdateError> {
     let omega = 2.0 * std::f64::consts::PI * freq_hz;
     let (n_ref, n_resp) = (plan.ref_eqs.len(), plan.resp_eqs.len());
-    let k = n_ref + n_resp;
     let n_par = params.len();
 
     // the derivatives' coefficients at this line
@@ -625,11 +690,59 @@ fn assemble_line(
     }
     solver.factorize(&mut scratch.ws, &scratch.z, freq_hz)?;
 
-    // 2 and 4: the columns of R at references and responses; each block's
-    // class sums as soon as its rows are final in the backward sweep
+    // class sums as right-hand sides need n_ref (1 + classes) solves in two
+    // rounds, the measured rows n_ref + n_resp in one
+    let class_sums = match strategy {
+        Strategy::Auto => {
+            matches!(table.coefficients, Coefficients::Rules(_)) && n_ref * (1 + table.n_classes) < n_ref + n_resp
+        }
+        Strategy::MeasuredRows => false,
+        Strategy::ClassSums => true,
+    };
+    let model = if class_sums {
+        by_class_sums(table, solver, plan, freq_hz, scratch)?
+    } else {
+        by_measured_rows(table, solver, plan, freq_hz, scratch)?
+    };
+    let (acc, coef) = (&scratch.acc, &scratch.coef);
+
+    // each parameter: its classes' sums times their coefficients
+    let mut per_param = vec![ZERO; n_ref * n_par * n_resp];
+    for ri in 0..n_ref {
+        for (&(i, class), &c) in table.pairs.iter().zip(coef.iter()) {
+            let from = (ri * table.n_classes + class as usize) * n_resp;
+            let to = (ri * n_par + i as usize) * n_resp;
+            for m in 0..n_resp {
+                per_param[to + m] += c * acc[from + m];
+            }
+        }
+    }
+    let mut sens = Mat::<C64>::zeros(plan.channels.len(), n_par);
+    for (c, &(ri, mi)) in plan.picks.iter().enumerate() {
+        for i in 0..n_par {
+            sens[(c, i)] = per_param[(ri * n_par + i) * n_resp + mi];
+        }
+    }
+    Ok(FrequencyBlock { freq_hz, model, sens })
+}
+
+/// Steps 2 and 4 by unit solves at the references and measured DOFs, each
+/// block's class sums taken as soon as its rows are final in the backward
+/// sweep. Returns the model FRFs of the plan's channels, and leaves in
+/// `scratch.acc` the class sums `R[m, :] (sum value U x)`,
+/// `references x classes x responses`.
+fn by_measured_rows(
+    table: &TermTable,
+    solver: &ZSolver,
+    plan: &ChannelPlan,
+    freq_hz: f64,
+    scratch: &mut Scratch,
+) -> Result<Vec<C64>, UpdateError> {
+    let (n_ref, n_resp) = (plan.ref_eqs.len(), plan.resp_eqs.len());
+    let k = n_ref + n_resp;
     scratch.eqs.clear();
     scratch.eqs.extend(plan.ref_eqs.iter().chain(&plan.resp_eqs));
-    let Scratch { ws, eqs, sol, coef, acc, measured_at, measured, .. } = scratch;
+    let Scratch { ws, eqs, sol, acc, measured_at, measured, .. } = scratch;
     acc.clear();
     acc.resize(n_ref * table.n_classes * n_resp, ZERO);
     let arch = Arch::new();
@@ -649,26 +762,68 @@ fn assemble_line(
             });
         }
     })?;
+    Ok(plan.picks.iter().map(|&(ri, mi)| sol[solver.position(plan.resp_eqs[mi]) * k + ri]).collect())
+}
 
-    let model: Vec<C64> = plan.picks.iter().map(|&(ri, mi)| sol[solver.position(plan.resp_eqs[mi]) * k + ri]).collect();
-    // each parameter: its classes' sums times their coefficients
-    let mut per_param = vec![ZERO; n_ref * n_par * n_resp];
-    for ri in 0..n_ref {
-        for (&(i, class), &c) in table.pairs.iter().zip(coef.iter()) {
-            let from = (ri * table.n_classes + class as usize) * n_resp;
-            let to = (ri * n_par + i as usize) * n_resp;
-            for m in 0..n_resp {
-                per_param[to + m] += c * acc[from + m];
+/// Steps 2 and 4 the other way round: `R[m, :] w = (Z^-1 w)[m]` by symmetry,
+/// so each class sum `w = sum value U x` (a sparse vector over the class's
+/// blocks) is solved for once and read at the measured rows. Needs the
+/// references' columns first, then `references x classes` solves: fewer
+/// than the measured DOFs when the parameters act through a few groups.
+/// Returns and leaves what [`by_measured_rows`] does.
+fn by_class_sums(
+    table: &TermTable,
+    solver: &ZSolver,
+    plan: &ChannelPlan,
+    freq_hz: f64,
+    scratch: &mut Scratch,
+) -> Result<Vec<C64>, UpdateError> {
+    let (n_ref, n_resp) = (plan.ref_eqs.len(), plan.resp_eqs.len());
+    let n = solver.n();
+    let Scratch { ws, sol, w, acc, measured_at, measured, .. } = scratch;
+    // the references' columns (hybrid), and in the same backward sweep the
+    // class sums, row-interleaved in solver order, one column per
+    // (reference, class): a block is added when its rows of x are final; a
+    // row of w is cleared when the sweep reaches it, before any block that
+    // touches it (those have their smallest row at or below it)
+    let kc = n_ref * table.n_classes;
+    w.resize(n * kc, ZERO);
+    solver.solve_units_ordered_with(ws, &plan.ref_eqs, sol, freq_hz, |r, rows| {
+        w[r * kc..(r + 1) * kc].fill(ZERO);
+        let (b0, b1) = (table.bucket[r] as usize, table.bucket[r + 1] as usize);
+        let mut xb = [ZERO; 6];
+        for item in &table.items[b0..b1] {
+            let nb = item.nb as usize;
+            let item_rows = &item.rows[..nb];
+            for ri in 0..n_ref {
+                for (x, &row) in xb.iter_mut().zip(item_rows) {
+                    let at = measured_at[row as usize];
+                    let replaced = if at == NONE { None } else { measured[at as usize * n_ref + ri] };
+                    *x = replaced.unwrap_or(rows[(row as usize - r) * n_ref + ri]);
+                }
+                for term in &table.terms[item.t0 as usize..item.t1 as usize] {
+                    let unit = &table.units[term.unit as usize..term.unit as usize + nb * nb];
+                    let col = ri * table.n_classes + term.class as usize;
+                    for (l, &row) in item_rows.iter().enumerate() {
+                        let urow = &unit[l * nb..(l + 1) * nb];
+                        let v = urow.iter().zip(&xb[..nb]).fold(ZERO, |s, (&u, &x)| s + x * u) * term.value;
+                        w[row as usize * kc + col] += v;
+                    }
+                }
             }
         }
-    }
-    let mut sens = Mat::<C64>::zeros(plan.channels.len(), n_par);
-    for (c, &(ri, mi)) in plan.picks.iter().enumerate() {
-        for i in 0..n_par {
-            sens[(c, i)] = per_param[(ri * n_par + i) * n_resp + mi];
+    })?;
+    let model = plan.picks.iter().map(|&(ri, mi)| sol[solver.position(plan.resp_eqs[mi]) * n_ref + ri]).collect();
+    solver.solve_ordered(ws, w, kc, freq_hz)?;
+    acc.clear();
+    acc.resize(kc * n_resp, ZERO);
+    for (mi, &m) in plan.resp_eqs.iter().enumerate() {
+        let at = solver.position(m) * kc;
+        for (col, &v) in w[at..at + kc].iter().enumerate() {
+            acc[col * n_resp + mi] = v;
         }
     }
-    Ok(FrequencyBlock { freq_hz, model, sens })
+    Ok(model)
 }
 
 /// Step 4 for the blocks of one bucket, every reference: for each used term,
@@ -775,8 +930,19 @@ pub fn assemble(
         .map(|(k, &f)| {
             let popped = pool.lock().unwrap_or_else(PoisonError::into_inner).pop();
             let mut scratch = popped.unwrap_or_else(|| Scratch::new(solver));
-            let block =
-                assemble_line(sys, cache.as_ref(), Some(&table), solver, plan, params, f, hybrid, k, &mut scratch);
+            let block = assemble_line(
+                sys,
+                cache.as_ref(),
+                Some(&table),
+                Strategy::Auto,
+                solver,
+                plan,
+                params,
+                f,
+                hybrid,
+                k,
+                &mut scratch,
+            );
             pool.lock().unwrap_or_else(PoisonError::into_inner).push(scratch);
             block
         })
@@ -837,7 +1003,9 @@ mod tests {
         assert!(rules.n_classes < fallback.n_classes, "classes merge terms");
         let mut scratch = Scratch::new(&solver);
         let mut at = |table: &TermTable| {
-            assemble_line(&sys, None, Some(table), &solver, &plan, &params, f, Hybrid::Model, 0, &mut scratch).unwrap()
+            let strategy = Strategy::MeasuredRows;
+            assemble_line(&sys, None, Some(table), strategy, &solver, &plan, &params, f, Hybrid::Model, 0, &mut scratch)
+                .unwrap()
         };
         let (a, b) = (at(&rules), at(&fallback));
         for i in 0..params.len() {
@@ -845,6 +1013,45 @@ mod tests {
             assert!(scale > 0.0);
             for c in 0..channels.len() {
                 assert!((a.sens[(c, i)] - b.sens[(c, i)]).norm() <= 1e-12 * scale, "parameter {i}, channel {c}");
+            }
+        }
+    }
+
+    /// Solving for each class sum and reading the measured rows gives what
+    /// the unit solves at the measured rows give, for both hybrid modes.
+    #[test]
+    fn class_sums_and_measured_rows_agree() {
+        let (truth, params) = every_kind();
+        let mut sys = truth.clone();
+        sys.set(params[0], 1.7 * sys.get(params[0])).unwrap();
+        let solver = ZSolver::new(&sys.assembly().pattern).unwrap();
+        let (a, b) = (DofRef::new(4, Dof::Uy), DofRef::new(2, Dof::Ux));
+        let channels: Vec<Channel> = [(2, Dof::Ux), (3, Dof::Rz), (4, Dof::Uy), (4, Dof::Rz)]
+            .iter()
+            .flat_map(|&(node, dof)| [Channel::new(DofRef::new(node, dof), a), Channel::new(DofRef::new(node, dof), b)])
+            .collect();
+        let plan = ChannelPlan::new(&sys, &channels).unwrap();
+        let freqs = [35.0, 240.0];
+        let measured = frf::synthesize(&truth, &channels, &freqs).unwrap();
+        let mut scratch = Scratch::new(&solver);
+        for (line, &f) in freqs.iter().enumerate() {
+            let table = TermTable::new(&sys, &solver, &params, 2.0 * std::f64::consts::PI * f);
+            for hybrid in [Hybrid::Model, Hybrid::Measured(&measured)] {
+                let mut run = |strategy| {
+                    let t = Some(&table);
+                    assemble_line(&sys, None, t, strategy, &solver, &plan, &params, f, hybrid, line, &mut scratch)
+                        .unwrap()
+                };
+                let (rows, sums) = (run(Strategy::MeasuredRows), run(Strategy::ClassSums));
+                assert_eq!(rows.model, sums.model);
+                for i in 0..params.len() {
+                    let scale = (0..channels.len()).map(|c| rows.sens[(c, i)].norm()).fold(0.0, f64::max);
+                    assert!(scale > 0.0);
+                    for c in 0..channels.len() {
+                        let e = (rows.sens[(c, i)] - sums.sens[(c, i)]).norm() / scale;
+                        assert!(e < 1e-10, "{hybrid:?} parameter {i} channel {c} at {f} Hz: {e:e}");
+                    }
+                }
             }
         }
     }
