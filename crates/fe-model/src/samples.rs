@@ -83,3 +83,123 @@ pub fn two_dof_oscillator() -> Model {
     m.add_support(2, &[Dof::Uy, Dof::Rz]).unwrap();
     m
 }
+
+/// Number of regions (damping groups) of [`long_beam`].
+pub const LONG_BEAM_REGIONS: usize = 6;
+
+/// A long continuous steel beam for benchmarks: `n_elements` elements of
+/// 50 mm (section 50 x 10 mm) along x, nodes `1..=n_elements+1`, clamped at
+/// node 1 and pinned (ux, uy) every 20 elements, so that it is a chain of
+/// 1 m spans whose conditioning does not grow with its length. It has
+/// `3 n - 2 floor(n / 20)` equations for `n` elements (34,483 elements give
+/// about 100,000).
+///
+/// The elements are split into [`LONG_BEAM_REGIONS`] consecutive regions
+/// (fewer when there are fewer elements), each its own group `r1`, `r2`, ...
+/// with its own non-viscous damping, so that each region offers five
+/// parameters (alpha, beta, mu, stiffness and mass factors).
+pub fn long_beam(n_elements: usize) -> Model {
+    let n = n_elements.max(1);
+    let mut m = Model::new("long multi-span beam");
+    let regions = LONG_BEAM_REGIONS.min(n);
+    let groups: Vec<usize> = (0..regions)
+        .map(|r| {
+            let x = r as f64;
+            let g = Group::new(&format!("r{}", r + 1)).rayleigh(1e-5 * (1.0 + 0.2 * x), 0.5 + 0.1 * x);
+            m.add_group(g.relaxation(500.0 * (1.0 + x))).unwrap()
+        })
+        .collect();
+    let mat = m.add_material("steel", 2.0e11, 7800.0).unwrap();
+    let sec = m.add_section(Section::rectangle("bar", 0.05, 0.01)).unwrap();
+    for i in 0..=n {
+        m.add_node(i as u32 + 1, 0.05 * i as f64, 0.0).unwrap();
+    }
+    for i in 0..n {
+        let g = groups[i * regions / n];
+        m.add_beam(i as u32 + 1, [i as u32 + 1, i as u32 + 2], mat, sec, g).unwrap();
+    }
+    m.add_support(1, &Dof::ALL).unwrap();
+    for i in (20..=n).step_by(20) {
+        m.add_support(i as u32 + 1, &[Dof::Ux, Dof::Uy]).unwrap();
+    }
+    m
+}
+
+/// A planar multi-storey steel frame for benchmarks: `bays` bays of 2 m and
+/// `storeys` storeys of 1.5 m, every column and floor beam divided into
+/// `elements_per_member` elements, columns clamped at the base. Columns
+/// (80 x 80 mm) are in group `columns` (non-viscous, mu = 800 rad/s), floor
+/// beams (60 x 120 mm) in group `beams` (viscous).
+///
+/// The joints are nodes `1..=(bays+1)(storeys+1)`, numbered along each floor
+/// from the ground up; member-interior nodes follow. There are
+/// `3 [(bays+1) storeys + members (elements_per_member - 1)]` equations with
+/// `members = (2 bays + 1) storeys`: `frame_grid(10, 10, 16)` has 9,780.
+pub fn frame_grid(bays: usize, storeys: usize, elements_per_member: usize) -> Model {
+    let (bays, storeys, per) = (bays.max(1), storeys.max(1), elements_per_member.max(1));
+    let mut m = Model::new("multi-storey frame");
+    let columns = m.add_group(Group::new("columns").rayleigh(2e-5, 0.2).relaxation(800.0)).unwrap();
+    let beams = m.add_group(Group::new("beams").rayleigh(3e-5, 0.3)).unwrap();
+    let steel = m.add_material("steel", 2.0e11, 7800.0).unwrap();
+    let col_sec = m.add_section(Section::rectangle("column", 0.08, 0.08)).unwrap();
+    let beam_sec = m.add_section(Section::rectangle("beam", 0.06, 0.12)).unwrap();
+    let (width, height) = (2.0, 1.5);
+    let joint = |bay: usize, floor: usize| (floor * (bays + 1) + bay + 1) as u32;
+    for floor in 0..=storeys {
+        for bay in 0..=bays {
+            m.add_node(joint(bay, floor), width * bay as f64, height * floor as f64).unwrap();
+        }
+    }
+    let mut next_node = joint(bays, storeys) + 1;
+    let mut next_element = 1u32;
+    let mut member = |m: &mut Model, a: (usize, usize), b: (usize, usize), sec: usize, group: usize| {
+        let (xa, ya) = (width * a.0 as f64, height * a.1 as f64);
+        let (xb, yb) = (width * b.0 as f64, height * b.1 as f64);
+        let mut prev = joint(a.0, a.1);
+        for e in 1..=per {
+            let node = if e == per {
+                joint(b.0, b.1)
+            } else {
+                let t = e as f64 / per as f64;
+                let id = next_node;
+                next_node += 1;
+                m.add_node(id, xa + t * (xb - xa), ya + t * (yb - ya)).unwrap();
+                id
+            };
+            m.add_beam(next_element, [prev, node], steel, sec, group).unwrap();
+            next_element += 1;
+            prev = node;
+        }
+    };
+    for floor in 0..storeys {
+        for bay in 0..=bays {
+            member(&mut m, (bay, floor), (bay, floor + 1), col_sec, columns);
+        }
+        for bay in 0..bays {
+            member(&mut m, (bay, floor + 1), (bay + 1, floor + 1), beam_sec, beams);
+        }
+    }
+    for bay in 0..=bays {
+        m.add_support(joint(bay, 0), &Dof::ALL).unwrap();
+    }
+    m
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Assembly;
+
+    #[test]
+    fn generators_have_the_documented_sizes() {
+        for n in [1, 19, 20, 41, 200] {
+            let a = Assembly::new(&long_beam(n)).unwrap();
+            assert_eq!(a.n(), 3 * n - 2 * (n / 20), "long_beam({n})");
+        }
+        let (bays, storeys, per) = (3, 2, 4);
+        let a = Assembly::new(&frame_grid(bays, storeys, per)).unwrap();
+        let members = (2 * bays + 1) * storeys;
+        assert_eq!(a.n(), 3 * ((bays + 1) * storeys + members * (per - 1)));
+        assert_eq!(frame_grid(bays, storeys, per).beams().len(), members * per);
+    }
+}

@@ -9,8 +9,9 @@
 //!
 //! and is never formed densely: [`ZSolver`] analyses the sparsity pattern once
 //! (fill-reducing ordering), then each frequency line costs one numeric sparse
-//! factorisation and one solve per excitation DOF ([`synthesize`]); lines are
-//! spread over rayon threads, each with its own reusable [`solver::Workspace`].
+//! complex-symmetric `L D L^T` factorisation (LU with pivoting as a fallback)
+//! and one solve per excitation DOF ([`synthesize`]); lines are spread over
+//! rayon threads, each with its own reusable [`solver::Workspace`].
 //! Because `Z` is complex symmetric, `H` is symmetric (reciprocity).
 //!
 //! [`FrfSet`] holds FRFs over common lines for a list of [`Channel`]s
@@ -77,6 +78,7 @@
 pub mod correlation;
 pub mod error;
 pub mod io;
+mod ldlt;
 pub mod lscf;
 pub mod modal;
 pub mod noise;
@@ -87,10 +89,12 @@ pub mod synth;
 pub use correlation::{BandSpec, Correlation, correlate};
 pub use error::FrfError;
 pub use lscf::{EstimatedMode, LscfError, LscfOptions, ModalEstimate, PoleStatus, lscf};
-pub use modal::{Mode, ModeError, ModePair, Pairing, mac, mac_matrix, measured_modes, model_modes, pair_modes};
+pub use modal::{
+    Mode, ModeError, ModePair, Pairing, Symptom, mac, mac_matrix, measured_modes, model_modes, pair_modes, symptom,
+};
 pub use noise::NoiseModel;
 pub use set::{Channel, FrfKind, FrfSet};
-pub use solver::{Workspace, ZSolver};
+pub use solver::{FactorKind, Workspace, ZSolver};
 pub use synth::{equation_of, receptance_columns, synthesize, synthesize_with};
 
 /// Complex double.

@@ -175,10 +175,74 @@ pub fn pair_modes(model: &[Mode], measured: &[Mode], min_mac: f64) -> Pairing {
     }
 }
 
+/// What a paired mode's differences suggest.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Symptom {
+    /// Frequency, damping and shape agree.
+    Matches,
+    /// The model's resonance is shifted by more than the measured peak's
+    /// width: a stiffness or mass error.
+    FrequencyShift,
+    /// The frequency agrees but the peak's height and width do not: a
+    /// damping error.
+    Damping,
+    /// Both the frequency and the damping differ.
+    FrequencyAndDamping,
+    /// Frequency and damping agree but the shape does not (MAC below 0.9):
+    /// a stiffness or mass error in the wrong place, or a sensor problem.
+    Shape,
+}
+
+impl Symptom {
+    /// One line a user can act on.
+    pub fn reading(self) -> &'static str {
+        match self {
+            Symptom::Matches => "matches",
+            Symptom::FrequencyShift => "frequency shift: a stiffness or mass error",
+            Symptom::Damping => "peak height and width: a damping error",
+            Symptom::FrequencyAndDamping => "frequency shift and peak width: stiffness or mass, and damping",
+            Symptom::Shape => "mode shape: an error in the distribution of stiffness or mass, or a sensor",
+        }
+    }
+}
+
+/// Reads a pair of modes. The frequency differs when the model's natural
+/// frequency lies outside twice the measured half-power half-width
+/// (`|f_model - f_meas| > 2 zeta_meas f_meas`, the resonance has moved by
+/// more than its peak is wide); the damping differs when the damping ratios
+/// differ by more than 25 %; the shape differs when the MAC is below 0.9.
+pub fn symptom(model: &Mode, measured: &Mode, mac: f64) -> Symptom {
+    let half_width = measured.damping_ratio.abs() * measured.frequency_hz;
+    let shifted = (model.frequency_hz - measured.frequency_hz).abs() > 2.0 * half_width;
+    let damping = (model.damping_ratio - measured.damping_ratio).abs() > 0.25 * measured.damping_ratio.abs();
+    match (shifted, damping) {
+        (true, true) => Symptom::FrequencyAndDamping,
+        (true, false) => Symptom::FrequencyShift,
+        (false, true) => Symptom::Damping,
+        (false, false) if mac < 0.9 => Symptom::Shape,
+        (false, false) => Symptom::Matches,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use fe_model::Dof;
+
+    fn mode(f: f64, z: f64) -> Mode {
+        Mode { frequency_hz: f, damping_ratio: z, dofs: vec![], shape: vec![] }
+    }
+
+    #[test]
+    fn symptoms_compare_the_shift_with_the_peak_width() {
+        // measured 100 Hz at 1 %: half-power half-width 1 Hz
+        let meas = mode(100.0, 0.01);
+        assert_eq!(symptom(&mode(101.5, 0.0105), &meas, 0.99), Symptom::Matches);
+        assert_eq!(symptom(&mode(103.0, 0.0105), &meas, 0.99), Symptom::FrequencyShift);
+        assert_eq!(symptom(&mode(100.5, 0.02), &meas, 0.99), Symptom::Damping);
+        assert_eq!(symptom(&mode(97.0, 0.005), &meas, 0.99), Symptom::FrequencyAndDamping);
+        assert_eq!(symptom(&mode(100.2, 0.01), &meas, 0.5), Symptom::Shape);
+    }
 
     #[test]
     fn mac_is_one_for_complex_multiples_and_zero_for_orthogonal_vectors() {

@@ -1,34 +1,85 @@
 //! Sparse factorisation of `Z(w)` once per frequency.
 //!
-//! [`ZSolver`] holds the symbolic analysis (fill-reducing ordering and
-//! elimination structure) of the model's sparsity pattern, computed once and
-//! shared by every frequency and iteration. Each thread owns a [`Workspace`]
-//! with the numeric factors and scratch memory, reused from one frequency to
-//! the next, so the hot loop allocates nothing. faer runs sequentially inside;
-//! parallelism is over frequencies (rayon) in the callers.
+//! `Z(w) = K - w^2 M + j w G(w)` is complex symmetric, so [`ZSolver`] factorises
+//! it as `P Z P^T = L D L^T` (complex, no conjugation, no pivoting): half the
+//! work and memory of an LU, with a structure fixed by the pattern alone.
+//!
+//! [`ZSolver::new`] does the symbolic analysis once per model pattern: a
+//! fill-reducing ordering (faer's approximate minimum degree), the elimination
+//! tree and the pattern of `L`. It is shared, read-only, by every frequency,
+//! iteration and thread. Each thread owns a [`Workspace`] with the numeric
+//! factors and buffers, reused from one frequency to the next: factorising
+//! and solving allocate nothing once the workspace has seen the largest
+//! number of right-hand sides. faer runs sequentially inside; parallelism is
+//! over frequencies (rayon) in the callers.
+//!
+//! Without pivoting the factorisation is only as stable as its pivots. A
+//! pivot that is not finite, or tiny against the entries of its row of `Z` or
+//! against the terms subtracted to form it, makes [`ZSolver::factorize`] fall
+//! back, for that frequency only, to faer's sparse LU with partial pivoting
+//! (its symbolic analysis is made on first need and then kept).
+//! [`Workspace::factor_kind`] tells which was used. A matrix that LU cannot
+//! factorise, or whose solution is not finite, is reported as
+//! [`FrfError::Singular`].
+//!
+//! # Right-hand side layouts
+//!
+//! - [`ZSolver::solve_in_place`]: a column-major faer matrix, one column per
+//!   right-hand side (convenient).
+//! - [`ZSolver::solve_interleaved`]: a slice with the `k` right-hand sides
+//!   interleaved by row, `x[i * k + j]` for equation `i`, right-hand side `j`.
+//!   Each elimination step then updates `k` contiguous values.
+//! - [`ZSolver::solve_ordered`]: the same, with rows in the solver's internal
+//!   order ([`ZSolver::position`]), which saves two permuting copies of the
+//!   whole block; for callers that build right-hand sides and read solutions
+//!   at a few rows per equation, such as the sensitivity assembly.
+
+use std::sync::OnceLock;
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::sparse::linalg::lu::{LuRef, NumericLu, SymbolicLu, factorize_symbolic_lu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
-use faer::{Conj, MatMut, Par};
+use faer::{Conj, Mat, MatMut, Par};
 use fe_model::Pattern;
 use num_complex::Complex64 as C64;
 
 use crate::error::FrfError;
+use crate::ldlt::{NumericLdlt, SymbolicLdlt};
+
+const ZERO: C64 = C64 { re: 0.0, im: 0.0 };
 
 /// Symbolic factorisation of a model's `Z` pattern; see the module docs.
 #[derive(Clone, Debug)]
 pub struct ZSolver {
     pattern: SymbolicSparseColMat<usize>,
-    lu: SymbolicLu<usize>,
+    ldlt: SymbolicLdlt,
+    /// Symbolic LU for the fallback, made on first need.
+    lu: OnceLock<Result<SymbolicLu<usize>, String>>,
+}
+
+/// Which factorisation a [`Workspace`] holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FactorKind {
+    /// Complex-symmetric `L D L^T` (the normal case).
+    Ldlt,
+    /// Sparse LU with partial pivoting (the fallback).
+    Lu,
 }
 
 /// Per-thread numeric factors and scratch memory.
 pub struct Workspace {
+    ldlt: NumericLdlt,
+    lu: Option<LuWorkspace>,
+    kind: Option<FactorKind>,
+}
+
+/// Numeric LU and its scratch, allocated only when the fallback is needed.
+struct LuWorkspace {
     numeric: NumericLu<usize, C64>,
     buffer: MemBuffer,
     capacity: StackReq,
-    factorized: bool,
+    /// Column-major copy of interleaved right-hand sides.
+    cols: Mat<C64>,
 }
 
 impl ZSolver {
@@ -41,64 +92,269 @@ impl ZSolver {
             None,
             pattern.row_idx.clone(),
         );
-        let lu = factorize_symbolic_lu(symbolic.as_ref(), Default::default())
-            .map_err(|e| FrfError::Factorization(format!("{e:?}")))?;
-        Ok(ZSolver { pattern: symbolic, lu })
+        let ldlt = SymbolicLdlt::new(pattern).map_err(FrfError::Factorization)?;
+        Ok(ZSolver { pattern: symbolic, ldlt, lu: OnceLock::new() })
     }
 
     /// Matrix dimension.
     pub fn n(&self) -> usize {
-        self.pattern.nrows()
+        self.ldlt.n()
+    }
+
+    /// Number of entries of the factor `L` below its diagonal (the fill-in
+    /// measure that sets the cost of factorising and solving).
+    pub fn factor_nnz(&self) -> usize {
+        self.ldlt.nnz_l()
+    }
+
+    /// Row of equation `eq` in the solver's internal order (the layout of
+    /// [`Self::solve_ordered`]).
+    pub fn position(&self, eq: usize) -> usize {
+        self.ldlt.perm_inv()[eq]
     }
 
     /// A fresh workspace for one thread.
     pub fn workspace(&self) -> Workspace {
-        let capacity = self
-            .lu
-            .factorize_numeric_lu_scratch::<C64>(Par::Seq, Default::default())
-            .or(self.lu.solve_in_place_scratch::<C64>(1, Par::Seq));
-        Workspace { numeric: NumericLu::new(), buffer: MemBuffer::new(capacity), capacity, factorized: false }
+        Workspace { ldlt: self.ldlt.numeric(), lu: None, kind: None }
     }
 
-    /// Factorises `Z` given as values on the pattern. `freq_hz` is only used
-    /// in the error message.
-    pub fn factorize(&self, ws: &mut Workspace, values: &[C64], freq_hz: f64) -> Result<(), FrfError> {
-        ws.factorized = false;
-        if values.iter().any(|v| !(v.re.is_finite() && v.im.is_finite())) {
-            return Err(FrfError::BadFrequency { freq_hz });
-        }
-        let mat = SparseColMatRef::new(self.pattern.as_ref(), values);
+    fn symbolic_lu(&self) -> Result<&SymbolicLu<usize>, FrfError> {
         self.lu
-            .factorize_numeric_lu(&mut ws.numeric, mat, Par::Seq, MemStack::new(&mut ws.buffer), Default::default())
+            .get_or_init(|| {
+                factorize_symbolic_lu(self.pattern.as_ref(), Default::default()).map_err(|e| format!("{e:?}"))
+            })
+            .as_ref()
+            .map_err(|e| FrfError::Factorization(e.clone()))
+    }
+
+    /// Factorises `Z` given as values on the pattern: `L D L^T`, or LU when a
+    /// pivot is tiny (see the module docs). `freq_hz` is only used in errors.
+    pub fn factorize(&self, ws: &mut Workspace, values: &[C64], freq_hz: f64) -> Result<(), FrfError> {
+        ws.kind = None;
+        check_values(self, values, freq_hz)?;
+        match self.ldlt.factorize(&mut ws.ldlt, values) {
+            Ok(()) => {
+                ws.kind = Some(FactorKind::Ldlt);
+                Ok(())
+            }
+            Err(_) => self.factorize_lu(ws, values, freq_hz),
+        }
+    }
+
+    /// Factorises `Z` with the pivoting sparse LU directly, as the fallback of
+    /// [`Self::factorize`] does; for cross-checks and tests.
+    pub fn factorize_lu(&self, ws: &mut Workspace, values: &[C64], freq_hz: f64) -> Result<(), FrfError> {
+        ws.kind = None;
+        check_values(self, values, freq_hz)?;
+        let lu = self.symbolic_lu()?;
+        let lw = ws.lu.get_or_insert_with(|| {
+            let capacity = lu
+                .factorize_numeric_lu_scratch::<C64>(Par::Seq, Default::default())
+                .or(lu.solve_in_place_scratch::<C64>(1, Par::Seq));
+            LuWorkspace { numeric: NumericLu::new(), buffer: MemBuffer::new(capacity), capacity, cols: Mat::new() }
+        });
+        let mat = SparseColMatRef::new(self.pattern.as_ref(), values);
+        lu.factorize_numeric_lu(&mut lw.numeric, mat, Par::Seq, MemStack::new(&mut lw.buffer), Default::default())
             .map_err(|_| FrfError::Singular { freq_hz })?;
-        ws.factorized = true;
+        ws.kind = Some(FactorKind::Lu);
         Ok(())
+    }
+
+    /// LU solve of a column-major block, with the factors in `lw`.
+    fn lu_solve(&self, lw: &mut LuWorkspace, rhs: MatMut<'_, C64>) {
+        let lu = self.symbolic_lu().expect("an LU factorisation exists, so does its symbolic part");
+        let need = lu.solve_in_place_scratch::<C64>(rhs.ncols(), Par::Seq);
+        if need.size_bytes() > lw.capacity.size_bytes() {
+            lw.capacity = lw.capacity.or(need);
+            lw.buffer = MemBuffer::new(lw.capacity);
+        }
+        LuRef::new_unchecked(lu, &lw.numeric).solve_in_place_with_conj(
+            Conj::No,
+            rhs,
+            Par::Seq,
+            MemStack::new(&mut lw.buffer),
+        );
     }
 
     /// Solves `Z x = b` in place for every column of `rhs`, with the factors in
-    /// `ws`. Returns [`FrfError::Singular`] when the solution is not finite
-    /// (faer signals a numerically singular matrix only through NaN or inf).
+    /// `ws`. Returns [`FrfError::Singular`] when the solution is not finite.
     pub fn solve_in_place(&self, ws: &mut Workspace, mut rhs: MatMut<'_, C64>, freq_hz: f64) -> Result<(), FrfError> {
-        assert!(ws.factorized, "solve called before a successful factorize");
-        let need = self.lu.solve_in_place_scratch::<C64>(rhs.ncols(), Par::Seq);
-        if need.size_bytes() > ws.capacity.size_bytes() {
-            ws.capacity = ws.capacity.or(need);
-            ws.buffer = MemBuffer::new(ws.capacity);
-        }
-        LuRef::new_unchecked(&self.lu, &ws.numeric).solve_in_place_with_conj(
-            Conj::No,
-            rhs.as_mut(),
-            Par::Seq,
-            MemStack::new(&mut ws.buffer),
-        );
-        for j in 0..rhs.ncols() {
-            for i in 0..rhs.nrows() {
-                let v = rhs[(i, j)];
-                if !(v.re.is_finite() && v.im.is_finite()) {
-                    return Err(FrfError::Singular { freq_hz });
+        let n = self.n();
+        assert_eq!(rhs.nrows(), n, "right-hand sides must have one row per equation");
+        match ws.kind.expect("solve called before a successful factorize") {
+            FactorKind::Ldlt => {
+                let k = rhs.ncols();
+                let perm = self.ldlt.perm();
+                let mut buf = std::mem::take(&mut ws.ldlt.buf);
+                buf.clear();
+                buf.resize(n * k, ZERO);
+                for j in 0..k {
+                    let col = rhs.as_ref().col(j);
+                    for (new, &old) in perm.iter().enumerate() {
+                        buf[new * k + j] = col[old];
+                    }
                 }
+                let finite = self.ldlt.solve_in_place(&ws.ldlt, &mut buf, k);
+                for j in 0..k {
+                    let mut col = rhs.as_mut().col_mut(j);
+                    for (new, &old) in perm.iter().enumerate() {
+                        col[old] = buf[new * k + j];
+                    }
+                }
+                ws.ldlt.buf = buf;
+                if finite { Ok(()) } else { Err(FrfError::Singular { freq_hz }) }
             }
+            FactorKind::Lu => {
+                let lw = ws.lu.as_mut().expect("LU factors exist");
+                self.lu_solve(lw, rhs.as_mut());
+                for j in 0..rhs.ncols() {
+                    if !rhs.as_ref().col(j).iter().all(|v| is_finite(*v)) {
+                        return Err(FrfError::Singular { freq_hz });
+                    }
+                }
+                Ok(())
+            }
+        }
+    }
+
+    /// Solves `Z X = B` in place for `k` right-hand sides stored
+    /// row-interleaved in equation order: `x[i * k + j]` is equation `i` of
+    /// right-hand side `j` (`x.len() == n * k`).
+    pub fn solve_interleaved(&self, ws: &mut Workspace, x: &mut [C64], k: usize, freq_hz: f64) -> Result<(), FrfError> {
+        let n = self.n();
+        assert_eq!(x.len(), n * k, "right-hand sides must be n x k, row-interleaved");
+        if ws.kind == Some(FactorKind::Ldlt) {
+            let perm = self.ldlt.perm();
+            let mut buf = std::mem::take(&mut ws.ldlt.buf);
+            buf.clear();
+            buf.reserve(n * k);
+            for &old in perm {
+                buf.extend_from_slice(&x[old * k..old * k + k]);
+            }
+            let finite = self.ldlt.solve_in_place(&ws.ldlt, &mut buf, k);
+            for (new, &old) in perm.iter().enumerate() {
+                x[old * k..old * k + k].copy_from_slice(&buf[new * k..new * k + k]);
+            }
+            ws.ldlt.buf = buf;
+            return if finite { Ok(()) } else { Err(FrfError::Singular { freq_hz }) };
+        }
+        self.solve_lu_interleaved(ws, x, k, |i| i, freq_hz)
+    }
+
+    /// As [`Self::solve_interleaved`], with rows in the solver's internal
+    /// order: row [`Self::position`]`(eq)` holds equation `eq`.
+    pub fn solve_ordered(&self, ws: &mut Workspace, x: &mut [C64], k: usize, freq_hz: f64) -> Result<(), FrfError> {
+        assert_eq!(x.len(), self.n() * k, "right-hand sides must be n x k, row-interleaved");
+        if ws.kind == Some(FactorKind::Ldlt) {
+            let finite = self.ldlt.solve_in_place(&ws.ldlt, x, k);
+            return if finite { Ok(()) } else { Err(FrfError::Singular { freq_hz }) };
+        }
+        let perm_inv = self.ldlt.perm_inv();
+        self.solve_lu_interleaved(ws, x, k, |eq| perm_inv[eq], freq_hz)
+    }
+
+    /// Columns of `R = Z^-1` for the equations `eqs`: `x` is resized to
+    /// `n x eqs.len()` and receives them row-interleaved in the solver's
+    /// internal order, `x[position(i) * k + j] = R[i, eqs[j]]`. The unit
+    /// right-hand sides are made on the fly, so `x` needs no clearing; by
+    /// symmetry of `R` the same numbers are the rows `R[eqs[j], i]`.
+    pub fn solve_units_ordered(
+        &self,
+        ws: &mut Workspace,
+        eqs: &[usize],
+        x: &mut Vec<C64>,
+        freq_hz: f64,
+    ) -> Result<(), FrfError> {
+        self.solve_units_ordered_with(ws, eqs, x, freq_hz, |_, _| {})
+    }
+
+    /// As [`Self::solve_units_ordered`], calling `visit(r, &x[r * k..])` for
+    /// each internal row `r` from the last to the first, as soon as rows
+    /// `r..n` of the solution are final: a caller that consumes the solution
+    /// a few rows at a time does so while they are still in cache, instead
+    /// of in another pass over the whole block. The rows passed may not be
+    /// the final answer if the solve then reports an error.
+    pub fn solve_units_ordered_with(
+        &self,
+        ws: &mut Workspace,
+        eqs: &[usize],
+        x: &mut Vec<C64>,
+        freq_hz: f64,
+        mut visit: impl FnMut(usize, &[C64]),
+    ) -> Result<(), FrfError> {
+        let (n, k) = (self.n(), eqs.len());
+        x.resize(n * k, ZERO);
+        if ws.kind == Some(FactorKind::Ldlt) {
+            let mut rows = std::mem::take(&mut ws.ldlt.buf_rows);
+            rows.clear();
+            rows.extend(eqs.iter().map(|&e| self.position(e)));
+            let finite = self.ldlt.solve_units(&mut ws.ldlt, &rows, x, visit);
+            ws.ldlt.buf_rows = rows;
+            return if finite { Ok(()) } else { Err(FrfError::Singular { freq_hz }) };
+        }
+        x.fill(ZERO);
+        for (j, &e) in eqs.iter().enumerate() {
+            x[self.position(e) * k + j] = C64::new(1.0, 0.0);
+        }
+        self.solve_ordered(ws, x, k, freq_hz)?;
+        for r in (0..n).rev() {
+            visit(r, &x[r * k..]);
         }
         Ok(())
     }
+
+    /// The LU path of the interleaved solves: `row(eq)` is the row of `x`
+    /// that holds equation `eq`.
+    fn solve_lu_interleaved(
+        &self,
+        ws: &mut Workspace,
+        x: &mut [C64],
+        k: usize,
+        row: impl Fn(usize) -> usize,
+        freq_hz: f64,
+    ) -> Result<(), FrfError> {
+        assert_eq!(ws.kind, Some(FactorKind::Lu), "solve called before a successful factorize");
+        let n = self.n();
+        let lw = ws.lu.as_mut().expect("LU factors exist");
+        let mut cols = std::mem::replace(&mut lw.cols, Mat::new());
+        cols.resize_with(n, k, |_, _| ZERO);
+        for eq in 0..n {
+            let r = row(eq);
+            for j in 0..k {
+                cols[(eq, j)] = x[r * k + j];
+            }
+        }
+        self.lu_solve(lw, cols.as_mut());
+        for eq in 0..n {
+            let r = row(eq);
+            for j in 0..k {
+                x[r * k + j] = cols[(eq, j)];
+            }
+        }
+        lw.cols = cols;
+        check_solution(x, freq_hz)
+    }
+}
+
+impl Workspace {
+    /// The factorisation held, or `None` before a successful
+    /// [`ZSolver::factorize`].
+    pub fn factor_kind(&self) -> Option<FactorKind> {
+        self.kind
+    }
+}
+
+fn is_finite(v: C64) -> bool {
+    v.re.is_finite() && v.im.is_finite()
+}
+
+fn check_values(solver: &ZSolver, values: &[C64], freq_hz: f64) -> Result<(), FrfError> {
+    assert_eq!(values.len(), solver.pattern.row_idx().len(), "values must lie on the solver's pattern");
+    if values.iter().all(|&v| is_finite(v)) { Ok(()) } else { Err(FrfError::BadFrequency { freq_hz }) }
+}
+
+/// faer signals a numerically singular LU only through NaN or inf in the
+/// solution; a huge but finite `L D L^T` solution passed the pivot test.
+fn check_solution(x: &[C64], freq_hz: f64) -> Result<(), FrfError> {
+    if x.iter().all(|&v| is_finite(v)) { Ok(()) } else { Err(FrfError::Singular { freq_hz }) }
 }

@@ -51,6 +51,36 @@ impl LstsqSolution {
         self.keep.iter().map(|&i| self.utb[i] * self.utb[i]).sum()
     }
 
+    /// For each unknown, whether it takes part (component above 0.1 in the
+    /// scaled variables) in a dropped direction: a combination the data
+    /// cannot resolve, whose variance is unbounded rather than the zero the
+    /// pseudo-inverse gives it. An all-zero column is always undetermined.
+    pub fn undetermined(&self) -> Vec<bool> {
+        let n = self.column_norms.len();
+        let mut out = vec![false; n];
+        for i in 0..self.v.ncols() {
+            if self.keep.contains(&i) {
+                continue;
+            }
+            for (j, flag) in out.iter_mut().enumerate() {
+                if self.v[(j, i)].abs() > 0.1 {
+                    *flag = true;
+                }
+            }
+        }
+        // a thin SVD of a tall matrix has n directions; with more unknowns
+        // than rows, those beyond the rank are undetermined too
+        if self.v.ncols() < n {
+            for (j, flag) in out.iter_mut().enumerate() {
+                let covered: f64 = self.keep.iter().map(|&i| self.v[(j, i)].powi(2)).sum();
+                if covered < 0.99 {
+                    *flag = true;
+                }
+            }
+        }
+        out
+    }
+
     /// Largest kept singular value (0 when none is kept).
     pub fn largest_singular_value(&self) -> f64 {
         self.singular_values.first().copied().unwrap_or(0.0)
@@ -143,6 +173,17 @@ mod tests {
         }
         let norm = |v: &[f64]| v.iter().zip(d).map(|(x, c)| (x * c).powi(2)).sum::<f64>();
         assert!(norm(&s.damped(10.0)) < norm(&x) && norm(&x) < norm(&s.x));
+    }
+
+    #[test]
+    fn unknowns_in_dropped_directions_are_undetermined() {
+        let a = Mat::from_fn(4, 3, |i, j| match j {
+            0 => (i + 1) as f64,
+            1 => 0.0,
+            _ => ((i * i) as f64).cos(),
+        });
+        let s = solve(&a, &[1.0, 0.0, 2.0, 1.0], 1e-10);
+        assert_eq!(s.undetermined(), vec![false, true, false]);
     }
 
     #[test]

@@ -135,6 +135,9 @@ pub struct UpdateOutcome {
     pub uncertainty: Option<UncertaintyReport>,
     /// Fitted gain per reference, when requested.
     pub gains: Vec<Gain>,
+    /// Relative noise level of the measured data, estimated from their
+    /// roughness (see [`crate::diagnose::estimate_noise`]).
+    pub noise_estimate: Option<f64>,
     /// The updated model.
     #[serde(skip)]
     pub system: DampedSystem,
@@ -301,6 +304,7 @@ impl Study {
             natural_frequencies_hz,
             uncertainty: None,
             gains: Vec::new(),
+            noise_estimate: crate::diagnose::estimate_noise(&self.measured),
             method: "rfm".into(),
             status: result.status,
             parameters: self.reports(&result.values),
@@ -371,6 +375,7 @@ impl Study {
             natural_frequencies_hz,
             uncertainty: Some(report),
             gains: result.gains,
+            noise_estimate: crate::diagnose::estimate_noise(&self.measured),
             system: sys,
         })
     }

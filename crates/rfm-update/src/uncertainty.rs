@@ -74,7 +74,9 @@ pub fn analyse(params: &ParameterSet, result: &OeResult, band_hz: (f64, f64)) ->
         if result.at_bound[i] {
             warnings.push("ended on its bound; its uncertainty is not meaningful".to_string());
         }
-        if s > 10.0 {
+        if !s.is_finite() {
+            warnings.push("not determined by the data at all: the FRFs do not depend on it".to_string());
+        } else if s > 10.0 {
             warnings.push("not determined by the data at all (its standard deviation is unbounded)".to_string());
         } else if s > 0.3 {
             warnings.push(format!("poorly determined by the data (+-{:.0} % at one standard deviation)", 100.0 * s));
@@ -95,7 +97,11 @@ pub fn analyse(params: &ParameterSet, result: &OeResult, band_hz: (f64, f64)) ->
             value,
             std: value * s,
             relative_std: s,
-            interval95: (value * (-1.96 * s).exp(), value * (1.96 * s).exp()),
+            interval95: if s.is_finite() {
+                (value * (-1.96 * s).exp(), value * (1.96 * s).exp())
+            } else {
+                (0.0, f64::INFINITY)
+            },
             at_bound: result.at_bound[i],
             well_determined: warnings.is_empty(),
             warnings,

@@ -4,4 +4,5 @@ mod correlation;
 mod lscf;
 mod modal;
 mod physics;
+mod solver;
 mod uff;

@@ -221,6 +221,19 @@ fn print_outcome(outcome: &UpdateOutcome) {
             }
         }
         println!("\nresidual RMS per value {:.3e} (the noise level the fit leaves)", u.residual_rms);
+        if let Some(noise) = outcome.noise_estimate {
+            let ratio = u.residual_rms / noise;
+            let reading = if ratio < 1.5 {
+                "the model explains the data down to their noise".to_string()
+            } else if outcome.status != Status::Converged {
+                format!("the fit leaves {ratio:.1} times the noise, but the iteration stopped before converging")
+            } else {
+                format!(
+                    "the fit leaves {ratio:.1} times the noise: something the parameters cannot represent remains (try rfm diagnose on the updated case)"
+                )
+            };
+            println!("noise level estimated from the data {noise:.3e}: {reading}");
+        }
     }
     for g in &outcome.gains {
         println!("gain of reference {}: {:.4} at {:+.2} deg", g.reference, g.magnitude, g.phase_deg);

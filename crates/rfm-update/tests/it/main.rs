@@ -1,5 +1,6 @@
 //! Integration tests of rfm-update.
 
+mod fast_vs_naive;
 mod hidden_effects;
 mod output_error;
 mod paper_cases;

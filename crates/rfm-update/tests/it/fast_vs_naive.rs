@@ -1,0 +1,133 @@
+//! The sparse sensitivity assembly equals the dense textbook formulation
+//! (dense inverse of Z, dense dZ/dp, `S = R[meas, :] dZ x`) for every kind of
+//! parameter and both hybrid modes.
+
+use damping::DampedSystem;
+use fe_model::{Dof, DofRef, Group, Model, Section, samples};
+use frf::{Channel, ZSolver, synthesize};
+use rfm_update::sensitivity::{ChannelPlan, FrequencyBlock, Hybrid, assemble, naive};
+
+/// An L-frame with every kind of item: two non-viscous groups and a viscous
+/// one, two materials, a joint with a rotational spring and ties, a ground
+/// spring with kx, ky and kr, a lumped mass with inertia, an added mass.
+fn every_kind_model() -> Model {
+    let mut m = samples::frame_with_joint();
+    let base = m.add_group(Group::new("base").rayleigh(4e-4, 0.2).relaxation(900.0)).unwrap();
+    let alu = m.add_material("aluminium", 0.7e11, 2700.0).unwrap();
+    let sec = m.add_section(Section::rectangle("strip", 0.04, 0.01)).unwrap();
+    let frame = m.group_index("frame").unwrap();
+    m.add_node(5, 1.5, 1.0).unwrap();
+    m.add_beam(3, [4, 5], alu, sec, frame).unwrap();
+    m.add_spring("ground", 5, None, [3e5, 2e5, 4e3], base).unwrap();
+    m.add_mass("sensor", 5, 0.2, 3e-4, base).unwrap();
+    m.set_added_mass(1, 0.8).unwrap();
+    m
+}
+
+const EVERY_KIND: [&str; 19] = [
+    "group.frame.alpha",
+    "group.joint.alpha",
+    "group.base.beta",
+    "group.frame.beta",
+    "group.joint.mu",
+    "group.base.mu",
+    "group.frame.stiffness",
+    "group.frame.mass",
+    "group.base.stiffness",
+    "material.steel.E",
+    "material.aluminium.rho",
+    "element.1.stiffness",
+    "element.3.mass",
+    "element.2.added_mass",
+    "spring.ground.kx",
+    "spring.ground.ky",
+    "spring.joint.kr",
+    "mass.sensor.m",
+    "mass.sensor.j",
+];
+
+/// Largest difference in each parameter's column (and in the model FRFs)
+/// relative to that column's largest entry.
+fn worst_relative_difference(fast: &[FrequencyBlock], slow: &[FrequencyBlock], names: &[&str]) -> (f64, String) {
+    let mut worst = (0.0, String::new());
+    assert_eq!(fast.len(), slow.len());
+    for (a, b) in fast.iter().zip(slow) {
+        assert_eq!(a.freq_hz, b.freq_hz);
+        let scale = b.model.iter().map(|v| v.norm()).fold(0.0, f64::max);
+        for (x, y) in a.model.iter().zip(&b.model) {
+            let e = (x - y).norm() / scale;
+            if e > worst.0 {
+                worst = (e, format!("model FRF at {} Hz", a.freq_hz));
+            }
+        }
+        assert_eq!((a.sens.nrows(), a.sens.ncols()), (b.sens.nrows(), b.sens.ncols()));
+        for i in 0..b.sens.ncols() {
+            let scale = (0..b.sens.nrows()).map(|c| b.sens[(c, i)].norm()).fold(0.0, f64::max);
+            assert!(scale > 0.0, "{} has no effect at {} Hz: the test would prove nothing", names[i], a.freq_hz);
+            for c in 0..b.sens.nrows() {
+                let e = (a.sens[(c, i)] - b.sens[(c, i)]).norm() / scale;
+                if e > worst.0 {
+                    worst = (e, format!("{} channel {c} at {} Hz", names[i], a.freq_hz));
+                }
+            }
+        }
+    }
+    worst
+}
+
+fn check(sys: &DampedSystem, names: &[&str], channels: &[Channel], freqs: &[f64], measured: &frf::FrfSet) {
+    let params: Vec<_> = names.iter().map(|n| sys.model().quantity(n).unwrap()).collect();
+    let solver = ZSolver::new(&sys.assembly().pattern).unwrap();
+    let plan = ChannelPlan::new(sys, channels).unwrap();
+    for (label, hybrid) in [("model", Hybrid::Model), ("measured", Hybrid::Measured(measured))] {
+        let fast = assemble(sys, &solver, &plan, &params, freqs, hybrid).unwrap();
+        let slow = naive::assemble(sys, &plan, &params, freqs, hybrid).unwrap();
+        let (e, at) = worst_relative_difference(&fast, &slow, names);
+        assert!(e < 1e-10, "Hybrid::{label}: relative difference {e:e} in {at}");
+    }
+}
+
+#[test]
+fn fast_assembly_equals_dense_formulation_for_every_parameter_kind() {
+    let truth = DampedSystem::new(every_kind_model()).unwrap();
+    let mut sys = truth.clone();
+    // a model away from the truth, so that measured and model columns differ
+    for (name, factor) in [("spring.ground.kx", 1.7), ("group.joint.mu", 0.4), ("mass.sensor.m", 1.3)] {
+        let q = sys.model().quantity(name).unwrap();
+        sys.set(q, factor * sys.get(q)).unwrap();
+    }
+    let (tip, mid) = (DofRef::new(5, Dof::Uy), DofRef::new(2, Dof::Ux));
+    let responses = [(2, Dof::Ux), (3, Dof::Rz), (4, Dof::Uy), (5, Dof::Ux), (5, Dof::Uy), (5, Dof::Rz)];
+    let mut channels = Vec::new();
+    for reference in [tip, mid] {
+        for &(node, dof) in &responses {
+            channels.push(Channel::new(DofRef::new(node, dof), reference));
+        }
+    }
+    let freqs = [11.0, 47.0, 133.0, 410.0];
+    let measured = synthesize(&truth, &channels, &freqs).unwrap();
+    check(&sys, &EVERY_KIND, &channels, &freqs, &measured);
+}
+
+#[test]
+fn fast_assembly_equals_dense_formulation_on_the_paper_beam() {
+    let truth = DampedSystem::new(samples::two_material_cantilever()).unwrap();
+    let mut sys = truth.clone();
+    let names = [
+        "group.steel.mu",
+        "group.aluminium.mu",
+        "group.steel.alpha",
+        "group.aluminium.alpha",
+        "group.steel.beta",
+        "group.aluminium.beta",
+    ];
+    for (name, factor) in names.iter().zip([0.3, 0.5, 0.4, 0.4, 0.6, 0.6]) {
+        let q = sys.model().quantity(name).unwrap();
+        sys.set(q, factor * sys.get(q)).unwrap();
+    }
+    let tip = DofRef::new(31, Dof::Uy);
+    let channels: Vec<Channel> = (2..=31).map(|n| Channel::new(DofRef::new(n, Dof::Uy), tip)).collect();
+    let freqs = [5.5, 48.0, 157.5, 336.0];
+    let measured = synthesize(&truth, &channels, &freqs).unwrap();
+    check(&sys, &names, &channels, &freqs, &measured);
+}
