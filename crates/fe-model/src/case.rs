@@ -523,6 +523,13 @@ impl CaseFile {
         Self::parse(path, &source)
     }
 
+    /// The files a run of this case reads: the case file itself and its
+    /// measured data file. Outputs must never be written over them.
+    pub fn inputs(&self) -> Vec<PathBuf> {
+        let data = self.measurement.as_ref().and_then(|m| m.data.clone());
+        std::iter::once(self.path.clone()).chain(data).collect()
+    }
+
     /// Parses case-file text; `path` is used in messages and to resolve data files.
     pub fn parse(path: &Path, source: &str) -> Result<Self, CaseError> {
         let ctx = Ctx { path, source };

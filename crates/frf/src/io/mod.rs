@@ -139,17 +139,26 @@ pub fn read_measured(path: &Path, map: &[ChannelMap]) -> Result<FrfSet, FrfError
     load_measured(path, map).map(|m| m.set)
 }
 
+/// Fails if one of `outputs` is one of `inputs` (the same file, however
+/// named), so that a command can refuse before it does any work.
+pub fn refuse_inputs(outputs: &[PathBuf], inputs: &[PathBuf]) -> Result<(), FrfError> {
+    for path in outputs {
+        let Ok(target) = path.canonicalize() else { continue };
+        if inputs.iter().any(|input| input.canonicalize().is_ok_and(|i| i == target)) {
+            return Err(FrfError::Io {
+                path: path.to_path_buf(),
+                message: "refusing to overwrite an input file; choose another output path".into(),
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Writes `bytes` to `path` atomically (temporary file in the same folder,
 /// flushed and synced, then renamed). Fails if `path` is one of `inputs`.
 pub fn atomic_write(path: &Path, bytes: &[u8], inputs: &[PathBuf]) -> Result<(), FrfError> {
     let io = |message: String| FrfError::Io { path: path.to_path_buf(), message };
-    if let Ok(target) = path.canonicalize() {
-        for input in inputs {
-            if input.canonicalize().is_ok_and(|i| i == target) {
-                return Err(io("refusing to overwrite an input file; choose another output path".into()));
-            }
-        }
-    }
+    refuse_inputs(&[path.to_path_buf()], inputs)?;
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
