@@ -3,4 +3,5 @@
 mod commands;
 mod diagnose;
 mod inspect;
+mod nothing_lost;
 mod report;
