@@ -145,6 +145,10 @@ pub struct UpdateOutcome {
     /// What the case's mask rules left out of the measured data, one line
     /// each (`non-finite: line 17, columns 4-5: H(3:uy,2:uy) at 20 Hz is NaN`).
     pub masked: Vec<String>,
+    /// What the data leave undetermined, for methods without an uncertainty
+    /// report (the RFM): parameters that ended on a bound, the combination
+    /// of parameters the sensitivity cannot separate.
+    pub warnings: Vec<String>,
     /// The updated model.
     #[serde(skip)]
     pub system: DampedSystem,
@@ -327,7 +331,20 @@ impl Study {
         let lines = self.lines_for(Method::Rfm)?;
         let measured = self.measured.at_frequencies(&lines)?;
         let mut sys = self.system.clone();
-        let result = rfm::run(&mut sys, &self.parameter_set(), &measured, opts, on_iteration)?;
+        let mut opts = opts.clone();
+        if let Some(spec) = &self.case.update {
+            opts.bounds = spec.bounds.clone();
+        }
+        let result = rfm::run(&mut sys, &self.parameter_set(), &measured, &opts, on_iteration)?;
+        let mut warnings: Vec<String> = self
+            .parameters
+            .iter()
+            .zip(&result.at_bound)
+            .zip(&opts.bounds)
+            .filter(|((_, at), _)| **at)
+            .filter_map(|((p, _), b)| b.map(|(lo, hi)| format!("{} ended on its bound [{lo:e}, {hi:e}]", p.name)))
+            .collect();
+        warnings.extend(result.unresolved.clone());
         let natural_frequencies_hz = self.frequency_table(&sys);
         Ok(UpdateOutcome {
             natural_frequencies_hz,
@@ -335,6 +352,7 @@ impl Study {
             gains: Vec::new(),
             noise_estimate: crate::diagnose::estimate_noise(&self.measured),
             masked: describe_masked(&self.masked),
+            warnings,
             method: "rfm".into(),
             status: result.status,
             parameters: self.reports(&result.values),
@@ -407,6 +425,7 @@ impl Study {
             gains: result.gains,
             noise_estimate: crate::diagnose::estimate_noise(&self.measured),
             masked: describe_masked(&self.masked),
+            warnings: Vec::new(),
             system: sys,
         })
     }

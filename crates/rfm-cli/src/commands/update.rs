@@ -249,6 +249,12 @@ fn print_outcome(outcome: &UpdateOutcome) -> Result<()> {
             outln!("noise level estimated from the data {noise:.3e}: {reading}");
         }
     }
+    if !outcome.warnings.is_empty() {
+        outln!("\nwhat the data determine only weakly:");
+        for w in &outcome.warnings {
+            outln!("  - {w}");
+        }
+    }
     for g in &outcome.gains {
         outln!("gain of reference {}: {:.4} at {:+.2} deg", g.reference, g.magnitude, g.phase_deg);
     }
