@@ -1070,12 +1070,14 @@ fn parse_frequencies(ctx: &Ctx<'_>, v: &Spanned<toml::Value>) -> Result<Vec<f64>
             .map(|x| num(x).ok_or_else(|| ctx.err(v.span(), "frequencies must be numbers (Hz)")))
             .collect::<Result<_, _>>()?,
         toml::Value::Table(t) => {
+            const KEYS: [&str; 4] = ["from", "to", "step", "count"];
             for k in t.keys() {
-                if !["from", "to", "step", "count"].contains(&k.as_str()) {
-                    return Err(ctx.err(
-                        v.span(),
-                        format!("unknown key `{k}` in a frequency range (use from, to and step or count)"),
-                    ));
+                if !KEYS.contains(&k.as_str()) {
+                    let hint = match crate::suggest::closest(k, KEYS) {
+                        Some(best) => format!("did you mean `{best}`?"),
+                        None => "use from, to and step or count".to_string(),
+                    };
+                    return Err(ctx.err(v.span(), format!("unknown key `{k}` in a frequency range; {hint}")));
                 }
             }
             let get = |k: &str| t.get(k).and_then(num);

@@ -1,5 +1,6 @@
 //! End-to-end tests of the `rfm` binary.
 
+mod catalogue;
 mod commands;
 mod diagnose;
 mod inspect;
