@@ -159,7 +159,8 @@ fn reproduce(cases: &[String]) -> Result<(), String> {
                 max_z = f64::max(max_z, (v / t).ln().abs() / s);
             }
         }
-        let z = if unc.is_empty() {
+        let z = if unc.is_empty() || max_z.is_nan() {
+            // no uncertainty (RFM) or no truth to measure against
             "-".to_string()
         } else if undetermined > 0 {
             format!("{max_z:.2} ({undetermined} undet.)")
