@@ -5,8 +5,8 @@
 //! | flexible, lossy support | each supported node | a ground spring per fixed DOF, its group's alpha |
 //! | flexible, lossy joint | where members meet at an angle, and existing joint springs | rotational spring, its group's alpha |
 //! | lumped mass | each node | mass |
-//! | stiffness change | each element (each region on large models) | stiffness factor |
-//! | mass change | each element (each region on large models) | mass factor |
+//! | stiffness change | each element (each region on large models, refined into its elements when it leads) | stiffness factor |
+//! | mass change | each element (each region on large models, refined likewise) | mass factor |
 //! | viscous damping | each region of a few elements | alpha of the region |
 //! | non-viscous damping | each region | alpha and mu of the region |
 //!
@@ -176,6 +176,58 @@ fn nodes_of(model: &Model, idx: &[usize]) -> Vec<u32> {
     n.sort_unstable();
     n.dedup();
     n
+}
+
+/// Stiffness-change and mass-change candidates of one element or one
+/// contiguous run of elements (`unit`: beam indices).
+fn change_candidates(model: &Model, unit: &[usize]) -> Vec<Candidate> {
+    let ids = element_ids(model, unit);
+    let field_name = |f: &str| {
+        if ids.len() == 1 {
+            format!("element.{}.{f}", ids[0])
+        } else {
+            format!("element.{}..{}.{f}", ids[0], ids[ids.len() - 1])
+        }
+    };
+    let contiguous = ids.windows(2).all(|w| w[1] == w[0] + 1);
+    if !contiguous {
+        return Vec::new();
+    }
+    let mut out = Vec::new();
+    for (kind, field, plaus) in [
+        (EffectKind::StiffnessChange, "stiffness", (0.05, 1.5, "a change beyond -95 % .. +50 % of the nominal stiffness")),
+        (EffectKind::MassChange, "mass", (0.5, 2.0, "a change beyond -50 % .. +100 % of the nominal mass")),
+    ] {
+        let Ok(p) = model.parameter(&field_name(field)) else { continue };
+        out.push(Candidate {
+            kind,
+            description: format!("{} of {}", kind.label(), range_name(&ids)),
+            nodes: nodes_of(model, unit),
+            elements: ids.clone(),
+            dofs: Vec::new(),
+            model: model.clone(),
+            parameters: vec![p],
+            bounds: vec![Some((1e-3, 100.0))],
+            plausible: vec![plaus],
+            edit: Edit::Set,
+        });
+    }
+    out
+}
+
+/// On large models stiffness and mass changes are first tried per region;
+/// a region that explains the data well is refined into its elements, each
+/// with both kinds (a single weakened element is not a weakened region,
+/// and a region's mass change can imitate it). Empty for other candidates.
+pub(crate) fn refine(model: &Model, c: &Candidate) -> Vec<Candidate> {
+    if !matches!(c.kind, EffectKind::StiffnessChange | EffectKind::MassChange) || c.elements.len() < 2 {
+        return Vec::new();
+    }
+    c.elements
+        .iter()
+        .filter_map(|&e| model.beam_index(fe_model::ElementId(e)))
+        .flat_map(|i| change_candidates(model, &[i]))
+        .collect()
 }
 
 /// Generates every candidate for a model; see the module docs.
@@ -378,40 +430,7 @@ pub fn generate(model: &Model, opts: &CandidateOptions) -> Vec<Candidate> {
         regions(model, model.beams().len().div_ceil(opts.per_element_limit / 2).max(opts.region_size))
     };
     for unit in &units {
-        let ids = element_ids(model, unit);
-        let field_name = |f: &str| {
-            if ids.len() == 1 {
-                format!("element.{}.{f}", ids[0])
-            } else {
-                format!("element.{}..{}.{f}", ids[0], ids[ids.len() - 1])
-            }
-        };
-        let contiguous = ids.windows(2).all(|w| w[1] == w[0] + 1);
-        if !contiguous {
-            continue;
-        }
-        for (kind, field, plaus) in [
-            (
-                EffectKind::StiffnessChange,
-                "stiffness",
-                (0.05, 1.5, "a change beyond -95 % .. +50 % of the nominal stiffness"),
-            ),
-            (EffectKind::MassChange, "mass", (0.5, 2.0, "a change beyond -50 % .. +100 % of the nominal mass")),
-        ] {
-            let Ok(p) = model.parameter(&field_name(field)) else { continue };
-            out.push(Candidate {
-                kind,
-                description: format!("{} of {}", kind.label(), range_name(&ids)),
-                nodes: nodes_of(model, unit),
-                elements: ids.clone(),
-                dofs: Vec::new(),
-                model: model.clone(),
-                parameters: vec![p],
-                bounds: vec![Some((1e-3, 100.0))],
-                plausible: vec![plaus],
-                edit: Edit::Set,
-            });
-        }
+        out.extend(change_candidates(model, unit));
     }
 
     // damping per region

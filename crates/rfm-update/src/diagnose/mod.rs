@@ -87,6 +87,9 @@ pub struct DiagnoseOptions {
     pub candidates: CandidateOptions,
 }
 
+/// Leading regions (by full-fit misfit) refined into their elements.
+const REFINED_REGIONS: usize = 2;
+
 impl Default for DiagnoseOptions {
     fn default() -> Self {
         DiagnoseOptions {
@@ -307,6 +310,35 @@ pub fn diagnose(model: &fe_model::Model, measured: &FrfSet, opts: &DiagnoseOptio
             (i, f)
         })
         .collect();
+
+    // Regions that lead are refined into their elements: a single weakened
+    // element fitted as a region's stiffness change explains the data only
+    // in part, and may rank behind the same region's mass change.
+    let mut by_cost: Vec<&(usize, Option<Fit>)> = full_fits.iter().filter(|(_, f)| f.is_some()).collect();
+    by_cost.sort_by(|a, b| a.1.as_ref().expect("some").cost.total_cmp(&b.1.as_ref().expect("some").cost));
+    let mut refined: Vec<Candidate> = Vec::new();
+    let mut regions_refined: Vec<Vec<u32>> = Vec::new();
+    for (i, _) in by_cost {
+        let c = &candidates[*i];
+        if regions_refined.len() == REFINED_REGIONS || regions_refined.contains(&c.elements) {
+            continue;
+        }
+        let more = candidates::refine(model, c);
+        if !more.is_empty() {
+            regions_refined.push(c.elements.clone());
+            refined.extend(more);
+        }
+    }
+    let first_refined = candidates.len();
+    let mut candidates = candidates;
+    candidates.extend(refined);
+    let mut full_fits = full_fits;
+    full_fits.extend(
+        (first_refined..candidates.len())
+            .into_par_iter()
+            .map(|i| (i, fit(&candidates[i], &full, opts.iterations, None)))
+            .collect::<Vec<_>>(),
+    );
 
     let ranked = |i: usize, f: &Fit, cost0: f64, n: usize, fully: bool| {
         let c = &candidates[i];
