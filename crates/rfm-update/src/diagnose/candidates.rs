@@ -5,7 +5,7 @@
 //! | flexible, lossy support | each supported node | a ground spring per fixed DOF, its group's alpha |
 //! | flexible, lossy joint | where members meet at an angle, and existing joint springs | rotational spring, its group's alpha |
 //! | lumped mass | each node | mass |
-//! | stiffness change | each element (each region on large models, refined into its elements when it leads) | stiffness factor |
+//! | stiffness change | each element (each region on large models; the leaders' locations are refined per element) | stiffness factor |
 //! | mass change | each element (each region on large models, refined likewise) | mass factor |
 //! | viscous damping | each region of a few elements | alpha of the region |
 //! | non-viscous damping | each region | alpha and mu of the region |
@@ -195,7 +195,11 @@ fn change_candidates(model: &Model, unit: &[usize]) -> Vec<Candidate> {
     }
     let mut out = Vec::new();
     for (kind, field, plaus) in [
-        (EffectKind::StiffnessChange, "stiffness", (0.05, 1.5, "a change beyond -95 % .. +50 % of the nominal stiffness")),
+        (
+            EffectKind::StiffnessChange,
+            "stiffness",
+            (0.05, 1.5, "a change beyond -95 % .. +50 % of the nominal stiffness"),
+        ),
         (EffectKind::MassChange, "mass", (0.5, 2.0, "a change beyond -50 % .. +100 % of the nominal mass")),
     ] {
         let Ok(p) = model.parameter(&field_name(field)) else { continue };
@@ -215,19 +219,28 @@ fn change_candidates(model: &Model, unit: &[usize]) -> Vec<Candidate> {
     out
 }
 
-/// On large models stiffness and mass changes are first tried per region;
-/// a region that explains the data well is refined into its elements, each
-/// with both kinds (a single weakened element is not a weakened region,
-/// and a region's mass change can imitate it). Empty for other candidates.
-pub(crate) fn refine(model: &Model, c: &Candidate) -> Vec<Candidate> {
-    if !matches!(c.kind, EffectKind::StiffnessChange | EffectKind::MassChange) || c.elements.len() < 2 {
-        return Vec::new();
+/// Per-element stiffness and mass changes around where a candidate acts: the
+/// elements of a regional change, or the elements meeting at the node of a
+/// mass, joint or support. On large models stiffness and mass changes are
+/// first tried per region, and one weakened element is neither a weakened
+/// region (of which it explains a part) nor a mass at its node (which can
+/// rank first when the regions are coarse); refining the leaders' locations
+/// lets the data choose. Beam indices; the caller drops those already tried.
+pub(crate) fn neighbourhood(model: &Model, c: &Candidate) -> Vec<usize> {
+    let mut out: Vec<usize> = c.elements.iter().filter_map(|&e| model.beam_index(ElementId(e))).collect();
+    for &n in &c.nodes {
+        if c.elements.is_empty() || c.kind == EffectKind::FlexibleJoint {
+            out.extend(model.beams_at(NodeId(n)));
+        }
     }
-    c.elements
-        .iter()
-        .filter_map(|&e| model.beam_index(fe_model::ElementId(e)))
-        .flat_map(|i| change_candidates(model, &[i]))
-        .collect()
+    out.sort_unstable();
+    out.dedup();
+    out
+}
+
+/// Stiffness-change and mass-change candidates of one element each.
+pub(crate) fn per_element(model: &Model, beams: &[usize]) -> Vec<Candidate> {
+    beams.iter().flat_map(|&i| change_candidates(model, &[i])).collect()
 }
 
 /// Generates every candidate for a model; see the module docs.

@@ -271,10 +271,11 @@ fn diagnosis_finds_nothing_significant_when_nothing_is_hidden() {
 }
 
 /// On large models stiffness and mass changes are first tried per region;
-/// the leading regions are refined into their elements. With regions of five
-/// elements forced on the cantilever, a 40 % stiffness loss in element 7
-/// must be named at element 7 itself, not as its region (which explains it
-/// only in part, and whose mass change can rank above its stiffness change).
+/// the leaders' locations are then refined per element. With regions of
+/// five elements forced on the cantilever, a 40 % stiffness loss in element
+/// 7 must be named at element 7 itself, not as its region (which explains
+/// it only in part) nor as a mass at one of its nodes (which leads without
+/// the refinement).
 #[test]
 fn a_leading_region_is_refined_to_the_element_that_changed() {
     let mut truth = nominal();
