@@ -40,6 +40,18 @@
 //! step gains less than a relative 1e-9, or when steps no longer change any
 //! parameter by more than the tolerance.
 //!
+//! Parameters the data hardly separate (a joint's stiffness, damping and
+//! relaxation together) make a long, curved, nearly flat valley, along which
+//! Levenberg-Marquardt creeps: the f-frame twin needs about 1,700 steps to a
+//! stationary point, the last 1,600 of which lower the chi-square
+//! (`cost / s^2`) by about 2.5 in all. So the fit also stops, with
+//! [`Status::WithinNoise`], when the chi-square fell by less than 0.5 over
+//! the last 10 steps (`OeOptions::stop_within_noise`, on by default; not
+//! applied with Tikhonov regularisation, where the cost is not a
+//! chi-square). A point whose chi-square is within a few units of the
+//! minimum's lies well inside its joint confidence region, and the
+//! covariance there reports the flat directions as undetermined.
+//!
 //! At the solution the covariance of `theta` is `s^2 (J^T J)^+` with `s^2` the
 //! residual variance estimated from the fit; see [`crate::uncertainty`].
 
@@ -77,6 +89,12 @@ impl Misfit {
     }
 }
 
+/// Steps over which the chi-square gain is tested against the noise.
+const NOISE_WINDOW: usize = 10;
+/// Chi-square gain over [`NOISE_WINDOW`] steps below which the fit stops
+/// ([`Status::WithinNoise`]).
+const NOISE_WINDOW_GAIN: f64 = 0.5;
+
 /// Options of the output-error estimator.
 #[derive(Clone, Debug)]
 pub struct OeOptions {
@@ -94,6 +112,10 @@ pub struct OeOptions {
     pub gains: bool,
     /// Relative singular-value cut-off.
     pub rcond: f64,
+    /// Stop when the last steps gain less than the noise can show
+    /// ([`Status::WithinNoise`]); off, the fit runs to a stationary point
+    /// or the iteration limit.
+    pub stop_within_noise: bool,
 }
 
 impl Default for OeOptions {
@@ -106,6 +128,7 @@ impl Default for OeOptions {
             bounds: Vec::new(),
             gains: false,
             rcond: 1e-12,
+            stop_within_noise: true,
         }
     }
 }
@@ -333,6 +356,7 @@ pub fn run(
     };
     let (n, ng) = (ev.n_params(), ev.n_gain());
     let n_data = ev.n_data();
+    let m_free = n + ng;
     if n_data == 0 {
         return Err(UpdateError::Setup("every measured value has zero weight".into()));
     }
@@ -387,6 +411,8 @@ pub fn run(
     on_iteration(&history[0]);
     let mut lambda = 0.0;
     let mut status = Status::MaxIterations;
+    // data misfit after each accepted step, for the test against the noise
+    let mut costs = vec![point.cost_data];
     for iteration in 1..=opts.max_iterations {
         let jac = point.jacobian.as_ref().expect("points kept have a Jacobian");
         let minus_r: Vec<f64> = point.residual.iter().map(|v| -v).collect();
@@ -437,6 +463,19 @@ pub fn run(
         if max_step < opts.tolerance || relative_gain < 1e-9 {
             status = Status::Converged;
             break;
+        }
+        // A fit in a long, flat valley (parameters the data hardly separate)
+        // can creep for thousands of steps. Stop when the chi-square fell by
+        // less than NOISE_WINDOW_GAIN over the last NOISE_WINDOW steps: no
+        // measurement with this noise could tell the points apart.
+        costs.push(point.cost_data);
+        if opts.stop_within_noise && costs.len() > NOISE_WINDOW && opts.regularization == 0.0 {
+            let sigma2 = point.cost_data / (n_data as f64 - m_free as f64).max(1.0);
+            let gain = (costs[costs.len() - 1 - NOISE_WINDOW] - point.cost_data) / sigma2;
+            if gain < NOISE_WINDOW_GAIN {
+                status = Status::WithinNoise;
+                break;
+            }
         }
     }
     // leave the system at the final point and analyse it

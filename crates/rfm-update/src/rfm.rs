@@ -97,6 +97,12 @@ pub enum Status {
     /// The residual stopped decreasing (numerical floor or noise) before the
     /// corrections fell below the tolerance; the best iterate is returned.
     Stalled,
+    /// The misfit still falls, but by less than the noise could show: over the
+    /// last iterations the chi-square (the misfit in units of the noise
+    /// variance estimated from the residual) fell by less than one half. The
+    /// parameters that still move do so along directions the data hardly
+    /// determine, and the covariance says so. Output-error only.
+    WithinNoise,
     /// The iteration limit was reached; the best iterate is returned.
     MaxIterations,
     /// The model could not be evaluated any more; the best iterate is returned.

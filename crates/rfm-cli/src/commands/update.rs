@@ -164,6 +164,10 @@ fn print_outcome(outcome: &UpdateOutcome) -> Result<()> {
     let status = match &outcome.status {
         Status::Converged => "converged".to_string(),
         Status::Stalled => "stalled: no step lowers the misfit further (best iterate kept)".to_string(),
+        Status::WithinNoise => {
+            "converged to within the noise: the last steps lowered the misfit by less than the noise can show"
+                .to_string()
+        }
         Status::MaxIterations => "iteration limit reached (best iterate kept)".to_string(),
         Status::Failed(e) => format!("failed: {e} (best iterate kept)"),
     };
@@ -239,7 +243,7 @@ fn print_outcome(outcome: &UpdateOutcome) -> Result<()> {
             let ratio = u.residual_rms / noise;
             let reading = if ratio < 1.5 {
                 "the model explains the data down to their noise".to_string()
-            } else if outcome.status != Status::Converged {
+            } else if !matches!(outcome.status, Status::Converged | Status::WithinNoise) {
                 format!("the fit leaves {ratio:.1} times the noise, but the iteration stopped before converging")
             } else {
                 format!(

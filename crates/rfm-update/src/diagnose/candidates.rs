@@ -5,8 +5,8 @@
 //! | flexible, lossy support | each supported node | a ground spring per fixed DOF, its group's alpha |
 //! | flexible, lossy joint | where members meet at an angle, and existing joint springs | rotational spring, its group's alpha |
 //! | lumped mass | each node | mass |
-//! | stiffness change | each element (each region on large models) | stiffness factor |
-//! | mass change | each element (each region on large models) | mass factor |
+//! | stiffness change | each element (each region on large models; the leaders' locations are refined per element) | stiffness factor |
+//! | mass change | each element (each region on large models, refined likewise) | mass factor |
 //! | viscous damping | each region of a few elements | alpha of the region |
 //! | non-viscous damping | each region | alpha and mu of the region |
 //!
@@ -176,6 +176,71 @@ fn nodes_of(model: &Model, idx: &[usize]) -> Vec<u32> {
     n.sort_unstable();
     n.dedup();
     n
+}
+
+/// Stiffness-change and mass-change candidates of one element or one
+/// contiguous run of elements (`unit`: beam indices).
+fn change_candidates(model: &Model, unit: &[usize]) -> Vec<Candidate> {
+    let ids = element_ids(model, unit);
+    let field_name = |f: &str| {
+        if ids.len() == 1 {
+            format!("element.{}.{f}", ids[0])
+        } else {
+            format!("element.{}..{}.{f}", ids[0], ids[ids.len() - 1])
+        }
+    };
+    let contiguous = ids.windows(2).all(|w| w[1] == w[0] + 1);
+    if !contiguous {
+        return Vec::new();
+    }
+    let mut out = Vec::new();
+    for (kind, field, plaus) in [
+        (
+            EffectKind::StiffnessChange,
+            "stiffness",
+            (0.05, 1.5, "a change beyond -95 % .. +50 % of the nominal stiffness"),
+        ),
+        (EffectKind::MassChange, "mass", (0.5, 2.0, "a change beyond -50 % .. +100 % of the nominal mass")),
+    ] {
+        let Ok(p) = model.parameter(&field_name(field)) else { continue };
+        out.push(Candidate {
+            kind,
+            description: format!("{} of {}", kind.label(), range_name(&ids)),
+            nodes: nodes_of(model, unit),
+            elements: ids.clone(),
+            dofs: Vec::new(),
+            model: model.clone(),
+            parameters: vec![p],
+            bounds: vec![Some((1e-3, 100.0))],
+            plausible: vec![plaus],
+            edit: Edit::Set,
+        });
+    }
+    out
+}
+
+/// Per-element stiffness and mass changes around where a candidate acts: the
+/// elements of a regional change, or the elements meeting at the node of a
+/// mass, joint or support. On large models stiffness and mass changes are
+/// first tried per region, and one weakened element is neither a weakened
+/// region (of which it explains a part) nor a mass at its node (which can
+/// rank first when the regions are coarse); refining the leaders' locations
+/// lets the data choose. Beam indices; the caller drops those already tried.
+pub(crate) fn neighbourhood(model: &Model, c: &Candidate) -> Vec<usize> {
+    let mut out: Vec<usize> = c.elements.iter().filter_map(|&e| model.beam_index(ElementId(e))).collect();
+    for &n in &c.nodes {
+        if c.elements.is_empty() || c.kind == EffectKind::FlexibleJoint {
+            out.extend(model.beams_at(NodeId(n)));
+        }
+    }
+    out.sort_unstable();
+    out.dedup();
+    out
+}
+
+/// Stiffness-change and mass-change candidates of one element each.
+pub(crate) fn per_element(model: &Model, beams: &[usize]) -> Vec<Candidate> {
+    beams.iter().flat_map(|&i| change_candidates(model, &[i])).collect()
 }
 
 /// Generates every candidate for a model; see the module docs.
@@ -378,40 +443,7 @@ pub fn generate(model: &Model, opts: &CandidateOptions) -> Vec<Candidate> {
         regions(model, model.beams().len().div_ceil(opts.per_element_limit / 2).max(opts.region_size))
     };
     for unit in &units {
-        let ids = element_ids(model, unit);
-        let field_name = |f: &str| {
-            if ids.len() == 1 {
-                format!("element.{}.{f}", ids[0])
-            } else {
-                format!("element.{}..{}.{f}", ids[0], ids[ids.len() - 1])
-            }
-        };
-        let contiguous = ids.windows(2).all(|w| w[1] == w[0] + 1);
-        if !contiguous {
-            continue;
-        }
-        for (kind, field, plaus) in [
-            (
-                EffectKind::StiffnessChange,
-                "stiffness",
-                (0.05, 1.5, "a change beyond -95 % .. +50 % of the nominal stiffness"),
-            ),
-            (EffectKind::MassChange, "mass", (0.5, 2.0, "a change beyond -50 % .. +100 % of the nominal mass")),
-        ] {
-            let Ok(p) = model.parameter(&field_name(field)) else { continue };
-            out.push(Candidate {
-                kind,
-                description: format!("{} of {}", kind.label(), range_name(&ids)),
-                nodes: nodes_of(model, unit),
-                elements: ids.clone(),
-                dofs: Vec::new(),
-                model: model.clone(),
-                parameters: vec![p],
-                bounds: vec![Some((1e-3, 100.0))],
-                plausible: vec![plaus],
-                edit: Edit::Set,
-            });
-        }
+        out.extend(change_candidates(model, unit));
     }
 
     // damping per region

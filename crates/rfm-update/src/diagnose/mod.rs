@@ -87,6 +87,11 @@ pub struct DiagnoseOptions {
     pub candidates: CandidateOptions,
 }
 
+/// Leaders (by full-fit misfit) whose locations are refined per element.
+const REFINED_LEADERS: usize = 2;
+/// Refined candidates fitted fully after screening.
+const REFINED_FITS: usize = 4;
+
 impl Default for DiagnoseOptions {
     fn default() -> Self {
         DiagnoseOptions {
@@ -307,6 +312,57 @@ pub fn diagnose(model: &fe_model::Model, measured: &FrfSet, opts: &DiagnoseOptio
             (i, f)
         })
         .collect();
+
+    // The leaders' locations are refined into per-element stiffness and mass
+    // changes (see `candidates::neighbourhood`): on large models those were
+    // tried only per region.
+    let mut by_cost: Vec<&(usize, Option<Fit>)> = full_fits.iter().filter(|(_, f)| f.is_some()).collect();
+    by_cost.sort_by(|a, b| a.1.as_ref().expect("some").cost.total_cmp(&b.1.as_ref().expect("some").cost));
+    let tried = |kind: EffectKind, e: u32| candidates.iter().any(|c| c.kind == kind && c.elements == [e]);
+    let mut beams: Vec<usize> = Vec::new();
+    for (i, _) in by_cost.into_iter().take(REFINED_LEADERS) {
+        for b in candidates::neighbourhood(model, &candidates[*i]) {
+            let id = model.beams()[b].id.0;
+            let both_tried = tried(EffectKind::StiffnessChange, id) && tried(EffectKind::MassChange, id);
+            if !beams.contains(&b) && !both_tried {
+                beams.push(b);
+            }
+        }
+    }
+    let refined = candidates::per_element(model, &beams);
+    // screened like the others; the best few fitted fully
+    let first_refined = candidates.len();
+    let mut candidates = candidates;
+    candidates.extend(refined);
+    let mut screened = screened;
+    screened.extend(
+        (first_refined..candidates.len())
+            .into_par_iter()
+            .map(|i| fit(&candidates[i], &coarse, opts.screen_iterations, None))
+            .collect::<Vec<_>>(),
+    );
+    let score = |i: usize| {
+        let f = screened[i].as_ref().expect("filtered");
+        bic(f.cost, cost0_coarse, n_coarse, candidates[i].parameters.len())
+    };
+    let mut new: Vec<usize> = (first_refined..candidates.len()).filter(|&i| screened[i].is_some()).collect();
+    new.sort_by(|&a, &b| score(a).total_cmp(&score(b)));
+    let mut full_fits = full_fits;
+    full_fits.extend(
+        new.iter()
+            .take(REFINED_FITS)
+            .collect::<Vec<_>>()
+            .into_par_iter()
+            .map(|&i| {
+                let start = screened[i].as_ref().map(|f| f.values.as_slice());
+                let f = fit(&candidates[i], &full, opts.iterations, start)
+                    .or_else(|| fit(&candidates[i], &full, opts.iterations, None));
+                (i, f)
+            })
+            .collect::<Vec<_>>(),
+    );
+    order.extend(new);
+    order.sort_by(|&a, &b| score(a).total_cmp(&score(b)));
 
     let ranked = |i: usize, f: &Fit, cost0: f64, n: usize, fully: bool| {
         let c = &candidates[i];
