@@ -144,21 +144,39 @@ pub(crate) fn print_line(args: std::fmt::Arguments<'_>) -> std::io::Result<()> {
 /// Held while a command writes its outputs.
 static WRITING: Mutex<()> = Mutex::new(());
 
+/// Set when a command's output phase has ended.
+static WRITTEN: AtomicBool = AtomicBool::new(false);
+
+/// The output phase of a command, from [`writing`] until dropped.
+pub(crate) struct Writing {
+    _guard: MutexGuard<'static, ()>,
+}
+
+impl Drop for Writing {
+    fn drop(&mut self) {
+        WRITTEN.store(true, Ordering::Relaxed);
+    }
+}
+
 /// Marks the output phase of a command: an interrupt (Ctrl-C, SIGTERM,
 /// SIGHUP) waits until the guard is dropped, so that a run stops either
 /// before it writes anything or after all its outputs, never between two of
 /// them (each file is written to a temporary and renamed, see
 /// [`frf::io::atomic_write`]).
-pub(crate) fn writing() -> MutexGuard<'static, ()> {
-    WRITING.lock().unwrap_or_else(PoisonError::into_inner)
+pub(crate) fn writing() -> Writing {
+    Writing { _guard: WRITING.lock().unwrap_or_else(PoisonError::into_inner) }
 }
 
 fn main() -> ExitCode {
     // Without a handler the signal would end the process at once, possibly
     // between two output files of one run.
     let interrupt = ctrlc::set_handler(|| {
-        let _held = writing();
-        eprintln!("interrupted: the outputs of this run were not written (earlier ones are untouched)");
+        let _held = WRITING.lock().unwrap_or_else(PoisonError::into_inner);
+        if WRITTEN.load(Ordering::Relaxed) {
+            eprintln!("interrupted after this run's outputs were written");
+        } else {
+            eprintln!("interrupted: the outputs of this run were not written (earlier ones are untouched)");
+        }
         std::process::exit(130);
     });
     if let Err(e) = interrupt {
