@@ -118,12 +118,7 @@ pub fn parse_csv(path: &Path, text: &str) -> Result<FrfSet, FrfError> {
 /// A number of a data field: decimal, or `NaN`/`inf` (refused or masked later).
 fn field_number(s: &str) -> Option<f64> {
     let t = s.trim();
-    let bare = t.trim_start_matches(['+', '-']).to_ascii_lowercase();
-    if matches!(bare.as_str(), "nan" | "inf" | "infinity") || t.bytes().any(|b| b.is_ascii_digit()) {
-        t.parse().ok()
-    } else {
-        None
-    }
+    super::non_finite_word(t).or_else(|| if t.bytes().any(|b| b.is_ascii_digit()) { t.parse().ok() } else { None })
 }
 
 /// Parses CSV text with mask rules; `path` is used in messages.

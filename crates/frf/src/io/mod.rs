@@ -139,6 +139,14 @@ pub fn read_measured(path: &Path, map: &[ChannelMap]) -> Result<FrfSet, FrfError
     load_measured(path, map).map(|m| m.set)
 }
 
+/// `NaN`, `inf` or `infinity` (any case, with an optional sign) as a
+/// number. The readers keep such values so that the checks of the FRF set
+/// refuse or mask them with their place in the file ([`mask`]).
+pub(crate) fn non_finite_word(token: &str) -> Option<f64> {
+    let bare = token.trim_start_matches(['+', '-']).to_ascii_lowercase();
+    if matches!(bare.as_str(), "nan" | "inf" | "infinity") { token.to_ascii_lowercase().parse().ok() } else { None }
+}
+
 /// Fails if one of `outputs` is one of `inputs` (the same file, however
 /// named), so that a command can refuse before it does any work.
 pub fn refuse_inputs(outputs: &[PathBuf], inputs: &[PathBuf]) -> Result<(), FrfError> {

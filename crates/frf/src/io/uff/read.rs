@@ -618,9 +618,8 @@ pub(super) fn numbers(text: &[u8]) -> Result<Vec<f64>, String> {
 }
 
 fn parse_number(token: &str) -> Option<f64> {
-    let bare = token.trim_start_matches(['+', '-']).to_ascii_lowercase();
-    if matches!(bare.as_str(), "nan" | "inf" | "infinity") {
-        return token.to_ascii_lowercase().parse().ok();
+    if let Some(x) = crate::io::non_finite_word(token) {
+        return Some(x);
     }
     // only digits, signs, a point and an exponent letter: refuses `infinite`, `1.#QNAN` and the like
     if !token.bytes().all(|b| b.is_ascii_digit() || matches!(b, b'+' | b'-' | b'.' | b'e' | b'E' | b'd' | b'D')) {
