@@ -198,6 +198,21 @@ pub struct TreeMember {
     pub depth: f64,
 }
 
+/// Tree members from raw numbers, as a property test draws them: member
+/// `k` starts at node `from % (k + 1) + 1` (always an earlier node) and
+/// takes `length`, `angle` and `depth` as they are.
+pub fn tree_members(raw: &[(usize, f64, f64, f64)]) -> Vec<TreeMember> {
+    raw.iter()
+        .enumerate()
+        .map(|(k, &(from, length, angle, depth))| TreeMember {
+            from: (from % (k + 1)) as u32 + 1,
+            length,
+            angle,
+            depth,
+        })
+        .collect()
+}
+
 /// A steel frame shaped as a tree, for property tests: node 1 at the
 /// origin, and member `k` (0-based, element id `k + 1`) from node
 /// `members[k].from` to a new node `k + 2`. Members alternate between the

@@ -1,7 +1,7 @@
 //! Invariants of the element matrices and the assembly, on random frames.
 
 use fe_model::kinematics::zero_energy_motions;
-use fe_model::samples::{TreeMember, tree_frame};
+use fe_model::samples::{TreeMember, tree_frame, tree_members};
 use fe_model::{Assembly, element};
 use nalgebra::{DMatrix, SymmetricEigen};
 use proptest::prelude::*;
@@ -9,18 +9,8 @@ use proptest::prelude::*;
 /// A random tree of 1 to 5 members: each starts at an earlier node, is
 /// 0.2-1 m long, points anywhere and is 10-80 mm deep.
 fn members() -> impl Strategy<Value = Vec<TreeMember>> {
-    prop::collection::vec((any::<prop::sample::Index>(), 0.2..1.0f64, 0.0..std::f64::consts::TAU, 0.01..0.08f64), 1..=5)
-        .prop_map(|raw| {
-            raw.iter()
-                .enumerate()
-                .map(|(k, (from, length, angle, depth))| TreeMember {
-                    from: from.index(k + 1) as u32 + 1,
-                    length: *length,
-                    angle: *angle,
-                    depth: *depth,
-                })
-                .collect()
-        })
+    let raw = (any::<usize>(), 0.2..1.0f64, 0.0..std::f64::consts::TAU, 0.01..0.08f64);
+    prop::collection::vec(raw, 1..=5).prop_map(|raw| tree_members(&raw))
 }
 
 /// A member order: a permutation of `0..n`.

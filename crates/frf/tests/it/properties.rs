@@ -2,25 +2,15 @@
 //! reciprocity, passivity, the viscous limit.
 
 use damping::DampedSystem;
-use fe_model::samples::{TreeMember, tree_frame};
+use fe_model::samples::{TreeMember, tree_frame, tree_members};
 use fe_model::{Model, Quantity};
 use frf::{C64, Channel, synthesize};
 use proptest::prelude::*;
 
 /// A random tree of 1 to 4 members (as in fe-model's property tests).
 fn members() -> impl Strategy<Value = Vec<TreeMember>> {
-    prop::collection::vec((any::<prop::sample::Index>(), 0.2..1.0f64, 0.0..std::f64::consts::TAU, 0.01..0.08f64), 1..=4)
-        .prop_map(|raw| {
-            raw.iter()
-                .enumerate()
-                .map(|(k, (from, length, angle, depth))| TreeMember {
-                    from: from.index(k + 1) as u32 + 1,
-                    length: *length,
-                    angle: *angle,
-                    depth: *depth,
-                })
-                .collect()
-        })
+    let raw = (any::<usize>(), 0.2..1.0f64, 0.0..std::f64::consts::TAU, 0.01..0.08f64);
+    prop::collection::vec(raw, 1..=4).prop_map(|raw| tree_members(&raw))
 }
 
 /// Damping of one group: alpha (s), beta (1/s), mu (rad/s, `None`: viscous).
