@@ -132,17 +132,22 @@ pub struct Assembly {
     by_quantity: HashMap<Quantity, Vec<(usize, usize)>>,
 }
 
-struct UnionFind(Vec<usize>);
+/// Disjoint sets of `0..n` whose representative is the smallest member
+/// (here: equations follow node order; in [`crate::kinematics`], bodies).
+pub(crate) struct UnionFind(Vec<usize>);
 
 impl UnionFind {
-    fn find(&mut self, mut i: usize) -> usize {
+    pub(crate) fn new(n: usize) -> Self {
+        UnionFind((0..n).collect())
+    }
+    pub(crate) fn find(&mut self, mut i: usize) -> usize {
         while self.0[i] != i {
             self.0[i] = self.0[self.0[i]];
             i = self.0[i];
         }
         i
     }
-    fn union(&mut self, a: usize, b: usize) {
+    pub(crate) fn union(&mut self, a: usize, b: usize) {
         let (ra, rb) = (self.find(a), self.find(b));
         if ra != rb {
             // keep the smaller index as root: equations follow node order
@@ -155,7 +160,7 @@ impl UnionFind {
 fn build_dof_map(model: &Model) -> DofMap {
     let n = model.nodes.len();
     let slot_of = |id: NodeId, d: Dof| 3 * model.node_index[&id] + d.index();
-    let mut uf = UnionFind((0..3 * n).collect());
+    let mut uf = UnionFind::new(3 * n);
     for tie in &model.ties {
         for &d in &tie.dofs {
             uf.union(slot_of(tie.nodes[0], d), slot_of(tie.nodes[1], d));

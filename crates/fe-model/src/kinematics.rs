@@ -23,6 +23,7 @@ use std::collections::HashMap;
 
 use nalgebra::DMatrix;
 
+use crate::assembly::UnionFind;
 use crate::dof::{Dof, DofRef};
 use crate::error::ModelError;
 use crate::model::{Model, NodeId};
@@ -44,27 +45,6 @@ pub struct ZeroEnergy {
     pub first: Vec<[f64; 3]>,
     /// True when some part was too large to check (its motions are not counted).
     pub skipped: bool,
-}
-
-struct UnionFind(Vec<usize>);
-
-impl UnionFind {
-    fn new(n: usize) -> Self {
-        UnionFind((0..n).collect())
-    }
-    fn find(&mut self, mut i: usize) -> usize {
-        while self.0[i] != i {
-            self.0[i] = self.0[self.0[i]];
-            i = self.0[i];
-        }
-        i
-    }
-    fn union(&mut self, a: usize, b: usize) {
-        let (ra, rb) = (self.find(a), self.find(b));
-        if ra != rb {
-            self.0[ra.max(rb)] = ra.min(rb);
-        }
-    }
 }
 
 /// A rigid body: its reference point and length scale.
