@@ -27,6 +27,10 @@
 //! To stay fast with many candidates, all are first fitted briefly on a
 //! coarse subset of lines (screening), and the leaders are then fitted fully
 //! on the updating lines; the final ranking rests on the full fits only.
+//! On large models stiffness and mass changes are candidates per region; the
+//! two leaders' locations are then refined into per-element changes, which
+//! are screened and the best four fitted fully, so that one weakened element
+//! is named as such and not as its region or a mass at its node.
 
 pub mod candidates;
 
