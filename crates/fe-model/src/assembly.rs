@@ -132,17 +132,22 @@ pub struct Assembly {
     by_quantity: HashMap<Quantity, Vec<(usize, usize)>>,
 }
 
-struct UnionFind(Vec<usize>);
+/// Disjoint sets of `0..n` whose representative is the smallest member
+/// (here: equations follow node order; in [`crate::kinematics`], bodies).
+pub(crate) struct UnionFind(Vec<usize>);
 
 impl UnionFind {
-    fn find(&mut self, mut i: usize) -> usize {
+    pub(crate) fn new(n: usize) -> Self {
+        UnionFind((0..n).collect())
+    }
+    pub(crate) fn find(&mut self, mut i: usize) -> usize {
         while self.0[i] != i {
             self.0[i] = self.0[self.0[i]];
             i = self.0[i];
         }
         i
     }
-    fn union(&mut self, a: usize, b: usize) {
+    pub(crate) fn union(&mut self, a: usize, b: usize) {
         let (ra, rb) = (self.find(a), self.find(b));
         if ra != rb {
             // keep the smaller index as root: equations follow node order
@@ -155,7 +160,7 @@ impl UnionFind {
 fn build_dof_map(model: &Model) -> DofMap {
     let n = model.nodes.len();
     let slot_of = |id: NodeId, d: Dof| 3 * model.node_index[&id] + d.index();
-    let mut uf = UnionFind((0..3 * n).collect());
+    let mut uf = UnionFind::new(3 * n);
     for tie in &model.ties {
         for &d in &tie.dofs {
             uf.union(slot_of(tie.nodes[0], d), slot_of(tie.nodes[1], d));
@@ -323,6 +328,14 @@ impl Assembly {
                 positions: Vec::new(),
             });
         }
+        if let Some(b) =
+            blocks.iter().find(|b| b.terms.iter().any(|t| !t.unit.iter().all(|u| (u * t.value).is_finite())))
+        {
+            return Err(ModelError::Invalid {
+                what: describe_source(model, b.source),
+                reason: "has a stiffness or mass that is not finite (values or geometry too large)".into(),
+            });
+        }
         for (i, node) in model.nodes.iter().enumerate() {
             let has_free = Dof::ALL.iter().any(|&d| dofs.equation(DofRef { node: node.id, dof: d }).is_some());
             if !touched[i] && has_free {
@@ -347,6 +360,7 @@ impl Assembly {
             }
         }
         let assembly = Assembly { dofs, pattern, blocks, group_blocks, by_quantity };
+        crate::kinematics::check(model)?;
         assembly.check_stiffness_diagonal()?;
         Ok(assembly)
     }
@@ -359,7 +373,11 @@ impl Assembly {
         let scale = diag.iter().map(|&p| k[p].abs()).fold(0.0, f64::max);
         for (eq, &p) in diag.iter().enumerate() {
             if k[p] <= 1e-14 * scale {
-                return Err(ModelError::Mechanism { hint: self.dofs.dof_of(eq).to_string() });
+                let dof = self.dofs.dof_of(eq);
+                let mut nodes: Vec<u32> = self.dofs.dofs_of(eq).iter().map(|r| r.node.0).collect();
+                nodes.sort_unstable();
+                nodes.dedup();
+                return Err(ModelError::Mechanism { hint: dof.to_string(), modes: 1, nodes });
             }
         }
         Ok(())
@@ -455,6 +473,15 @@ impl Assembly {
     }
 }
 
+/// `element 3`, `spring `clamp``, `mass `sensor``: a block's model item, for messages.
+fn describe_source(model: &Model, source: BlockSource) -> String {
+    match source {
+        BlockSource::Beam(i) => format!("element {}", model.beams[i].id),
+        BlockSource::Spring(i) => format!("spring `{}`", model.springs[i].name),
+        BlockSource::Mass(i) => format!("mass `{}`", model.masses[i].name),
+    }
+}
+
 fn build_pattern(n: usize, blocks: &[Block]) -> Pattern {
     let mut cols: Vec<Vec<usize>> = vec![Vec::new(); n];
     for i in 0..n {
@@ -528,7 +555,7 @@ mod tests {
         m.add_mass("tip", 3, 1.0, 0.0, g).unwrap();
         m.add_support(1, &Dof::ALL).unwrap();
         let e = Assembly::new(&m).unwrap_err();
-        assert_eq!(e, ModelError::Mechanism { hint: "3:rz".into() });
+        assert_eq!(e, ModelError::Mechanism { hint: "3:rz".into(), modes: 1, nodes: vec![3] });
     }
 
     #[test]

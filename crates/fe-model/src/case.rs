@@ -192,6 +192,8 @@ struct RawMeasurement {
     data: Option<Spanned<String>>,
     #[serde(default)]
     map: Vec<Spanned<RawChannelMap>>,
+    #[serde(default)]
+    mask: Vec<Spanned<String>>,
 }
 
 #[derive(Deserialize)]
@@ -278,6 +280,51 @@ pub struct MeasurementSpec {
     pub data: Option<PathBuf>,
     /// Test (node, direction) to model DOF mapping for measured files.
     pub map: Vec<ChannelMap>,
+    /// What to leave out of the measured data instead of refusing it
+    /// (`mask = ["non-finite", ...]`); empty: refuse every defect.
+    pub mask: Vec<MaskRule>,
+}
+
+/// A kind of defect in measured data that a case accepts by leaving the
+/// affected values out (`[measurement] mask = [...]`), instead of refusing
+/// the file. What is left out is reported.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum MaskRule {
+    /// `non-finite`: a frequency line where any channel's value is NaN or
+    /// infinite is left out, for every channel.
+    NonFinite,
+    /// `duplicate-lines`: a line that repeats the frequency of the line
+    /// before it is left out (the first is kept). Lines that go backwards
+    /// are still refused.
+    DuplicateLines,
+    /// `unmodelled-channels`: a channel whose response or reference is at a
+    /// node the model lacks, or at a DOF it holds fixed, is left out.
+    UnmodelledChannels,
+}
+
+impl MaskRule {
+    /// Every rule, in the order of the documentation.
+    pub const ALL: [MaskRule; 3] = [MaskRule::NonFinite, MaskRule::DuplicateLines, MaskRule::UnmodelledChannels];
+
+    /// The name used in case files.
+    pub fn name(self) -> &'static str {
+        match self {
+            MaskRule::NonFinite => "non-finite",
+            MaskRule::DuplicateLines => "duplicate-lines",
+            MaskRule::UnmodelledChannels => "unmodelled-channels",
+        }
+    }
+
+    /// The rule of a case-file name.
+    pub fn parse(name: &str) -> Option<MaskRule> {
+        MaskRule::ALL.into_iter().find(|r| r.name() == name.trim())
+    }
+}
+
+impl std::fmt::Display for MaskRule {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
 }
 
 /// Mapping of a test point and direction to a model DOF: the unit vector of
@@ -442,6 +489,9 @@ pub struct CaseFile {
 
 // ------------------------------------------------------------------ loading
 
+/// Most elements one `[[lines]]` entry may generate.
+pub const MAX_LINE_ELEMENTS: u32 = 100_000;
+
 struct Ctx<'a> {
     path: &'a Path,
     source: &'a str,
@@ -453,6 +503,10 @@ impl Ctx<'_> {
     }
     fn model_err(&self, span: Range<usize>, e: ModelError) -> CaseError {
         self.err(span, e.to_string())
+    }
+    /// An error about the file as a whole (no line to point at).
+    fn whole(&self, message: impl Into<String>) -> CaseError {
+        CaseError::at(self.path, self.source, None, message.into())
     }
 }
 
@@ -469,11 +523,18 @@ impl CaseFile {
         Self::parse(path, &source)
     }
 
+    /// The files a run of this case reads: the case file itself and its
+    /// measured data file. Outputs must never be written over them.
+    pub fn inputs(&self) -> Vec<PathBuf> {
+        let data = self.measurement.as_ref().and_then(|m| m.data.clone());
+        std::iter::once(self.path.clone()).chain(data).collect()
+    }
+
     /// Parses case-file text; `path` is used in messages and to resolve data files.
     pub fn parse(path: &Path, source: &str) -> Result<Self, CaseError> {
         let ctx = Ctx { path, source };
         let raw: RawCase = toml::from_str(source)
-            .map_err(|e| CaseError::at(path, source, e.span(), e.message().trim_end().to_string()))?;
+            .map_err(|e| CaseError::at(path, source, e.span(), with_suggestion(e.message().trim_end())))?;
         let mut model = Model::new(raw.title.as_deref().unwrap_or("untitled"));
         build_model(&ctx, &raw, &mut model)?;
         for (name, v) in &raw.set {
@@ -481,7 +542,7 @@ impl CaseFile {
             model.set(q, *v.get_ref()).map_err(|e| ctx.model_err(v.span(), e))?;
         }
         // Assemble once so that structural errors are reported at load time.
-        crate::assembly::Assembly::new(&model).map_err(|e| ctx.err(0..0, e.to_string()))?;
+        crate::assembly::Assembly::new(&model).map_err(|e| ctx.whole(e.to_string()))?;
 
         let measurement = raw.measurement.as_ref().map(|m| parse_measurement(&ctx, m, &model)).transpose()?;
         let truth = raw.truth.as_ref().map(|t| parse_truth(&ctx, t, &model)).transpose()?;
@@ -651,6 +712,19 @@ impl CaseFile {
     }
 }
 
+/// A serde message about an unknown key (`unknown field `alpah`, expected
+/// one of `alpha`, `beta`, ...`) with the closest valid key suggested.
+fn with_suggestion(message: &str) -> String {
+    let Some(rest) = message.strip_prefix("unknown field `") else { return message.to_string() };
+    let Some((word, expected)) = rest.split_once('`') else { return message.to_string() };
+    // the valid keys are the backquoted names after the unknown one
+    let valid: Vec<&str> = expected.split('`').skip(1).step_by(2).collect();
+    match crate::suggest::closest(word, valid.iter().copied()) {
+        Some(best) => format!("{message}; did you mean `{best}`?"),
+        None => message.to_string(),
+    }
+}
+
 fn lookup(
     ctx: &Ctx<'_>,
     kind: &str,
@@ -800,7 +874,7 @@ fn build_model(ctx: &Ctx<'_>, raw: &RawCase, model: &mut Model) -> Result<(), Ca
         }
     }
     if model.beams.is_empty() && model.springs.is_empty() {
-        return Err(ctx.err(0..0, "the case defines no beams, lines or springs"));
+        return Err(ctx.whole("the case defines no beams, lines or springs"));
     }
     Ok(())
 }
@@ -838,7 +912,13 @@ fn add_spring(ctx: &Ctx<'_>, model: &mut Model, s: &Spanned<RawSpring>) -> Resul
 fn add_joint(ctx: &Ctx<'_>, model: &mut Model, j: &Spanned<RawJoint>) -> Result<(), CaseError> {
     let r = j.get_ref();
     let g = group_ref(ctx, model, &r.group)?;
-    let new_id = r.new_node.unwrap_or(model.max_node_id() + 1);
+    let new_id = match r.new_node {
+        Some(id) => id,
+        None => model
+            .max_node_id()
+            .checked_add(1)
+            .ok_or_else(|| ctx.err(j.span(), format!("joint `{}`: no node id left above {}", r.name, u32::MAX)))?,
+    };
     model.split_node(r.node, &r.elements, new_id).map_err(|e| ctx.model_err(j.span(), e))?;
     let tied: Vec<Dof> =
         [(Dof::Ux, r.kx), (Dof::Uy, r.ky)].iter().filter(|(_, k)| k.is_none()).map(|(d, _)| *d).collect();
@@ -886,6 +966,12 @@ fn add_line(ctx: &Ctx<'_>, model: &mut Model, line: &Spanned<RawLine>) -> Result
     if n == 0 {
         return Err(ctx.err(r.elements.span(), "a line needs at least one element"));
     }
+    if n > MAX_LINE_ELEMENTS {
+        return Err(ctx.err(
+            r.elements.span(),
+            format!("{n} elements in one line is more than this tool accepts ({MAX_LINE_ELEMENTS})"),
+        ));
+    }
     let mat = lookup(
         ctx,
         "material",
@@ -901,8 +987,15 @@ fn add_line(ctx: &Ctx<'_>, model: &mut Model, line: &Spanned<RawLine>) -> Result
         model.sections.iter().map(|m| m.name.as_str()).collect(),
     )?;
     let g = group_ref(ctx, model, &r.group)?;
-    let mut next_node = r.first_node.unwrap_or(model.max_node_id() + 1);
-    let mut next_elem = r.first_element.unwrap_or(model.max_element_id() + 1);
+    let exhausted = |what: &str| ctx.err(line.span(), format!("{what} ids of this line would pass {}", u32::MAX));
+    let mut next_node = match r.first_node {
+        Some(id) => Some(id),
+        None => model.max_node_id().checked_add(1),
+    };
+    let mut next_elem = match r.first_element {
+        Some(id) => Some(id),
+        None => model.max_element_id().checked_add(1),
+    };
     let point = |model: &Model, end: &End, span: Range<usize>| -> Result<(f64, f64), CaseError> {
         match *end {
             End::Point(x, y) => Ok((x, y)),
@@ -917,8 +1010,8 @@ fn add_line(ctx: &Ctx<'_>, model: &mut Model, line: &Spanned<RawLine>) -> Result
     let (x0, y0) = point(model, &from, r.from.span())?;
     let (x1, y1) = point(model, &to, r.to.span())?;
     let mut add = |model: &mut Model, x: f64, y: f64| -> Result<u32, CaseError> {
-        let id = next_node;
-        next_node += 1;
+        let id = next_node.ok_or_else(|| exhausted("node"))?;
+        next_node = id.checked_add(1);
         model.add_node(id, x, y).map_err(|e| ctx.model_err(line.span(), e))?;
         Ok(id)
     };
@@ -936,8 +1029,8 @@ fn add_line(ctx: &Ctx<'_>, model: &mut Model, line: &Spanned<RawLine>) -> Result
         End::Point(x, y) => add(model, x, y)?,
     });
     for w in ids.windows(2) {
-        let id = next_elem;
-        next_elem += 1;
+        let id = next_elem.ok_or_else(|| exhausted("element"))?;
+        next_elem = id.checked_add(1);
         let i = model.add_beam(id, [w[0], w[1]], mat, sec, g).map_err(|e| ctx.model_err(line.span(), e))?;
         model.set_added_mass(i, r.added_mass).map_err(|e| ctx.model_err(line.span(), e))?;
     }
@@ -977,12 +1070,14 @@ fn parse_frequencies(ctx: &Ctx<'_>, v: &Spanned<toml::Value>) -> Result<Vec<f64>
             .map(|x| num(x).ok_or_else(|| ctx.err(v.span(), "frequencies must be numbers (Hz)")))
             .collect::<Result<_, _>>()?,
         toml::Value::Table(t) => {
+            const KEYS: [&str; 4] = ["from", "to", "step", "count"];
             for k in t.keys() {
-                if !["from", "to", "step", "count"].contains(&k.as_str()) {
-                    return Err(ctx.err(
-                        v.span(),
-                        format!("unknown key `{k}` in a frequency range (use from, to and step or count)"),
-                    ));
+                if !KEYS.contains(&k.as_str()) {
+                    let hint = match crate::suggest::closest(k, KEYS) {
+                        Some(best) => format!("did you mean `{best}`?"),
+                        None => "use from, to and step or count".to_string(),
+                    };
+                    return Err(ctx.err(v.span(), format!("unknown key `{k}` in a frequency range; {hint}")));
                 }
             }
             let get = |k: &str| t.get(k).and_then(num);
@@ -991,7 +1086,7 @@ fn parse_frequencies(ctx: &Ctx<'_>, v: &Spanned<toml::Value>) -> Result<Vec<f64>
                 _ => return Err(ctx.err(v.span(), "a frequency range needs `from` and `to` (Hz)")),
             };
             let count = match (get("step"), t.get("count")) {
-                (Some(step), None) if step > 0.0 => ((to - from) / step + 1e-9).floor() as usize + 1,
+                (Some(step), None) if step > 0.0 => (((to - from) / step + 1e-9).floor() as usize).saturating_add(1),
                 (None, Some(toml::Value::Integer(c))) if *c >= 2 => *c as usize,
                 _ => {
                     return Err(
@@ -1073,7 +1168,26 @@ fn parse_measurement(ctx: &Ctx<'_>, m: &Spanned<RawMeasurement>, model: &Model) 
         }
         map.push(ChannelMap { test: c.test.get_ref().clone(), model: model_dof, sign: c.sign });
     }
-    Ok(MeasurementSpec { frequencies_hz, references, responses, data, map })
+    let mut mask: Vec<MaskRule> = Vec::new();
+    for m in &r.mask {
+        let rule = MaskRule::parse(m.get_ref()).ok_or_else(|| {
+            let names = MaskRule::ALL.map(MaskRule::name);
+            let hint = crate::suggest::closest(m.get_ref(), names)
+                .map(|s| format!("; did you mean `{s}`?"))
+                .unwrap_or_else(|| format!(" (available: {})", names.join(", ")));
+            ctx.err(m.span(), format!("unknown mask `{}`{hint}", m.get_ref()))
+        })?;
+        if mask.contains(&rule) {
+            return Err(ctx.err(m.span(), format!("mask `{rule}` is listed twice")));
+        }
+        mask.push(rule);
+    }
+    if !mask.is_empty() && r.data.is_none() {
+        return Err(
+            ctx.err(r.mask[0].span(), "`mask` applies to a measured `data` file, and this measurement has none")
+        );
+    }
+    Ok(MeasurementSpec { frequencies_hz, references, responses, data, map, mask })
 }
 
 fn resolve_values(
@@ -1378,6 +1492,42 @@ node = 1
         let e = parse(&text).unwrap_err();
         assert!(e.message.contains("`105:-z` is already mapped by `105:+Z`"), "{e}");
         assert_eq!(text.lines().nth(e.location.unwrap().line - 1).unwrap(), "test = \"105:-z\"");
+    }
+
+    #[test]
+    fn unknown_keys_get_the_closest_valid_key_of_their_table() {
+        for (good, bad, table_line) in [
+            ("alpha = 1e-5", "alpah = 1e-5", "alpah = 1e-5"),
+            ("elements = 4", "elemnts = 4", "elemnts = 4"),
+            ("rho = 7800", "rh0 = 7800", "rh0 = 7800"),
+        ] {
+            let text = BEAM.replace(good, bad);
+            let e = parse(&text).unwrap_err();
+            let want = good.split(' ').next().unwrap();
+            assert!(e.message.contains(&format!("did you mean `{want}`?")), "{e}");
+            assert_eq!(text.lines().nth(e.location.unwrap().line - 1).unwrap(), table_line);
+        }
+        // a key far from every valid one gets the list, not a guess
+        let e = parse(&BEAM.replace("alpha = 1e-5", "zzzzzz = 1")).unwrap_err();
+        assert!(e.message.contains("unknown field `zzzzzz`") && !e.message.contains("did you mean"), "{e}");
+    }
+
+    #[test]
+    fn mask_rules_are_named_checked_and_need_a_data_file() {
+        let base =
+            format!("{BEAM}[measurement]\nfrequencies = [10.0]\nreferences = [\"5:uy\"]\nresponses = [\"5:uy\"]\n");
+        let with_data = format!("{base}data = \"m.csv\"\n");
+        let c = parse(&format!("{with_data}mask = [\"non-finite\", \"unmodelled-channels\"]\n")).unwrap();
+        assert_eq!(c.measurement.unwrap().mask, vec![MaskRule::NonFinite, MaskRule::UnmodelledChannels]);
+        let e = parse(&format!("{with_data}mask = [\"non-finit\"]\n")).unwrap_err();
+        assert!(e.message.contains("unknown mask `non-finit`; did you mean `non-finite`?"), "{e}");
+        let e = parse(&format!("{with_data}mask = [\"nan\", \"x\"]\n")).unwrap_err();
+        assert!(e.message.contains("(available: non-finite, duplicate-lines, unmodelled-channels)"), "{e}");
+        let e = parse(&format!("{with_data}mask = [\"non-finite\", \"non-finite\"]\n")).unwrap_err();
+        assert!(e.message.contains("listed twice"), "{e}");
+        let e = parse(&format!("{base}mask = [\"non-finite\"]\n")).unwrap_err();
+        assert!(e.message.contains("has none"), "{e}");
+        assert_eq!(e.location.unwrap().line, base.lines().count() + 1);
     }
 
     #[test]

@@ -81,14 +81,53 @@ pub enum ModelError {
         id: u32,
     },
     /// Stiffness is singular: a mechanism or an unsupported body.
-    #[error(
-        "the stiffness matrix is singular: the structure is a mechanism or a free body \
-         (check supports and joints near {hint})"
-    )]
+    #[error("{}", mechanism_message(*modes, hint, nodes))]
     Mechanism {
-        /// Where the zero-energy motion is largest (a `node:dof`).
+        /// Where the (first) zero-energy motion is largest, as `node:dof`.
         hint: String,
+        /// Number of independent zero-energy motions found.
+        modes: usize,
+        /// Nodes the first zero-energy motion moves, in increasing id order.
+        nodes: Vec<u32>,
     },
+}
+
+/// `1-4, 7, 9-10`: node ids (sorted) as ranges, at most about 12 items.
+pub(crate) fn id_ranges(ids: &[u32]) -> String {
+    let mut parts: Vec<String> = Vec::new();
+    let mut i = 0;
+    while i < ids.len() {
+        let mut j = i;
+        while j + 1 < ids.len() && ids[j + 1] == ids[j].saturating_add(1) {
+            j += 1;
+        }
+        parts.push(if j > i { format!("{}-{}", ids[i], ids[j]) } else { ids[i].to_string() });
+        i = j + 1;
+    }
+    if parts.len() > 12 {
+        let more = parts.len() - 10;
+        parts.truncate(10);
+        parts.push(format!("and {more} more"));
+    }
+    parts.join(", ")
+}
+
+fn mechanism_message(modes: usize, hint: &str, nodes: &[u32]) -> String {
+    let what = if modes > 1 {
+        format!("{modes} independent zero-energy motions; the first")
+    } else {
+        "a zero-energy motion that".to_string()
+    };
+    let moving = match nodes.len() {
+        0 => String::new(),
+        1 => format!(" (node {})", nodes[0]),
+        _ => format!(" (nodes {})", id_ranges(nodes)),
+    };
+    format!(
+        "the stiffness matrix is singular: the structure is a mechanism or a body without enough supports; it has \
+         {what} moves it without deforming it, largest at {hint}{moving}; check the supports, ties, joints and \
+         springs there (a free-free test is modelled with soft suspension springs)"
+    )
 }
 
 /// Line and column (1-based) in a text file.
@@ -165,5 +204,15 @@ mod tests {
         assert_eq!(Location::of(s, 6), Location { line: 2, column: 1 });
         assert_eq!(Location::of(s, 9), Location { line: 2, column: 4 });
         assert_eq!(Location::of(s, 999), Location { line: 3, column: 1 });
+    }
+
+    #[test]
+    fn a_mechanism_names_its_dof_its_count_and_the_moving_nodes_as_ranges() {
+        let e = ModelError::Mechanism { hint: "31:uy".into(), modes: 3, nodes: (1..=31).chain([40, 42, 43]).collect() };
+        let m = e.to_string();
+        assert!(m.contains("3 independent zero-energy motions"), "{m}");
+        assert!(m.contains("largest at 31:uy (nodes 1-31, 40, 42-43)"), "{m}");
+        let many: Vec<u32> = (0..20).map(|i| 3 * i).collect();
+        assert_eq!(id_ranges(&many), "0, 3, 6, 9, 12, 15, 18, 21, 24, 27, and 10 more");
     }
 }

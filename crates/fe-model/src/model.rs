@@ -429,9 +429,15 @@ impl Model {
         }
         self.require_group(group, &ctx)?;
         let (a, b) = (self.node(nodes[0]).unwrap(), self.node(nodes[1]).unwrap());
-        let length = ((b.x - a.x).powi(2) + (b.y - a.y).powi(2)).sqrt();
+        let length = (b.x - a.x).hypot(b.y - a.y);
         if nodes[0] == nodes[1] || length <= 1e-12 {
             return Err(ModelError::ZeroLength { element: id.0 });
+        }
+        if !length.is_finite() {
+            return Err(ModelError::Invalid {
+                what: ctx,
+                reason: format!("is too long: its length between nodes {} and {} overflows", nodes[0], nodes[1]),
+            });
         }
         self.beams.push(Beam {
             id,

@@ -185,6 +185,65 @@ pub fn frame_grid(bays: usize, storeys: usize, elements_per_member: usize) -> Mo
     m
 }
 
+/// One member of a [`tree_frame`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TreeMember {
+    /// Node it starts at: an earlier node (1-based).
+    pub from: u32,
+    /// Length (m).
+    pub length: f64,
+    /// Direction from the x axis (rad).
+    pub angle: f64,
+    /// Depth of its 50 mm wide rectangular section (m).
+    pub depth: f64,
+}
+
+/// Tree members from raw numbers, as a property test draws them: member
+/// `k` starts at node `from % (k + 1) + 1` (always an earlier node) and
+/// takes `length`, `angle` and `depth` as they are.
+pub fn tree_members(raw: &[(usize, f64, f64, f64)]) -> Vec<TreeMember> {
+    raw.iter()
+        .enumerate()
+        .map(|(k, &(from, length, angle, depth))| TreeMember {
+            from: (from % (k + 1)) as u32 + 1,
+            length,
+            angle,
+            depth,
+        })
+        .collect()
+}
+
+/// A steel frame shaped as a tree, for property tests: node 1 at the
+/// origin, and member `k` (0-based, element id `k + 1`) from node
+/// `members[k].from` to a new node `k + 2`. Members alternate between the
+/// undamped groups `a` and `b`. The elements are added in `order` (a
+/// permutation of the member indices), so that two orders give the same
+/// structure. Clamped at node 1 when `clamped`; otherwise free.
+pub fn tree_frame(members: &[TreeMember], order: &[usize], clamped: bool) -> Model {
+    let mut m = Model::new("tree frame");
+    let groups = [m.add_group(Group::new("a")).unwrap(), m.add_group(Group::new("b")).unwrap()];
+    let steel = m.add_material("steel", 2.0e11, 7800.0).unwrap();
+    let sections: Vec<usize> = members
+        .iter()
+        .enumerate()
+        .map(|(k, t)| m.add_section(Section::rectangle(&format!("s{}", k + 1), 0.05, t.depth)).unwrap())
+        .collect();
+    m.add_node(1, 0.0, 0.0).unwrap();
+    for (k, t) in members.iter().enumerate() {
+        let start = m.node(crate::NodeId(t.from)).expect("members start at an earlier node");
+        let (x, y) = (start.x + t.length * t.angle.cos(), start.y + t.length * t.angle.sin());
+        m.add_node(k as u32 + 2, x, y).unwrap();
+    }
+    for &k in order {
+        let t = &members[k];
+        m.add_beam(k as u32 + 1, [t.from, k as u32 + 2], steel, sections[k], groups[k % 2]).unwrap();
+    }
+    if clamped {
+        m.add_support(1, &Dof::ALL).unwrap();
+    }
+    m
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,12 +1,23 @@
 //! `rfm`: compare, update and simulate FE models of damped structures against
 //! measured FRFs. Run `rfm --help`.
 
+/// `println!` through [`print_line`]: a closed standard output does not
+/// panic, and other write errors (a full disk) are handed back with `?`.
+macro_rules! outln {
+    ($($arg:tt)*) => {
+        crate::print_line(format_args!($($arg)*))?
+    };
+}
+
 mod commands;
 mod report;
 mod table;
 
+use std::io::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Mutex, MutexGuard, PoisonError};
 
 use clap::{Parser, Subcommand};
 
@@ -106,7 +117,71 @@ enum Command {
     },
 }
 
+/// Set by a command that has files to write (`--out`, `--apply`).
+static FILES_TO_WRITE: AtomicBool = AtomicBool::new(false);
+
+/// Tells [`print_line`] that the command has files to write.
+pub(crate) fn files_to_write() {
+    FILES_TO_WRITE.store(true, Ordering::Relaxed);
+}
+
+/// Prints a line on standard output. When the reader has gone (`rfm ... |
+/// head`), a command with files to write goes on without printing, and any
+/// other stops at once and quietly: nothing would be lost.
+pub(crate) fn print_line(args: std::fmt::Arguments<'_>) -> std::io::Result<()> {
+    match writeln!(std::io::stdout().lock(), "{args}") {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {
+            if FILES_TO_WRITE.load(Ordering::Relaxed) {
+                Ok(())
+            } else {
+                std::process::exit(0)
+            }
+        }
+        other => other,
+    }
+}
+
+/// Held while a command writes its outputs.
+static WRITING: Mutex<()> = Mutex::new(());
+
+/// Set when a command's output phase has ended.
+static WRITTEN: AtomicBool = AtomicBool::new(false);
+
+/// The output phase of a command, from [`writing`] until dropped.
+pub(crate) struct Writing {
+    _guard: MutexGuard<'static, ()>,
+}
+
+impl Drop for Writing {
+    fn drop(&mut self) {
+        WRITTEN.store(true, Ordering::Relaxed);
+    }
+}
+
+/// Marks the output phase of a command: an interrupt (Ctrl-C, SIGTERM,
+/// SIGHUP) waits until the guard is dropped, so that a run stops either
+/// before it writes anything or after all its outputs, never between two of
+/// them (each file is written to a temporary and renamed, see
+/// [`frf::io::atomic_write`]).
+pub(crate) fn writing() -> Writing {
+    Writing { _guard: WRITING.lock().unwrap_or_else(PoisonError::into_inner) }
+}
+
 fn main() -> ExitCode {
+    // Without a handler the signal would end the process at once, possibly
+    // between two output files of one run.
+    let interrupt = ctrlc::set_handler(|| {
+        let _held = WRITING.lock().unwrap_or_else(PoisonError::into_inner);
+        if WRITTEN.load(Ordering::Relaxed) {
+            eprintln!("interrupted after this run's outputs were written");
+        } else {
+            eprintln!("interrupted: the outputs of this run were not written (earlier ones are untouched)");
+        }
+        std::process::exit(130);
+    });
+    if let Err(e) = interrupt {
+        eprintln!("warning: cannot handle Ctrl-C ({e}); an interrupt may stop a run between two output files");
+    }
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Simulate { case, out, truth, noise, seed } => commands::simulate(&case, &out, truth, noise, seed),

@@ -30,6 +30,13 @@
 //!
 //! When the full step lowers the misfit, as it does near the solution, the
 //! iteration is exactly the paper's.
+//!
+//! Bounds from the case (`[update] bounds`) clip each new value; a parameter
+//! that ends on one is flagged in [`RfmResult::at_bound`]. At the returned
+//! iterate the column-scaled sensitivity's singular values tell whether the
+//! data determine every parameter: [`RfmResult::unresolved`] names the
+//! combination along the weakest direction when its singular value is below
+//! 1e-6 of the largest (the same test as the output-error uncertainty).
 
 use damping::DampedSystem;
 use faer::Mat;
@@ -52,11 +59,13 @@ pub struct RfmOptions {
     /// Stalled when this many iterations in a row fail to lower the best
     /// residual by 1 %.
     pub stall_iterations: usize,
+    /// Bounds per parameter in physical units (`None` or missing: unbounded).
+    pub bounds: Vec<Option<(f64, f64)>>,
 }
 
 impl Default for RfmOptions {
     fn default() -> Self {
-        RfmOptions { max_iterations: 50, tolerance: 1e-6, rcond: 1e-10, stall_iterations: 5 }
+        RfmOptions { max_iterations: 50, tolerance: 1e-6, rcond: 1e-10, stall_iterations: 5, bounds: Vec::new() }
     }
 }
 
@@ -111,6 +120,23 @@ pub struct RfmResult {
     pub values: Vec<f64>,
     /// Residual of the final values.
     pub residual: f64,
+    /// Parameters whose final value lies on one of their bounds.
+    pub at_bound: Vec<bool>,
+    /// Singular values of the column-scaled sensitivity at the returned
+    /// iterate, descending (empty if it was never solved for).
+    pub singular_values: Vec<f64>,
+    /// The parameter combination the data cannot separate, when the scaled
+    /// sensitivity is nearly singular (see the module docs).
+    pub unresolved: Option<String>,
+}
+
+/// Clips each value into its bounds.
+fn clip(values: &mut [f64], bounds: &[Option<(f64, f64)>]) {
+    for (v, b) in values.iter_mut().zip(bounds) {
+        if let Some((lo, hi)) = *b {
+            *v = v.clamp(lo, hi);
+        }
+    }
 }
 
 /// `|R_FE - R_EX| / |R_EX|` over a set of blocks.
@@ -196,6 +222,8 @@ pub fn run(
     let mut converged = false;
     // (max |u|, corrections limited, rank, lambda) of the step just taken
     let mut last_step = (0.0, 0, params.len(), 0.0);
+    // singular values and right singular vectors at the best iterate
+    let mut best_svd: (Vec<f64>, Mat<f64>) = (Vec::new(), Mat::zeros(0, 0));
     for iteration in 0..=opts.max_iterations {
         let blocks =
             match sensitivity::assemble(sys, &solver, &plan, params.quantities(), &freqs, Hybrid::Measured(measured)) {
@@ -223,7 +251,8 @@ pub fn run(
         } else {
             since_best += 1;
         }
-        if residual.is_finite() && residual < best.0 {
+        let at_best = residual.is_finite() && residual < best.0;
+        if at_best {
             best = (residual, values(sys));
         }
         if converged {
@@ -239,6 +268,9 @@ pub fn run(
         }
         let (a, b) = stack(&blocks, measured, params);
         let sol = crate::lstsq::solve(&a, &b, opts.rcond);
+        if at_best {
+            best_svd = (sol.singular_values.clone(), sol.v.clone());
+        }
         let current = values(sys);
         let mut full = sol.x.clone();
         let full_limited = guard(&mut full);
@@ -249,7 +281,8 @@ pub fn run(
         }
         if full_max < opts.tolerance {
             // converged: take the (tiny) paper step and stop after recording it
-            let next: Vec<f64> = current.iter().zip(&full).map(|(p, u)| p * (1.0 + u)).collect();
+            let mut next: Vec<f64> = current.iter().zip(&full).map(|(p, u)| p * (1.0 + u)).collect();
+            clip(&mut next, &opts.bounds);
             params.set_values(sys, &next)?;
             last_step = (full_max, full_limited, sol.rank, 0.0);
             converged = true;
@@ -260,7 +293,8 @@ pub fn run(
         for _ in 0..16 {
             let mut u = if lambda == 0.0 { sol.x.clone() } else { sol.damped(lambda) };
             let limited = guard(&mut u);
-            let next: Vec<f64> = current.iter().zip(&u).map(|(p, u)| p * (1.0 + u)).collect();
+            let mut next: Vec<f64> = current.iter().zip(&u).map(|(p, u)| p * (1.0 + u)).collect();
+            clip(&mut next, &opts.bounds);
             let trial = params.set_values(sys, &next).ok().and_then(|()| misfit(sys, &solver, measured));
             if trial.is_some_and(|r| r < residual) {
                 last_step = (u.iter().map(|x| x.abs()).fold(0.0, f64::max), limited, sol.rank, lambda);
@@ -281,5 +315,15 @@ pub fn run(
     }
     let final_values = values(sys);
     let residual = if status == Status::Converged { history.last().map_or(f64::NAN, |r| r.residual) } else { best.0 };
-    Ok(RfmResult { history, status, values: final_values, residual })
+    let at_bound = (0..final_values.len())
+        .map(|i| {
+            opts.bounds.get(i).copied().flatten().is_some_and(|(lo, hi)| {
+                let v = final_values[i];
+                (v - lo).abs() <= 1e-9 * lo.abs() || (v - hi).abs() <= 1e-9 * hi.abs()
+            })
+        })
+        .collect();
+    let names: Vec<String> = params.params().iter().map(|p| p.name.clone()).collect();
+    let unresolved = crate::uncertainty::unresolved_combination(&best_svd.0, &best_svd.1, &names);
+    Ok(RfmResult { history, status, values: final_values, residual, at_bound, singular_values: best_svd.0, unresolved })
 }

@@ -1,6 +1,8 @@
 //! A study: a case file turned into a model, measured data and an updating
 //! set-up, ready for a solver.
 
+use std::path::Path;
+
 use damping::DampedSystem;
 use fe_model::case::{FrequencyChoice, MeasurementSpec};
 use fe_model::{CaseFile, Parameter};
@@ -58,6 +60,8 @@ pub struct Study {
     pub parameters: Vec<Parameter>,
     /// Lines used for updating (Hz).
     pub update_frequencies_hz: Vec<f64>,
+    /// What the case's `[measurement] mask` left out of the measured file.
+    pub masked: Vec<frf::io::Masked>,
 }
 
 /// One parameter's values for reporting.
@@ -138,9 +142,35 @@ pub struct UpdateOutcome {
     /// Relative noise level of the measured data, estimated from their
     /// roughness (see [`crate::diagnose::estimate_noise`]).
     pub noise_estimate: Option<f64>,
+    /// What the case's mask rules left out of the measured data, one line
+    /// each (`non-finite: line 17, columns 4-5: H(3:uy,2:uy) at 20 Hz is NaN`).
+    pub masked: Vec<String>,
+    /// What the data leave undetermined, for methods without an uncertainty
+    /// report (the RFM): parameters that ended on a bound, the combination
+    /// of parameters the sensitivity cannot separate.
+    pub warnings: Vec<String>,
     /// The updated model.
     #[serde(skip)]
     pub system: DampedSystem,
+}
+
+/// Reads a measured FRF file for a model with the case's channel map and
+/// mask rules (`[measurement] map` and `mask`; none without a spec), and
+/// checks that every channel is at a free DOF of the model (or leaves it out
+/// where the mask allows). What the rules left out is in
+/// [`frf::io::Measured::masked`].
+pub fn read_measured_for(
+    system: &DampedSystem,
+    path: &Path,
+    spec: Option<&MeasurementSpec>,
+) -> Result<frf::io::Measured, UpdateError> {
+    let (map, mask) = spec.map_or((&[][..], &[][..]), |s| (&s.map[..], &s.mask[..]));
+    Ok(frf::io::load_measured_with(path, map, mask)?.check_channels(path, &system.assembly().dofs, mask)?)
+}
+
+/// One line per thing a mask rule left out: the rule, then where and why.
+pub fn describe_masked(masked: &[frf::io::Masked]) -> Vec<String> {
+    masked.iter().map(|m| format!("{}: {}", m.rule, m.detail)).collect()
 }
 
 fn channels_of(m: &MeasurementSpec) -> Vec<Channel> {
@@ -173,9 +203,12 @@ impl Study {
                 grid.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * b.abs());
             }
         }
+        let mut masked = Vec::new();
         let measured = match (&spec.data, &case.truth, &truth) {
             (Some(path), _, _) => {
-                let set = frf::io::read_measured(path, &spec.map)?.to_receptance();
+                let read = read_measured_for(&system, path, Some(spec))?;
+                masked = read.masked;
+                let set = read.set.to_receptance();
                 for c in &channels {
                     if set.find(*c).is_none() {
                         return Err(UpdateError::Setup(format!(
@@ -195,7 +228,7 @@ impl Study {
             _ => unreachable!("the case loader requires data or a truth"),
         };
         let parameters = case.update.as_ref().map(|u| u.parameters.clone()).unwrap_or_default();
-        let mut study = Study { case, system, truth, measured, parameters, update_frequencies_hz: Vec::new() };
+        let mut study = Study { case, system, truth, measured, parameters, update_frequencies_hz: Vec::new(), masked };
         if study.case.update.is_some() {
             study.update_frequencies_hz = study.lines_for(study.method())?;
         }
@@ -298,13 +331,28 @@ impl Study {
         let lines = self.lines_for(Method::Rfm)?;
         let measured = self.measured.at_frequencies(&lines)?;
         let mut sys = self.system.clone();
-        let result = rfm::run(&mut sys, &self.parameter_set(), &measured, opts, on_iteration)?;
+        let mut opts = opts.clone();
+        if let Some(spec) = &self.case.update {
+            opts.bounds = spec.bounds.clone();
+        }
+        let result = rfm::run(&mut sys, &self.parameter_set(), &measured, &opts, on_iteration)?;
+        let mut warnings: Vec<String> = self
+            .parameters
+            .iter()
+            .zip(&result.at_bound)
+            .zip(&opts.bounds)
+            .filter(|((_, at), _)| **at)
+            .filter_map(|((p, _), b)| b.map(|(lo, hi)| format!("{} ended on its bound [{lo:e}, {hi:e}]", p.name)))
+            .collect();
+        warnings.extend(result.unresolved.clone());
         let natural_frequencies_hz = self.frequency_table(&sys);
         Ok(UpdateOutcome {
             natural_frequencies_hz,
             uncertainty: None,
             gains: Vec::new(),
             noise_estimate: crate::diagnose::estimate_noise(&self.measured),
+            masked: describe_masked(&self.masked),
+            warnings,
             method: "rfm".into(),
             status: result.status,
             parameters: self.reports(&result.values),
@@ -376,6 +424,8 @@ impl Study {
             uncertainty: Some(report),
             gains: result.gains,
             noise_estimate: crate::diagnose::estimate_noise(&self.measured),
+            masked: describe_masked(&self.masked),
+            warnings: Vec::new(),
             system: sys,
         })
     }

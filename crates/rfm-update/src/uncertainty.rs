@@ -134,15 +134,20 @@ pub fn analyse(params: &ParameterSet, result: &OeResult, band_hz: (f64, f64)) ->
             }
         }
     }
-    if let Some(w) = unresolved_combination(&result.singular_values, &result.v, &out, n) {
+    let names: Vec<String> = out.iter().map(|p| p.name.clone()).collect();
+    if let Some(w) = unresolved_combination(&result.singular_values, &result.v, &names) {
         warnings.push(w);
     }
     UncertaintyReport { parameters: out, correlation, warnings, residual_rms: (2.0 * result.sigma2).sqrt() }
 }
 
-/// Names the parameter combination along the weakest direction of the
-/// scaled Jacobian when it is nearly singular.
-fn unresolved_combination(sv: &[f64], v: &Mat<f64>, params: &[ParameterUncertainty], n: usize) -> Option<String> {
+/// Names the parameter combination along the weakest direction of a
+/// column-scaled sensitivity matrix (singular values `sv`, right singular
+/// vectors as the columns of `v`, one row per parameter of `names`) when it
+/// is nearly singular: its smallest singular value is below 1e-6 of the
+/// largest. Also used for the response function method.
+pub(crate) fn unresolved_combination(sv: &[f64], v: &Mat<f64>, names: &[String]) -> Option<String> {
+    let n = names.len();
     let smax = sv.first().copied()?;
     let (k, &smin) = sv.iter().enumerate().min_by(|a, b| a.1.total_cmp(b.1))?;
     if smax == 0.0 || smin > 1e-6 * smax {
@@ -154,7 +159,7 @@ fn unresolved_combination(sv: &[f64], v: &Mat<f64>, params: &[ParameterUncertain
         .iter()
         .take(3)
         .filter(|(c, _)| c.abs() > 0.1)
-        .map(|(c, i)| format!("{:+.2} ln({})", c, params[*i].name))
+        .map(|(c, i)| format!("{:+.2} ln({})", c, names[*i]))
         .collect();
     Some(format!(
         "the data cannot separate the combination {} (singular value ratio {:.1e})",

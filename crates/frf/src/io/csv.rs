@@ -17,8 +17,10 @@
 use std::path::Path;
 
 use fe_model::DofRef;
+use fe_model::case::MaskRule;
 use num_complex::Complex64 as C64;
 
+use super::mask::{Masked, Origin};
 use crate::error::FrfError;
 use crate::set::{Channel, FrfKind, FrfSet};
 
@@ -83,15 +85,44 @@ fn parse_channel(name: &str) -> Option<(Channel, &str)> {
     Some((Channel::new(response, reference), part))
 }
 
-/// Reads a CSV FRF file (see the module docs).
+/// Reads a CSV FRF file (see the module docs). Non-finite values and
+/// repeated lines are refused; see [`read_csv_with`] to leave them out.
 pub fn read_csv(path: &Path) -> Result<FrfSet, FrfError> {
+    read_csv_with(path, &[]).map(|r| r.set)
+}
+
+/// A CSV file read with mask rules.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CsvFrfs {
+    /// The FRFs.
+    pub set: FrfSet,
+    /// Where each channel comes from (its columns), in the set's order.
+    pub origins: Vec<Origin>,
+    /// What the rules left out.
+    pub masked: Vec<Masked>,
+}
+
+/// Reads a CSV FRF file, leaving out what `rules` allow (non-finite values,
+/// repeated lines; see [`MaskRule`]).
+pub fn read_csv_with(path: &Path, rules: &[MaskRule]) -> Result<CsvFrfs, FrfError> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| FrfError::Io { path: path.to_path_buf(), message: format!("cannot read: {e}") })?;
-    parse_csv(path, &text)
+    parse_csv_with(path, &text, rules)
 }
 
 /// Parses CSV text; `path` is used in messages.
 pub fn parse_csv(path: &Path, text: &str) -> Result<FrfSet, FrfError> {
+    parse_csv_with(path, text, &[]).map(|r| r.set)
+}
+
+/// A number of a data field: decimal, or `NaN`/`inf` (refused or masked later).
+fn field_number(s: &str) -> Option<f64> {
+    let t = s.trim();
+    super::non_finite_word(t).or_else(|| if t.bytes().any(|b| b.is_ascii_digit()) { t.parse().ok() } else { None })
+}
+
+/// Parses CSV text with mask rules; `path` is used in messages.
+pub fn parse_csv_with(path: &Path, text: &str, rules: &[MaskRule]) -> Result<CsvFrfs, FrfError> {
     let err = |line: usize, message: String| FrfError::Parse { path: path.to_path_buf(), line, message };
     let mut kind = FrfKind::Receptance;
     let mut header: Option<(usize, Vec<String>, char)> = None;
@@ -135,15 +166,14 @@ pub fn parse_csv(path: &Path, text: &str) -> Result<FrfSet, FrfError> {
                     .iter()
                     .enumerate()
                     .map(|(j, f)| {
-                        let v: f64 = f.trim().parse().map_err(|_| {
+                        field_number(f).ok_or_else(|| {
                             err(line_no, format!("column {} (`{}`): `{}` is not a number", j + 1, cols[j], f.trim()))
-                        })?;
-                        if !v.is_finite() {
-                            return Err(err(line_no, format!("column {} (`{}`): value is {v}", j + 1, cols[j])));
-                        }
-                        Ok(v)
+                        })
                     })
                     .collect::<Result<Vec<f64>, _>>()?;
+                if !values[0].is_finite() {
+                    return Err(err(line_no, format!("column 1 (`{}`): the frequency is {}", cols[0], values[0])));
+                }
                 rows.push((line_no, values));
             }
         }
@@ -157,6 +187,7 @@ pub fn parse_csv(path: &Path, text: &str) -> Result<FrfSet, FrfError> {
     }
     let mut channels = Vec::new();
     let mut pairs = Vec::new();
+    let mut origins = Vec::new();
     for j in (1..cols.len()).step_by(2) {
         let (c1, p1) = parse_channel(&cols[j]).ok_or_else(|| {
             err(hline, format!("column {} `{}` is not a channel name like H(31:uy,31:uy).re", j + 1, cols[j]))
@@ -177,28 +208,25 @@ pub fn parse_csv(path: &Path, text: &str) -> Result<FrfSet, FrfError> {
                 ));
             }
         };
-        if channels.contains(&c1) {
-            return Err(err(hline, format!("channel {c1} appears twice")));
+        if let Some(other) = channels.iter().position(|c| *c == c1) {
+            return Err(err(hline, format!("channel {c1} appears twice (columns {} and {})", 2 * other + 2, j + 1)));
         }
         channels.push(c1);
         pairs.push(pair);
+        origins.push(Origin { line: hline, label: format!("columns {}-{}", j + 1, j + 2) });
     }
     if rows.is_empty() {
         return Err(err(hline, "no data rows".into()));
-    }
-    for w in rows.windows(2) {
-        if !(w[1].1[0] > w[0].1[0]) {
-            return Err(err(
-                w[1].0,
-                format!("frequency {} Hz does not increase (previous line has {} Hz)", w[1].1[0], w[0].1[0]),
-            ));
-        }
     }
     if let Some((line, r)) = rows.iter().find(|(_, r)| !(r[0] > 0.0)) {
         return Err(err(*line, format!("frequency {} Hz must be positive", r[0])));
     }
     let freqs: Vec<f64> = rows.iter().map(|(_, r)| r[0]).collect();
-    let mut set = FrfSet::zeros(freqs, channels, kind)?;
+    let allow_repeats = rules.contains(&MaskRule::DuplicateLines);
+    let at = |k: usize| (rows[k].0, format!("line {}: ", rows[k].0));
+    let (keep, mut masked) = super::mask::duplicate_lines(path, &freqs, &at, allow_repeats)?;
+    let rows: Vec<&(usize, Vec<f64>)> = keep.iter().map(|&k| &rows[k]).collect();
+    let mut set = FrfSet::zeros(rows.iter().map(|(_, r)| r[0]).collect(), channels, kind)?;
     for (k, (_, r)) in rows.iter().enumerate() {
         for (c, pair) in pairs.iter().enumerate() {
             let (a, b) = (r[1 + 2 * c], r[2 + 2 * c]);
@@ -209,7 +237,13 @@ pub fn parse_csv(path: &Path, text: &str) -> Result<FrfSet, FrfError> {
             set.set(c, k, v);
         }
     }
-    Ok(set)
+    let locate = |c: usize, k: usize| {
+        let line = rows[k].0;
+        (line, format!("line {line}, columns {}-{}", 2 * c + 2, 2 * c + 3))
+    };
+    let (set, more) = super::mask::non_finite_lines(path, set, rules.contains(&MaskRule::NonFinite), &locate)?;
+    masked.extend(more);
+    Ok(CsvFrfs { set, origins, masked })
 }
 
 #[cfg(test)]
@@ -243,11 +277,46 @@ mod tests {
         assert!((s.get(0, 0) - C64::new(0.0, 2.0)).norm() < 1e-12);
         let bad = "freq,H(2:uy,2:uy).re,H(2:uy,2:uy).im\n10,1,0\n9,1,0\n";
         let e = parse_csv(p, bad).unwrap_err().to_string();
-        assert!(e.starts_with("m.csv:3:") && e.contains("does not increase"), "{e}");
+        assert!(e.starts_with("m.csv:3: line 3: frequency 2 (9 Hz) is below the one before it"), "{e}");
         let bad = "freq,H(2:uy,2:uy).re,H(2:uy,2:uy).im\n10,1,x\n";
         let e = parse_csv(p, bad).unwrap_err().to_string();
         assert!(e.starts_with("m.csv:2:") && e.contains("`x` is not a number"), "{e}");
         let bad = "freq,H(2:uy,2:uy).re,H(2:uy,2:uy).im\n10,1,NaN\n";
-        assert!(parse_csv(p, bad).unwrap_err().to_string().contains("NaN"));
+        let e = parse_csv(p, bad).unwrap_err().to_string();
+        assert!(e.starts_with("m.csv:2: line 2, columns 2-3: H(2:uy,2:uy) at 10 Hz is NaN"), "{e}");
+        assert!(e.contains("mask = [\"non-finite\"]"), "{e}");
+    }
+
+    #[test]
+    fn masks_leave_out_non_finite_and_repeated_lines_and_say_which() {
+        let p = Path::new("m.csv");
+        let text = "freq,H(2:uy,2:uy).re,H(2:uy,2:uy).im,H(3:uy,2:uy).re,H(3:uy,2:uy).im\n\
+                    10,1,0,1,0\n20,2,0,inf,0\n20,2,0,2,0\n30,3,0,nan,0\n40,4,0,4,0\n";
+        // the frequency axis is checked before the values
+        for rules in [&[][..], &[MaskRule::NonFinite]] {
+            let e = parse_csv_with(p, text, rules).unwrap_err().to_string();
+            assert!(
+                e.starts_with("m.csv:4: line 4: frequency 3 repeats 20 Hz") && e.contains("duplicate-lines"),
+                "{e}"
+            );
+        }
+        let e = parse_csv_with(p, text, &[MaskRule::DuplicateLines]).unwrap_err().to_string();
+        assert!(e.starts_with("m.csv:3: line 3, columns 4-5: H(3:uy,2:uy) at 20 Hz is inf+0i"), "{e}");
+        assert!(e.contains("(2 lines have such values)") && e.contains("non-finite"), "{e}");
+        let r = parse_csv_with(p, text, &[MaskRule::DuplicateLines, MaskRule::NonFinite]).unwrap();
+        assert_eq!(r.set.frequencies_hz(), &[10.0, 40.0]);
+        assert_eq!(r.set.get(1, 1), C64::new(4.0, 0.0));
+        let what: Vec<(MaskRule, Option<f64>)> = r.masked.iter().map(|m| (m.rule, m.freq_hz)).collect();
+        assert_eq!(
+            what,
+            vec![
+                (MaskRule::DuplicateLines, Some(20.0)),
+                (MaskRule::NonFinite, Some(20.0)),
+                (MaskRule::NonFinite, Some(30.0))
+            ]
+        );
+        assert_eq!(r.masked[0].detail, "line 4: frequency 3 repeats 20 Hz");
+        assert_eq!(r.masked[2].detail, "line 5, columns 4-5: H(3:uy,2:uy) at 30 Hz is NaN");
+        assert_eq!(r.origins[1], Origin { line: 1, label: "columns 4-5".into() });
     }
 }

@@ -11,12 +11,16 @@
 //! replace a file the caller marks as an input.
 
 pub mod csv;
+pub mod mask;
 pub mod uff;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use fe_model::case::ChannelMap;
+use fe_model::DofMap;
+use fe_model::case::{ChannelMap, MaskRule};
+
+pub use mask::{Masked, Origin, check_channels};
 
 use crate::error::FrfError;
 use crate::set::FrfSet;
@@ -78,20 +82,54 @@ pub struct Measured {
     pub format: MeasuredFormat,
     /// Notes for the user (skipped datasets, dropped lines, conversions).
     pub notes: Vec<String>,
+    /// Where each channel of `set` comes from in the file, in the same order.
+    pub origins: Vec<Origin>,
+    /// What the case's mask rules left out (empty without rules).
+    pub masked: Vec<Masked>,
+}
+
+impl Measured {
+    /// Checks the channels against a model's DOFs (see [`check_channels`]):
+    /// a channel at a node the model lacks or at a supported DOF is refused,
+    /// naming the file, its record or columns and the DOF, or left out when
+    /// `rules` hold [`MaskRule::UnmodelledChannels`].
+    pub fn check_channels(self, path: &Path, dofs: &DofMap, rules: &[MaskRule]) -> Result<Measured, FrfError> {
+        let (set, origins, masked) = check_channels(path, self.set, &self.origins, dofs, rules)?;
+        let mut all = self.masked;
+        all.extend(masked);
+        Ok(Measured { set, format: self.format, notes: self.notes, origins, masked: all })
+    }
 }
 
 /// Reads a measured FRF file (see [`detect_format`]) and maps its channels
 /// to model DOFs. CSV files name model DOFs directly (the map is not used);
 /// universal files name test nodes and directions, mapped through `map`
-/// (see [`uff::map_test_dof`] and `docs/measured-data.md`).
+/// (see [`uff::map_test_dof`] and `docs/measured-data.md`). Defects are
+/// refused; see [`load_measured_with`] to leave some out.
 pub fn load_measured(path: &Path, map: &[ChannelMap]) -> Result<Measured, FrfError> {
+    load_measured_with(path, map, &[])
+}
+
+/// Reads a measured FRF file like [`load_measured`], leaving out what the
+/// mask rules allow (non-finite values, repeated lines) instead of refusing
+/// the file; [`Measured::masked`] lists what was left out. Channel rules
+/// need the model: see [`Measured::check_channels`].
+pub fn load_measured_with(path: &Path, map: &[ChannelMap], rules: &[MaskRule]) -> Result<Measured, FrfError> {
     match detect_format(path)? {
         MeasuredFormat::Csv => {
-            Ok(Measured { set: csv::read_csv(path)?, format: MeasuredFormat::Csv, notes: Vec::new() })
+            let c = csv::read_csv_with(path, rules)?;
+            Ok(Measured {
+                set: c.set,
+                format: MeasuredFormat::Csv,
+                notes: Vec::new(),
+                origins: c.origins,
+                masked: c.masked,
+            })
         }
         MeasuredFormat::Uff => {
-            let u = uff::read_uff_frfs(path, map)?;
-            Ok(Measured { set: u.set, format: MeasuredFormat::Uff, notes: u.notes })
+            let u = uff::read_uff_frfs_with(path, map, rules)?;
+            let origins = u.origins();
+            Ok(Measured { set: u.set, format: MeasuredFormat::Uff, notes: u.notes, origins, masked: u.masked })
         }
     }
 }
@@ -101,17 +139,34 @@ pub fn read_measured(path: &Path, map: &[ChannelMap]) -> Result<FrfSet, FrfError
     load_measured(path, map).map(|m| m.set)
 }
 
+/// `NaN`, `inf` or `infinity` (any case, with an optional sign) as a
+/// number. The readers keep such values so that the checks of the FRF set
+/// refuse or mask them with their place in the file ([`mask`]).
+pub(crate) fn non_finite_word(token: &str) -> Option<f64> {
+    let bare = token.trim_start_matches(['+', '-']).to_ascii_lowercase();
+    if matches!(bare.as_str(), "nan" | "inf" | "infinity") { token.to_ascii_lowercase().parse().ok() } else { None }
+}
+
+/// Fails if one of `outputs` is one of `inputs` (the same file, however
+/// named), so that a command can refuse before it does any work.
+pub fn refuse_inputs(outputs: &[PathBuf], inputs: &[PathBuf]) -> Result<(), FrfError> {
+    for path in outputs {
+        let Ok(target) = path.canonicalize() else { continue };
+        if inputs.iter().any(|input| input.canonicalize().is_ok_and(|i| i == target)) {
+            return Err(FrfError::Io {
+                path: path.to_path_buf(),
+                message: "refusing to overwrite an input file; choose another output path".into(),
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Writes `bytes` to `path` atomically (temporary file in the same folder,
 /// flushed and synced, then renamed). Fails if `path` is one of `inputs`.
 pub fn atomic_write(path: &Path, bytes: &[u8], inputs: &[PathBuf]) -> Result<(), FrfError> {
     let io = |message: String| FrfError::Io { path: path.to_path_buf(), message };
-    if let Ok(target) = path.canonicalize() {
-        for input in inputs {
-            if input.canonicalize().is_ok_and(|i| i == target) {
-                return Err(io("refusing to overwrite an input file; choose another output path".into()));
-            }
-        }
-    }
+    refuse_inputs(&[path.to_path_buf()], inputs)?;
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),

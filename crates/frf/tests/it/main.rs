@@ -4,5 +4,6 @@ mod correlation;
 mod lscf;
 mod modal;
 mod physics;
+mod properties;
 mod solver;
 mod uff;

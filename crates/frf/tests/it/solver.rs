@@ -3,7 +3,7 @@
 use damping::DampedSystem;
 use faer::Mat;
 use fe_model::{Model, Pattern, samples};
-use frf::{C64, FactorKind, FrfError, ZSolver};
+use frf::{C64, Channel, FactorKind, FrfError, ZSolver, synthesize};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -217,4 +217,26 @@ fn a_singular_matrix_is_reported_with_its_frequency() {
         solver.solve_in_place(&mut ws, x.as_mut(), 42.0)
     });
     assert_eq!(result, Err(FrfError::Singular { freq_hz: 42.0 }));
+}
+
+/// faer's LU factorises a matrix singular to working precision and returns
+/// huge finite numbers; an undamped model at each of its computed natural
+/// frequencies must be refused with that frequency, and 1 % beside it must not.
+#[test]
+fn an_undamped_model_on_a_resonance_is_singular_at_that_frequency() {
+    for mut model in [samples::two_dof_oscillator(), samples::cantilever(30), samples::frame_with_joint()] {
+        for g in 0..model.groups().len() {
+            let group = model.group_mut(g);
+            (group.alpha, group.beta) = (0.0, 0.0);
+        }
+        let sys = DampedSystem::new(model).unwrap();
+        let modes = damping::normal_modes(sys.assembly()).unwrap();
+        let dof = sys.assembly().dofs.dof_of(sys.n() - 1);
+        let channels = [Channel::new(dof, dof)];
+        for &f in modes.frequencies_hz.iter().take(3) {
+            assert_eq!(synthesize(&sys, &channels, &[f]).unwrap_err(), FrfError::Singular { freq_hz: f });
+            let beside = synthesize(&sys, &channels, &[1.01 * f]).unwrap();
+            assert!(beside.get(0, 0).norm().is_finite());
+        }
+    }
 }

@@ -12,10 +12,11 @@ use damping::DampedSystem;
 use fe_model::CaseFile;
 use frf::correlation::{BandSpec, Correlation, correlate};
 use frf::{FrfSet, synthesize};
+use rfm_update::study::{describe_masked, read_measured_for};
 use rfm_update::{Study, UpdateError};
 use serde::Serialize;
 
-use super::{Result, load_case};
+use super::{Result, load_case, print_masked};
 use crate::report::html::{self, Block, Report, Section, Tone};
 use crate::report::json::CorrelationJson;
 use crate::report::{self, ModelFrfs, Output, plot, sig, signed};
@@ -195,8 +196,13 @@ pub(crate) fn parse_bands(s: &str) -> std::result::Result<BandSpec, String> {
     }
 }
 
-/// The measured FRFs and a description of where they came from.
-fn measured_data(case: CaseFile, files: &[PathBuf]) -> Result<(CaseFile, FrfSet, String)> {
+/// The measured FRFs, a description of where they came from, and what the
+/// case's mask rules left out of them.
+fn measured_data(
+    case: CaseFile,
+    system: &DampedSystem,
+    files: &[PathBuf],
+) -> Result<(CaseFile, FrfSet, String, Vec<String>)> {
     if files.is_empty() {
         let study = Study::from_case(case).map_err(|e| match e {
             UpdateError::Case(c) => c.render(),
@@ -212,15 +218,18 @@ fn measured_data(case: CaseFile, files: &[PathBuf]) -> Result<(CaseFile, FrfSet,
             (None, Some(_)) => "synthesised from the case's truth model (noise-free)".into(),
             (None, None) => "the case's data".into(),
         };
-        return Ok((study.case, study.measured, source));
+        let masked = describe_masked(&study.masked);
+        return Ok((study.case, study.measured, source, masked));
     }
-    let map = case.measurement.as_ref().map(|m| m.map.clone()).unwrap_or_default();
     let mut sets = Vec::new();
+    let mut masked = Vec::new();
     for f in files {
-        sets.push((f.clone(), frf::io::read_measured(f, &map)?));
+        let read = read_measured_for(system, f, case.measurement.as_ref())?;
+        masked.extend(describe_masked(&read.masked).into_iter().map(|m| format!("{}: {m}", f.display())));
+        sets.push((f.clone(), read.set));
     }
     let names = files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(", ");
-    Ok((case, merge(sets)?, format!("measured file(s) {names}")))
+    Ok((case, merge(sets)?, format!("measured file(s) {names}"), masked))
 }
 
 /// Joins the channels of several measured files on the same lines, in the
@@ -275,10 +284,19 @@ pub(crate) fn compare(
     json: bool,
     bands: &str,
 ) -> Result<()> {
+    if out.is_some() {
+        crate::files_to_write();
+    }
     let spec = parse_bands(bands)?;
     let case = load_case(case_path)?;
-    let (case, measured, source) = measured_data(case, measured_files)?;
+    let mut inputs = case.inputs();
+    inputs.extend(measured_files.iter().cloned());
+    if let Some(dir) = out {
+        frf::io::refuse_inputs(&[dir.join("compare.json"), dir.join("report.html")], &inputs)?;
+    }
     let system = DampedSystem::new(case.model.clone())?;
+    let (case, measured, source, masked) = measured_data(case, &system, measured_files)?;
+    print_masked(&masked, json)?;
     let frfs = synthesize(&system, measured.channels(), measured.frequencies_hz())?;
     let correlation = correlate(&measured, &frfs, &spec)?;
     let modes = compare_modes(&system, &measured);
@@ -292,9 +310,9 @@ pub(crate) fn compare(
         modes,
     };
     if json {
-        println!("{}", serde_json::to_string_pretty(&doc)?);
+        outln!("{}", serde_json::to_string_pretty(&doc)?);
     } else {
-        print_tables(&case, &measured, &source, &correlation);
+        print_tables(&case, &measured, &source, &correlation)?;
         match &doc.modes {
             Ok(m) => {
                 let (header, rows) = mode_table_rows(m);
@@ -302,14 +320,13 @@ pub(crate) fn compare(
                 for r in rows {
                     t.row(r);
                 }
-                println!("\nmodes (measured by LSCF, paired with the model's by MAC)\n{}", t.render());
+                outln!("\nmodes (measured by LSCF, paired with the model's by MAC)\n{}", t.render());
             }
-            Err(e) => println!("\nmodes not compared: {e}"),
+            Err(e) => outln!("\nmodes not compared: {e}"),
         }
     }
     if let Some(dir) = out {
-        let mut inputs = vec![case_path.to_path_buf()];
-        inputs.extend(measured_files.iter().cloned());
+        let _writing = crate::writing();
         let mut output = Output::new(dir, inputs);
         let path = output.write("compare.json", serde_json::to_string_pretty(&doc)?.as_bytes())?;
         let model = ModelFrfs { label: "model".into(), colour: plot::UPDATED, frfs, correlation };
@@ -318,7 +335,7 @@ pub(crate) fn compare(
         report.sections = report_sections(&case, &measured, &source, &model, &doc.modes, &mut output)?;
         let html = output.write("report.html", report.render().as_bytes())?;
         if !json {
-            println!("\nwrote {}, {} and {} figures", path.display(), html.display(), output.written().len() - 2);
+            outln!("\nwrote {}, {} and {} figures", path.display(), html.display(), output.written().len() - 2);
         }
     }
     Ok(())
@@ -394,11 +411,11 @@ fn summary(case: &CaseFile, measured: &FrfSet, source: &str, c: &Correlation) ->
     s
 }
 
-fn print_tables(case: &CaseFile, measured: &FrfSet, source: &str, c: &Correlation) {
+fn print_tables(case: &CaseFile, measured: &FrfSet, source: &str, c: &Correlation) -> Result<()> {
     let f = measured.frequencies_hz();
     let t = &c.total;
-    println!("{}", case.model.title);
-    println!(
+    outln!("{}", case.model.title);
+    outln!(
         "model against {source}: {} channels x {} lines, {} to {} Hz, {}",
         measured.channels().len(),
         f.len(),
@@ -406,7 +423,7 @@ fn print_tables(case: &CaseFile, measured: &FrfSet, source: &str, c: &Correlatio
         report::short(f.last().copied().unwrap_or(0.0)),
         measured.kind()
     );
-    println!(
+    outln!(
         "overall: RMS {} dB (mean {} dB), RMS phase {} deg, FRAC mean {:.4} / lowest {:.4}, complex-log misfit {}",
         sig(t.rms_db, 3),
         signed(t.mean_db, 3),
@@ -416,7 +433,7 @@ fn print_tables(case: &CaseFile, measured: &FrfSet, source: &str, c: &Correlatio
         sig(t.log_misfit, 3)
     );
     if t.lines_excluded > 0 {
-        println!("({} values left out: zero or not finite)", t.lines_excluded);
+        outln!("({} values left out: zero or not finite)", t.lines_excluded);
     }
     let worst = c.worst_channels(3);
     let mut table = Table::new(&["channel", "RMS dB", "mean dB", "max |dB| at Hz", "RMS phase", "FRAC", "share", ""]);
@@ -432,7 +449,7 @@ fn print_tables(case: &CaseFile, measured: &FrfSet, source: &str, c: &Correlatio
             if worst.contains(&i) { "<- worst".into() } else { String::new() },
         ]);
     }
-    println!("\nper channel\n{}", table.render());
+    outln!("\nper channel\n{}", table.render());
     let worst = c.worst_bands(3);
     let mut table = Table::new(&["band", "lines", "RMS dB", "mean dB", "RMS phase", "share", ""]);
     for (i, b) in c.bands.iter().enumerate() {
@@ -446,7 +463,8 @@ fn print_tables(case: &CaseFile, measured: &FrfSet, source: &str, c: &Correlatio
             if worst.contains(&i) { "<- worst".into() } else { String::new() },
         ]);
     }
-    println!("\nper band\n{}", table.render());
+    outln!("\nper band\n{}", table.render());
+    Ok(())
 }
 
 #[cfg(test)]

@@ -3,9 +3,10 @@
 use std::path::Path;
 
 use rfm_update::diagnose::{DiagnoseOptions, Diagnosis, diagnose as run_diagnosis};
+use rfm_update::study::{describe_masked, read_measured_for};
 use rfm_update::{Study, UpdateError};
 
-use super::Result;
+use super::{Result, print_masked};
 use crate::table::{Table, num, percent};
 
 /// Options of the diagnose command.
@@ -19,20 +20,32 @@ pub(crate) struct DiagnoseArgs<'a> {
 }
 
 pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<()> {
+    if args.apply.is_some() {
+        crate::files_to_write();
+    }
     let study = Study::load(args.case).map_err(|e| match e {
         UpdateError::Case(c) => c.render(),
         other => other.to_string(),
     })?;
+    let mut inputs = study.case.inputs();
+    inputs.extend(args.measured.map(Path::to_path_buf));
+    if let Some(out) = args.out {
+        frf::io::refuse_inputs(&[out.to_path_buf()], &inputs)?;
+    }
     let measured = match args.measured {
         Some(path) => {
-            let map = study.case.measurement.as_ref().map(|m| m.map.clone()).unwrap_or_default();
-            frf::io::read_measured(path, &map)?.to_receptance()
+            let read = read_measured_for(&study.system, path, study.case.measurement.as_ref())?;
+            print_masked(&describe_masked(&read.masked), args.json)?;
+            read.set.to_receptance()
         }
-        None => study.measured.clone(),
+        None => {
+            print_masked(&describe_masked(&study.masked), args.json)?;
+            study.measured.clone()
+        }
     };
     if !args.json {
-        println!("{}", study.case.model.title);
-        println!(
+        outln!("{}", study.case.model.title);
+        outln!(
             "fitting every candidate effect to {} channels x {} lines ({} to {} Hz) ...",
             measured.channels().len(),
             measured.n_freq(),
@@ -42,25 +55,26 @@ pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<()> {
     }
     let d = run_diagnosis(&study.case.model, &measured, &DiagnoseOptions::default())?;
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&d)?);
+        outln!("{}", serde_json::to_string_pretty(&d)?);
     } else {
-        print_diagnosis(&d, args.top);
+        print_diagnosis(&d, args.top)?;
     }
     if let Some(rank) = args.apply {
         let out = args.out.ok_or("--apply needs --out FILE for the new case file")?;
         let text =
             d.case_text(&study.case, rank.checked_sub(1).ok_or("ranks start at 1")?).map_err(|e| e.to_string())?;
         let text = study.case.relocate(&text, out);
-        frf::io::atomic_write(out, text.as_bytes(), &[args.case.to_path_buf()])?;
+        let _writing = crate::writing();
+        frf::io::atomic_write(out, text.as_bytes(), &inputs)?;
         if !args.json {
-            println!("\nwrote {} with effect {rank} added", out.display());
+            outln!("\nwrote {} with effect {rank} added", out.display());
         }
     }
     Ok(())
 }
 
-fn print_diagnosis(d: &Diagnosis, top: usize) {
-    println!(
+fn print_diagnosis(d: &Diagnosis, top: usize) -> Result<()> {
+    outln!(
         "noise level estimated from the data: {:.2} %; nominal model misfit: {:.2} % (RMS relative)\n",
         100.0 * d.noise,
         100.0 * d.nominal_misfit
@@ -88,30 +102,31 @@ fn print_diagnosis(d: &Diagnosis, top: usize) {
             note,
         ]);
     }
-    println!("{}", t.render());
-    println!("\n(dBIC: change of the Bayesian information criterion; below -10 the evidence is very strong)");
+    outln!("{}", t.render());
+    outln!("\n(dBIC: change of the Bayesian information criterion; below -10 the evidence is very strong)");
     match d.leader() {
         None if d.consistent() => {
-            println!("\nNo candidate explains the misfit beyond the noise: the model is consistent with the data.")
+            outln!("\nNo candidate explains the misfit beyond the noise: the model is consistent with the data.")
         }
-        None => println!(
+        None => outln!(
             "\nSome effects are significant, but none at plausible values: the missing effect may not be among the candidates."
         ),
         Some(leader) => {
             let rank = d.ranking.iter().position(|r| std::ptr::eq(r, leader)).expect("from the ranking");
-            println!("\nMost likely missing: {}.", leader.description);
+            outln!("\nMost likely missing: {}.", leader.description);
             let (text, set) = d.proposal(rank);
-            println!("Add it to the case file with these lines:\n");
+            outln!("Add it to the case file with these lines:\n");
             for l in text.lines() {
-                println!("    {l}");
+                outln!("    {l}");
             }
             if !set.is_empty() {
-                println!("    [set]    # merge into the case's [set] table");
+                outln!("    [set]    # merge into the case's [set] table");
                 for (k, v) in &set {
-                    println!("    \"{k}\" = {v:e}");
+                    outln!("    \"{k}\" = {v:e}");
                 }
             }
-            println!("\nor let rfm write the new case: rfm diagnose CASE --apply {} --out NEW.toml", rank + 1);
+            outln!("\nor let rfm write the new case: rfm diagnose CASE --apply {} --out NEW.toml", rank + 1);
         }
     }
+    Ok(())
 }

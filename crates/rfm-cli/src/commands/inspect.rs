@@ -15,9 +15,9 @@ pub(crate) fn inspect(file: &Path, json: bool) -> Result<()> {
         MeasuredFormat::Csv => csv_report(file)?,
     };
     if json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        outln!("{}", serde_json::to_string_pretty(&report)?);
     } else {
-        print_report(&report);
+        print_report(&report)?;
     }
     Ok(())
 }
@@ -104,12 +104,12 @@ fn csv_report(file: &Path) -> Result<Value> {
     }))
 }
 
-fn print_report(report: &Value) {
+fn print_report(report: &Value) -> Result<()> {
     let records = report["records"].as_array().map(Vec::as_slice).unwrap_or_default();
     let skipped = report["skipped"].as_array().map(Vec::as_slice).unwrap_or_default();
     let csv = report["format"] == "csv";
     let count = |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
-    println!(
+    outln!(
         "{}: {}, {}{}",
         report["file"].as_str().unwrap_or_default(),
         if csv { "CSV (channels name model DOFs)" } else { "universal file" },
@@ -151,19 +151,20 @@ fn print_report(report: &Value) {
                 r["encoding"].as_str().unwrap_or_default().to_string(),
             ]);
         }
-        println!("{}", t.render());
+        outln!("{}", t.render());
     }
     for n in report["notes"].as_array().map(Vec::as_slice).unwrap_or_default() {
-        println!("note: {}", n.as_str().unwrap_or_default());
+        outln!("note: {}", n.as_str().unwrap_or_default());
     }
     for d in skipped {
-        println!(
+        outln!(
             "skipped dataset {} ({}) at line {}",
             d["dataset"],
             d["description"].as_str().unwrap_or_default(),
             d["line"]
         );
     }
+    Ok(())
 }
 
 fn dof_text(v: &Value) -> String {

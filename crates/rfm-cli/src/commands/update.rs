@@ -6,7 +6,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use rfm_update::rfm::{IterationRecord, RfmOptions, Status};
 use rfm_update::{Method, Study, UpdateError, UpdateOutcome};
 
-use super::Result;
+use super::{Result, print_masked};
 use crate::table::{Table, num};
 
 fn db(x: f64) -> f64 {
@@ -32,7 +32,14 @@ pub(crate) struct Overrides {
 }
 
 pub(crate) fn update(case: &Path, out: Option<&Path>, json: bool, over: &Overrides) -> Result<()> {
+    if out.is_some() {
+        crate::files_to_write();
+    }
     let mut study = load_study(case)?;
+    if let Some(dir) = out {
+        let outputs = ["results.json", "updated.toml", "report.html"].map(|name| dir.join(name));
+        frf::io::refuse_inputs(&outputs, &study.case.inputs())?;
+    }
     if let Some(n) = over.lines
         && let Some(u) = study.case.update.as_mut()
     {
@@ -49,20 +56,21 @@ pub(crate) fn update(case: &Path, out: Option<&Path>, json: bool, over: &Overrid
         Method::Rfm => spec.max_iterations.map_or(RfmOptions::default().max_iterations, |n| n as usize),
         Method::OutputError => study.output_error_options()?.max_iterations,
     });
+    print_masked(&rfm_update::study::describe_masked(&study.masked), json)?;
     if !json {
-        println!("{}", study.case.model.title);
+        outln!("{}", study.case.model.title);
         let what = match method {
             Method::Rfm => "the response function method",
             Method::OutputError => "output-error Levenberg-Marquardt",
         };
-        println!(
+        outln!(
             "updating {} parameters with {what} at {} lines ({} to {} Hz)",
             study.parameters.len(),
             lines.len(),
             num(lines[0]),
             num(lines[lines.len() - 1])
         );
-        println!("{:>5}  {:>11}  {:>9}  {:>11}", "iter", "misfit", "(dB)", "max step");
+        outln!("{:>5}  {:>11}  {:>9}  {:>11}", "iter", "misfit", "(dB)", "max step");
     }
     let bar = if json { ProgressBar::hidden() } else { ProgressBar::new(max_iterations as u64) };
     bar.set_style(
@@ -78,7 +86,12 @@ pub(crate) fn update(case: &Path, out: Option<&Path>, json: bool, over: &Overrid
                 r.max_correction
             );
             // a hidden bar (output not a terminal) swallows println
-            if bar.is_hidden() { println!("{line}") } else { bar.println(line) }
+            if bar.is_hidden() {
+                // an error here would be the same as at the next print, which reports it
+                let _ = crate::print_line(format_args!("{line}"));
+            } else {
+                bar.println(line)
+            }
         }
         bar.set_position(r.iteration as u64);
         bar.set_message(format!("misfit {:.3e}", r.residual));
@@ -99,21 +112,22 @@ pub(crate) fn update(case: &Path, out: Option<&Path>, json: bool, over: &Overrid
     };
     bar.finish_and_clear();
     if json {
-        println!("{}", serde_json::to_string_pretty(&outcome)?);
+        outln!("{}", serde_json::to_string_pretty(&outcome)?);
     } else {
-        print_outcome(&outcome);
+        print_outcome(&outcome)?;
     }
     if let Some(dir) = out {
-        let inputs = [case.to_path_buf()];
+        let _writing = crate::writing();
+        let inputs = study.case.inputs();
         let path = dir.join("results.json");
         frf::io::atomic_write(&path, serde_json::to_string_pretty(&outcome)?.as_bytes(), &inputs)?;
         let updated = write_updated_model(&study, &outcome, dir, &inputs)?;
         if !json {
-            println!("\nwrote {} and {}", path.display(), updated.display());
+            outln!("\nwrote {} and {}", path.display(), updated.display());
         }
-        let report = crate::report::update_report::write(&study, &outcome, dir, case)?;
+        let report = crate::report::update_report::write(&study, &outcome, dir, case, inputs)?;
         if !json {
-            println!("wrote {} (figures beside it)", report.display());
+            outln!("wrote {} (figures beside it)", report.display());
         }
     }
     Ok(())
@@ -146,7 +160,7 @@ fn write_updated_model(
     Ok(path)
 }
 
-fn print_outcome(outcome: &UpdateOutcome) {
+fn print_outcome(outcome: &UpdateOutcome) -> Result<()> {
     let status = match &outcome.status {
         Status::Converged => "converged".to_string(),
         Status::Stalled => "stalled: no step lowers the misfit further (best iterate kept)".to_string(),
@@ -158,7 +172,7 @@ fn print_outcome(outcome: &UpdateOutcome) {
         Status::Failed(e) => format!("failed: {e} (best iterate kept)"),
     };
     let first = outcome.history.first().map_or(f64::NAN, |r| r.residual);
-    println!(
+    outln!(
         "{status} after {} iterations; misfit {:.3e} -> {:.3e} ({:+.1} dB)\n",
         outcome.history.len().saturating_sub(1),
         first,
@@ -210,7 +224,7 @@ fn print_outcome(outcome: &UpdateOutcome) {
         row.push(if u.is_some_and(|u| !u.well_determined) { "weakly determined".into() } else { String::new() });
         t.row(row);
     }
-    println!("{}", t.render());
+    outln!("{}", t.render());
     if let Some(u) = unc {
         let notes: Vec<String> = u
             .parameters
@@ -219,12 +233,12 @@ fn print_outcome(outcome: &UpdateOutcome) {
             .chain(u.warnings.iter().cloned())
             .collect();
         if !notes.is_empty() {
-            println!("\nwhat the data determine only weakly:");
+            outln!("\nwhat the data determine only weakly:");
             for n in notes {
-                println!("  - {n}");
+                outln!("  - {n}");
             }
         }
-        println!("\nresidual RMS per value {:.3e} (the noise level the fit leaves)", u.residual_rms);
+        outln!("\nresidual RMS per value {:.3e} (the noise level the fit leaves)", u.residual_rms);
         if let Some(noise) = outcome.noise_estimate {
             let ratio = u.residual_rms / noise;
             let reading = if ratio < 1.5 {
@@ -236,11 +250,17 @@ fn print_outcome(outcome: &UpdateOutcome) {
                     "the fit leaves {ratio:.1} times the noise: something the parameters cannot represent remains (try rfm diagnose on the updated case)"
                 )
             };
-            println!("noise level estimated from the data {noise:.3e}: {reading}");
+            outln!("noise level estimated from the data {noise:.3e}: {reading}");
+        }
+    }
+    if !outcome.warnings.is_empty() {
+        outln!("\nwhat the data determine only weakly:");
+        for w in &outcome.warnings {
+            outln!("  - {w}");
         }
     }
     for g in &outcome.gains {
-        println!("gain of reference {}: {:.4} at {:+.2} deg", g.reference, g.magnitude, g.phase_deg);
+        outln!("gain of reference {}: {:.4} at {:+.2} deg", g.reference, g.magnitude, g.phase_deg);
     }
     let nf = &outcome.natural_frequencies_hz;
     let mut header = vec!["mode", "initial (Hz)", "updated (Hz)"];
@@ -263,5 +283,6 @@ fn print_outcome(outcome: &UpdateOutcome) {
         }
         t.row(row);
     }
-    println!("\n{} natural frequencies in the measured band\n{}", nf.kind, t.render());
+    outln!("\n{} natural frequencies in the measured band\n{}", nf.kind, t.render());
+    Ok(())
 }

@@ -24,9 +24,15 @@ const MAX_ITERATIONS_EVALUATED: usize = 30;
 const OVERLAYS: usize = 4;
 
 /// Writes the report files of an updating run into `dir` and returns the
-/// path of `report.html`. `case_path` is protected from being overwritten.
-pub(crate) fn write(study: &Study, outcome: &UpdateOutcome, dir: &Path, case_path: &Path) -> Result<PathBuf> {
-    let mut out = Output::new(dir, vec![case_path.to_path_buf()]);
+/// path of `report.html`. `inputs` are protected from being overwritten.
+pub(crate) fn write(
+    study: &Study,
+    outcome: &UpdateOutcome,
+    dir: &Path,
+    case_path: &Path,
+    inputs: Vec<PathBuf>,
+) -> Result<PathBuf> {
+    let mut out = Output::new(dir, inputs);
     let measured = &study.measured;
     let channels = measured.channels();
     let freqs = measured.frequencies_hz();

@@ -1,6 +1,8 @@
 //! End-to-end tests of the `rfm` binary.
 
+mod catalogue;
 mod commands;
 mod diagnose;
 mod inspect;
+mod nothing_lost;
 mod report;

@@ -2,9 +2,10 @@
 
 use std::path::Path;
 
-use fe_model::case::ChannelMap;
+use fe_model::case::{ChannelMap, MaskRule};
 use num_complex::Complex64 as C64;
 
+use super::super::mask::{self, Masked, Origin};
 use super::units::abscissa_to_hz;
 use super::{
     FUNCTION_COHERENCE, FUNCTION_FRF, Header58, Record58, TestDof, UffFile, frf_units, function_type_name, map_test_dof,
@@ -23,6 +24,18 @@ pub struct UffFrfs {
     /// Things the user may want to know: skipped datasets, dropped 0 Hz
     /// lines, converted kinds or units, assumptions.
     pub notes: Vec<String>,
+    /// What the mask rules left out (see [`read_uff_frfs_with`]).
+    pub masked: Vec<Masked>,
+}
+
+impl UffFrfs {
+    /// Where each channel comes from (`record 3 (line 90)`), for messages.
+    pub fn origins(&self) -> Vec<Origin> {
+        self.sources
+            .iter()
+            .map(|s| Origin { line: s.line, label: format!("record {} (line {})", s.record, s.line) })
+            .collect()
+    }
 }
 
 /// The record behind one channel of a [`UffFrfs`].
@@ -45,6 +58,13 @@ pub struct ChannelSource {
 /// another function type is refused as soon as its header is read, before
 /// its data.
 pub fn read_uff_frfs(path: &Path, map: &[ChannelMap]) -> Result<UffFrfs, FrfError> {
+    read_uff_frfs_with(path, map, &[])
+}
+
+/// Reads the FRFs of a universal file like [`read_uff_frfs`], leaving out
+/// what `rules` allow (non-finite values, repeated lines) instead of
+/// refusing the file; [`UffFrfs::masked`] lists what was left out.
+pub fn read_uff_frfs_with(path: &Path, map: &[ChannelMap], rules: &[MaskRule]) -> Result<UffFrfs, FrfError> {
     let bytes = super::read_bytes(path)?;
     let file = super::read::parse_with(path, &bytes, &mut |index, line, h| {
         check_function_type(h).map_err(|m| FrfError::Parse {
@@ -53,7 +73,7 @@ pub fn read_uff_frfs(path: &Path, map: &[ChannelMap]) -> Result<UffFrfs, FrfErro
             message: format!("record {index} (line {line}): {m}"),
         })
     })?;
-    frfs_from_uff(path, &file, map)
+    frfs_from_uff_with(path, &file, map, rules)
 }
 
 fn check_function_type(h: &Header58) -> Result<(), String> {
@@ -91,6 +111,18 @@ struct Frf {
 ///   a channel has none;
 /// - other datasets are skipped with a note; other function types are refused.
 pub fn frfs_from_uff(path: &Path, file: &UffFile, map: &[ChannelMap]) -> Result<UffFrfs, FrfError> {
+    frfs_from_uff_with(path, file, map, &[])
+}
+
+/// As [`frfs_from_uff`], leaving out what `rules` allow: lines with a
+/// non-finite value in any record, lines that repeat the previous line's
+/// frequency within a record.
+pub fn frfs_from_uff_with(
+    path: &Path,
+    file: &UffFile,
+    map: &[ChannelMap],
+    rules: &[MaskRule],
+) -> Result<UffFrfs, FrfError> {
     let err = |line: usize, message: String| FrfError::Parse { path: path.to_path_buf(), line, message };
     let mut notes: Vec<String> = file.notes.clone();
     notes.extend(
@@ -118,6 +150,7 @@ pub fn frfs_from_uff(path: &Path, file: &UffFile, map: &[ChannelMap]) -> Result<
     }
 
     let mut frfs: Vec<Frf> = Vec::new();
+    let mut masked: Vec<Masked> = Vec::new();
     let mut dropped_zero = false;
     let mut unstated_hz = Vec::new();
     for r in file.records.iter().filter(|r| r.function.header.function_type == FUNCTION_FRF) {
@@ -132,6 +165,9 @@ pub fn frfs_from_uff(path: &Path, file: &UffFile, map: &[ChannelMap]) -> Result<
             map_test_dof(h.response, map).map_err(|m| at(format!("response {}: {m}", h.response)))?;
         let (reference, s_ref) =
             map_test_dof(h.reference, map).map_err(|m| at(format!("reference {}: {m}", h.reference)))?;
+        if !(units.scale.is_finite() && units.scale > 0.0) {
+            return Err(at(format!("the units {} give a scale of {} to SI", units.basis, units.scale)));
+        }
         let factor = s_resp * s_ref * units.scale;
         if units.assumed_si {
             notes.push(format!("{}: units not stated ({}); SI assumed", r.label(), units.basis));
@@ -140,6 +176,14 @@ pub fn frfs_from_uff(path: &Path, file: &UffFile, map: &[ChannelMap]) -> Result<
         }
         let (freqs, values, dropped) = positive_lines(r, to_hz, |v| v * factor);
         dropped_zero |= dropped;
+        let place = |_: usize| (r.line, format!("{}: ", r.label()));
+        let (keep, repeats) = mask::duplicate_lines(path, &freqs, &place, rules.contains(&MaskRule::DuplicateLines))?;
+        let (freqs, values) = if repeats.is_empty() {
+            (freqs, values)
+        } else {
+            masked.extend(repeats);
+            (keep.iter().map(|&k| freqs[k]).collect(), keep.iter().map(|&k| values[k]).collect())
+        };
         let channel = Channel::new(response, reference);
         let source =
             ChannelSource { record: r.index, line: r.line, response: h.response, reference: h.reference, factor };
@@ -208,8 +252,11 @@ pub fn frfs_from_uff(path: &Path, file: &UffFile, map: &[ChannelMap]) -> Result<
     }
 
     attach_coherence(file, map, &mut set, &mut notes);
+    let locate = |c: usize, _: usize| (frfs[c].line, format!("record {} (line {})", frfs[c].record, frfs[c].line));
+    let (set, more) = mask::non_finite_lines(path, set, rules.contains(&MaskRule::NonFinite), &locate)?;
+    masked.extend(more);
     let sources = frfs.into_iter().map(|f| f.source).collect();
-    Ok(UffFrfs { set, sources, notes })
+    Ok(UffFrfs { set, sources, notes, masked })
 }
 
 /// The record's positive-frequency lines (Hz) and its values through `f`;
@@ -221,7 +268,8 @@ fn positive_lines(r: &Record58, to_hz: f64, f: impl Fn(C64) -> C64) -> (Vec<f64>
     for k in 0..r.function.len() {
         let (Some(x), Some(v)) = (r.function.abscissa_at(k), r.function.ordinates.get(k)) else { continue };
         let hz = x * to_hz;
-        if hz > 0.0 {
+        // a NaN frequency is kept here to be refused, with its record, by the line checks
+        if hz > 0.0 || hz.is_nan() {
             freqs.push(hz);
             values.push(f(v));
         } else {

@@ -56,7 +56,7 @@ use num_complex::Complex64 as C64;
 
 use crate::error::FrfError;
 
-pub use frfs::{ChannelSource, UffFrfs, frfs_from_uff, read_uff_frfs};
+pub use frfs::{ChannelSource, UffFrfs, frfs_from_uff, frfs_from_uff_with, read_uff_frfs, read_uff_frfs_with};
 pub use map::{map_test_dof, model_to_test_dof};
 pub use read::{parse_uff, read_uff};
 pub use units::{FrfUnits, frf_units};

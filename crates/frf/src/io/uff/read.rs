@@ -456,7 +456,7 @@ impl<'a> Parser<'a, '_> {
             ));
         };
         let mut values = Vec::with_capacity(data.len() / size);
-        for (i, chunk) in data.chunks_exact(size).enumerate() {
+        for chunk in data.chunks_exact(size) {
             let x = if size == 4 {
                 let mut b = [0u8; 4];
                 b.copy_from_slice(chunk);
@@ -466,10 +466,6 @@ impl<'a> Parser<'a, '_> {
                 b.copy_from_slice(chunk);
                 if info.big_endian { f64::from_be_bytes(b) } else { f64::from_le_bytes(b) }
             };
-            if !x.is_finite() {
-                let off = start + i * size;
-                return Err(boff(off, format!("value {} of the data is {x}", i + 1)));
-            }
             values.push(x);
         }
         let end = self.cur.pos;
@@ -598,7 +594,9 @@ fn show(bytes: &[u8]) -> String {
 
 /// The numbers of a line: whitespace-separated, Fortran `D` exponents
 /// accepted, and fields that touch (`1.0E+00-2.0E+00`, as some writers
-/// produce when a value fills its column) split at the sign.
+/// produce when a value fills its column) split at the sign. `NaN` and
+/// infinities (`nan`, `inf`, or an exponent too large) are kept: the FRF
+/// conversion refuses or masks them with the record and frequency.
 pub(super) fn numbers(text: &[u8]) -> Result<Vec<f64>, String> {
     let s = std::str::from_utf8(text).map_err(|_| "the line is not text (non-ASCII bytes)".to_string())?;
     let mut out = Vec::new();
@@ -616,14 +614,14 @@ pub(super) fn numbers(text: &[u8]) -> Result<Vec<f64>, String> {
             }
         }
     }
-    if let Some(x) = out.iter().find(|x| !x.is_finite()) {
-        return Err(format!("value {x} is not finite"));
-    }
     Ok(out)
 }
 
 fn parse_number(token: &str) -> Option<f64> {
-    // only digits, signs, a point and an exponent letter: refuses `inf`, `nan` and the like
+    if let Some(x) = crate::io::non_finite_word(token) {
+        return Some(x);
+    }
+    // only digits, signs, a point and an exponent letter: refuses `infinite`, `1.#QNAN` and the like
     if !token.bytes().all(|b| b.is_ascii_digit() || matches!(b, b'+' | b'-' | b'.' | b'e' | b'E' | b'd' | b'D')) {
         return None;
     }
@@ -660,9 +658,10 @@ mod tests {
         assert_eq!(numbers(b"4.111111E+03-3.111111E+03").unwrap(), vec![4111.111, -3111.111]);
         assert_eq!(numbers(b"1.0E-100-2.5E+00").unwrap(), vec![1e-100, -2.5]);
         assert!(numbers(b"1.0 x").unwrap_err().contains("`x` is not a number"));
-        assert!(numbers(b"1.0 NaN").is_err());
-        assert!(numbers(b"inf").is_err());
-        assert!(numbers(b"1e999").unwrap_err().contains("not finite"));
+        let v = numbers(b"1.0 NaN -inf 1e999").unwrap();
+        assert!(v[1].is_nan() && v[2] == f64::NEG_INFINITY && v[3] == f64::INFINITY, "{v:?}");
+        assert!(numbers(b"1.#QNAN").is_err());
+        assert!(numbers(b"infinite").is_err());
     }
 
     #[test]

@@ -1,0 +1,3 @@
+//! Integration tests of fe-model.
+
+mod properties;

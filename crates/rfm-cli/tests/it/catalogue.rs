@@ -1,0 +1,470 @@
+//! A catalogue of malformed inputs: case files and measured files written to
+//! a temporary folder, each run through `rfm`, which must exit non-zero with
+//! a message that names the file and line, or the node, element, group or
+//! frequency at fault.
+
+use std::path::Path;
+use std::process::Command;
+
+use damping::DampedSystem;
+use fe_model::{CaseFile, Dof, DofRef};
+use frf::Channel;
+
+/// A 4-element steel cantilever along x, nodes 1-5, clamped at node 1.
+const BEAM: &str = r#"title = "catalogue beam"
+
+[materials]
+steel = { E = 2.0e11, rho = 7800 }
+
+[sections]
+bar = { b = 0.05, h = 0.01 }
+
+[groups.beam]
+alpha = 1e-5
+beta = 0.5
+
+[[lines]]
+from = [0.0, 0.0]
+to = [1.0, 0.0]
+elements = 4
+material = "steel"
+section = "bar"
+group = "beam"
+
+[[supports]]
+node = 1
+
+[truth]
+
+[measurement]
+frequencies = { from = 10.0, to = 100.0, step = 10.0 }
+references = ["5:uy"]
+responses = ["3:uy", "5:uy"]
+"#;
+
+/// One malformed input.
+struct Entry {
+    /// What is wrong.
+    what: &'static str,
+    /// Files to write (name, contents).
+    files: Vec<(&'static str, Vec<u8>)>,
+    /// The command, `{dir}` standing for the folder of the files.
+    args: Vec<&'static str>,
+    /// Words the error must contain; `@file:text` stands for
+    /// `file:LINE:` with the line of the first occurrence of `text` in
+    /// that file.
+    expect: Vec<&'static str>,
+}
+
+fn replaced(from: &str, to: &str) -> String {
+    assert!(BEAM.contains(from), "{from}");
+    BEAM.replacen(from, to, 1)
+}
+
+fn case(text: String) -> Vec<(&'static str, Vec<u8>)> {
+    vec![("cat.toml", text.into_bytes())]
+}
+
+/// A case file entry run with `rfm simulate`.
+fn bad_case(what: &'static str, text: String, expect: Vec<&'static str>) -> Entry {
+    Entry { what, files: case(text), args: vec!["simulate", "{dir}/cat.toml", "--out", "{dir}/h.csv"], expect }
+}
+
+/// Measured receptances of the beam at 10, 20, ... 100 Hz, for the 3:uy
+/// and 5:uy responses to 5:uy.
+fn measured() -> frf::FrfSet {
+    let model = CaseFile::parse(Path::new("cat.toml"), BEAM).unwrap().model;
+    let tip = DofRef::new(5, Dof::Uy);
+    let channels = [Channel::new(DofRef::new(3, Dof::Uy), tip), Channel::new(tip, tip)];
+    let freqs: Vec<f64> = (1..=10).map(|k| 10.0 * f64::from(k)).collect();
+    frf::synthesize(&DampedSystem::new(model).unwrap(), &channels, &freqs).unwrap()
+}
+
+fn csv() -> String {
+    frf::io::csv::to_csv_string(&measured())
+}
+
+fn uff() -> String {
+    String::from_utf8(frf::io::uff::to_uff_bytes(&measured(), &Default::default()).unwrap()).unwrap()
+}
+
+/// The beam case reading `data`, with extra `[measurement]` lines, and the
+/// data file; run with `rfm compare`.
+fn bad_data(what: &'static str, name: &'static str, data: String, extra: &str, expect: Vec<&'static str>) -> Entry {
+    let text = format!("{BEAM}data = \"{name}\"\n{extra}");
+    let mut files = case(text);
+    files.push((name, data.into_bytes()));
+    Entry { what, files, args: vec!["compare", "{dir}/cat.toml"], expect }
+}
+
+/// Line `n` (1-based) of `text` replaced by `f(line)`.
+fn edit_line(text: &str, n: usize, f: impl Fn(&str) -> String) -> String {
+    text.lines().enumerate().map(|(i, l)| if i + 1 == n { f(l) } else { l.to_string() } + "\n").collect()
+}
+
+/// The first line of `text` containing `pat` (1-based).
+fn line_of(text: &str, pat: &str) -> usize {
+    text.lines().position(|l| l.contains(pat)).unwrap_or_else(|| panic!("`{pat}` not found")) + 1
+}
+
+/// The single-DOF oscillators of an undamped 1 kg mass (1 kg m^2) on
+/// springs of 1e4 to ground in x, y and rotation: all three at
+/// sqrt(1e4) / (2 pi) = 15.915494309189533 Hz.
+const OSCILLATOR: &str = r#"title = "undamped oscillator"
+nodes = [[1, 0.0, 0.0]]
+
+[groups.g]
+"#;
+
+fn catalogue() -> Vec<Entry> {
+    let csv = csv();
+    let uff = uff();
+    // CSV: line 1 is a comment (kind), line 2 the header, data from line 3
+    let csv_header = line_of(&csv, "frequency_hz");
+    let first_row = csv_header + 1;
+    let uff_line = |pat: &str| line_of(&uff, pat);
+    vec![
+        // ------------------------------------------------------------ case files
+        bad_case("TOML syntax", replaced("elements = 4", "elements = "), vec!["@cat.toml:elements = ", "expected"]),
+        bad_case(
+            "unknown top-level key",
+            replaced("title =", "titel ="),
+            vec!["@cat.toml:titel", "unknown field `titel`", "did you mean `title`?"],
+        ),
+        bad_case(
+            "unknown key in a group",
+            replaced("alpha = 1e-5", "alpah = 1e-5"),
+            vec!["@cat.toml:alpah", "did you mean `alpha`?"],
+        ),
+        bad_case(
+            "unknown key in a line",
+            replaced("elements = 4", "elemnts = 4"),
+            vec!["@cat.toml:elemnts", "did you mean `elements`?"],
+        ),
+        bad_case(
+            "unknown key in a material",
+            replaced("rho = 7800", "rh0 = 7800"),
+            vec!["@cat.toml:rh0", "did you mean `rho`?"],
+        ),
+        bad_case(
+            "unknown key in [measurement]",
+            replaced("references =", "referencs ="),
+            vec!["@cat.toml:referencs", "did you mean `references`?"],
+        ),
+        bad_case(
+            "unknown key in [truth]",
+            replaced("[truth]\n", "[truth]\nnoize = 0.01\n"),
+            vec!["@cat.toml:noize", "did you mean `noise`?"],
+        ),
+        bad_case(
+            "unknown key in [update]",
+            format!("{BEAM}\n[update]\nparameters = [\"group.beam.alpha\"]\nmax_iteration = 3\n"),
+            vec!["@cat.toml:max_iteration", "did you mean `max_iterations`?"],
+        ),
+        bad_case(
+            "unknown key in [[joints]]",
+            format!("{BEAM}\n[[joints]]\nname = \"j\"\nnode = 3\nelemets = [3]\ngroup = \"beam\"\n"),
+            vec!["@cat.toml:elemets", "did you mean `elements`?"],
+        ),
+        bad_case(
+            "unknown key in a frequency range",
+            replaced("step = 10.0", "stpe = 10.0"),
+            vec!["@cat.toml:stpe", "unknown key `stpe`", "did you mean `step`?"],
+        ),
+        bad_case(
+            "missing field",
+            replaced("material = \"steel\"\n", ""),
+            vec!["@cat.toml:[[lines]]", "missing field `material`"],
+        ),
+        bad_case(
+            "mistyped field",
+            replaced("elements = 4", "elements = \"four\""),
+            vec!["@cat.toml:\"four\"", "invalid type"],
+        ),
+        bad_case(
+            "E <= 0",
+            replaced("E = 2.0e11", "E = -2.0e11"),
+            vec!["@cat.toml:E = -2.0e11", "material `steel`: E", "positive"],
+        ),
+        bad_case(
+            "rho = 0",
+            replaced("rho = 7800", "rho = 0"),
+            vec!["@cat.toml:rho = 0", "material `steel`: rho", "positive"],
+        ),
+        bad_case(
+            "mu <= 0",
+            replaced("beta = 0.5", "beta = 0.5\nmu = -3.0"),
+            vec!["@cat.toml:[groups.beam]", "group `beam`: mu", "positive"],
+        ),
+        bad_case(
+            "negative spring stiffness",
+            format!("{BEAM}\n[[springs]]\nname = \"s\"\nnode = 5\nky = -1e3\ngroup = \"beam\"\n"),
+            vec!["@cat.toml:[[springs]]", "spring `s`: ky", "zero or positive"],
+        ),
+        bad_case(
+            "zero-length element",
+            format!(
+                "{BEAM}\n[[beams]]\nid = 9\nnodes = [5, 5]\nmaterial = \"steel\"\nsection = \"bar\"\ngroup = \"beam\"\n"
+            ),
+            vec!["@cat.toml:[[beams]]", "element 9", "zero length"],
+        ),
+        bad_case(
+            "duplicate node id",
+            replaced(
+                "title = \"catalogue beam\"\n",
+                "title = \"catalogue beam\"\nnodes = [[1, 0.0, 0.0], [1, 0.5, 0.0]]\n",
+            ),
+            vec!["@cat.toml:[1, 0.5, 0.0]", "node 1"],
+        ),
+        bad_case(
+            "support at an unknown node",
+            replaced("node = 1", "node = 71"),
+            vec!["@cat.toml:[[supports]]", "node 71", "does not exist"],
+        ),
+        bad_case(
+            "unknown group",
+            replaced("group = \"beam\"", "group = \"bean\""),
+            vec!["@cat.toml:group = \"bean\"", "unknown group `bean`", "did you mean `beam`?"],
+        ),
+        bad_case(
+            "unknown material",
+            replaced("material = \"steel\"", "material = \"steal\""),
+            vec!["@cat.toml:material = \"steal\"", "unknown material `steal`", "did you mean `steel`?"],
+        ),
+        bad_case(
+            "measured DOF at an unknown node",
+            replaced("\"3:uy\", \"5:uy\"]", "\"3:uy\", \"50:uy\"]"),
+            vec!["@cat.toml:50:uy", "50"],
+        ),
+        bad_case(
+            "frequencies that go backwards",
+            replaced("frequencies = { from = 10.0, to = 100.0, step = 10.0 }", "frequencies = [10.0, 30.0, 20.0]"),
+            vec!["@cat.toml:[10.0, 30.0, 20.0]", "increase"],
+        ),
+        bad_case(
+            "unknown [update] parameter",
+            format!("{BEAM}\n[update]\nparameters = [\"group.beam.alpah\"]\n"),
+            vec!["@cat.toml:group.beam.alpah", "alpha"],
+        ),
+        bad_case(
+            "unknown mask rule",
+            format!("{BEAM}data = \"m.csv\"\nmask = [\"non-finit\"]\n"),
+            vec!["@cat.toml:non-finit", "did you mean `non-finite`?"],
+        ),
+        bad_case(
+            "a pin instead of a clamp: mechanism",
+            replaced("node = 1\n", "node = 1\ndofs = [\"ux\", \"uy\"]\n"),
+            vec!["cat.toml: ", "zero-energy motion", "largest at 5:uy", "nodes 1-5"],
+        ),
+        bad_case(
+            "no support: free body",
+            replaced("[[supports]]\nnode = 1\n", ""),
+            vec!["cat.toml: ", "3 independent zero-energy motions", "nodes 1-5"],
+        ),
+        bad_case(
+            "a sensor mass on a pin: its rotation is free",
+            format!(
+                "{}\n[[springs]]\nname = \"pin\"\nnodes = [5, 6]\nkx = 1e6\nky = 1e6\ngroup = \"beam\"\n\n[[masses]]\nname = \"sensor\"\nnode = 6\nm = 0.05\nj = 1e-5\ngroup = \"beam\"\n",
+                replaced("title = \"catalogue beam\"\n", "title = \"catalogue beam\"\nnodes = [[6, 1.0, 0.0]]\n")
+                    .replace("elements = 4\n", "elements = 4\nfirst_node = 1\n")
+            ),
+            vec!["cat.toml: ", "a zero-energy motion", "largest at 6:rz (node 6)"],
+        ),
+        Entry {
+            what: "undamped model on its resonance",
+            files: case(format!(
+                "{OSCILLATOR}\n[[springs]]\nname = \"k\"\nnode = 1\nkx = 1e4\nky = 1e4\nkr = 1e4\ngroup = \"g\"\n\n[[masses]]\nname = \"m\"\nnode = 1\nm = 1.0\nj = 1.0\ngroup = \"g\"\n\n[truth]\n\n[measurement]\nfrequencies = [10.0, 15.915494309189533]\nreferences = [\"1:uy\"]\nresponses = [\"1:uy\"]\n"
+            )),
+            args: vec!["simulate", "{dir}/cat.toml", "--out", "{dir}/h.csv"],
+            expect: vec!["singular at 15.915494309189533 Hz"],
+        },
+        // ------------------------------------------------------------ measured data
+        bad_data(
+            "CSV row cut short",
+            "m.csv",
+            edit_line(&csv, first_row + 2, |l| l.rsplit_once(',').unwrap().0.to_string()),
+            "",
+            vec!["m.csv:", "4 fields, but the header has 5"],
+        ),
+        bad_data(
+            "CSV NaN",
+            "m.csv",
+            edit_line(&csv, first_row + 4, |l| {
+                let mut f: Vec<&str> = l.split(',').collect();
+                f[2] = "NaN";
+                f.join(",")
+            }),
+            "",
+            vec!["m.csv:", "50 Hz is NaN", "mask = [\"non-finite\"]"],
+        ),
+        bad_data(
+            "CSV frequencies going backwards",
+            "m.csv",
+            edit_line(&csv, first_row + 3, |l| format!("5{}", &l[l.find(',').unwrap()..])),
+            "",
+            vec!["m.csv:", "below the one before it"],
+        ),
+        bad_data(
+            "CSV repeated frequency",
+            "m.csv",
+            edit_line(&csv, first_row + 3, |l| format!("30{}", &l[l.find(',').unwrap()..])),
+            "",
+            vec!["m.csv:", "repeats 30 Hz", "duplicate-lines"],
+        ),
+        bad_data(
+            "CSV duplicate channel",
+            "m.csv",
+            edit_line(&csv, csv_header, |l| l.replace("H(3:uy,5:uy)", "H(5:uy,5:uy)")),
+            "",
+            vec!["m.csv:", "appears twice"],
+        ),
+        bad_data(
+            "CSV channel at a node the model lacks",
+            "m.csv",
+            edit_line(&csv, csv_header, |l| l.replace("H(3:uy,5:uy)", "H(99:uy,5:uy)")),
+            "",
+            vec!["m.csv:", "the model has no node 99", "unmodelled-channels"],
+        ),
+        bad_data(
+            "CSV channel at a supported DOF",
+            "m.csv",
+            edit_line(&csv, csv_header, |l| l.replace("H(3:uy,5:uy)", "H(1:uy,5:uy)")),
+            "",
+            vec!["m.csv:", "1:uy is held fixed"],
+        ),
+        bad_data(
+            "CSV text in a number",
+            "m.csv",
+            edit_line(&csv, first_row + 1, |l| l.replacen(',', ",x", 1)),
+            "",
+            vec!["m.csv:", "is not a number"],
+        ),
+        bad_data(
+            "CSV channels the case lists are missing",
+            "m.csv",
+            edit_line(&csv, csv_header, |l| l.replace("H(3:uy,5:uy)", "H(4:uy,5:uy)")),
+            "",
+            vec!["m.csv", "no channel H(3:uy,5:uy)"],
+        ),
+        bad_data("UFF cut short", "m.uff", uff[..uff.len() / 3].to_string(), "", vec!["m.uff:", "record 1"]),
+        bad_data(
+            "UFF NaN in the data",
+            "m.uff",
+            {
+                let line = uff_line("    -1") + 13;
+                edit_line(&uff, line, |l| format!("{:>20}{}", "NaN", &l[20..]))
+            },
+            "",
+            vec!["m.uff:", "record 1", "NaN", "non-finite"],
+        ),
+        bad_data(
+            "UFF units that contradict the data types",
+            "m.uff",
+            uff.replacen("Displacement         m   ", "Displacement         m/s ", 1),
+            "",
+            vec!["m.uff:", "record 1", "say mobility", "say receptance"],
+        ),
+        bad_data(
+            "UFF abscissa in seconds",
+            "m.uff",
+            uff.replacen("Hz", "s ", 1),
+            "",
+            vec!["m.uff:", "record 1", "not frequency"],
+        ),
+        bad_data(
+            "UFF response at a node the model lacks",
+            "m.uff",
+            uff.replacen("NONE               3   2", "NONE              93   2", 1),
+            "",
+            vec!["m.uff:", "record 1", "no node 93"],
+        ),
+        Entry {
+            what: "measured file missing",
+            files: case(format!("{BEAM}data = \"absent.uff\"\n")),
+            args: vec!["compare", "{dir}/cat.toml"],
+            expect: vec!["absent.uff", "cannot read"],
+        },
+    ]
+}
+
+fn run(entry: &Entry, dir: &Path) -> Result<(), String> {
+    for (name, bytes) in &entry.files {
+        std::fs::write(dir.join(name), bytes).unwrap();
+    }
+    let d = dir.to_str().unwrap();
+    let args: Vec<String> = entry.args.iter().map(|a| a.replace("{dir}", d)).collect();
+    let out = Command::new(env!("CARGO_BIN_EXE_rfm")).args(&args).output().expect("rfm runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if out.status.success() {
+        return Err(format!("succeeded; stderr: {stderr}"));
+    }
+    if out.status.code() != Some(1) {
+        return Err(format!("exit code {:?}: {stderr}", out.status.code()));
+    }
+    for e in &entry.expect {
+        let want = match e.strip_prefix('@') {
+            Some(spec) => {
+                let (file, pat) = spec.split_once(':').unwrap();
+                let text = &entry.files.iter().find(|(n, _)| *n == file).unwrap().1;
+                format!("{file}:{}:", line_of(&String::from_utf8_lossy(text), pat))
+            }
+            None => e.to_string(),
+        };
+        if !stderr.contains(&want) {
+            return Err(format!("lacks `{want}`: {stderr}"));
+        }
+    }
+    Ok(())
+}
+
+/// At least 30 malformed inputs, each refused with a located message.
+#[test]
+fn every_malformed_input_of_the_catalogue_is_refused_with_a_located_message() {
+    let entries = catalogue();
+    assert!(entries.len() >= 30, "{} entries", entries.len());
+    let root = tempfile::tempdir().unwrap();
+    let mut failures = Vec::new();
+    for (i, e) in entries.iter().enumerate() {
+        let dir = root.path().join(format!("{i:02}"));
+        std::fs::create_dir(&dir).unwrap();
+        if let Err(why) = run(e, &dir) {
+            failures.push(format!("{i:02} {}: {why}", e.what));
+        }
+    }
+    assert!(failures.is_empty(), "{} of {} entries failed:\n{}", failures.len(), entries.len(), failures.join("\n"));
+}
+
+/// The same defects with the case's mask: the run succeeds and says what
+/// it left out.
+#[test]
+fn masked_defects_are_left_out_and_reported() {
+    let csv = csv();
+    let row = line_of(&csv, "frequency_hz") + 5;
+    let nan = edit_line(&csv, row, |l| {
+        let mut f: Vec<&str> = l.split(',').collect();
+        f[2] = "NaN";
+        f.join(",")
+    });
+    let data = edit_line(&nan, line_of(&nan, "frequency_hz"), |l| format!("{l},H(99:uy,5:uy).re,H(99:uy,5:uy).im"));
+    let data: String = data
+        .lines()
+        .enumerate()
+        .map(|(i, l)| if i + 1 > line_of(&nan, "frequency_hz") { format!("{l},1.0,0.0\n") } else { format!("{l}\n") })
+        .collect();
+    let dir = tempfile::tempdir().unwrap();
+    let text = format!("{BEAM}data = \"m.csv\"\nmask = [\"non-finite\", \"unmodelled-channels\"]\n");
+    std::fs::write(dir.path().join("cat.toml"), text).unwrap();
+    std::fs::write(dir.path().join("m.csv"), data).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_rfm"))
+        .args(["compare", dir.path().join("cat.toml").to_str().unwrap()])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(stdout.contains("left out of the measured data, as the case's [measurement] mask allows (2)"), "{stdout}");
+    assert!(stdout.contains(&format!("non-finite: line {row}, columns 2-3: H(3:uy,5:uy) at 50 Hz is NaN")), "{stdout}");
+    assert!(
+        stdout.contains("unmodelled-channels: columns 6-7: H(99:uy,5:uy): its response the model has no node 99"),
+        "{stdout}"
+    );
+}
