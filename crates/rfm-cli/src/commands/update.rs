@@ -263,6 +263,14 @@ fn print_outcome(outcome: &UpdateOutcome) -> Result<()> {
         outln!("gain of reference {}: {:.4} at {:+.2} deg", g.reference, g.magnitude, g.phase_deg);
     }
     let nf = &outcome.natural_frequencies_hz;
+    if nf.kind == "none" {
+        outln!(
+            "\nnatural frequencies: not computed ({} equations, above the {} the dense modal analyses take)",
+            outcome.system.n(),
+            rfm_update::study::MAX_UNDAMPED_DOFS
+        );
+        return Ok(());
+    }
     let mut header = vec!["mode", "initial (Hz)", "updated (Hz)"];
     if nf.truth.is_some() {
         header.push("truth (Hz)");

@@ -415,7 +415,16 @@ fn frequency_table(outcome: &UpdateOutcome) -> Table {
     if nf.paper.is_some() {
         header.push("paper (Hz)");
     }
-    let mut t = Table::new(&header).caption("Undamped natural frequencies in the measured band.");
+    let caption = match nf.kind.as_str() {
+        "damped" => "Natural frequencies of the damped model's complex modes in the measured band.".to_string(),
+        "undamped" => "Undamped natural frequencies in the measured band.".to_string(),
+        _ => format!(
+            "Natural frequencies not computed: {} equations, above the {} the dense modal analyses take.",
+            outcome.system.n(),
+            rfm_update::study::MAX_UNDAMPED_DOFS
+        ),
+    };
+    let mut t = Table::new(&header).caption(&caption);
     let rows = nf.initial.len().max(nf.updated.len()).max(nf.paper.as_ref().map_or(0, Vec::len));
     let cell = |v: Option<&f64>| v.map(|f| format!("{f:.2}")).unwrap_or_default();
     for k in 0..rows {
