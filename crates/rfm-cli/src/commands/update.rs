@@ -271,24 +271,9 @@ fn print_outcome(outcome: &UpdateOutcome) -> Result<()> {
         );
         return Ok(());
     }
-    let mut header = vec!["mode", "initial (Hz)", "updated (Hz)"];
-    if nf.truth.is_some() {
-        header.push("truth (Hz)");
-    }
-    if nf.paper.is_some() {
-        header.push("paper (Hz)");
-    }
+    let (header, rows) = crate::report::update_report::frequency_rows(nf);
     let mut t = Table::new(&header);
-    let rows = nf.initial.len().max(nf.updated.len()).max(nf.paper.as_ref().map_or(0, Vec::len));
-    let cell = |v: Option<&f64>| v.map(|f| format!("{f:.2}")).unwrap_or_default();
-    for k in 0..rows {
-        let mut row = vec![format!("{}", k + 1), cell(nf.initial.get(k)), cell(nf.updated.get(k))];
-        if let Some(tr) = &nf.truth {
-            row.push(cell(tr.get(k)));
-        }
-        if let Some(p) = &nf.paper {
-            row.push(cell(p.get(k)));
-        }
+    for row in rows {
         t.row(row);
     }
     outln!("\n{} natural frequencies in the measured band\n{}", nf.kind, t.render());

@@ -10,6 +10,7 @@ use frf::correlation::{BandSpec, correlate};
 use frf::{FrfSet, synthesize};
 use rfm_update::oe::Gain;
 use rfm_update::rfm::Status;
+use rfm_update::study::FrequencyTable;
 use rfm_update::{Study, UpdateOutcome};
 
 use super::html::{Block, Report, Section, Table, Tone};
@@ -406,8 +407,9 @@ fn parameter_table(outcome: &UpdateOutcome) -> (Table, String) {
     (t, csv)
 }
 
-fn frequency_table(outcome: &UpdateOutcome) -> Table {
-    let nf = &outcome.natural_frequencies_hz;
+/// Header and rows of the natural-frequency table (mode, initial, updated,
+/// truth and paper when known), shared by the terminal and the report.
+pub(crate) fn frequency_rows(nf: &FrequencyTable) -> (Vec<&'static str>, Vec<Vec<String>>) {
     let mut header = vec!["mode", "initial (Hz)", "updated (Hz)"];
     if nf.truth.is_some() {
         header.push("truth (Hz)");
@@ -415,6 +417,25 @@ fn frequency_table(outcome: &UpdateOutcome) -> Table {
     if nf.paper.is_some() {
         header.push("paper (Hz)");
     }
+    let n = nf.initial.len().max(nf.updated.len()).max(nf.paper.as_ref().map_or(0, Vec::len));
+    let cell = |v: Option<&f64>| v.map(|f| format!("{f:.2}")).unwrap_or_default();
+    let rows = (0..n)
+        .map(|k| {
+            let mut row = vec![format!("{}", k + 1), cell(nf.initial.get(k)), cell(nf.updated.get(k))];
+            if let Some(tr) = &nf.truth {
+                row.push(cell(tr.get(k)));
+            }
+            if let Some(p) = &nf.paper {
+                row.push(cell(p.get(k)));
+            }
+            row
+        })
+        .collect();
+    (header, rows)
+}
+
+fn frequency_table(outcome: &UpdateOutcome) -> Table {
+    let nf = &outcome.natural_frequencies_hz;
     let caption = match nf.kind.as_str() {
         "damped" => "Natural frequencies of the damped model's complex modes in the measured band.".to_string(),
         "undamped" => "Undamped natural frequencies in the measured band.".to_string(),
@@ -424,17 +445,9 @@ fn frequency_table(outcome: &UpdateOutcome) -> Table {
             rfm_update::study::MAX_UNDAMPED_DOFS
         ),
     };
+    let (header, rows) = frequency_rows(nf);
     let mut t = Table::new(&header).caption(&caption);
-    let rows = nf.initial.len().max(nf.updated.len()).max(nf.paper.as_ref().map_or(0, Vec::len));
-    let cell = |v: Option<&f64>| v.map(|f| format!("{f:.2}")).unwrap_or_default();
-    for k in 0..rows {
-        let mut row = vec![format!("{}", k + 1), cell(nf.initial.get(k)), cell(nf.updated.get(k))];
-        if let Some(tr) = &nf.truth {
-            row.push(cell(tr.get(k)));
-        }
-        if let Some(p) = &nf.paper {
-            row.push(cell(p.get(k)));
-        }
+    for row in rows {
         t.row(row);
     }
     t
