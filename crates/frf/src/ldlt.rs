@@ -34,6 +34,8 @@ use faer::traits::pulp::{Arch, Simd, WithSimd};
 use fe_model::Pattern;
 use num_complex::Complex64 as C64;
 
+use crate::solver::mul_add;
+
 /// A pivot `d` is accepted when `|d| > PIVOT_TOLERANCE * scale`, where
 /// `scale` is the larger of the largest entry of its row of `Z` and the sum of
 /// the terms subtracted from the diagonal to form it (so at most about eight
@@ -442,21 +444,6 @@ impl<V: FnMut(usize, &[C64])> WithSimd for Substitution<'_, V> {
             visit(j, &x[j * k..]);
         }
         finite
-    }
-}
-
-/// `dst += a * src` over equal-length slices.
-#[inline(always)]
-fn mul_add<S: Simd>(simd: S, dst: &mut [C64], a: C64, src: &[C64]) {
-    let av = simd.splat_c64s(a);
-    let (dh, dt) = S::as_mut_simd_c64s(dst);
-    let (sh, st) = S::as_simd_c64s(src);
-    for (d, s) in dh.iter_mut().zip(sh) {
-        *d = simd.mul_add_c64s(av, *s, *d);
-    }
-    if !dt.is_empty() {
-        let r = simd.mul_add_c64s(av, simd.partial_load_c64s(st), simd.partial_load_c64s(dt));
-        simd.partial_store_c64s(dt, r);
     }
 }
 

@@ -74,6 +74,7 @@ use damping::{DampedSystem, Derivative, GroupCoefficients, kernel};
 use faer::Mat;
 use faer::traits::pulp::{Arch, Simd, WithSimd};
 use fe_model::{Group, MatrixKind, Quantity};
+use frf::solver::mul_add;
 use frf::{Channel, FrfSet, Workspace, ZSolver, equation_of};
 use num_complex::Complex64 as C64;
 use rayon::prelude::*;
@@ -882,21 +883,6 @@ impl WithSimd for BucketProducts<'_> {
                 }
             }
         }
-    }
-}
-
-/// `dst += a * src` over equal-length slices.
-#[inline(always)]
-fn mul_add<S: Simd>(simd: S, dst: &mut [C64], a: C64, src: &[C64]) {
-    let av = simd.splat_c64s(a);
-    let (dh, dt) = S::as_mut_simd_c64s(dst);
-    let (sh, st) = S::as_simd_c64s(src);
-    for (d, s) in dh.iter_mut().zip(sh) {
-        *d = simd.mul_add_c64s(av, *s, *d);
-    }
-    if !dt.is_empty() {
-        let r = simd.mul_add_c64s(av, simd.partial_load_c64s(st), simd.partial_load_c64s(dt));
-        simd.partial_store_c64s(dt, r);
     }
 }
 
