@@ -182,12 +182,62 @@ pub struct OeData<'a> {
     pub weights: Option<&'a [f64]>,
 }
 
-struct Evaluator<'a> {
+/// Model receptances at the fitted lines and channels and their
+/// sensitivities, as a function of the parameters: what the iteration fits.
+/// The full model ([`FullModel`]) is the normal source; the diagnosis screens
+/// candidates that change `Z` only locally with an exact low-rank update of
+/// the nominal model instead (`crate::diagnose::local`).
+pub(crate) trait Response {
+    /// Sets the physical parameter values.
+    fn set(&mut self, values: &[f64]) -> Result<(), UpdateError>;
+
+    /// Model receptances `[line][channel]` at the current values and, with
+    /// `jacobian`, per line the channels x parameters block `-(dH/dp) p`;
+    /// `None` when the model cannot be evaluated.
+    fn evaluate(&mut self, lines: &[f64], jacobian: bool) -> Option<Evaluated>;
+}
+
+/// Model receptances `[line][channel]` and optional sensitivity blocks.
+pub(crate) type Evaluated = (Vec<Vec<C64>>, Option<Vec<Mat<C64>>>);
+
+/// [`Response`] of a whole damped system: one sparse factorisation per line
+/// and the shared sensitivity assembly.
+struct FullModel<'a> {
+    sys: &'a mut DampedSystem,
     params: &'a ParameterSet,
-    data: &'a OeData<'a>,
-    opts: &'a OeOptions,
     solver: ZSolver,
     plan: ChannelPlan,
+}
+
+impl Response for FullModel<'_> {
+    fn set(&mut self, values: &[f64]) -> Result<(), UpdateError> {
+        self.params.set_values(self.sys, values)
+    }
+
+    fn evaluate(&mut self, lines: &[f64], jacobian: bool) -> Option<Evaluated> {
+        if jacobian {
+            let blocks = sensitivity::assemble(
+                self.sys,
+                &self.solver,
+                &self.plan,
+                self.params.quantities(),
+                lines,
+                Hybrid::Model,
+            )
+            .ok()?;
+            let sens = blocks.iter().map(|b| self.params.combine(b)).collect();
+            Some((blocks.into_iter().map(|b| b.model).collect(), Some(sens)))
+        } else {
+            let set = frf::synthesize_with(self.sys, &self.solver, &self.plan.channels, lines).ok()?;
+            let nc = self.plan.channels.len();
+            Some(((0..lines.len()).map(|k| (0..nc).map(|c| set.get(c, k)).collect()).collect(), None))
+        }
+    }
+}
+
+struct Evaluator<'a> {
+    data: &'a OeData<'a>,
+    opts: &'a OeOptions,
     /// Reference index of each channel.
     ref_of: Vec<usize>,
     refs: Vec<DofRef>,
@@ -203,7 +253,7 @@ struct Point {
 
 impl Evaluator<'_> {
     fn n_params(&self) -> usize {
-        self.params.len()
+        self.p0.len()
     }
 
     fn n_gain(&self) -> usize {
@@ -223,10 +273,10 @@ impl Evaluator<'_> {
         2 * (0..nc).flat_map(|c| (0..nf).map(move |k| (c, k))).filter(|&(c, k)| self.weight(c, k) > 0.0).count()
     }
 
-    /// Sets the system to `theta` (structural part of `x`).
-    fn apply(&self, sys: &mut DampedSystem, x: &[f64]) -> Result<(), UpdateError> {
+    /// Sets the model to `theta` (structural part of `x`).
+    fn apply(&self, src: &mut impl Response, x: &[f64]) -> Result<(), UpdateError> {
         let values: Vec<f64> = self.p0.iter().zip(x).map(|(p, t)| p * t.exp()).collect();
-        self.params.set_values(sys, &values)
+        src.set(&values)
     }
 
     fn gain(&self, x: &[f64], v: usize) -> C64 {
@@ -240,23 +290,17 @@ impl Evaluator<'_> {
 
     /// Residuals (and optionally the Jacobian) at `x`; `None` when the model
     /// cannot be evaluated there.
-    fn eval(&self, sys: &mut DampedSystem, x: &[f64], jacobian: bool) -> Option<Point> {
-        self.apply(sys, x).ok()?;
+    fn eval(&self, src: &mut impl Response, x: &[f64], jacobian: bool) -> Option<Point> {
+        self.apply(src, x).ok()?;
         let m = self.data.measured;
         let lines = m.frequencies_hz();
         let (nf, nc, n) = (lines.len(), m.channels().len(), self.n_params());
         let ncol = n + self.n_gain();
         // model FRFs [line][channel] and per-parameter sensitivities
-        let (model, sens): (Vec<Vec<C64>>, Option<Vec<Mat<C64>>>) = if jacobian {
-            let blocks =
-                sensitivity::assemble(sys, &self.solver, &self.plan, self.params.quantities(), lines, Hybrid::Model)
-                    .ok()?;
-            let sens = blocks.iter().map(|b| self.params.combine(b)).collect();
-            (blocks.into_iter().map(|b| b.model).collect(), Some(sens))
-        } else {
-            let set = frf::synthesize_with(sys, &self.solver, m.channels(), lines).ok()?;
-            ((0..nf).map(|k| (0..nc).map(|c| set.get(c, k)).collect()).collect(), None)
-        };
+        let (model, sens) = src.evaluate(lines, jacobian)?;
+        if model.len() != nf || model.iter().any(|h| h.len() != nc) {
+            return None;
+        }
         let n_reg = if self.opts.regularization > 0.0 { n } else { 0 };
         let rows = nf * nc;
         let mut residual = vec![0.0; 2 * rows + n_reg];
@@ -334,6 +378,25 @@ pub fn run(
     params: &ParameterSet,
     data: &OeData<'_>,
     opts: &OeOptions,
+    on_iteration: impl FnMut(&IterationRecord),
+) -> Result<OeResult, UpdateError> {
+    let p0 = params.values(sys);
+    let mut src = FullModel {
+        solver: ZSolver::new(&sys.assembly().pattern)?,
+        plan: ChannelPlan::new(sys, data.measured.channels())?,
+        sys,
+        params,
+    };
+    run_with(&mut src, p0, data, opts, on_iteration)
+}
+
+/// As [`run`], for any [`Response`] starting at the parameter values `p0`;
+/// the response is left at the final values.
+pub(crate) fn run_with(
+    src: &mut impl Response,
+    p0: Vec<f64>,
+    data: &OeData<'_>,
+    opts: &OeOptions,
     mut on_iteration: impl FnMut(&IterationRecord),
 ) -> Result<OeResult, UpdateError> {
     let measured = data.measured;
@@ -344,16 +407,7 @@ pub fn run(
     }
     let refs = measured.references();
     let ref_of = measured.channels().iter().map(|c| refs.iter().position(|&r| r == c.reference).unwrap()).collect();
-    let ev = Evaluator {
-        params,
-        data,
-        opts,
-        solver: ZSolver::new(&sys.assembly().pattern)?,
-        plan: ChannelPlan::new(sys, measured.channels())?,
-        ref_of,
-        refs,
-        p0: params.values(sys),
-    };
+    let ev = Evaluator { data, opts, ref_of, refs, p0 };
     let (n, ng) = (ev.n_params(), ev.n_gain());
     let n_data = ev.n_data();
     let m_free = n + ng;
@@ -378,12 +432,15 @@ pub fn run(
     let mut x = vec![0.0; n + ng];
     if opts.gains {
         // start each gain at its least-squares value for the initial model
-        let model = frf::synthesize_with(sys, &ev.solver, measured.channels(), measured.frequencies_hz())?;
+        ev.apply(src, &x)?;
+        let (model, _) = src
+            .evaluate(measured.frequencies_hz(), false)
+            .ok_or_else(|| UpdateError::Setup("the initial model cannot be evaluated".into()))?;
         for v in 0..ev.refs.len() {
             let (mut num, mut den) = (C64::new(0.0, 0.0), 0.0);
             for c in (0..measured.channels().len()).filter(|&c| ev.ref_of[c] == v) {
                 for k in 0..measured.n_freq() {
-                    let (h, m) = (model.get(c, k), measured.get(c, k));
+                    let (h, m) = (model[k][c], measured.get(c, k));
                     let w = ev.weight(c, k) / m.norm().max(1e-300);
                     num += h.conj() * m * w * w;
                     den += h.norm_sqr() * w * w;
@@ -397,7 +454,7 @@ pub fn run(
         }
     }
     let mut point =
-        ev.eval(sys, &x, true).ok_or_else(|| UpdateError::Setup("the initial model cannot be evaluated".into()))?;
+        ev.eval(src, &x, true).ok_or_else(|| UpdateError::Setup("the initial model cannot be evaluated".into()))?;
     let record = |iteration: usize, p: &Point, x: &[f64], max_step: f64, lambda: f64, rank: usize| IterationRecord {
         iteration,
         residual: (p.cost_data / (n_data as f64 / 2.0)).sqrt(),
@@ -433,7 +490,7 @@ pub fn run(
             }
             let mut trial: Vec<f64> = x.iter().zip(&step).map(|(a, b)| a + b).collect();
             project(&mut trial, &lo, &hi);
-            if let Some(p) = ev.eval(sys, &trial, false)
+            if let Some(p) = ev.eval(src, &trial, false)
                 && p.cost < point.cost
             {
                 accepted = Some((trial, p.cost));
@@ -450,7 +507,7 @@ pub fn run(
         let max_step = trial.iter().zip(&x).take(n).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
         let relative_gain = (point.cost - trial_cost) / point.cost;
         x = trial;
-        point = match ev.eval(sys, &x, true) {
+        point = match ev.eval(src, &x, true) {
             Some(p) => p,
             None => {
                 status = Status::Failed("the model cannot be evaluated at the accepted step".into());
@@ -482,10 +539,10 @@ pub fn run(
     let final_point = match point.jacobian {
         Some(_) => point,
         None => {
-            ev.eval(sys, &x, true).ok_or_else(|| UpdateError::Setup("the final model cannot be evaluated".into()))?
+            ev.eval(src, &x, true).ok_or_else(|| UpdateError::Setup("the final model cannot be evaluated".into()))?
         }
     };
-    ev.apply(sys, &x)?;
+    ev.apply(src, &x)?;
     let at_bound: Vec<bool> = (0..n).map(|i| (x[i] - lo[i]).abs() < 1e-9 || (x[i] - hi[i]).abs() < 1e-9).collect();
     let jac = final_point.jacobian.as_ref().expect("final point has a Jacobian");
     let sol = lstsq::solve(jac, &vec![0.0; jac.nrows()], opts.rcond);

@@ -33,6 +33,7 @@
 //! is named as such and not as its region or a mass at its node.
 
 pub mod candidates;
+mod local;
 
 use damping::DampedSystem;
 use frf::FrfSet;
@@ -41,6 +42,7 @@ use serde::Serialize;
 
 pub use candidates::{Candidate, CandidateOptions, EffectKind};
 
+use self::local::{LocalData, LocalForm};
 use crate::error::UpdateError;
 use crate::oe::{self, Misfit, OeData, OeOptions};
 use crate::params::ParameterSet;
@@ -245,7 +247,11 @@ struct Fit {
     relative_std: Vec<f64>,
 }
 
-fn fit(candidate: &Candidate, measured: &FrfSet, iterations: usize, start: Option<&[f64]>) -> Option<Fit> {
+/// The nominal system, the data for the candidates fitted by low-rank
+/// updates of it, and their local forms (see [`local`]).
+type Local<'a> = Option<(&'a DampedSystem, &'a LocalData, &'a LocalForm)>;
+
+fn fit(candidate: &Candidate, measured: &FrfSet, local: Local<'_>, iterations: usize, start: Option<&[f64]>) -> Option<Fit> {
     let mut sys = DampedSystem::new(candidate.model.clone()).ok()?;
     let params = ParameterSet::new(candidate.parameters.clone());
     if let Some(v) = start {
@@ -257,9 +263,21 @@ fn fit(candidate: &Candidate, measured: &FrfSet, iterations: usize, start: Optio
     let opts =
         OeOptions { misfit: Misfit::Log, max_iterations: iterations, tolerance: 1e-6, bounds, ..OeOptions::default() };
     let data = OeData { measured, weights: None };
-    let r = oe::run(&mut sys, &params, &data, &opts, |_| {}).ok()?;
+    let r = match local {
+        Some((nominal, ld, form)) => {
+            let mut response = ld.response(nominal, form, sys, &params);
+            oe::run_with(&mut response, now, &data, &opts, |_| {}).ok()?
+        }
+        None => oe::run(&mut sys, &params, &data, &opts, |_| {}).ok()?,
+    };
     let relative_std = (0..params.len()).map(|i| r.covariance[(i, i)].max(0.0).sqrt()).collect();
     Some(Fit { values: r.values, cost: r.cost, n: r.n_data, relative_std })
+}
+
+/// The local form of a candidate, when it has one.
+fn local_form(nominal: &DampedSystem, candidate: &Candidate) -> Option<LocalForm> {
+    let sys = DampedSystem::new(candidate.model.clone()).ok()?;
+    LocalForm::of(nominal, &sys, &ParameterSet::new(candidate.parameters.clone()))
 }
 
 fn nominal_cost(sys: &DampedSystem, measured: &FrfSet) -> Result<(f64, usize), UpdateError> {
@@ -295,27 +313,53 @@ pub fn diagnose(model: &fe_model::Model, measured: &FrfSet, opts: &DiagnoseOptio
     let candidates = candidates::generate(model, &copts);
     let bic = |cost: f64, cost0: f64, n: usize, k: usize| (cost - cost0) / s2 + k as f64 * (n as f64).ln();
 
+    // Candidates that change Z only locally are fitted by exact low-rank
+    // updates of the nominal model (see `local`), the others on their own.
+    let mut forms: Vec<Option<LocalForm>> = candidates.par_iter().map(|c| local_form(&nominal, c)).collect();
+    let local_data = |set: &FrfSet, forms: &[&Option<LocalForm>]| {
+        let forms: Vec<&LocalForm> = forms.iter().filter_map(|f| f.as_ref()).collect();
+        LocalData::new(&nominal, set.channels(), set.frequencies_hz(), &forms)
+    };
+    let screen = |candidates: &[Candidate], forms: &[Option<LocalForm>]| -> Result<Vec<Option<Fit>>, UpdateError> {
+        let data = local_data(&coarse, &forms.iter().collect::<Vec<_>>())?;
+        Ok(candidates
+            .par_iter()
+            .zip(forms)
+            .map(|(c, f)| {
+                let local = f.as_ref().map(|f| (&nominal, &data, f));
+                fit(c, &coarse, local, opts.screen_iterations, None)
+            })
+            .collect())
+    };
+    // full fits, warm-started from screening
+    let full_fit = |candidates: &[Candidate],
+                    forms: &[Option<LocalForm>],
+                    screened: &[Option<Fit>],
+                    which: &[usize]|
+     -> Result<Vec<(usize, Option<Fit>)>, UpdateError> {
+        let data = local_data(&full, &which.iter().map(|&i| &forms[i]).collect::<Vec<_>>())?;
+        Ok(which
+            .par_iter()
+            .map(|&i| {
+                let local = forms[i].as_ref().map(|f| (&nominal, &data, f));
+                let start = screened[i].as_ref().map(|f| f.values.as_slice());
+                let f = fit(&candidates[i], &full, local, opts.iterations, start)
+                    .or_else(|| fit(&candidates[i], &full, local, opts.iterations, None));
+                (i, f)
+            })
+            .collect())
+    };
+
     // screening
-    let screened: Vec<Option<Fit>> =
-        candidates.par_iter().map(|c| fit(c, &coarse, opts.screen_iterations, None)).collect();
+    let mut screened = screen(&candidates, &forms)?;
     let mut order: Vec<usize> = (0..candidates.len()).filter(|&i| screened[i].is_some()).collect();
-    let score = |i: usize| {
+    let score = |screened: &[Option<Fit>], candidates: &[Candidate], i: usize| {
         let f = screened[i].as_ref().expect("filtered");
         bic(f.cost, cost0_coarse, n_coarse, candidates[i].parameters.len())
     };
-    order.sort_by(|&a, &b| score(a).total_cmp(&score(b)));
+    order.sort_by(|&a, &b| score(&screened, &candidates, a).total_cmp(&score(&screened, &candidates, b)));
     let keep: Vec<usize> = order.iter().copied().take(opts.keep).collect();
-
-    // full fits of the leaders, warm-started from screening
-    let full_fits: Vec<(usize, Option<Fit>)> = keep
-        .par_iter()
-        .map(|&i| {
-            let start = screened[i].as_ref().map(|f| f.values.as_slice());
-            let f = fit(&candidates[i], &full, opts.iterations, start)
-                .or_else(|| fit(&candidates[i], &full, opts.iterations, None));
-            (i, f)
-        })
-        .collect();
+    let mut full_fits = full_fit(&candidates, &forms, &screened, &keep)?;
 
     // The leaders' locations are refined into per-element stiffness and mass
     // changes (see `candidates::neighbourhood`): on large models those were
@@ -334,39 +378,20 @@ pub fn diagnose(model: &fe_model::Model, measured: &FrfSet, opts: &DiagnoseOptio
         }
     }
     let refined = candidates::per_element(model, &beams);
+    let refined_forms: Vec<Option<LocalForm>> = refined.par_iter().map(|c| local_form(&nominal, c)).collect();
     // screened like the others; the best few fitted fully
+    let refined_screened = screen(&refined, &refined_forms)?;
     let first_refined = candidates.len();
     let mut candidates = candidates;
     candidates.extend(refined);
-    let mut screened = screened;
-    screened.extend(
-        (first_refined..candidates.len())
-            .into_par_iter()
-            .map(|i| fit(&candidates[i], &coarse, opts.screen_iterations, None))
-            .collect::<Vec<_>>(),
-    );
-    let score = |i: usize| {
-        let f = screened[i].as_ref().expect("filtered");
-        bic(f.cost, cost0_coarse, n_coarse, candidates[i].parameters.len())
-    };
+    forms.extend(refined_forms);
+    screened.extend(refined_screened);
     let mut new: Vec<usize> = (first_refined..candidates.len()).filter(|&i| screened[i].is_some()).collect();
-    new.sort_by(|&a, &b| score(a).total_cmp(&score(b)));
-    let mut full_fits = full_fits;
-    full_fits.extend(
-        new.iter()
-            .take(REFINED_FITS)
-            .collect::<Vec<_>>()
-            .into_par_iter()
-            .map(|&i| {
-                let start = screened[i].as_ref().map(|f| f.values.as_slice());
-                let f = fit(&candidates[i], &full, opts.iterations, start)
-                    .or_else(|| fit(&candidates[i], &full, opts.iterations, None));
-                (i, f)
-            })
-            .collect::<Vec<_>>(),
-    );
+    new.sort_by(|&a, &b| score(&screened, &candidates, a).total_cmp(&score(&screened, &candidates, b)));
+    let best_new: Vec<usize> = new.iter().copied().take(REFINED_FITS).collect();
+    full_fits.extend(full_fit(&candidates, &forms, &screened, &best_new)?);
     order.extend(new);
-    order.sort_by(|&a, &b| score(a).total_cmp(&score(b)));
+    order.sort_by(|&a, &b| score(&screened, &candidates, a).total_cmp(&score(&screened, &candidates, b)));
 
     let ranked = |i: usize, f: &Fit, cost0: f64, n: usize, fully: bool| {
         let c = &candidates[i];
