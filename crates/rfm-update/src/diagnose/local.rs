@@ -104,10 +104,15 @@ impl LocalForm {
                 continue;
             };
             let bc = &a.blocks[b];
-            let same_eqs = b0.eqs.len() == bc.eqs.len() && b0.eqs.iter().zip(&bc.eqs).all(|(&e0, &e)| map[e] == Some(e0));
+            let same_eqs =
+                b0.eqs.len() == bc.eqs.len() && b0.eqs.iter().zip(&bc.eqs).all(|(&e0, &e)| map[e] == Some(e0));
             let same_group = b0.group == bc.group && g0.get(b0.group) == g.get(bc.group);
             let same_terms = b0.terms.len() == bc.terms.len()
-                && b0.terms.iter().zip(&bc.terms).all(|(x, y)| x.value == y.value && x.kind == y.kind && x.unit == y.unit);
+                && b0
+                    .terms
+                    .iter()
+                    .zip(&bc.terms)
+                    .all(|(x, y)| x.value == y.value && x.kind == y.kind && x.unit == y.unit);
             if !(same_eqs && same_group && same_terms) {
                 *t = true;
             }
@@ -191,14 +196,20 @@ pub(crate) struct LocalData {
     w_eqs: Vec<usize>,
     /// Per channel: (index of its response, index of its reference) in `w_eqs`.
     picks: Vec<(usize, usize)>,
-    /// Per line: `H_0` at the channels.
-    h0: Vec<Vec<C64>>,
-    /// Per line: `H_0[:, W]`, `n x |W|` row-interleaved in equation order.
-    w_cols: Vec<Vec<C64>>,
     /// The distinct `D`s.
     slots: Vec<Vec<usize>>,
-    /// Per line and slot: `S = H_0[D, D]`.
-    s: Vec<Vec<Mat<C64>>>,
+    /// Per line: the nominal receptances needed.
+    per_line: Vec<Line>,
+}
+
+/// The nominal receptances at one line.
+struct Line {
+    /// `H_0` at the channels.
+    h0: Vec<C64>,
+    /// `H_0[:, W]`, `n x |W|` row-interleaved in equation order.
+    w_cols: Vec<C64>,
+    /// Per slot: `S = H_0[D, D]`.
+    s: Vec<Mat<C64>>,
 }
 
 impl LocalData {
@@ -241,7 +252,7 @@ impl LocalData {
         columns.sort_unstable();
         let solver = ZSolver::new(&nominal.assembly().pattern)?;
         let n = nominal.n();
-        let per_line: Vec<(Vec<C64>, Vec<C64>, Vec<Mat<C64>>)> = lines
+        let per_line: Vec<Line> = lines
             .par_iter()
             .map_init(
                 || (solver.workspace(), Vec::new(), Vec::new()),
@@ -270,19 +281,11 @@ impl LocalData {
                             }
                         }
                     }
-                    Ok((h0, w_cols, s))
+                    Ok(Line { h0, w_cols, s })
                 },
             )
             .collect::<Result<_, frf::FrfError>>()?;
-        let mut h0 = Vec::with_capacity(lines.len());
-        let mut w_cols = Vec::with_capacity(lines.len());
-        let mut s = Vec::with_capacity(lines.len());
-        for (a, b, c) in per_line {
-            h0.push(a);
-            w_cols.push(b);
-            s.push(c);
-        }
-        Ok(LocalData { lines: lines.to_vec(), w_eqs, picks, h0, w_cols, slots, s })
+        Ok(LocalData { lines: lines.to_vec(), w_eqs, picks, slots, per_line })
     }
 
     /// The model response of one candidate, starting at its system's values.
@@ -308,11 +311,7 @@ impl LocalData {
             })
             .collect();
         let k = self.w_eqs.len();
-        let x = self
-            .w_cols
-            .iter()
-            .map(|cols| Mat::from_fn(d, k, |a, j| cols[form.eqs[a] * k + j]))
-            .collect();
+        let x = self.per_line.iter().map(|line| Mat::from_fn(d, k, |a, j| line.w_cols[form.eqs[a] * k + j])).collect();
         LocalResponse { data: self, slot, form, sys, params, nominal_z, x }
     }
 }
@@ -353,7 +352,8 @@ impl Response for LocalResponse<'_> {
             LocalForm::add_blocks(a, &self.form.blocks, |g, kind| coefs[g].of(kind), &index, &mut z);
             // condensed onto D: dZ = A - B C^-1 B^T = T^T Z T with T = [I; -C^-1 B^T]
             let t = (e > 0).then(|| {
-                let c_inv_bt = z.as_ref().submatrix(d, d, e, e).partial_piv_lu().solve(z.as_ref().submatrix(d, 0, e, d));
+                let c_inv_bt =
+                    z.as_ref().submatrix(d, d, e, e).partial_piv_lu().solve(z.as_ref().submatrix(d, 0, e, d));
                 let mut t = Mat::<C64>::zeros(d + e, d);
                 t.as_mut().submatrix_mut(0, 0, d, d).copy_from(Mat::<C64>::identity(d, d));
                 t.as_mut().submatrix_mut(d, 0, e, d).copy_from(-&c_inv_bt);
@@ -364,7 +364,7 @@ impl Response for LocalResponse<'_> {
                 None => m.clone(),
             };
             let dz = condense(&z);
-            let s = &self.data.s[k][self.slot];
+            let s = &self.data.per_line[k].s[self.slot];
             let y = (Mat::<C64>::identity(d, d) + s * &dz).partial_piv_lu().solve(&self.x[k]);
             let p = &dz * &y;
             let x = &self.x[k];
@@ -373,7 +373,7 @@ impl Response for LocalResponse<'_> {
                 .picks
                 .iter()
                 .enumerate()
-                .map(|(c, &(r, fi))| self.data.h0[k][c] - column_dot(x, r, &p, fi))
+                .map(|(c, &(r, fi))| self.data.per_line[k].h0[c] - column_dot(x, r, &p, fi))
                 .collect();
             if h.iter().any(|v| !(v.re.is_finite() && v.im.is_finite())) {
                 return None;

@@ -31,6 +31,13 @@
 //! two leaders' locations are then refined into per-element changes, which
 //! are screened and the best four fitted fully, so that one weakened element
 //! is named as such and not as its region or a mass at its node.
+//!
+//! Every fit is exact but none refactorises the candidate's model: a
+//! candidate changes `Z` only on the few equations it touches, so its
+//! receptances and sensitivities follow from the nominal model's by a
+//! low-rank (Woodbury) update ([`local`]), and one factorisation of the
+//! nominal `Z` per line serves every candidate. A candidate touching more
+//! than a few dozen equations is fitted on its own model instead.
 
 pub mod candidates;
 mod local;
@@ -251,7 +258,13 @@ struct Fit {
 /// updates of it, and their local forms (see [`local`]).
 type Local<'a> = Option<(&'a DampedSystem, &'a LocalData, &'a LocalForm)>;
 
-fn fit(candidate: &Candidate, measured: &FrfSet, local: Local<'_>, iterations: usize, start: Option<&[f64]>) -> Option<Fit> {
+fn fit(
+    candidate: &Candidate,
+    measured: &FrfSet,
+    local: Local<'_>,
+    iterations: usize,
+    start: Option<&[f64]>,
+) -> Option<Fit> {
     let mut sys = DampedSystem::new(candidate.model.clone()).ok()?;
     let params = ParameterSet::new(candidate.parameters.clone());
     if let Some(v) = start {
