@@ -35,7 +35,7 @@
 //! Every fit is exact but none refactorises the candidate's model: a
 //! candidate changes `Z` only on the few equations it touches, so its
 //! receptances and sensitivities follow from the nominal model's by a
-//! low-rank (Woodbury) update ([`local`]), and one factorisation of the
+//! low-rank (Woodbury) update (module `local`), and one factorisation of the
 //! nominal `Z` per line serves every candidate. A candidate touching more
 //! than a few dozen equations is fitted on its own model instead.
 
@@ -255,7 +255,7 @@ struct Fit {
 }
 
 /// The nominal system, the data for the candidates fitted by low-rank
-/// updates of it, and their local forms (see [`local`]).
+/// updates of it, and their local forms (see module `local`).
 type Local<'a> = Option<(&'a DampedSystem, &'a LocalData, &'a LocalForm)>;
 
 fn fit(
@@ -340,7 +340,10 @@ pub fn diagnose(model: &fe_model::Model, measured: &FrfSet, opts: &DiagnoseOptio
             .zip(forms)
             .map(|(c, f)| {
                 let local = f.as_ref().map(|f| (&nominal, &data, f));
+                // a low-rank update that cannot be evaluated (a singular
+                // local system at some line) falls back to the whole model
                 fit(c, &coarse, local, opts.screen_iterations, None)
+                    .or_else(|| local.and_then(|_| fit(c, &coarse, None, opts.screen_iterations, None)))
             })
             .collect())
     };
@@ -357,7 +360,8 @@ pub fn diagnose(model: &fe_model::Model, measured: &FrfSet, opts: &DiagnoseOptio
                 let local = forms[i].as_ref().map(|f| (&nominal, &data, f));
                 let start = screened[i].as_ref().map(|f| f.values.as_slice());
                 let f = fit(&candidates[i], &full, local, opts.iterations, start)
-                    .or_else(|| fit(&candidates[i], &full, local, opts.iterations, None));
+                    .or_else(|| fit(&candidates[i], &full, None, opts.iterations, start))
+                    .or_else(|| fit(&candidates[i], &full, None, opts.iterations, None));
                 (i, f)
             })
             .collect())
