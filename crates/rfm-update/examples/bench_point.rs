@@ -15,16 +15,12 @@
 #[path = "../benches/common/mod.rs"]
 mod common;
 
+mod point;
+
 use std::time::Instant;
 
+use point::{arg, peak_kib};
 use rfm_update::sensitivity::{self, ChannelPlan, Hybrid};
-
-fn arg<T: std::str::FromStr>(args: &[String], name: &str, default: T) -> T {
-    match args.iter().position(|a| a == name) {
-        Some(i) => args.get(i + 1).and_then(|v| v.parse().ok()).unwrap_or_else(|| panic!("{name} needs a value")),
-        None => default,
-    }
-}
 
 /// CPU time used so far by all threads of this process (s), from
 /// /proc/self/task/*/schedstat (nanoseconds on the CPU).
@@ -35,13 +31,6 @@ fn cpu_seconds() -> Option<f64> {
         total += stat.split_whitespace().next()?.parse::<u64>().ok()?;
     }
     Some(total as f64 * 1e-9)
-}
-
-/// Peak resident set size of this process (KiB), from /proc/self/status.
-fn peak_kib() -> Option<u64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    line.split_whitespace().nth(1)?.parse().ok()
 }
 
 fn main() {

@@ -13,26 +13,15 @@
 //! leader is the hidden stiffness loss at the right element (or a neighbour).
 //! `--verbose` prints the first six of the ranking to stderr.
 
+mod point;
+
 use std::time::Instant;
 
 use damping::DampedSystem;
 use fe_model::{Dof, samples};
 use frf::{Channel, NoiseModel, synthesize};
+use point::{arg, peak_kib};
 use rfm_update::diagnose::{DiagnoseOptions, EffectKind, diagnose};
-
-fn arg<T: std::str::FromStr>(args: &[String], name: &str, default: T) -> T {
-    match args.iter().position(|a| a == name) {
-        Some(i) => args.get(i + 1).and_then(|v| v.parse().ok()).unwrap_or_else(|| panic!("{name} needs a value")),
-        None => default,
-    }
-}
-
-/// Peak resident set size of this process (KiB), from /proc/self/status.
-fn peak_kib() -> Option<u64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    line.split_whitespace().nth(1)?.parse().ok()
-}
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
