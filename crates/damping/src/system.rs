@@ -74,6 +74,13 @@ impl DampedSystem {
         Ok(DampedSystem { model, assembly })
     }
 
+    /// Assembles a part of a model ([`Model::part`]), which may float free;
+    /// see [`Assembly::of_part`].
+    pub fn of_part(model: Model) -> Result<Self, ModelError> {
+        let assembly = Assembly::of_part(&model)?;
+        Ok(DampedSystem { model, assembly })
+    }
+
     /// The model.
     pub fn model(&self) -> &Model {
         &self.model

@@ -284,6 +284,21 @@ impl Assembly {
     /// Assembles a model. Fails when no DOF is free, when a node with free
     /// DOFs touches nothing, or when a free DOF has no stiffness at all.
     pub fn new(model: &Model) -> Result<Self, ModelError> {
+        let assembly = Self::build(model, true)?;
+        crate::kinematics::check(model)?;
+        assembly.check_stiffness_diagonal()?;
+        Ok(assembly)
+    }
+
+    /// Assembles a part of a model ([`Model::part`]) without the checks that
+    /// only a whole structure passes: a part may float free, and its nodes
+    /// may touch nothing. Fails only when no DOF is free or a stiffness or
+    /// mass is not finite.
+    pub fn of_part(model: &Model) -> Result<Self, ModelError> {
+        Self::build(model, false)
+    }
+
+    fn build(model: &Model, whole: bool) -> Result<Self, ModelError> {
         let dofs = build_dof_map(model);
         if dofs.is_empty() {
             return Err(ModelError::NoFreeDof);
@@ -338,7 +353,7 @@ impl Assembly {
         }
         for (i, node) in model.nodes.iter().enumerate() {
             let has_free = Dof::ALL.iter().any(|&d| dofs.equation(DofRef { node: node.id, dof: d }).is_some());
-            if !touched[i] && has_free {
+            if whole && !touched[i] && has_free {
                 return Err(ModelError::DanglingNode { id: node.id.0 });
             }
         }
@@ -359,10 +374,7 @@ impl Assembly {
                 }
             }
         }
-        let assembly = Assembly { dofs, pattern, blocks, group_blocks, by_quantity };
-        crate::kinematics::check(model)?;
-        assembly.check_stiffness_diagonal()?;
-        Ok(assembly)
+        Ok(Assembly { dofs, pattern, blocks, group_blocks, by_quantity })
     }
 
     /// Every free DOF needs some stiffness: a zero diagonal in K means a DOF

@@ -604,6 +604,54 @@ impl Model {
         Ok(())
     }
 
+    /// The part of the model on the given nodes, for local computations: the
+    /// beams with both ends among them, the springs, masses and supports on
+    /// them, and the ties between them. A node tied to one of them is taken
+    /// in too (with its supports), so that every DOF of the part is free or
+    /// fixed as in the whole model. Materials, sections and groups are kept
+    /// whole, at the same indices; beams, springs and masses keep their ids
+    /// and names but not their indices. A part usually floats free, so it is
+    /// assembled with [`crate::Assembly::of_part`], not [`crate::Assembly::new`].
+    pub fn part(&self, nodes: &[NodeId]) -> Model {
+        let mut keep = vec![false; self.nodes.len()];
+        for id in nodes {
+            if let Some(&i) = self.node_index.get(id) {
+                keep[i] = true;
+            }
+        }
+        // closure over ties: a tie chain can reach further than one step
+        loop {
+            let mut grew = false;
+            for t in &self.ties {
+                let [a, b] = t.nodes.map(|n| self.node_index[&n]);
+                if keep[a] != keep[b] {
+                    keep[a] = true;
+                    keep[b] = true;
+                    grew = true;
+                }
+            }
+            if !grew {
+                break;
+            }
+        }
+        let kept = |id: &NodeId| keep[self.node_index[id]];
+        let nodes: Vec<Node> = self.nodes.iter().filter(|n| kept(&n.id)).cloned().collect();
+        let node_index = nodes.iter().enumerate().map(|(i, n)| (n.id, i)).collect();
+        Model {
+            title: self.title.clone(),
+            nodes,
+            node_index,
+            materials: self.materials.clone(),
+            sections: self.sections.clone(),
+            beams: self.beams.iter().filter(|b| b.nodes.iter().all(kept)).cloned().collect(),
+            springs: self.springs.iter().filter(|s| kept(&s.a) && s.b.as_ref().is_none_or(kept)).cloned().collect(),
+            masses: self.masses.iter().filter(|m| kept(&m.node)).cloned().collect(),
+            supports: self.supports.iter().filter(|s| kept(&s.node)).cloned().collect(),
+            ties: self.ties.iter().filter(|t| t.nodes.iter().all(kept)).cloned().collect(),
+            groups: self.groups.clone(),
+        }
+    }
+
     /// Indices of the beams with an end at `node`.
     pub fn beams_at(&self, node: NodeId) -> Vec<usize> {
         self.beams.iter().enumerate().filter(|(_, b)| b.nodes.contains(&node)).map(|(i, _)| i).collect()
@@ -633,5 +681,49 @@ impl Model {
             .sum();
         let lumped: f64 = self.masses.iter().map(|m| m.m * self.groups[m.group].mass).sum();
         beams + lumped
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::assembly::{Assembly, BlockSource};
+    use crate::samples;
+
+    /// A part keeps what lies on its nodes, pulls in tied nodes, and
+    /// assembles the same blocks as the whole model, though it floats free.
+    #[test]
+    fn a_part_holds_the_blocks_on_its_nodes() {
+        let whole = samples::frame_with_joint();
+        let part = whole.part(&[NodeId(3), NodeId(4)]);
+        // node 2 is tied to node 3, so it belongs to the part
+        let ids: Vec<u32> = part.nodes().iter().map(|n| n.id.0).collect();
+        assert_eq!(ids, [2, 3, 4]);
+        assert_eq!(part.beams().iter().map(|b| b.id.0).collect::<Vec<_>>(), [2]);
+        assert_eq!(part.springs().len(), 1);
+        assert_eq!(part.masses().len(), 1);
+        assert_eq!(part.ties().len(), 1);
+        assert!(part.supports().is_empty());
+        assert_eq!(part.groups(), whole.groups());
+        // the arm alone is a mechanism: only a part assembly accepts it
+        assert!(Assembly::new(&part).is_err());
+        let (a, w) = (Assembly::of_part(&part).unwrap(), Assembly::new(&whole).unwrap());
+        assert_eq!(a.n(), 7, "ux, uy shared by nodes 2 and 3, three rotations, node 4's ux, uy");
+        let beam = |asm: &Assembly, m: &Model| {
+            asm.blocks
+                .iter()
+                .find(|b| matches!(b.source, BlockSource::Beam(i) if m.beams()[i].id.0 == 2))
+                .cloned()
+                .unwrap()
+        };
+        let (bp, bw) = (beam(&a, &part), beam(&w, &whole));
+        for (tp, tw) in bp.terms.iter().zip(&bw.terms) {
+            assert_eq!(tp.unit, tw.unit);
+            assert_eq!(tp.value, tw.value);
+        }
+        // the same DOFs in both numberings
+        for (&ep, &ew) in bp.eqs.iter().zip(&bw.eqs) {
+            assert_eq!(a.dofs.dof_of(ep), w.dofs.dof_of(ew));
+        }
     }
 }

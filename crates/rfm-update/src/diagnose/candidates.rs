@@ -10,14 +10,20 @@
 //! | viscous damping | each region of a few elements | alpha of the region |
 //! | non-viscous damping | each region | alpha and mu of the region |
 //!
-//! Each candidate is the nominal model with the effect inserted at a
+//! Each candidate is a change of the nominal model, the effect inserted at a
 //! starting value that changes little (a very stiff spring, a tiny mass, a
 //! factor of one), the parameters to fit, wide search bounds, and a
 //! plausible range: a sensor mass of a quarter of the structure's mass, or a
 //! joint stiffer than the member it connects, explains data only in a way
 //! no engineer would accept, and the ranking says so.
+//!
+//! A candidate does not carry a copy of the whole model: a large model has
+//! thousands of candidates. It carries the recipe of its change ([`Edit`]),
+//! applied to the whole model on demand ([`Candidate::model`]), and the part
+//! of the model where it acts with the change applied ([`Model::part`]),
+//! which is all the diagnosis needs to fit it (module `local`).
 
-use fe_model::{Dof, ElementId, Group, Model, NodeId, Parameter};
+use fe_model::{Dof, ElementId, Group, Model, ModelError, NodeId, Parameter};
 use serde::Serialize;
 
 /// The kind of a candidate effect.
@@ -55,14 +61,58 @@ impl EffectKind {
     }
 }
 
-/// How a candidate is written into a case file.
+/// The change a candidate makes to the nominal model, at its starting
+/// values: applied to a model by [`Edit::apply`] and written into a case
+/// file by [`Candidate::case_lines`]. Names are chosen free in the whole
+/// nominal model.
 #[derive(Clone, Debug)]
 pub(crate) enum Edit {
-    Mass { node: u32, name: String, group: String },
-    Support { node: u32, dofs: Vec<Dof>, name: String, group: String },
-    NewJoint { node: u32, elements: Vec<u32>, name: String, group: String },
+    /// A lumped mass `m` at a node, in an undamped group of its own.
+    Mass { node: u32, name: String, group: String, m: f64 },
+    /// The rigid support of a node replaced by ground springs `k` on the
+    /// fixed DOFs, in a group with damping `alpha`.
+    Support { node: u32, dofs: Vec<Dof>, name: String, group: String, k: [f64; 3], alpha: f64 },
+    /// Members detached from a node onto a new coincident node, tied to it in
+    /// translation and joined by a rotational spring `kr` with damping `alpha`.
+    NewJoint { node: u32, elements: Vec<u32>, new_node: u32, name: String, group: String, kr: f64, alpha: f64 },
+    /// Nothing added: the parameters exist in the nominal model.
     Set,
-    Region { first: u32, last: u32, group: String, base_beta: f64, viscous: bool },
+    /// Elements `first..=last` moved to a new group.
+    Region { first: u32, last: u32, group: Group, viscous: bool },
+}
+
+impl Edit {
+    /// Applies the change to `m`: the whole nominal model, or a part of it
+    /// that holds the nodes and elements the change touches.
+    pub(crate) fn apply(&self, m: &mut Model) -> Result<(), ModelError> {
+        match self {
+            Edit::Mass { node, name, group, m: mass } => {
+                let g = m.add_group(Group::new(group))?;
+                m.add_mass(name, *node, *mass, 0.0, g)?;
+            }
+            Edit::Support { node, name, group, k, alpha, .. } => {
+                m.remove_support(*node);
+                let g = m.add_group(Group::new(group).rayleigh(*alpha, 0.0))?;
+                m.add_spring(name, *node, None, *k, g)?;
+            }
+            Edit::NewJoint { node, elements, new_node, name, group, kr, alpha } => {
+                let g = m.add_group(Group::new(group).rayleigh(*alpha, 0.0))?;
+                m.split_node(*node, elements, *new_node)?;
+                m.add_tie(*node, *new_node, &[Dof::Ux, Dof::Uy])?;
+                m.add_spring(name, *node, Some(*new_node), [0.0, 0.0, *kr], g)?;
+            }
+            Edit::Set => {}
+            Edit::Region { first, last, group, .. } => {
+                let g = m.add_group(group.clone())?;
+                for id in *first..=*last {
+                    if let Some(i) = m.beam_index(ElementId(id)) {
+                        m.set_beam_group(i, g)?;
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 /// A candidate effect; see the module docs.
@@ -78,15 +128,17 @@ pub struct Candidate {
     pub elements: Vec<u32>,
     /// DOFs it acts on, where that applies.
     pub dofs: Vec<Dof>,
-    /// The nominal model with the effect at its starting values.
-    pub model: Model,
-    /// Parameters to fit (resolved in `model`).
-    pub parameters: Vec<Parameter>,
+    /// Names of the parameters to fit (resolved in [`Candidate::model`]).
+    pub parameters: Vec<String>,
     /// Search bounds per parameter.
     pub bounds: Vec<Option<(f64, f64)>>,
     /// Plausible range per parameter, with the reason shown when outside.
     pub plausible: Vec<(f64, f64, &'static str)>,
     pub(crate) edit: Edit,
+    /// The nominal nodes of [`Self::part`].
+    pub(crate) part_nodes: Vec<NodeId>,
+    /// The part of the nominal model on `part_nodes`, with the change applied.
+    pub(crate) part: Model,
 }
 
 /// Options of candidate generation.
@@ -160,6 +212,19 @@ fn regions(model: &Model, size: usize) -> Vec<Vec<usize>> {
     out
 }
 
+/// Most elements in the region of a stiffness or mass change. A region of
+/// twelve elements in a row touches 39 equations, so its change is still a
+/// low-rank update of the nominal model (module `local`); a larger one
+/// would be fitted on its own model, a factorisation per line and iteration.
+const MAX_CHANGE_REGION: usize = 12;
+
+/// Elements per region of stiffness and mass changes on a model with more
+/// than [`CandidateOptions::per_element_limit`] elements: about half that
+/// many regions, each no larger than [`MAX_CHANGE_REGION`].
+fn change_region_size(elements: usize, opts: &CandidateOptions) -> usize {
+    elements.div_ceil((opts.per_element_limit / 2).max(1)).min(MAX_CHANGE_REGION).max(opts.region_size)
+}
+
 fn element_ids(model: &Model, idx: &[usize]) -> Vec<u32> {
     idx.iter().map(|&i| model.beams()[i].id.0).collect()
 }
@@ -203,18 +268,20 @@ fn change_candidates(model: &Model, unit: &[usize]) -> Vec<Candidate> {
         (EffectKind::MassChange, "mass", (0.5, 2.0, "a change beyond -50 % .. +100 % of the nominal mass")),
     ] {
         let Ok(p) = model.parameter(&field_name(field)) else { continue };
-        out.push(Candidate {
-            kind,
-            description: format!("{} of {}", kind.label(), range_name(&ids)),
-            nodes: nodes_of(model, unit),
-            elements: ids.clone(),
-            dofs: Vec::new(),
-            model: model.clone(),
-            parameters: vec![p],
-            bounds: vec![Some((1e-3, 100.0))],
-            plausible: vec![plaus],
-            edit: Edit::Set,
-        });
+        let nodes = nodes_of(model, unit);
+        out.extend(Candidate::new(
+            model,
+            Head {
+                kind,
+                description: format!("{} of {}", kind.label(), range_name(&ids)),
+                part_nodes: nodes.clone(),
+                nodes,
+                elements: ids.clone(),
+                dofs: Vec::new(),
+            },
+            Edit::Set,
+            vec![(p.name, Some((1e-3, 100.0)), plaus)],
+        ));
     }
     out
 }
@@ -243,6 +310,70 @@ pub(crate) fn per_element(model: &Model, beams: &[usize]) -> Vec<Candidate> {
     beams.iter().flat_map(|&i| change_candidates(model, &[i])).collect()
 }
 
+/// What a candidate is, apart from its change and parameters.
+struct Head {
+    kind: EffectKind,
+    description: String,
+    nodes: Vec<u32>,
+    elements: Vec<u32>,
+    dofs: Vec<Dof>,
+    /// Nominal nodes of every element, spring and mass the change touches.
+    part_nodes: Vec<u32>,
+}
+
+/// A parameter to fit: name, search bounds, plausible range.
+type Fitted = (String, Option<(f64, f64)>, (f64, f64, &'static str));
+
+impl Candidate {
+    /// Builds a candidate: the part of `model` it touches, with the change
+    /// applied. `None` when the change does not apply (it then would not
+    /// apply to the whole model either).
+    fn new(model: &Model, head: Head, edit: Edit, fitted: Vec<Fitted>) -> Option<Candidate> {
+        let part_nodes: Vec<NodeId> = head.part_nodes.iter().map(|&n| NodeId(n)).collect();
+        let mut part = model.part(&part_nodes);
+        edit.apply(&mut part).ok()?;
+        if fitted.iter().any(|(name, ..)| part.parameter(name).is_err()) {
+            return None;
+        }
+        Some(Candidate {
+            kind: head.kind,
+            description: head.description,
+            nodes: head.nodes,
+            elements: head.elements,
+            dofs: head.dofs,
+            parameters: fitted.iter().map(|(n, ..)| n.clone()).collect(),
+            bounds: fitted.iter().map(|f| f.1).collect(),
+            plausible: fitted.iter().map(|f| f.2).collect(),
+            edit,
+            part_nodes,
+            part,
+        })
+    }
+
+    /// The whole nominal model with this effect inserted at its starting values.
+    pub fn model(&self, nominal: &Model) -> Result<Model, ModelError> {
+        let mut m = nominal.clone();
+        self.edit.apply(&mut m)?;
+        Ok(m)
+    }
+
+    /// The parameters to fit, resolved in `model` ([`Self::model`] or a part of it).
+    pub fn parameters_in(&self, model: &Model) -> Result<Vec<Parameter>, ModelError> {
+        self.parameters.iter().map(|n| model.parameter(n)).collect()
+    }
+
+    /// The part of the nominal model that the effect touches, with the
+    /// effect inserted (see [`Model::part`]).
+    pub(crate) fn part(&self) -> &Model {
+        &self.part
+    }
+
+    /// The nominal nodes of [`Self::part`].
+    pub(crate) fn part_nodes(&self) -> &[NodeId] {
+        &self.part_nodes
+    }
+}
+
 /// Generates every candidate for a model; see the module docs.
 pub fn generate(model: &Model, opts: &CandidateOptions) -> Vec<Candidate> {
     let mut out = Vec::new();
@@ -253,6 +384,14 @@ pub fn generate(model: &Model, opts: &CandidateOptions) -> Vec<Candidate> {
     let alpha_start = 1e-4 / w_mid; // a loss factor of 1e-4 at mid band
     let alpha_bounds = Some((1e-9 / w_max, 10.0 / w_min));
     let alpha_plausible = (0.0, 1.0 / w_max, "a loss factor above 1 in the band");
+    let ring = |node: NodeId| -> Vec<u32> {
+        let mut v: Vec<u32> =
+            model.beams_at(node).into_iter().flat_map(|i| model.beams()[i].nodes.map(|n| n.0)).collect();
+        v.push(node.0);
+        v.sort_unstable();
+        v.dedup();
+        v
+    };
 
     // flexible, lossy supports
     let supported: Vec<u32> = {
@@ -262,50 +401,47 @@ pub fn generate(model: &Model, opts: &CandidateOptions) -> Vec<Candidate> {
         v
     };
     for node in supported {
-        let mut m = model.clone();
-        let dofs = m.remove_support(node);
+        let mut dofs: Vec<Dof> =
+            model.supports().iter().filter(|s| s.node.0 == node).flat_map(|s| s.dofs.iter().copied()).collect();
+        dofs.sort();
+        dofs.dedup();
         let kref = local_stiffness(model, NodeId(node));
         if dofs.is_empty() || dofs.iter().any(|d| kref[d.index()] <= 0.0) {
             continue;
         }
-        let group = unique_name(&m, &format!("support_{node}"));
-        let g = m.add_group(Group::new(&group).rayleigh(alpha_start, 0.0)).expect("fresh group");
+        let group = unique_name(model, &format!("support_{node}"));
         let mut k = [0.0; 3];
         for d in &dofs {
             k[d.index()] = 100.0 * kref[d.index()];
         }
         let name = group.clone();
-        if m.add_spring(&name, node, None, k, g).is_err() {
-            continue;
-        }
-        let mut parameters = Vec::new();
-        let mut bounds = Vec::new();
-        let mut plausible = Vec::new();
-        for d in &dofs {
-            let field = ["kx", "ky", "kr"][d.index()];
-            parameters.push(m.parameter(&format!("spring.{name}.{field}")).expect("just added"));
-            let r = kref[d.index()];
-            bounds.push(Some((1e-6 * r, 1e4 * r)));
-            plausible.push((0.0, 10.0 * r, "stiffer than the member it holds"));
-        }
-        parameters.push(m.parameter(&format!("group.{group}.alpha")).expect("just added"));
-        bounds.push(alpha_bounds);
-        plausible.push(alpha_plausible);
-        out.push(Candidate {
+        let mut fitted: Vec<Fitted> = dofs
+            .iter()
+            .map(|d| {
+                let r = kref[d.index()];
+                (
+                    format!("spring.{name}.{}", ["kx", "ky", "kr"][d.index()]),
+                    Some((1e-6 * r, 1e4 * r)),
+                    (0.0, 10.0 * r, "stiffer than the member it holds"),
+                )
+            })
+            .collect();
+        fitted.push((format!("group.{group}.alpha"), alpha_bounds, alpha_plausible));
+        let head = Head {
             kind: EffectKind::FlexibleSupport,
             description: format!("flexible, lossy support at node {node}"),
             nodes: vec![node],
             elements: Vec::new(),
             dofs: dofs.clone(),
-            model: m,
-            parameters,
-            bounds,
-            plausible,
-            edit: Edit::Support { node, dofs, name, group },
-        });
+            // the released DOFs enter every element at the node
+            part_nodes: ring(NodeId(node)),
+        };
+        let edit = Edit::Support { node, dofs, name, group, k, alpha: alpha_start };
+        out.extend(Candidate::new(model, head, edit, fitted));
     }
 
     // flexible, lossy joints where members meet at an angle
+    let new_node = model.max_node_id() + 1;
     for node in model.nodes() {
         let at = model.beams_at(node.id);
         if at.len() < 2 {
@@ -333,76 +469,77 @@ pub fn generate(model: &Model, opts: &CandidateOptions) -> Vec<Candidate> {
         }
         // detach each member except the first (the through-member keeps the node)
         for member in members.iter().skip(1) {
-            let mut m = model.clone();
             let elements = element_ids(model, member);
-            let group = unique_name(&m, &format!("joint_{}_{}", node.id, elements[0]));
-            let g = m.add_group(Group::new(&group).rayleigh(alpha_start, 0.0)).expect("fresh group");
-            let new_id = m.max_node_id() + 1;
-            if m.split_node(node.id.0, &elements, new_id).is_err() {
-                continue;
-            }
-            m.add_tie(node.id.0, new_id, &[Dof::Ux, Dof::Uy]).expect("both nodes exist");
+            let group = unique_name(model, &format!("joint_{}_{}", node.id, elements[0]));
             let kref = local_stiffness(model, node.id)[2];
-            m.add_spring(&group, node.id.0, Some(new_id), [0.0, 0.0, 100.0 * kref], g).expect("valid spring");
-            let parameters = vec![
-                m.parameter(&format!("spring.{group}.kr")).expect("just added"),
-                m.parameter(&format!("group.{group}.alpha")).expect("just added"),
+            let fitted: Vec<Fitted> = vec![
+                (
+                    format!("spring.{group}.kr"),
+                    Some((1e-6 * kref, 1e4 * kref)),
+                    (0.0, 10.0 * kref, "stiffer than the members it joins"),
+                ),
+                (format!("group.{group}.alpha"), alpha_bounds, alpha_plausible),
             ];
-            out.push(Candidate {
+            let mut part_nodes = nodes_of(model, member);
+            part_nodes.push(node.id.0);
+            part_nodes.sort_unstable();
+            part_nodes.dedup();
+            let head = Head {
                 kind: EffectKind::FlexibleJoint,
                 description: format!("flexible, lossy joint at node {} ({})", node.id, range_name(&elements)),
                 nodes: vec![node.id.0],
                 elements: elements.clone(),
                 dofs: vec![Dof::Rz],
-                model: m,
-                parameters,
-                bounds: vec![Some((1e-6 * kref, 1e4 * kref)), alpha_bounds],
-                plausible: vec![(0.0, 10.0 * kref, "stiffer than the members it joins"), alpha_plausible],
-                edit: Edit::NewJoint { node: node.id.0, elements, name: group.clone(), group },
-            });
+                part_nodes,
+            };
+            let edit = Edit::NewJoint {
+                node: node.id.0,
+                elements,
+                new_node,
+                name: group.clone(),
+                group,
+                kr: 100.0 * kref,
+                alpha: alpha_start,
+            };
+            out.extend(Candidate::new(model, head, edit, fitted));
         }
     }
     // existing joint springs: their stiffness and damping as modelled
-    for (si, sp) in model.springs().iter().enumerate() {
+    for sp in model.springs() {
         let Some(b) = sp.b else { continue };
-        let mut parameters = Vec::new();
-        let mut bounds = Vec::new();
-        let mut plausible = Vec::new();
         let kref = local_stiffness(model, sp.a);
-        for d in Dof::ALL {
-            if sp.k[d.index()] > 0.0 {
-                let field = ["kx", "ky", "kr"][d.index()];
-                parameters.push(model.parameter(&format!("spring.{}.{field}", sp.name)).expect("exists"));
+        let mut fitted: Vec<Fitted> = Dof::ALL
+            .iter()
+            .filter(|d| sp.k[d.index()] > 0.0)
+            .map(|d| {
                 let r = kref[d.index()].max(sp.k[d.index()]);
-                bounds.push(Some((1e-6 * r, 1e4 * r)));
-                plausible.push((0.0, 10.0 * r, "stiffer than the members it joins"));
-            }
-        }
+                (
+                    format!("spring.{}.{}", sp.name, ["kx", "ky", "kr"][d.index()]),
+                    Some((1e-6 * r, 1e4 * r)),
+                    (0.0, 10.0 * r, "stiffer than the members it joins"),
+                )
+            })
+            .collect();
         let g = &model.groups()[sp.group];
         let group_only_this = model.springs().iter().filter(|o| o.group == sp.group).count() == 1
             && model.beams().iter().all(|o| o.group != sp.group)
             && model.masses().iter().all(|o| o.group != sp.group);
         if group_only_this && g.alpha > 0.0 {
-            parameters.push(model.parameter(&format!("group.{}.alpha", g.name)).expect("exists"));
-            bounds.push(alpha_bounds);
-            plausible.push(alpha_plausible);
+            fitted.push((format!("group.{}.alpha", g.name), alpha_bounds, alpha_plausible));
         }
-        let _ = si;
-        out.push(Candidate {
+        let head = Head {
             kind: EffectKind::FlexibleJoint,
             description: format!("joint `{}` between nodes {} and {} (as modelled)", sp.name, sp.a, b),
             nodes: vec![sp.a.0, b.0],
             elements: Vec::new(),
             dofs: Dof::ALL.iter().copied().filter(|d| sp.k[d.index()] > 0.0).collect(),
-            model: model.clone(),
-            parameters,
-            bounds,
-            plausible,
-            edit: Edit::Set,
-        });
+            part_nodes: vec![sp.a.0, b.0],
+        };
+        out.extend(Candidate::new(model, head, Edit::Set, fitted));
     }
 
     // lumped masses at free nodes
+    let mass_group = unique_name(model, "added_masses");
     for node in model.nodes() {
         let fully_fixed = model
             .supports()
@@ -415,23 +552,22 @@ pub fn generate(model: &Model, opts: &CandidateOptions) -> Vec<Candidate> {
         if fully_fixed || model.beams_at(node.id).is_empty() {
             continue;
         }
-        let mut m = model.clone();
-        let group = unique_name(&m, "added_masses");
-        let g = m.add_group(Group::new(&group)).expect("fresh group");
-        let name = unique_name(&m, &format!("mass_{}", node.id));
-        m.add_mass(&name, node.id.0, 1e-3 * total_mass, 0.0, g).expect("valid mass");
-        out.push(Candidate {
+        let name = unique_name(model, &format!("mass_{}", node.id));
+        let fitted: Vec<Fitted> = vec![(
+            format!("mass.{name}.m"),
+            Some((1e-7 * total_mass, 10.0 * total_mass)),
+            (0.0, 0.25 * total_mass, "more than a quarter of the structure's mass"),
+        )];
+        let head = Head {
             kind: EffectKind::LumpedMass,
             description: format!("lumped mass at node {}", node.id),
             nodes: vec![node.id.0],
             elements: Vec::new(),
             dofs: vec![Dof::Ux, Dof::Uy],
-            parameters: vec![m.parameter(&format!("mass.{name}.m")).expect("just added")],
-            model: m,
-            bounds: vec![Some((1e-7 * total_mass, 10.0 * total_mass))],
-            plausible: vec![(0.0, 0.25 * total_mass, "more than a quarter of the structure's mass")],
-            edit: Edit::Mass { node: node.id.0, name, group },
-        });
+            part_nodes: vec![node.id.0],
+        };
+        let edit = Edit::Mass { node: node.id.0, name, group: mass_group.clone(), m: 1e-3 * total_mass };
+        out.extend(Candidate::new(model, head, edit, fitted));
     }
 
     // stiffness and mass changes per element or per region
@@ -440,7 +576,7 @@ pub fn generate(model: &Model, opts: &CandidateOptions) -> Vec<Candidate> {
         v.sort_by_key(|&i| model.beams()[i].id);
         v.into_iter().map(|i| vec![i]).collect()
     } else {
-        regions(model, model.beams().len().div_ceil(opts.per_element_limit / 2).max(opts.region_size))
+        regions(model, change_region_size(model.beams().len(), opts))
     };
     for unit in &units {
         out.extend(change_candidates(model, unit));
@@ -451,41 +587,30 @@ pub fn generate(model: &Model, opts: &CandidateOptions) -> Vec<Candidate> {
         let ids = element_ids(model, &region);
         let base = model.groups()[model.beams()[region[0]].group].clone();
         for viscous in [true, false] {
-            let mut m = model.clone();
-            let group = unique_name(&m, &format!("damping_{}_{}", ids[0], ids[ids.len() - 1]));
+            let name = unique_name(model, &format!("damping_{}_{}", ids[0], ids[ids.len() - 1]));
             let alpha0 = if base.alpha > 0.0 { base.alpha } else { alpha_start };
-            let mut g = Group::new(&group).rayleigh(alpha0, base.beta);
+            let mut g = Group::new(&name).rayleigh(alpha0, base.beta);
             g.mu = if viscous { base.mu } else { Some(w_mid) };
             g.stiffness = base.stiffness;
             g.mass = base.mass;
-            let gi = m.add_group(g).expect("fresh group");
-            for &i in &region {
-                m.set_beam_group(i, gi).expect("group exists");
-            }
-            let mut parameters = vec![m.parameter(&format!("group.{group}.alpha")).expect("just added")];
-            let mut bounds = vec![alpha_bounds];
-            let mut plausible = vec![alpha_plausible];
+            let mut fitted: Vec<Fitted> = vec![(format!("group.{name}.alpha"), alpha_bounds, alpha_plausible)];
             if !viscous {
-                parameters.push(m.parameter(&format!("group.{group}.mu")).expect("just added"));
-                bounds.push(Some((1e-3 * w_min, 1e3 * w_max)));
-                plausible.push((0.0, f64::INFINITY, ""));
+                fitted.push((format!("group.{name}.mu"), Some((1e-3 * w_min, 1e3 * w_max)), (0.0, f64::INFINITY, "")));
             }
             let kind = if viscous { EffectKind::ViscousDamping } else { EffectKind::NonViscousDamping };
-            out.push(Candidate {
+            let nodes = nodes_of(model, &region);
+            let head = Head {
                 kind,
                 description: format!("{} in {}", kind.label(), range_name(&ids)),
-                nodes: nodes_of(model, &region),
+                part_nodes: nodes.clone(),
+                nodes,
                 elements: ids.clone(),
                 dofs: Vec::new(),
-                model: m,
-                parameters,
-                bounds,
-                plausible,
-                edit: Edit::Region { first: ids[0], last: ids[ids.len() - 1], group, base_beta: base.beta, viscous },
-            });
+            };
+            let edit = Edit::Region { first: ids[0], last: ids[ids.len() - 1], group: g, viscous };
+            out.extend(Candidate::new(model, head, edit, fitted));
         }
     }
-    out.retain(|c| fe_model::Assembly::new(&c.model).is_ok());
     out
 }
 
@@ -495,11 +620,11 @@ impl Candidate {
     pub fn case_lines(&self, values: &[f64]) -> (String, Vec<(String, f64)>) {
         let mut set = Vec::new();
         let text = match &self.edit {
-            Edit::Mass { node, name, group } => format!(
+            Edit::Mass { node, name, group, .. } => format!(
                 "[groups.{group}]                # an undamped group for added masses\n\n[[masses]]\nname = \"{name}\"\nnode = {node}\nm = {:e}\ngroup = \"{group}\"\n",
                 values[0]
             ),
-            Edit::Support { node, dofs, name, group } => {
+            Edit::Support { node, dofs, name, group, .. } => {
                 let mut s = format!(
                     "# replaces the rigid support of node {node}: delete its [[supports]] entry\n[groups.{group}]\nalpha = {:e}\n\n[[springs]]\nname = \"{name}\"\nnode = {node}                      # to ground\n",
                     values[dofs.len()]
@@ -510,23 +635,24 @@ impl Candidate {
                 s.push_str(&format!("group = \"{group}\"\n"));
                 s
             }
-            Edit::NewJoint { node, elements, name, group } => format!(
+            Edit::NewJoint { node, elements, name, group, .. } => format!(
                 "[groups.{group}]\nalpha = {:e}\n\n[[joints]]\nname = \"{name}\"\nnode = {node}\nelements = {elements:?}\nkr = {:e}\ngroup = \"{group}\"\n",
                 values[1], values[0]
             ),
             Edit::Set => {
-                for (p, &v) in self.parameters.iter().zip(values) {
+                let params = self.parameters_in(&self.part).expect("resolved when the candidate was made");
+                for (p, &v) in params.iter().zip(values) {
                     for &q in &p.quantities {
-                        set.push((self.model.quantity_name(q).to_string(), v));
+                        set.push((self.part.quantity_name(q).to_string(), v));
                     }
                 }
                 String::new()
             }
-            Edit::Region { first, last, group, base_beta, viscous } => {
+            Edit::Region { first, last, group, viscous } => {
                 let mu = if *viscous { String::new() } else { format!("mu = {:e}\n", values[1]) };
                 format!(
-                    "[groups.{group}]\nalpha = {:e}\nbeta = {base_beta:e}\n{mu}\n[[assign]]\nelements = \"{first}..{last}\"\ngroup = \"{group}\"\n",
-                    values[0]
+                    "[groups.{}]\nalpha = {:e}\nbeta = {:e}\n{mu}\n[[assign]]\nelements = \"{first}..{last}\"\ngroup = \"{}\"\n",
+                    group.name, values[0], group.beta, group.name
                 )
             }
         };
@@ -535,8 +661,8 @@ impl Candidate {
 
     /// The first plausibility problem of the given values, if any.
     pub fn implausible(&self, values: &[f64]) -> Option<String> {
-        self.parameters.iter().zip(values).zip(&self.plausible).find_map(|((p, &v), &(lo, hi, why))| {
-            (v < lo || v > hi).then(|| format!("{} = {v:.4e} is not plausible: {why}", p.name))
+        self.parameters.iter().zip(values).zip(&self.plausible).find_map(|((name, &v), &(lo, hi, why))| {
+            (v < lo || v > hi).then(|| format!("{name} = {v:.4e} is not plausible: {why}"))
         })
     }
 
@@ -571,5 +697,31 @@ impl Candidate {
                 .nodes
                 .iter()
                 .any(|&n| model.beams_at(NodeId(n)).into_iter().any(|i| elements.contains(&model.beams()[i].id.0)))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use fe_model::{Assembly, samples};
+
+    /// Every candidate's change applies to the whole model, which still
+    /// assembles (a candidate carries no whole model that could be checked
+    /// beforehand), and its parameters start at the same values there as in
+    /// its part.
+    #[test]
+    fn every_candidate_applies_to_the_whole_model() {
+        for model in [samples::frame_grid(2, 2, 3), samples::frame_with_joint(), samples::cantilever(6)] {
+            let all = generate(&model, &CandidateOptions { per_element_limit: 8, ..CandidateOptions::default() });
+            assert!(all.iter().any(|c| c.kind == EffectKind::FlexibleSupport));
+            for c in &all {
+                let whole = c.model(&model).unwrap();
+                assert!(Assembly::new(&whole).is_ok(), "{} breaks the model", c.description);
+                let (pw, pp) = (c.parameters_in(&whole).unwrap(), c.parameters_in(c.part()).unwrap());
+                for (w, p) in pw.iter().zip(&pp) {
+                    assert_eq!(whole.get(w.quantities[0]), c.part().get(p.quantities[0]), "{}", w.name);
+                }
+            }
+        }
     }
 }

@@ -35,6 +35,7 @@ use frf::{Channel, ZSolver};
 use num_complex::Complex64 as C64;
 use rayon::prelude::*;
 
+use super::Candidate;
 use crate::error::UpdateError;
 use crate::oe::{Evaluated, Response};
 use crate::params::ParameterSet;
@@ -48,6 +49,62 @@ const MAX_LOCAL_EQS: usize = 60;
 /// Unit right-hand sides solved together when gathering `H_0[D, D]`.
 const CHUNK: usize = 32;
 
+/// A candidate fitted by low-rank updates: the part of the nominal model it
+/// touches, before and after its change, and where the two differ. All of
+/// it is as small as the change; nothing here grows with the model.
+pub(crate) struct LocalCandidate {
+    /// The nominal model's part (see [`fe_model::Model::part`]).
+    nominal_part: DampedSystem,
+    /// The same part with the change, at its starting values.
+    pub(crate) part: DampedSystem,
+    /// The parameters to fit, resolved in `part`.
+    pub(crate) params: ParameterSet,
+    pub(crate) form: LocalForm,
+}
+
+impl LocalCandidate {
+    /// The local form of `candidate` relative to `nominal` (the whole
+    /// nominal system), or `None` when it has none (see [`LocalForm`]).
+    pub(crate) fn new(nominal: &DampedSystem, candidate: &Candidate) -> Option<Self> {
+        let nominal_part = DampedSystem::of_part(nominal.model().part(candidate.part_nodes())).ok()?;
+        let part = DampedSystem::of_part(candidate.part().clone()).ok()?;
+        let params = ParameterSet::new(candidate.parameters_in(part.model()).ok()?);
+        let form = LocalForm::of(nominal, &nominal_part, &part, &params)?;
+        Some(LocalCandidate { nominal_part, part, params, form })
+    }
+}
+
+/// The model item a block comes from, by id or name: block indices differ
+/// between a part and the whole, and between a part before and after a
+/// change.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+enum Item {
+    Beam(u32),
+    Spring(String),
+    Mass(String),
+}
+
+fn item(model: &fe_model::Model, source: BlockSource) -> Item {
+    match source {
+        BlockSource::Beam(i) => Item::Beam(model.beams()[i].id.0),
+        BlockSource::Spring(i) => Item::Spring(model.springs()[i].name.clone()),
+        BlockSource::Mass(i) => Item::Mass(model.masses()[i].name.clone()),
+    }
+}
+
+/// The equation of the whole nominal model for each equation of a part,
+/// when it has one (a DOF the part frees, or a node it adds, has none).
+fn whole_equations(nominal: &Assembly, part: &Assembly) -> Vec<Option<usize>> {
+    (0..part.n())
+        .map(|eq| {
+            part.dofs.dofs_of(eq).iter().find_map(|&r| match nominal.dofs.slot(r) {
+                Some(fe_model::Slot::Free(e)) => Some(e),
+                _ => None,
+            })
+        })
+        .collect()
+}
+
 /// Where a candidate's `Z` differs from the nominal one.
 #[derive(Clone, Debug)]
 pub(crate) struct LocalForm {
@@ -56,41 +113,47 @@ pub(crate) struct LocalForm {
     /// Equations of the candidate that the nominal model lacks (a released
     /// support, the rotation of a split node), after `D` in the local order.
     new_eqs: usize,
-    /// Local index of each candidate equation of the changed blocks.
-    index: HashMap<usize, usize>,
-    /// Blocks of the candidate's assembly that differ or may differ.
+    /// Local index of each equation of the candidate's part (`usize::MAX`
+    /// where no changed block touches it).
+    index: Vec<usize>,
+    /// Local index of each equation of the nominal part (likewise).
+    nominal_index: Vec<usize>,
+    /// Blocks of the candidate's part that differ or may differ.
     blocks: Vec<usize>,
-    /// The same blocks' counterparts in the nominal assembly.
+    /// The same blocks' counterparts in the nominal part.
     nominal_blocks: Vec<usize>,
 }
 
 impl LocalForm {
-    /// The local form of `cand` (the candidate's system, with `params` the
-    /// parameters to fit) relative to `nominal`, or `None` when the
-    /// candidate's equations do not extend the nominal ones or it touches
-    /// too many.
-    pub(crate) fn of(nominal: &DampedSystem, cand: &DampedSystem, params: &ParameterSet) -> Option<Self> {
-        let (a0, a) = (nominal.assembly(), cand.assembly());
-        // each candidate equation: its nominal equation, if it has one
-        let map: Vec<Option<usize>> = (0..a.n())
-            .map(|eq| match a0.dofs.slot(a.dofs.dof_of(eq)) {
-                Some(fe_model::Slot::Free(e)) => Some(e),
-                _ => None,
-            })
-            .collect();
-        let mut seen = vec![false; a0.n()];
-        for &e in map.iter().flatten() {
-            if std::mem::replace(&mut seen[e], true) {
-                return None;
-            }
-        }
-        // each candidate block: the nominal block of the same element, spring or mass
-        let by_source: HashMap<BlockSource, usize> = a0.blocks.iter().enumerate().map(|(i, b)| (b.source, i)).collect();
-        let counterpart: Vec<Option<usize>> = a.blocks.iter().map(|b| by_source.get(&b.source).copied()).collect();
-        if seen.contains(&false) || counterpart.iter().flatten().count() != a0.blocks.len() {
+    /// The local form of a candidate (`cand`: its part with the change,
+    /// `params` the parameters to fit in it) relative to `nominal` (the
+    /// whole nominal system; `nominal_part` its part on the same nodes), or
+    /// `None` when the candidate's equations do not extend the nominal ones
+    /// or it touches too many.
+    pub(crate) fn of(
+        nominal: &DampedSystem,
+        nominal_part: &DampedSystem,
+        cand: &DampedSystem,
+        params: &ParameterSet,
+    ) -> Option<Self> {
+        let (a0, a) = (nominal_part.assembly(), cand.assembly());
+        let map0 = whole_equations(nominal.assembly(), a0);
+        let map = whole_equations(nominal.assembly(), a);
+        // two candidate equations on one nominal equation cannot be expressed
+        let mut seen: Vec<usize> = map.iter().flatten().copied().collect();
+        seen.sort_unstable();
+        if seen.windows(2).any(|w| w[0] == w[1]) || map0.iter().any(Option::is_none) {
             return None;
         }
-        let (g0, g) = (nominal.model().groups(), cand.model().groups());
+        // each candidate block: the nominal block of the same element, spring or mass
+        let by_item: HashMap<Item, usize> =
+            a0.blocks.iter().enumerate().map(|(i, b)| (item(nominal_part.model(), b.source), i)).collect();
+        let counterpart: Vec<Option<usize>> =
+            a.blocks.iter().map(|b| by_item.get(&item(cand.model(), b.source)).copied()).collect();
+        if counterpart.iter().flatten().count() != a0.blocks.len() {
+            return None;
+        }
+        let (g0, g) = (nominal_part.model().groups(), cand.model().groups());
         let mut touched = vec![false; a.blocks.len()];
         for &q in params.quantities() {
             match q {
@@ -107,7 +170,7 @@ impl LocalForm {
             };
             let bc = &a.blocks[b];
             let same_eqs =
-                b0.eqs.len() == bc.eqs.len() && b0.eqs.iter().zip(&bc.eqs).all(|(&e0, &e)| map[e] == Some(e0));
+                b0.eqs.len() == bc.eqs.len() && b0.eqs.iter().zip(&bc.eqs).all(|(&e0, &e)| map[e] == map0[e0]);
             let same_group = b0.group == bc.group && g0.get(b0.group) == g.get(bc.group);
             let same_terms = b0.terms.len() == bc.terms.len()
                 && b0
@@ -126,20 +189,21 @@ impl LocalForm {
         cand_eqs.sort_unstable();
         cand_eqs.dedup();
         let mut eqs: Vec<usize> = cand_eqs.iter().filter_map(|&e| map[e]).collect();
-        eqs.extend(nominal_blocks.iter().flat_map(|&b| a0.blocks[b].eqs.iter().copied()));
+        eqs.extend(nominal_blocks.iter().flat_map(|&b| a0.blocks[b].eqs.iter().filter_map(|&e| map0[e])));
         eqs.sort_unstable();
         eqs.dedup();
         let added: Vec<usize> = cand_eqs.iter().copied().filter(|&e| map[e].is_none()).collect();
-        let mut index = HashMap::new();
+        let mut index = vec![usize::MAX; a.n()];
         for &e in &cand_eqs {
-            let i = match map[e] {
+            index[e] = match map[e] {
                 Some(e0) => eqs.binary_search(&e0).expect("mapped equations are in D"),
                 None => eqs.len() + added.binary_search(&e).expect("listed"),
             };
-            index.insert(e, i);
         }
+        let nominal_index =
+            map0.iter().map(|e| e.and_then(|e| eqs.binary_search(&e).ok()).unwrap_or(usize::MAX)).collect();
         let fits = !eqs.is_empty() && eqs.len() + added.len() <= MAX_LOCAL_EQS;
-        fits.then_some(LocalForm { eqs, new_eqs: added.len(), index, blocks, nominal_blocks })
+        fits.then_some(LocalForm { eqs, new_eqs: added.len(), index, nominal_index, blocks, nominal_blocks })
     }
 
     /// Adds `c * unit` of one term of `block` onto `out`, its equations
@@ -157,14 +221,14 @@ impl LocalForm {
         }
     }
 
-    /// Local index of a nominal equation of `D`.
+    /// Local index of an equation of the nominal part's changed blocks.
     fn nominal_index(&self, eq: usize) -> usize {
-        self.eqs.binary_search(&eq).expect("nominal block equations are in D")
+        self.nominal_index[eq]
     }
 
     /// Local index of an equation of the candidate's changed blocks.
     fn candidate_index(&self, eq: usize) -> usize {
-        self.index[&eq]
+        self.index[eq]
     }
 
     /// Adds `sum over blocks and terms of coef(group, kind) * value * unit`
@@ -290,14 +354,10 @@ impl LocalData {
         Ok(LocalData { lines: lines.to_vec(), w_eqs, picks, slots, per_line })
     }
 
-    /// The model response of one candidate, starting at its system's values.
-    pub(crate) fn response<'a>(
-        &'a self,
-        nominal: &DampedSystem,
-        form: &'a LocalForm,
-        sys: DampedSystem,
-        params: &'a ParameterSet,
-    ) -> LocalResponse<'a> {
+    /// The model response of one candidate, starting at the values of
+    /// `sys` (its part, [`LocalCandidate::part`], possibly with other values).
+    pub(crate) fn response<'a>(&'a self, local: &'a LocalCandidate, sys: DampedSystem) -> LocalResponse<'a> {
+        let (form, params, nominal) = (&local.form, &local.params, &local.nominal_part);
         let slot = self.slots.iter().position(|e| *e == form.eqs).expect("the form was given to LocalData::new");
         let d = form.eqs.len();
         let a0 = nominal.assembly();
@@ -443,22 +503,18 @@ mod tests {
         let lines = [3.0, 17.0, 41.0, 88.0];
         let opts = CandidateOptions { band_hz: (1.0, 100.0), ..CandidateOptions::default() };
         let all = candidates::generate(model, &opts);
-        let forms: Vec<Option<LocalForm>> = all
-            .iter()
-            .map(|c| {
-                let sys = DampedSystem::new(c.model.clone()).unwrap();
-                LocalForm::of(&nominal, &sys, &ParameterSet::new(c.parameters.clone()))
-            })
-            .collect();
-        let data = LocalData::new(&nominal, &channels, &lines, &forms.iter().flatten().collect::<Vec<_>>()).unwrap();
-        for (c, form) in all.iter().zip(&forms) {
-            let Some(form) = form else { panic!("{} has no local form", c.description) };
+        let locals: Vec<Option<LocalCandidate>> = all.iter().map(|c| LocalCandidate::new(&nominal, c)).collect();
+        let forms: Vec<&LocalForm> = locals.iter().flatten().map(|l| &l.form).collect();
+        let data = LocalData::new(&nominal, &channels, &lines, &forms).unwrap();
+        for (c, local) in all.iter().zip(&locals) {
+            let Some(local) = local else { panic!("{} has no local form", c.description) };
             kinds.push(c.kind);
-            let params = ParameterSet::new(c.parameters.clone());
-            let sys = DampedSystem::new(c.model.clone()).unwrap();
+            // the truth: the candidate's whole model
+            let sys = DampedSystem::new(c.model(model).unwrap()).unwrap();
+            let params = ParameterSet::new(c.parameters_in(sys.model()).unwrap());
             // away from the start: masses and damping grow, stiffness falls
             let values: Vec<f64> = params.values(&sys).iter().map(|v| v * 1.7).collect();
-            let mut response = data.response(&nominal, form, sys.clone(), &params);
+            let mut response = data.response(local, local.part.clone());
             response.set(&values).unwrap();
             let (h, sens) = response.evaluate(&lines, true).unwrap();
             let mut truth = sys;

@@ -49,7 +49,7 @@ use serde::Serialize;
 
 pub use candidates::{Candidate, CandidateOptions, EffectKind};
 
-use self::local::{LocalData, LocalForm};
+use self::local::{LocalCandidate, LocalData};
 use crate::error::UpdateError;
 use crate::oe::{self, Misfit, OeData, OeOptions};
 use crate::params::ParameterSet;
@@ -254,19 +254,28 @@ struct Fit {
     relative_std: Vec<f64>,
 }
 
-/// The nominal system, the data for the candidates fitted by low-rank
-/// updates of it, and their local forms (see module `local`).
-type Local<'a> = Option<(&'a DampedSystem, &'a LocalData, &'a LocalForm)>;
+/// The data and the local form of a candidate fitted by low-rank updates of
+/// the nominal model (see module `local`).
+type Local<'a> = Option<(&'a LocalData, &'a LocalCandidate)>;
 
+/// Fits one candidate: by low-rank updates when `local` is given, else on
+/// its whole model (the nominal model with the candidate's change).
 fn fit(
     candidate: &Candidate,
+    nominal: &fe_model::Model,
     measured: &FrfSet,
     local: Local<'_>,
     iterations: usize,
     start: Option<&[f64]>,
 ) -> Option<Fit> {
-    let mut sys = DampedSystem::new(candidate.model.clone()).ok()?;
-    let params = ParameterSet::new(candidate.parameters.clone());
+    let (mut sys, params) = match local {
+        Some((_, lc)) => (lc.part.clone(), lc.params.clone()),
+        None => {
+            let sys = DampedSystem::new(candidate.model(nominal).ok()?).ok()?;
+            let params = ParameterSet::new(candidate.parameters_in(sys.model()).ok()?);
+            (sys, params)
+        }
+    };
     if let Some(v) = start {
         params.set_values(&mut sys, v).ok()?;
     }
@@ -277,20 +286,14 @@ fn fit(
         OeOptions { misfit: Misfit::Log, max_iterations: iterations, tolerance: 1e-6, bounds, ..OeOptions::default() };
     let data = OeData { measured, weights: None };
     let r = match local {
-        Some((nominal, ld, form)) => {
-            let mut response = ld.response(nominal, form, sys, &params);
+        Some((ld, lc)) => {
+            let mut response = ld.response(lc, sys);
             oe::run_with(&mut response, now, &data, &opts, |_| {}).ok()?
         }
         None => oe::run(&mut sys, &params, &data, &opts, |_| {}).ok()?,
     };
     let relative_std = (0..params.len()).map(|i| r.covariance[(i, i)].max(0.0).sqrt()).collect();
     Some(Fit { values: r.values, cost: r.cost, n: r.n_data, relative_std })
-}
-
-/// The local form of a candidate, when it has one.
-fn local_form(nominal: &DampedSystem, candidate: &Candidate) -> Option<LocalForm> {
-    let sys = DampedSystem::new(candidate.model.clone()).ok()?;
-    LocalForm::of(nominal, &sys, &ParameterSet::new(candidate.parameters.clone()))
 }
 
 fn nominal_cost(sys: &DampedSystem, measured: &FrfSet) -> Result<(f64, usize), UpdateError> {
@@ -328,47 +331,49 @@ pub fn diagnose(model: &fe_model::Model, measured: &FrfSet, opts: &DiagnoseOptio
 
     // Candidates that change Z only locally are fitted by exact low-rank
     // updates of the nominal model (see `local`), the others on their own.
-    let mut forms: Vec<Option<LocalForm>> = candidates.par_iter().map(|c| local_form(&nominal, c)).collect();
-    let local_data = |set: &FrfSet, forms: &[&Option<LocalForm>]| {
-        let forms: Vec<&LocalForm> = forms.iter().filter_map(|f| f.as_ref()).collect();
+    let mut locals: Vec<Option<LocalCandidate>> =
+        candidates.par_iter().map(|c| LocalCandidate::new(&nominal, c)).collect();
+    let local_data = |set: &FrfSet, locals: &[&Option<LocalCandidate>]| {
+        let forms: Vec<_> = locals.iter().filter_map(|l| l.as_ref().map(|l| &l.form)).collect();
         LocalData::new(&nominal, set.channels(), set.frequencies_hz(), &forms)
     };
-    let screen = |candidates: &[Candidate], forms: &[Option<LocalForm>]| -> Result<Vec<Option<Fit>>, UpdateError> {
-        let data = local_data(&coarse, &forms.iter().collect::<Vec<_>>())?;
-        Ok(candidates
-            .par_iter()
-            .zip(forms)
-            .map(|(c, f)| {
-                let local = f.as_ref().map(|f| (&nominal, &data, f));
-                // a low-rank update that cannot be evaluated (a singular
-                // local system at some line) falls back to the whole model
-                fit(c, &coarse, local, opts.screen_iterations, None)
-                    .or_else(|| local.and_then(|_| fit(c, &coarse, None, opts.screen_iterations, None)))
-            })
-            .collect())
-    };
+    let screen =
+        |candidates: &[Candidate], locals: &[Option<LocalCandidate>]| -> Result<Vec<Option<Fit>>, UpdateError> {
+            let data = local_data(&coarse, &locals.iter().collect::<Vec<_>>())?;
+            Ok(candidates
+                .par_iter()
+                .zip(locals)
+                .map(|(c, l)| {
+                    let local = l.as_ref().map(|l| (&data, l));
+                    // a low-rank update that cannot be evaluated (a singular
+                    // local system at some line) falls back to the whole model
+                    fit(c, model, &coarse, local, opts.screen_iterations, None)
+                        .or_else(|| local.and_then(|_| fit(c, model, &coarse, None, opts.screen_iterations, None)))
+                })
+                .collect())
+        };
     // full fits, warm-started from screening
     let full_fit = |candidates: &[Candidate],
-                    forms: &[Option<LocalForm>],
+                    locals: &[Option<LocalCandidate>],
                     screened: &[Option<Fit>],
                     which: &[usize]|
      -> Result<Vec<(usize, Option<Fit>)>, UpdateError> {
-        let data = local_data(&full, &which.iter().map(|&i| &forms[i]).collect::<Vec<_>>())?;
+        let data = local_data(&full, &which.iter().map(|&i| &locals[i]).collect::<Vec<_>>())?;
         Ok(which
             .par_iter()
             .map(|&i| {
-                let local = forms[i].as_ref().map(|f| (&nominal, &data, f));
+                let local = locals[i].as_ref().map(|l| (&data, l));
                 let start = screened[i].as_ref().map(|f| f.values.as_slice());
-                let f = fit(&candidates[i], &full, local, opts.iterations, start)
-                    .or_else(|| fit(&candidates[i], &full, None, opts.iterations, start))
-                    .or_else(|| fit(&candidates[i], &full, None, opts.iterations, None));
+                let f = fit(&candidates[i], model, &full, local, opts.iterations, start)
+                    .or_else(|| fit(&candidates[i], model, &full, None, opts.iterations, start))
+                    .or_else(|| fit(&candidates[i], model, &full, None, opts.iterations, None));
                 (i, f)
             })
             .collect())
     };
 
     // screening
-    let mut screened = screen(&candidates, &forms)?;
+    let mut screened = screen(&candidates, &locals)?;
     let mut order: Vec<usize> = (0..candidates.len()).filter(|&i| screened[i].is_some()).collect();
     let score = |screened: &[Option<Fit>], candidates: &[Candidate], i: usize| {
         let f = screened[i].as_ref().expect("filtered");
@@ -376,7 +381,7 @@ pub fn diagnose(model: &fe_model::Model, measured: &FrfSet, opts: &DiagnoseOptio
     };
     order.sort_by(|&a, &b| score(&screened, &candidates, a).total_cmp(&score(&screened, &candidates, b)));
     let keep: Vec<usize> = order.iter().copied().take(opts.keep).collect();
-    let mut full_fits = full_fit(&candidates, &forms, &screened, &keep)?;
+    let mut full_fits = full_fit(&candidates, &locals, &screened, &keep)?;
 
     // The leaders' locations are refined into per-element stiffness and mass
     // changes (see `candidates::neighbourhood`): on large models those were
@@ -395,18 +400,19 @@ pub fn diagnose(model: &fe_model::Model, measured: &FrfSet, opts: &DiagnoseOptio
         }
     }
     let refined = candidates::per_element(model, &beams);
-    let refined_forms: Vec<Option<LocalForm>> = refined.par_iter().map(|c| local_form(&nominal, c)).collect();
+    let refined_locals: Vec<Option<LocalCandidate>> =
+        refined.par_iter().map(|c| LocalCandidate::new(&nominal, c)).collect();
     // screened like the others; the best few fitted fully
-    let refined_screened = screen(&refined, &refined_forms)?;
+    let refined_screened = screen(&refined, &refined_locals)?;
     let first_refined = candidates.len();
     let mut candidates = candidates;
     candidates.extend(refined);
-    forms.extend(refined_forms);
+    locals.extend(refined_locals);
     screened.extend(refined_screened);
     let mut new: Vec<usize> = (first_refined..candidates.len()).filter(|&i| screened[i].is_some()).collect();
     new.sort_by(|&a, &b| score(&screened, &candidates, a).total_cmp(&score(&screened, &candidates, b)));
     let best_new: Vec<usize> = new.iter().copied().take(REFINED_FITS).collect();
-    full_fits.extend(full_fit(&candidates, &forms, &screened, &best_new)?);
+    full_fits.extend(full_fit(&candidates, &locals, &screened, &best_new)?);
     order.extend(new);
     order.sort_by(|&a, &b| score(&screened, &candidates, a).total_cmp(&score(&screened, &candidates, b)));
 
@@ -430,7 +436,7 @@ pub fn diagnose(model: &fe_model::Model, measured: &FrfSet, opts: &DiagnoseOptio
                 .iter()
                 .zip(&f.values)
                 .zip(&f.relative_std)
-                .map(|((p, &value), &relative_std)| FittedParameter { name: p.name.clone(), value, relative_std })
+                .map(|((name, &value), &relative_std)| FittedParameter { name: name.clone(), value, relative_std })
                 .collect(),
             fully_fitted: fully,
             candidate: i,

@@ -144,8 +144,8 @@ fn run_trial(h: &Hidden, measured: &FrfSet, opts: &DiagnoseOptions) -> Outcome {
     let right_kind = top.kind == h.kind;
     let right_place = cand.near(&model, &h.nodes, &h.elements);
     // add the proposed effect, starting from its diagnosed values, and update
-    let mut sys = DampedSystem::new(cand.model.clone()).unwrap();
-    let params = ParameterSet::new(cand.parameters.clone());
+    let mut sys = DampedSystem::new(cand.model(&model).unwrap()).unwrap();
+    let params = ParameterSet::new(cand.parameters_in(sys.model()).unwrap());
     let start: Vec<f64> = top.parameters.iter().map(|p| p.value).collect();
     params.set_values(&mut sys, &start).unwrap();
     let fit_lines: Vec<f64> = lines().into_iter().step_by(4).collect();
