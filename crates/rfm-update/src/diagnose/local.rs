@@ -29,7 +29,6 @@ use std::collections::HashMap;
 
 use damping::DampedSystem;
 use faer::Mat;
-use faer::linalg::solvers::Solve;
 use fe_model::{Assembly, Block, BlockSource, Quantity};
 use frf::{Channel, ZSolver};
 use num_complex::Complex64 as C64;
@@ -206,21 +205,6 @@ impl LocalForm {
         fits.then_some(LocalForm { eqs, new_eqs: added.len(), index, nominal_index, blocks, nominal_blocks })
     }
 
-    /// Adds `c * unit` of one term of `block` onto `out`, its equations
-    /// placed by `index`.
-    fn scatter(block: &Block, unit: &[f64], c: C64, index: &impl Fn(usize) -> usize, out: &mut Mat<C64>) {
-        let idx: Vec<usize> = block.eqs.iter().map(|&e| index(e)).collect();
-        let n = idx.len();
-        for (r, &ir) in idx.iter().enumerate() {
-            for (col, &ic) in idx.iter().enumerate() {
-                let u = unit[r * n + col];
-                if u != 0.0 {
-                    out[(ir, ic)] += c * u;
-                }
-            }
-        }
-    }
-
     /// Local index of an equation of the nominal part's changed blocks.
     fn nominal_index(&self, eq: usize) -> usize {
         self.nominal_index[eq]
@@ -230,28 +214,6 @@ impl LocalForm {
     fn candidate_index(&self, eq: usize) -> usize {
         self.index[eq]
     }
-
-    /// Adds `sum over blocks and terms of coef(group, kind) * value * unit`
-    /// onto `out`, the equations placed by `index`.
-    fn add_blocks(
-        assembly: &Assembly,
-        blocks: &[usize],
-        coef: impl Fn(usize, fe_model::MatrixKind) -> C64,
-        index: &impl Fn(usize) -> usize,
-        out: &mut Mat<C64>,
-    ) {
-        for &b in blocks {
-            let block = &assembly.blocks[b];
-            for t in block.terms.iter().filter(|t| t.value != 0.0) {
-                Self::scatter(block, &t.unit, coef(block.group, t.kind) * t.value, index, out);
-            }
-        }
-    }
-}
-
-/// `sum_a u[(a, i)] v[(a, j)]` (no conjugation).
-fn column_dot(u: &Mat<C64>, i: usize, v: &Mat<C64>, j: usize) -> C64 {
-    (0..u.nrows()).map(|a| u[(a, i)] * v[(a, j)]).sum()
 }
 
 /// What every local candidate needs from the nominal model at a set of
@@ -274,8 +236,8 @@ struct Line {
     h0: Vec<C64>,
     /// `H_0[:, W]`, `n x |W|` row-interleaved in equation order.
     w_cols: Vec<C64>,
-    /// Per slot: `S = H_0[D, D]`.
-    s: Vec<Mat<C64>>,
+    /// Per slot: `S = H_0[D, D]`, row-major.
+    s: Vec<Vec<C64>>,
 }
 
 impl LocalData {
@@ -335,14 +297,15 @@ impl LocalData {
                         w_cols[eq * k..eq * k + k].copy_from_slice(&x[p * k..p * k + k]);
                     }
                     let h0 = picks.iter().map(|&(r, c)| w_cols[w_eqs[r] * k + c]).collect();
-                    let mut s: Vec<Mat<C64>> = slots.iter().map(|e| Mat::zeros(e.len(), e.len())).collect();
+                    let mut s: Vec<Vec<C64>> = slots.iter().map(|e| vec![ZERO; e.len() * e.len()]).collect();
                     for chunk in columns.chunks(CHUNK) {
                         let k = chunk.len();
                         solver.solve_units_ordered(ws, chunk, x, f)?;
                         for (j, eq) in chunk.iter().enumerate() {
                             for &(slot, col) in &users[eq] {
                                 for (row, &e) in slots[slot].iter().enumerate() {
-                                    s[slot][(row, col)] = x[solver.position(e) * k + j];
+                                    let d = slots[slot].len();
+                                    s[slot][row * d + col] = x[solver.position(e) * k + j];
                                 }
                             }
                         }
@@ -357,24 +320,231 @@ impl LocalData {
     /// The model response of one candidate, starting at the values of
     /// `sys` (its part, [`LocalCandidate::part`], possibly with other values).
     pub(crate) fn response<'a>(&'a self, local: &'a LocalCandidate, sys: DampedSystem) -> LocalResponse<'a> {
-        let (form, params, nominal) = (&local.form, &local.params, &local.nominal_part);
+        let (form, nominal) = (&local.form, &local.nominal_part);
         let slot = self.slots.iter().position(|e| *e == form.eqs).expect("the form was given to LocalData::new");
         let d = form.eqs.len();
         let a0 = nominal.assembly();
+        let nominal_blocks: Vec<Placed> =
+            form.nominal_blocks.iter().map(|&b| Placed::new(&a0.blocks[b], |e| form.nominal_index(e))).collect();
         let nominal_z = self
             .lines
             .iter()
             .map(|&f| {
                 let coefs = nominal.coefficients(2.0 * std::f64::consts::PI * f);
-                let mut z = Mat::zeros(d, d);
-                let index = |e| form.nominal_index(e);
-                LocalForm::add_blocks(a0, &form.nominal_blocks, |g, kind| coefs[g].of(kind), &index, &mut z);
+                let mut z = vec![ZERO; d * d];
+                for (p, &b) in nominal_blocks.iter().zip(&form.nominal_blocks) {
+                    let block = &a0.blocks[b];
+                    for t in &block.terms {
+                        p.add(&t.unit, -coefs[block.group].of(t.kind) * t.value, &mut z, d);
+                    }
+                }
                 z
             })
             .collect();
         let k = self.w_eqs.len();
-        let x = self.per_line.iter().map(|line| Mat::from_fn(d, k, |a, j| line.w_cols[form.eqs[a] * k + j])).collect();
-        LocalResponse { data: self, slot, form, sys, params, nominal_z, x }
+        let x = self
+            .per_line
+            .iter()
+            .map(|line| form.eqs.iter().flat_map(|&e| line.w_cols[e * k..e * k + k].iter().copied()).collect())
+            .collect();
+        let a = sys.assembly();
+        let blocks = form.blocks.iter().map(|&b| Placed::new(&a.blocks[b], |e| form.candidate_index(e))).collect();
+        let by_block = form.blocks.iter().enumerate().map(|(i, &b)| (b, i)).collect();
+        let mut refs: Vec<usize> = self.picks.iter().map(|&(_, f)| f).collect();
+        refs.sort_unstable();
+        refs.dedup();
+        let n_local = d + form.new_eqs;
+        LocalResponse {
+            data: self,
+            slot,
+            form,
+            sys,
+            params: &local.params,
+            nominal_z,
+            x,
+            blocks,
+            by_block,
+            refs,
+            work: Work::new(n_local, d, k),
+        }
+    }
+}
+
+/// A block's row-major pattern placed in a local matrix: for each local
+/// pair `(r, c)` of the block, the position `i * n + j` in the local
+/// matrix, computed for a given local size.
+struct Placed {
+    /// Local index of each block equation.
+    idx: Vec<usize>,
+}
+
+impl Placed {
+    fn new(block: &Block, index: impl Fn(usize) -> usize) -> Self {
+        Placed { idx: block.eqs.iter().map(|&e| index(e)).collect() }
+    }
+
+    /// `out += c * unit` with `out` row-major `n x n`.
+    fn add(&self, unit: &[f64], c: C64, out: &mut [C64], n: usize) {
+        let m = self.idx.len();
+        for (r, &ir) in self.idx.iter().enumerate() {
+            let row = &mut out[ir * n..ir * n + n];
+            for (col, &ic) in self.idx.iter().enumerate() {
+                let u = unit[r * m + col];
+                if u != 0.0 {
+                    row[ic] += c * u;
+                }
+            }
+        }
+    }
+}
+
+/// Scratch of one candidate's evaluation, allocated once.
+struct Work {
+    /// The local change `[[A, B], [B^T, C]]`, `(d + e)^2`.
+    z: Vec<C64>,
+    /// `G = C^-1 B^T`, `e x d`, and the LU of `C`.
+    g: Vec<C64>,
+    c: Vec<C64>,
+    c_piv: Vec<usize>,
+    /// The condensed change `dZ`, `d x d`.
+    dz: Vec<C64>,
+    /// `I + S dZ` and its LU.
+    m: Vec<C64>,
+    m_piv: Vec<usize>,
+    /// `Y = (I + S dZ)^-1 X`, `d x |W|`.
+    y: Vec<C64>,
+    /// One parameter's derivative, `(d + e)^2`, and condensed, `d x d`.
+    dzi: Vec<C64>,
+    dzi_c: Vec<C64>,
+    /// A column of `d` values.
+    col: Vec<C64>,
+}
+
+impl Work {
+    fn new(n_local: usize, d: usize, k: usize) -> Self {
+        let e = n_local - d;
+        Work {
+            z: vec![ZERO; n_local * n_local],
+            g: vec![ZERO; e * d],
+            c: vec![ZERO; e * e],
+            c_piv: vec![0; e],
+            dz: vec![ZERO; d * d],
+            m: vec![ZERO; d * d],
+            m_piv: vec![0; d],
+            y: vec![ZERO; d * k],
+            dzi: vec![ZERO; n_local * n_local],
+            dzi_c: vec![ZERO; d * d],
+            col: vec![ZERO; d],
+        }
+    }
+}
+
+/// LU factorisation with partial pivoting of a row-major `n x n` matrix in
+/// place (unit lower and upper triangles share the storage). Returns false
+/// when a pivot is zero or not finite.
+fn lu_in_place(a: &mut [C64], n: usize, piv: &mut [usize]) -> bool {
+    for k in 0..n {
+        let p = (k..n).max_by(|&i, &j| a[i * n + k].norm_sqr().total_cmp(&a[j * n + k].norm_sqr())).expect("k < n");
+        piv[k] = p;
+        if p != k {
+            for j in 0..n {
+                a.swap(k * n + j, p * n + j);
+            }
+        }
+        let pivot = a[k * n + k];
+        if pivot.norm_sqr() == 0.0 || !(pivot.re.is_finite() && pivot.im.is_finite()) {
+            return false;
+        }
+        let inv = pivot.inv();
+        let (head, tail) = a.split_at_mut((k + 1) * n);
+        let row_k = &head[k * n..];
+        for row in tail.chunks_exact_mut(n) {
+            let l = row[k] * inv;
+            row[k] = l;
+            if l != ZERO {
+                for j in k + 1..n {
+                    row[j] -= l * row_k[j];
+                }
+            }
+        }
+    }
+    true
+}
+
+/// Solves `A X = B` with the LU of [`lu_in_place`]; `b` is row-major `n x k`
+/// and is overwritten by `X`.
+fn lu_solve(a: &[C64], n: usize, piv: &[usize], b: &mut [C64], k: usize) {
+    for i in 0..n {
+        if piv[i] != i {
+            for j in 0..k {
+                b.swap(i * k + j, piv[i] * k + j);
+            }
+        }
+    }
+    for i in 0..n {
+        let (head, tail) = b.split_at_mut(i * k);
+        let bi = &mut tail[..k];
+        for m in 0..i {
+            let l = a[i * n + m];
+            if l != ZERO {
+                for (v, &u) in bi.iter_mut().zip(&head[m * k..m * k + k]) {
+                    *v -= l * u;
+                }
+            }
+        }
+    }
+    for i in (0..n).rev() {
+        let (head, tail) = b.split_at_mut((i + 1) * k);
+        let bi = &mut head[i * k..];
+        for m in i + 1..n {
+            let u = a[i * n + m];
+            if u != ZERO {
+                let off = (m - i - 1) * k;
+                for (v, &w) in bi.iter_mut().zip(&tail[off..off + k]) {
+                    *v -= u * w;
+                }
+            }
+        }
+        let inv = a[i * n + i].inv();
+        bi.iter_mut().for_each(|v| *v *= inv);
+    }
+}
+
+/// Condenses a local matrix `q` (`(d + e)^2`, row-major) onto `D`:
+/// `T^T q T` with `T = [I; -G]`, written to `out` (`d x d`).
+fn condense(q: &[C64], g: &[C64], d: usize, e: usize, out: &mut [C64]) {
+    let n = d + e;
+    for i in 0..d {
+        for j in 0..d {
+            out[i * d + j] = q[i * n + j];
+        }
+    }
+    if e == 0 {
+        return;
+    }
+    // out -= Q_AB G + G^T Q_BA, then out += G^T Q_BB G
+    for i in 0..d {
+        for m in 0..e {
+            let (qab, gmi) = (q[i * n + d + m], g[m * d + i]);
+            let (g_row, qba_row) = (&g[m * d..m * d + d], &q[(d + m) * n..(d + m) * n + d]);
+            for ((o, &gj), &qj) in out[i * d..i * d + d].iter_mut().zip(g_row).zip(qba_row) {
+                *o -= qab * gj + gmi * qj;
+            }
+        }
+    }
+    for m in 0..e {
+        for l in 0..e {
+            let qbb = q[(d + m) * n + d + l];
+            if qbb == ZERO {
+                continue;
+            }
+            for i in 0..d {
+                let gi = g[m * d + i] * qbb;
+                for j in 0..d {
+                    out[i * d + j] += gi * g[l * d + j];
+                }
+            }
+        }
     }
 }
 
@@ -385,10 +555,18 @@ pub(crate) struct LocalResponse<'a> {
     form: &'a LocalForm,
     sys: DampedSystem,
     params: &'a ParameterSet,
-    /// Per line: the nominal model's part of `Z` on `D` that the candidate replaces.
-    nominal_z: Vec<Mat<C64>>,
-    /// Per line: `X = H_0[D, W]`.
-    x: Vec<Mat<C64>>,
+    /// Per line: minus the nominal model's part of `Z` on `D` that the
+    /// candidate replaces, row-major `d x d`.
+    nominal_z: Vec<Vec<C64>>,
+    /// Per line: `X = H_0[D, W]`, row-major `d x |W|`.
+    x: Vec<Vec<C64>>,
+    /// The changed blocks of the candidate's part, placed locally.
+    blocks: Vec<Placed>,
+    /// Position in `blocks` of each changed block of the part.
+    by_block: HashMap<usize, usize>,
+    /// Distinct reference columns in `W`.
+    refs: Vec<usize>,
+    work: Work,
 }
 
 impl Response for LocalResponse<'_> {
@@ -400,60 +578,101 @@ impl Response for LocalResponse<'_> {
         if lines != self.data.lines.as_slice() {
             return None;
         }
-        let (d, e, a) = (self.form.eqs.len(), self.form.new_eqs, self.sys.assembly());
-        let index = |eq| self.form.candidate_index(eq);
+        let (d, e) = (self.form.eqs.len(), self.form.new_eqs);
+        let (n, k) = (d + e, self.data.w_eqs.len());
+        let a = self.sys.assembly();
         let n_par = self.params.len();
+        let w = &mut self.work;
         let mut model = Vec::with_capacity(lines.len());
         let mut sens = jacobian.then(|| Vec::with_capacity(lines.len()));
-        for (k, &f) in lines.iter().enumerate() {
+        for (li, &f) in lines.iter().enumerate() {
             let omega = 2.0 * std::f64::consts::PI * f;
             let coefs = self.sys.coefficients(omega);
             // the change on D and the candidate's own equations, [[A, B], [B^T, C]]
-            let mut z = Mat::<C64>::zeros(d + e, d + e);
-            z.as_mut().submatrix_mut(0, 0, d, d).copy_from(-&self.nominal_z[k]);
-            LocalForm::add_blocks(a, &self.form.blocks, |g, kind| coefs[g].of(kind), &index, &mut z);
-            // condensed onto D: dZ = A - B C^-1 B^T = T^T Z T with T = [I; -C^-1 B^T]
-            let t = (e > 0).then(|| {
-                let c_inv_bt =
-                    z.as_ref().submatrix(d, d, e, e).partial_piv_lu().solve(z.as_ref().submatrix(d, 0, e, d));
-                let mut t = Mat::<C64>::zeros(d + e, d);
-                t.as_mut().submatrix_mut(0, 0, d, d).copy_from(Mat::<C64>::identity(d, d));
-                t.as_mut().submatrix_mut(d, 0, e, d).copy_from(-&c_inv_bt);
-                t
-            });
-            let condense = |m: &Mat<C64>| match &t {
-                Some(t) => t.transpose() * m * t,
-                None => m.clone(),
-            };
-            let dz = condense(&z);
-            let s = &self.data.per_line[k].s[self.slot];
-            let y = (Mat::<C64>::identity(d, d) + s * &dz).partial_piv_lu().solve(&self.x[k]);
-            let p = &dz * &y;
-            let x = &self.x[k];
-            let h: Vec<C64> = self
-                .data
-                .picks
-                .iter()
-                .enumerate()
-                .map(|(c, &(r, fi))| self.data.per_line[k].h0[c] - column_dot(x, r, &p, fi))
-                .collect();
+            w.z.fill(ZERO);
+            for (i, row) in self.nominal_z[li].chunks_exact(d).enumerate() {
+                w.z[i * n..i * n + d].copy_from_slice(row);
+            }
+            for (p, &b) in self.blocks.iter().zip(&self.form.blocks) {
+                let block = &a.blocks[b];
+                for t in block.terms.iter().filter(|t| t.value != 0.0) {
+                    p.add(&t.unit, coefs[block.group].of(t.kind) * t.value, &mut w.z, n);
+                }
+            }
+            // condensed onto D: dZ = A - B C^-1 B^T, with G = C^-1 B^T
+            if e > 0 {
+                for m in 0..e {
+                    w.c[m * e..m * e + e].copy_from_slice(&w.z[(d + m) * n + d..(d + m) * n + n]);
+                    w.g[m * d..m * d + d].copy_from_slice(&w.z[(d + m) * n..(d + m) * n + d]);
+                }
+                if !lu_in_place(&mut w.c, e, &mut w.c_piv) {
+                    return None;
+                }
+                lu_solve(&w.c, e, &w.c_piv, &mut w.g, d);
+            }
+            condense(&w.z, &w.g, d, e, &mut w.dz);
+            // I + S dZ, by rows of dZ that are not zero
+            let s = &self.data.per_line[li].s[self.slot];
+            w.m.fill(ZERO);
+            for i in 0..d {
+                w.m[i * d + i] = C64::new(1.0, 0.0);
+            }
+            for kk in 0..d {
+                let dz_row = &w.dz[kk * d..kk * d + d];
+                if dz_row.iter().all(|v| *v == ZERO) {
+                    continue;
+                }
+                for i in 0..d {
+                    let sik = s[i * d + kk];
+                    if sik != ZERO {
+                        for (mv, &z) in w.m[i * d..i * d + d].iter_mut().zip(dz_row) {
+                            *mv += sik * z;
+                        }
+                    }
+                }
+            }
+            if !lu_in_place(&mut w.m, d, &mut w.m_piv) {
+                return None;
+            }
+            let x = &self.x[li];
+            w.y.copy_from_slice(x);
+            lu_solve(&w.m, d, &w.m_piv, &mut w.y, k);
+            // H = H_0 - X^T dZ Y on the channels: (dZ Y)[:, f] per reference
+            let line = &self.data.per_line[li];
+            let mut h = line.h0.clone();
+            for &fr in &self.refs {
+                for i in 0..d {
+                    w.col[i] = (0..d).map(|j| w.dz[i * d + j] * w.y[j * k + fr]).sum();
+                }
+                for (c, &(r, fi)) in self.data.picks.iter().enumerate() {
+                    if fi == fr {
+                        h[c] -= (0..d).map(|i| x[i * k + r] * w.col[i]).sum::<C64>();
+                    }
+                }
+            }
             if h.iter().any(|v| !(v.re.is_finite() && v.im.is_finite())) {
                 return None;
             }
             if let Some(sens) = sens.as_mut() {
                 let mut block = Mat::<C64>::zeros(h.len(), n_par);
-                let mut dzi = Mat::zeros(d + e, d + e);
-                for (i, p) in self.params.params().iter().enumerate() {
-                    dzi.fill(ZERO);
+                for (pi, p) in self.params.params().iter().enumerate() {
+                    w.dzi.fill(ZERO);
                     for &q in &p.quantities {
                         for (b, t, c) in self.sys.derivative(q, omega).terms {
-                            let block = &a.blocks[b];
-                            LocalForm::scatter(block, &block.terms[t].unit, c * block.terms[t].value, &index, &mut dzi);
+                            let term = &a.blocks[b].terms[t];
+                            self.blocks[self.by_block[&b]].add(&term.unit, c * term.value, &mut w.dzi, n);
                         }
                     }
-                    let q = condense(&dzi) * &y;
-                    for (c, &(r, fi)) in self.data.picks.iter().enumerate() {
-                        block[(c, i)] = column_dot(&y, r, &q, fi);
+                    condense(&w.dzi, &w.g, d, e, &mut w.dzi_c);
+                    for &fr in &self.refs {
+                        for i in 0..d {
+                            w.col[i] = (0..d).map(|j| w.dzi_c[i * d + j] * w.y[j * k + fr]).sum();
+                        }
+                        for (c, &(r, fi)) in self.data.picks.iter().enumerate() {
+                            if fi == fr {
+                                block[(c, pi)] = (0..d).map(|i| w.y[i * k + r] * w.col[i]).sum();
+                            }
+                        }
                     }
                 }
                 sens.push(block);
