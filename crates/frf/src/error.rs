@@ -27,6 +27,17 @@ pub enum FrfError {
         /// The frequency.
         freq_hz: f64,
     },
+    /// A clique given to [`ZSolver::with_cliques`](crate::ZSolver::with_cliques)
+    /// names an equation the pattern does not have.
+    #[error("clique {clique} names equation {eq}, but the pattern has {n} equations")]
+    CliqueOutOfRange {
+        /// Index of the clique in the list.
+        clique: usize,
+        /// The equation.
+        eq: usize,
+        /// Number of equations.
+        n: usize,
+    },
     /// The sparse factorisation failed for another reason.
     #[error("sparse factorisation failed: {0}")]
     Factorization(String),

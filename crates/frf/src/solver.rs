@@ -99,14 +99,29 @@ struct LuWorkspace {
 impl ZSolver {
     /// Analyses a pattern (once per model).
     pub fn new(pattern: &Pattern) -> Result<Self, FrfError> {
-        let symbolic = SymbolicSparseColMat::new_checked(
-            pattern.n,
-            pattern.n,
-            pattern.col_ptr.clone(),
-            None,
-            pattern.row_idx.clone(),
-        );
-        let ldlt = SymbolicLdlt::new(pattern).map_err(FrfError::Factorization)?;
+        Self::with_cliques(pattern, &[])
+    }
+
+    /// As [`Self::new`], with an ordering and a factor pattern chosen so
+    /// that `L + L^T` covers every pair of equations of each clique
+    /// (equation numbers, as in the pattern): the pattern on which `Z^-1`
+    /// can be computed from the factors alone.
+    ///
+    /// The analysis is that of `pattern` with every pair of equations within
+    /// each clique added; [`Self::factorize`] still takes values on
+    /// `pattern` itself, the added pairs being structural zeros. Each added
+    /// pair can bring fill, so the factor grows with the cliques
+    /// ([`Self::factor_nnz`]); pairs already in `pattern` (the equations of
+    /// one element) change nothing. With no cliques this is [`Self::new`].
+    pub fn with_cliques(pattern: &Pattern, cliques: &[Vec<usize>]) -> Result<Self, FrfError> {
+        let n = pattern.n;
+        for (clique, eqs) in cliques.iter().enumerate() {
+            if let Some(&eq) = eqs.iter().find(|&&eq| eq >= n) {
+                return Err(FrfError::CliqueOutOfRange { clique, eq, n });
+            }
+        }
+        let symbolic = SymbolicSparseColMat::new_checked(n, n, pattern.col_ptr.clone(), None, pattern.row_idx.clone());
+        let ldlt = SymbolicLdlt::new(pattern, cliques).map_err(FrfError::Factorization)?;
         Ok(ZSolver { pattern: symbolic, ldlt, lu: OnceLock::new() })
     }
 
