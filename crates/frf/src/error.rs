@@ -4,6 +4,8 @@ use std::path::PathBuf;
 
 use fe_model::DofRef;
 
+use crate::solver::FactorKind;
+
 /// An FRF computation or data error.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum FrfError {
@@ -26,6 +28,25 @@ pub enum FrfError {
     Singular {
         /// The frequency.
         freq_hz: f64,
+    },
+    /// A selected inverse was asked of a workspace without `L D L^T`
+    /// factors: the factorisation fell back to LU at that frequency (a tiny
+    /// pivot), or none succeeded. Solve for unit right-hand sides instead.
+    #[error("the selected inverse needs L D L^T factors, but the workspace holds {}", held_factors(.held))]
+    NoLdltFactors {
+        /// The factorisation held, if any.
+        held: Option<FactorKind>,
+    },
+    /// A clique given to [`ZSolver::with_cliques`](crate::ZSolver::with_cliques)
+    /// names an equation the pattern does not have.
+    #[error("clique {clique} names equation {eq}, but the pattern has {n} equations")]
+    CliqueOutOfRange {
+        /// Index of the clique in the list.
+        clique: usize,
+        /// The equation.
+        eq: usize,
+        /// Number of equations.
+        n: usize,
     },
     /// The sparse factorisation failed for another reason.
     #[error("sparse factorisation failed: {0}")]
@@ -66,4 +87,12 @@ pub enum FrfError {
     /// Two FRF sets that should match do not.
     #[error("{0}")]
     Mismatch(String),
+}
+
+fn held_factors(held: &Option<FactorKind>) -> &'static str {
+    match held {
+        Some(FactorKind::Lu) => "an LU factorisation (the fallback after a tiny pivot)",
+        Some(FactorKind::Ldlt) => "L D L^T factors",
+        None => "no factorisation",
+    }
 }

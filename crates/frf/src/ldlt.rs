@@ -9,7 +9,9 @@
 //! - [`SymbolicLdlt`] (once per pattern): a fill-reducing ordering (faer's
 //!   approximate minimum degree), the elimination tree and the pattern of `L`
 //!   (faer's simplicial symbolic Cholesky), and the row structure of `L` for
-//!   the up-looking numeric factorisation below.
+//!   the up-looking numeric factorisation below. Optional cliques of
+//!   equations are added to the pattern analysed (not to the values), so
+//!   that the selected inverse covers them.
 //! - [`NumericLdlt`] (per thread): the values of `L` and `D^-1`, a dense work
 //!   vector and a solve buffer, all reused from one frequency to the next.
 //!
@@ -20,6 +22,10 @@
 //! or against the terms that were subtracted to form it, or that is not
 //! finite, aborts the factorisation with [`TinyPivot`], and the caller falls
 //! back to LU with partial pivoting.
+//!
+//! [`SymbolicLdlt::selected_inverse`] computes `(P Z P^T)^-1` on the pattern
+//! of `L` plus the diagonal from the factors, by the Takahashi equations,
+//! for about the cost of the numeric factorisation.
 //!
 //! Right-hand sides are stored *row-interleaved* (`x[i * k + j]` is row `i`
 //! of right-hand side `j`) in the solver's internal order: each elimination
@@ -44,6 +50,10 @@ pub(crate) const PIVOT_TOLERANCE: f64 = 1e-8;
 
 const ZERO: C64 = C64 { re: 0.0, im: 0.0 };
 
+/// Marks a row that is not in the column of `L` being inverted; see
+/// [`SymbolicLdlt::selected_inverse`].
+pub(crate) const NOT_IN_COLUMN: u32 = u32::MAX;
+
 /// Solution values smaller than this in magnitude are set to zero as each
 /// row is finalised. Responses can decay by hundreds of orders of magnitude
 /// across a large model (a long periodic structure in a stop band), and
@@ -62,6 +72,12 @@ fn flush_tiny(row: &mut [C64]) {
             v.im = 0.0;
         }
     }
+}
+
+/// Whether both parts are finite.
+#[inline(always)]
+fn is_finite(z: C64) -> bool {
+    z.re.is_finite() && z.im.is_finite()
 }
 
 /// `|re| + |im|`: a cheap norm within a factor sqrt(2) of the modulus.
@@ -120,17 +136,28 @@ pub(crate) struct NumericLdlt {
 impl SymbolicLdlt {
     /// Orders and analyses a symmetric pattern (both triangles stored, rows
     /// sorted, diagonal present).
-    pub(crate) fn new(pattern: &Pattern) -> Result<Self, String> {
+    ///
+    /// The ordering and the pattern of `L` are those of the pattern with
+    /// every pair of equations within each clique added (caller's numbering,
+    /// an index out of range is an error), so that `L + L^T` covers each clique
+    /// and the selected inverse holds every entry of `Z^-1` between its
+    /// equations. The added pairs are structural zeros: values are still
+    /// read on the original pattern. With no cliques this is the plain
+    /// analysis of `pattern`.
+    pub(crate) fn new(pattern: &Pattern, cliques: &[Vec<usize>]) -> Result<Self, String> {
         let n = pattern.n;
         if u32::try_from(n).is_err() {
             return Err(format!("{n} equations exceed the solver's 32-bit row indices"));
         }
-        // upper triangle of the original pattern, for the ordering
+        let augmented = if cliques.is_empty() { None } else { Some(with_clique_pairs(pattern, cliques)?) };
+        let analysed = augmented.as_ref().unwrap_or(pattern);
+
+        // upper triangle of the analysed pattern, for the ordering
         let mut up_ptr = Vec::with_capacity(n + 1);
-        let mut up_idx = Vec::with_capacity(pattern.nnz() / 2 + n);
+        let mut up_idx = Vec::with_capacity(analysed.nnz() / 2 + n);
         up_ptr.push(0);
         for c in 0..n {
-            let rows = &pattern.row_idx[pattern.col_ptr[c]..pattern.col_ptr[c + 1]];
+            let rows = &analysed.row_idx[analysed.col_ptr[c]..analysed.col_ptr[c + 1]];
             up_idx.extend(rows.iter().copied().take_while(|&r| r <= c));
             up_ptr.push(up_idx.len());
         }
@@ -144,49 +171,27 @@ impl SymbolicLdlt {
         }
         drop((up_ptr, up_idx));
 
-        // upper triangle of P Z P^T by column, rows ascending: walk new rows
-        // i in order; each original entry (r, perm[i]) with j = perm_inv[r] >= i
-        // is B[j, i] = B[i, j] by symmetry, appended to column j
-        let mut a_col_ptr = vec![0usize; n + 1];
-        for i in 0..n {
-            let c = perm[i];
-            for &r in &pattern.row_idx[pattern.col_ptr[c]..pattern.col_ptr[c + 1]] {
-                let j = perm_inv[r];
-                if j >= i {
-                    a_col_ptr[j + 1] += 1;
-                }
+        // the numeric factorisation reads the values of the original pattern
+        let (a_col_ptr, a_row_usize, a_src) = permuted_upper(pattern, &perm, &perm_inv);
+        let a_row_idx: Vec<u32> = a_row_usize.iter().map(|&i| i as u32).collect();
+        // while the elimination tree and L come from the analysed one
+        let (e_col_ptr, e_row_idx) = match &augmented {
+            Some(aug) => {
+                let (ptr, rows, _) = permuted_upper(aug, &perm, &perm_inv);
+                (ptr, rows)
             }
-        }
-        for j in 0..n {
-            a_col_ptr[j + 1] += a_col_ptr[j];
-        }
-        let nnz_a = a_col_ptr[n];
-        let mut next = a_col_ptr[..n].to_vec();
-        let mut a_row_idx = vec![0u32; nnz_a];
-        let mut a_src = vec![0usize; nnz_a];
-        let mut a_row_usize = vec![0usize; nnz_a];
-        for i in 0..n {
-            let c = perm[i];
-            for p in pattern.col_ptr[c]..pattern.col_ptr[c + 1] {
-                let j = perm_inv[pattern.row_idx[p]];
-                if j >= i {
-                    let q = next[j];
-                    next[j] += 1;
-                    a_row_idx[q] = i as u32;
-                    a_row_usize[q] = i;
-                    a_src[q] = p;
-                }
-            }
-        }
-        drop(next);
+            None => (a_col_ptr.clone(), a_row_usize),
+        };
+        drop(augmented);
+        let nnz_e = e_row_idx.len();
 
         // elimination tree, column counts and the pattern of L (faer)
         let l_symbolic = {
-            let upper = SymbolicSparseColMatRef::new_checked(n, n, &a_col_ptr, None, &a_row_usize);
+            let upper = SymbolicSparseColMatRef::new_checked(n, n, &e_col_ptr, None, &e_row_idx);
             let mut etree = vec![0isize; n];
             let mut counts = vec![0usize; n];
             let mut mem = MemBuffer::new(
-                simplicial::prefactorize_symbolic_cholesky_scratch::<usize>(n, nnz_a)
+                simplicial::prefactorize_symbolic_cholesky_scratch::<usize>(n, nnz_e)
                     .or(simplicial::factorize_simplicial_symbolic_cholesky_scratch::<usize>(n)),
             );
             let etree_ref =
@@ -194,7 +199,7 @@ impl SymbolicLdlt {
             simplicial::factorize_simplicial_symbolic_cholesky(upper, etree_ref, &counts, MemStack::new(&mut mem))
                 .map_err(|e| format!("symbolic factorisation failed: {e:?}"))?
         };
-        drop(a_row_usize);
+        drop((e_col_ptr, e_row_idx));
 
         // strictly lower part (faer stores the diagonal first in each column)
         let (f_ptr, f_idx) = (l_symbolic.col_ptr(), l_symbolic.row_idx());
@@ -380,6 +385,188 @@ impl SymbolicLdlt {
         num.units = units;
         finite
     }
+
+    /// Position in the column storage of `L` of the entry `(row, col)`,
+    /// internal order, `row > col`; `None` when it is not in the pattern.
+    pub(crate) fn lower_position(&self, row: usize, col: usize) -> Option<usize> {
+        let start = self.l_col_ptr[col];
+        let rows = &self.l_row_idx[start..self.l_col_ptr[col + 1]];
+        rows.binary_search(&(row as u32)).ok().map(|p| start + p)
+    }
+
+    /// Selected inverse by the Takahashi equations: `B^-1` (`B = P Z P^T`,
+    /// factorised in `num`) on the pattern of `L` plus the diagonal, written
+    /// to `diag` (length `n`) and `lower` (the layout of `L`'s columns).
+    /// `slot` is `n` entries of [`NOT_IN_COLUMN`] and is left so. Allocates
+    /// nothing. Returns whether every entry is finite.
+    ///
+    /// From `B^-1 = L^-T D^-1 L^-1`, `L^T B^-1 = D^-1 L^-1` is lower
+    /// triangular with diagonal `D^-1`. Reading its column `j` below and on
+    /// the diagonal, with `S` the rows of `L`'s column `j`:
+    ///
+    /// ```text
+    /// B^-1[S, j] = -B^-1[S, S] L[S, j]
+    /// B^-1[j, j] = D^-1[j] - L[S, j]^T B^-1[S, j]
+    /// ```
+    ///
+    /// Columns are computed from the last to the first, and every `B^-1[S, S]`
+    /// needed is already known and in the pattern: the filled graph is
+    /// chordal, so for `t` in `S` the rows of `S` below `t` are rows of
+    /// `L`'s column `t`. The product walks `B^-1[S, S]` by its stored lower
+    /// triangle: the entry `(r, t)`, `r > t`, contributes to row `t` through
+    /// `L[r, j]` and to row `r` through `L[t, j]`.
+    pub(crate) fn selected_inverse(
+        &self,
+        num: &NumericLdlt,
+        diag: &mut [C64],
+        lower: &mut [C64],
+        slot: &mut [u32],
+    ) -> bool {
+        let n = self.n;
+        assert!(diag.len() == n && lower.len() == self.nnz_l() && slot.len() == n, "selected inverse of another size");
+        let (l_val, d_inv) = (&num.l_val[..], &num.d_inv[..n]);
+        let mut finite = true;
+        for j in (0..n).rev() {
+            let (c0, c1) = (self.l_col_ptr[j], self.l_col_ptr[j + 1]);
+            let rows = &self.l_row_idx[c0..c1];
+            let l_j = &l_val[c0..c1];
+            // columns right of j are final and read-only while column j is made
+            let (head, done) = lower.split_at_mut(c1);
+            let out = &mut head[c0..];
+            out.fill(ZERO);
+            let Some(&last) = rows.last() else {
+                diag[j] = d_inv[j];
+                finite &= is_finite(diag[j]);
+                continue;
+            };
+            for (b, &r) in rows.iter().enumerate() {
+                slot[r as usize] = b as u32;
+            }
+            for (a, (&t, &l_tj)) in rows.iter().zip(l_j).enumerate() {
+                let t = t as usize;
+                let mut acc = -diag[t] * l_tj;
+                let (t0, t1) = (self.l_col_ptr[t], self.l_col_ptr[t + 1]);
+                // rows of column t below the last row of S cannot be in S
+                for (&r, &z) in self.l_row_idx[t0..t1].iter().zip(&done[t0 - c1..t1 - c1]) {
+                    if r > last {
+                        break;
+                    }
+                    let b = slot[r as usize];
+                    if b != NOT_IN_COLUMN {
+                        let b = b as usize;
+                        out[b] -= z * l_tj;
+                        acc -= z * l_j[b];
+                    }
+                }
+                out[a] += acc;
+            }
+            let mut d = d_inv[j];
+            for ((&r, &l), &v) in rows.iter().zip(l_j).zip(out.iter()) {
+                d -= l * v;
+                slot[r as usize] = NOT_IN_COLUMN;
+                finite &= is_finite(v);
+            }
+            diag[j] = d;
+            finite &= is_finite(d);
+        }
+        finite
+    }
+}
+
+/// `pattern` with every pair of equations within each clique added: both
+/// triangles, rows sorted and unique. Clique indices must be below `n`.
+fn with_clique_pairs(pattern: &Pattern, cliques: &[Vec<usize>]) -> Result<Pattern, String> {
+    let n = pattern.n;
+    if let Some(eq) = cliques.iter().flatten().copied().find(|&eq| eq >= n) {
+        return Err(format!("clique equation {eq} is not below {n}"));
+    }
+    // room for the original rows and every clique row (duplicates included),
+    // then each column sorted and compacted in place
+    let mut room: Vec<usize> = (0..n).map(|c| pattern.col_ptr[c + 1] - pattern.col_ptr[c]).collect();
+    for clique in cliques {
+        for &c in clique {
+            room[c] += clique.len();
+        }
+    }
+    let mut start = Vec::with_capacity(n + 1);
+    start.push(0);
+    for c in 0..n {
+        start.push(start[c] + room[c]);
+    }
+    drop(room);
+    let mut rows = vec![0usize; start[n]];
+    let mut next = start[..n].to_vec();
+    for c in 0..n {
+        let col = &pattern.row_idx[pattern.col_ptr[c]..pattern.col_ptr[c + 1]];
+        rows[next[c]..next[c] + col.len()].copy_from_slice(col);
+        next[c] += col.len();
+    }
+    for clique in cliques {
+        for &c in clique {
+            rows[next[c]..next[c] + clique.len()].copy_from_slice(clique);
+            next[c] += clique.len();
+        }
+    }
+    let mut col_ptr = Vec::with_capacity(n + 1);
+    col_ptr.push(0);
+    let mut kept = 0;
+    for c in 0..n {
+        rows[start[c]..next[c]].sort_unstable();
+        let mut last = None;
+        // kept <= p throughout, so the compaction never overwrites a row
+        // that is still to be read
+        for p in start[c]..next[c] {
+            let r = rows[p];
+            if last != Some(r) {
+                rows[kept] = r;
+                kept += 1;
+                last = Some(r);
+            }
+        }
+        col_ptr.push(kept);
+    }
+    rows.truncate(kept);
+    Ok(Pattern { n, col_ptr, row_idx: rows })
+}
+
+/// Upper triangle of `P A P^T` by column, rows ascending, for a symmetric
+/// pattern `A` with both triangles stored: column pointers, rows, and the
+/// position of each entry in `A`'s values.
+///
+/// New rows `i` are walked in order; each entry `(r, perm[i])` of `A` with
+/// `j = perm_inv[r] >= i` is `B[j, i] = B[i, j]` by symmetry, appended to
+/// column `j`, so every column receives its rows in ascending order.
+fn permuted_upper(pattern: &Pattern, perm: &[usize], perm_inv: &[usize]) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
+    let n = pattern.n;
+    let mut col_ptr = vec![0usize; n + 1];
+    for i in 0..n {
+        let c = perm[i];
+        for &r in &pattern.row_idx[pattern.col_ptr[c]..pattern.col_ptr[c + 1]] {
+            let j = perm_inv[r];
+            if j >= i {
+                col_ptr[j + 1] += 1;
+            }
+        }
+    }
+    for j in 0..n {
+        col_ptr[j + 1] += col_ptr[j];
+    }
+    let nnz = col_ptr[n];
+    let mut next = col_ptr[..n].to_vec();
+    let mut rows = vec![0usize; nnz];
+    let mut src = vec![0usize; nnz];
+    for i in 0..n {
+        let c = perm[i];
+        for p in pattern.col_ptr[c]..pattern.col_ptr[c + 1] {
+            let j = perm_inv[pattern.row_idx[p]];
+            if j >= i {
+                rows[next[j]] = i;
+                src[next[j]] = p;
+                next[j] += 1;
+            }
+        }
+    }
+    (col_ptr, rows, src)
 }
 
 /// Forward and backward substitution, vectorised over the right-hand sides
@@ -485,7 +672,7 @@ mod tests {
     fn tridiagonal_solution_has_small_residual_and_no_fill() {
         let n = 50;
         let (pat, vals) = tridiagonal(n);
-        let sym = SymbolicLdlt::new(&pat).unwrap();
+        let sym = SymbolicLdlt::new(&pat, &[]).unwrap();
         assert_eq!(sym.nnz_l(), n - 1, "a tridiagonal matrix has no fill under AMD");
         let mut num = sym.numeric();
         sym.factorize(&mut num, &vals).unwrap();
@@ -513,11 +700,40 @@ mod tests {
     }
 
     #[test]
+    fn clique_pairs_are_added_once_to_both_triangles() {
+        let (pat, _) = tridiagonal(9);
+        // a repeated equation, an overlap with the pattern and a singleton
+        let cliques = vec![vec![0, 4, 8, 4], vec![3, 4], vec![6]];
+        let aug = with_clique_pairs(&pat, &cliques).unwrap();
+        let mut expected = std::collections::BTreeSet::new();
+        for c in 0..pat.n {
+            for &r in &pat.row_idx[pat.col_ptr[c]..pat.col_ptr[c + 1]] {
+                expected.insert((c, r));
+            }
+        }
+        for clique in &cliques {
+            for &a in clique {
+                for &b in clique {
+                    expected.insert((a, b));
+                }
+            }
+        }
+        let mut got = Vec::new();
+        for c in 0..aug.n {
+            for &r in &aug.row_idx[aug.col_ptr[c]..aug.col_ptr[c + 1]] {
+                got.push((c, r));
+            }
+        }
+        assert_eq!(got, expected.into_iter().collect::<Vec<_>>(), "sorted by column, then row, without repeats");
+        assert!(with_clique_pairs(&pat, &[vec![2, 9]]).is_err());
+    }
+
+    #[test]
     fn a_zero_leading_pivot_is_reported() {
         // [[0, 1], [1, 0]]: nonsingular, but no LDL^T without pivoting
         let pat = Pattern { n: 2, col_ptr: vec![0, 2, 4], row_idx: vec![0, 1, 0, 1] };
         let vals = [ZERO, C64::new(1.0, 0.0), C64::new(1.0, 0.0), ZERO];
-        let sym = SymbolicLdlt::new(&pat).unwrap();
+        let sym = SymbolicLdlt::new(&pat, &[]).unwrap();
         let mut num = sym.numeric();
         assert_eq!(sym.factorize(&mut num, &vals), Err(TinyPivot { index: 0 }));
     }

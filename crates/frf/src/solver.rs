@@ -26,6 +26,31 @@
 //! resonance) without complaint and returns numbers of 1e15 times the
 //! right-hand side over `|Z|`, none of whose digits can be trusted.
 //!
+//! # Selected inversion
+//!
+//! A caller that needs `H = Z^-1` only on small sets of equations `D` (one
+//! element, one node, a few neighbouring elements), `H[D, D]`, would make a
+//! unit solve per equation. [`ZSolver::selected_inverse`] instead computes
+//! every entry of `H` on the pattern of the factor (`L + L^T` plus the
+//! diagonal) from the `L D L^T` factors, by the Takahashi equations
+//! (Takahashi, Fagan and Chen, 1973; Erisman and Tinney, 1975), for about
+//! the cost of the numeric factorisation. With `B = P Z P^T` and `S` the
+//! rows of column `j` of `L` below `j`, from the last column to the first:
+//!
+//! ```text
+//! B^-1[S, j] = -B^-1[S, S] L[S, j]
+//! B^-1[j, j] = D^-1[j] - L[S, j]^T B^-1[S, j]
+//! ```
+//!
+//! The pattern of the factor is closed under this recurrence (the filled
+//! graph is chordal), but holds a set `D` only if it happens to: build the
+//! solver with [`ZSolver::with_cliques`] to add every pair of each set to the
+//! pattern analysed, at the price of some fill. Read the result with
+//! [`ZSolver::inverse_entry`] or [`ZSolver::inverse_block`]. After the LU
+//! fallback there are no such factors: [`ZSolver::selected_inverse`] returns
+//! [`FrfError::NoLdltFactors`], and the caller solves for unit right-hand
+//! sides ([`ZSolver::solve_units_ordered`]) at that frequency.
+//!
 //! # Right-hand side layouts
 //!
 //! - [`ZSolver::solve_in_place`]: a column-major faer matrix, one column per
@@ -49,7 +74,7 @@ use fe_model::Pattern;
 use num_complex::Complex64 as C64;
 
 use crate::error::FrfError;
-use crate::ldlt::{NumericLdlt, SymbolicLdlt};
+use crate::ldlt::{NOT_IN_COLUMN, NumericLdlt, SymbolicLdlt};
 
 const ZERO: C64 = C64 { re: 0.0, im: 0.0 };
 
@@ -85,6 +110,8 @@ pub struct Workspace {
     kind: Option<FactorKind>,
     /// Largest `|Z_ij|` of the matrix factorised.
     z_max: f64,
+    /// Frequency of the matrix factorised, for errors.
+    freq_hz: f64,
 }
 
 /// Numeric LU and its scratch, allocated only when the fallback is needed.
@@ -99,14 +126,28 @@ struct LuWorkspace {
 impl ZSolver {
     /// Analyses a pattern (once per model).
     pub fn new(pattern: &Pattern) -> Result<Self, FrfError> {
-        let symbolic = SymbolicSparseColMat::new_checked(
-            pattern.n,
-            pattern.n,
-            pattern.col_ptr.clone(),
-            None,
-            pattern.row_idx.clone(),
-        );
-        let ldlt = SymbolicLdlt::new(pattern).map_err(FrfError::Factorization)?;
+        Self::with_cliques(pattern, &[])
+    }
+
+    /// As [`Self::new`], with an ordering and a factor pattern chosen so
+    /// that [`Self::selected_inverse`] holds `Z^-1[D, D]` for every clique
+    /// `D` (equation numbers, as in the pattern).
+    ///
+    /// The analysis is that of `pattern` with every pair of equations within
+    /// each clique added; [`Self::factorize`] still takes values on
+    /// `pattern` itself, the added pairs being structural zeros. Each added
+    /// pair can bring fill, so the factor grows with the cliques
+    /// ([`Self::factor_nnz`]); pairs already in `pattern` (the equations of
+    /// one element) change nothing. With no cliques this is [`Self::new`].
+    pub fn with_cliques(pattern: &Pattern, cliques: &[Vec<usize>]) -> Result<Self, FrfError> {
+        let n = pattern.n;
+        for (clique, eqs) in cliques.iter().enumerate() {
+            if let Some(&eq) = eqs.iter().find(|&&eq| eq >= n) {
+                return Err(FrfError::CliqueOutOfRange { clique, eq, n });
+            }
+        }
+        let symbolic = SymbolicSparseColMat::new_checked(n, n, pattern.col_ptr.clone(), None, pattern.row_idx.clone());
+        let ldlt = SymbolicLdlt::new(pattern, cliques).map_err(FrfError::Factorization)?;
         Ok(ZSolver { pattern: symbolic, ldlt, lu: OnceLock::new() })
     }
 
@@ -129,7 +170,7 @@ impl ZSolver {
 
     /// A fresh workspace for one thread.
     pub fn workspace(&self) -> Workspace {
-        Workspace { ldlt: self.ldlt.numeric(), lu: None, kind: None, z_max: 0.0 }
+        Workspace { ldlt: self.ldlt.numeric(), lu: None, kind: None, z_max: 0.0, freq_hz: f64::NAN }
     }
 
     fn symbolic_lu(&self) -> Result<&SymbolicLu<usize>, FrfError> {
@@ -145,6 +186,7 @@ impl ZSolver {
     /// pivot is tiny (see the module docs). `freq_hz` is only used in errors.
     pub fn factorize(&self, ws: &mut Workspace, values: &[C64], freq_hz: f64) -> Result<(), FrfError> {
         ws.kind = None;
+        ws.freq_hz = freq_hz;
         ws.z_max = check_values(self, values, freq_hz)?;
         match self.ldlt.factorize(&mut ws.ldlt, values) {
             Ok(()) => {
@@ -159,6 +201,7 @@ impl ZSolver {
     /// [`Self::factorize`] does; for cross-checks and tests.
     pub fn factorize_lu(&self, ws: &mut Workspace, values: &[C64], freq_hz: f64) -> Result<(), FrfError> {
         ws.kind = None;
+        ws.freq_hz = freq_hz;
         ws.z_max = check_values(self, values, freq_hz)?;
         let lu = self.symbolic_lu()?;
         let lw = ws.lu.get_or_insert_with(|| {
@@ -351,6 +394,125 @@ impl ZSolver {
         lw.cols = cols;
         check_solution(x, freq_hz)?;
         check_amplification(z_max, b_max, largest_norm(x), freq_hz)
+    }
+}
+
+/// Entries of `Z^-1` on the pattern of the factor (`L + L^T` plus the
+/// diagonal), made by [`ZSolver::selected_inverse`] and read with
+/// [`ZSolver::inverse_entry`] and [`ZSolver::inverse_block`].
+///
+/// Make one per thread with [`SelectedInverse::new`] and reuse it from one
+/// frequency to the next: its storage is allocated on first use only.
+#[derive(Clone, Debug, Default)]
+pub struct SelectedInverse {
+    /// Diagonal, in the solver's internal order.
+    diag: Vec<C64>,
+    /// Below the diagonal, in the layout of the factor's columns.
+    lower: Vec<C64>,
+    /// Scratch of the recurrence: the position of each row in the column
+    /// being computed, or `NOT_IN_COLUMN`.
+    slot: Vec<u32>,
+    /// Whether the values are those of the last successful inversion.
+    ready: bool,
+}
+
+impl SelectedInverse {
+    /// Empty storage, sized on first use.
+    pub fn new() -> Self {
+        Self::default()
+    }
+}
+
+/// Selected inversion: entries of `Z^-1` without a solve per equation.
+impl ZSolver {
+    /// `Z^-1` on the pattern of the factor, from the `L D L^T` factors in
+    /// `ws`, by the Takahashi equations (see the module docs): about the
+    /// cost of the numeric factorisation, whatever the number of entries
+    /// then read. Allocates nothing once `out` has been used with this
+    /// solver.
+    ///
+    /// Returns [`FrfError::NoLdltFactors`] when `ws` holds the LU fallback
+    /// or no factorisation (solve for unit right-hand sides instead), and
+    /// [`FrfError::Singular`] when an entry is not finite. On error `out`
+    /// holds nothing that can be read.
+    pub fn selected_inverse(&self, ws: &Workspace, out: &mut SelectedInverse) -> Result<(), FrfError> {
+        let (n, nnz) = (self.n(), self.factor_nnz());
+        out.ready = false;
+        if ws.kind != Some(FactorKind::Ldlt) {
+            return Err(FrfError::NoLdltFactors { held: ws.kind });
+        }
+        // every value is overwritten by the recurrence, so storage of the
+        // right size is reused as it is
+        if out.diag.len() != n || out.lower.len() != nnz || out.slot.len() != n {
+            *out = SelectedInverse {
+                diag: vec![ZERO; n],
+                lower: vec![ZERO; nnz],
+                slot: vec![NOT_IN_COLUMN; n],
+                ready: false,
+            };
+        }
+        if !self.ldlt.selected_inverse(&ws.ldlt, &mut out.diag, &mut out.lower, &mut out.slot) {
+            return Err(FrfError::Singular { freq_hz: ws.freq_hz });
+        }
+        out.ready = true;
+        Ok(())
+    }
+
+    /// `Z^-1[i, j]` (equation numbers; `Z^-1` is symmetric) from a selected
+    /// inverse of this solver, or `None` when `(i, j)` is not in the factor's
+    /// pattern (see [`Self::with_cliques`]). Costs a binary search in one
+    /// column of the factor.
+    ///
+    /// # Panics
+    ///
+    /// If `inv` was not made by a successful [`Self::selected_inverse`] of
+    /// this solver, or an equation is out of range.
+    pub fn inverse_entry(&self, inv: &SelectedInverse, i: usize, j: usize) -> Option<C64> {
+        self.check_inverse(inv);
+        self.entry(inv, i, j)
+    }
+
+    /// [`Self::inverse_entry`] once `inv` is known to be of this solver.
+    fn entry(&self, inv: &SelectedInverse, i: usize, j: usize) -> Option<C64> {
+        let (p, q) = (self.position(i), self.position(j));
+        if p == q {
+            return Some(inv.diag[p]);
+        }
+        self.ldlt.lower_position(p.max(q), p.min(q)).map(|pos| inv.lower[pos])
+    }
+
+    /// The dense block `Z^-1[D, D]` for the equations `D = eqs`, row-major
+    /// (`out[a * eqs.len() + b] = Z^-1[eqs[a], eqs[b]]`, `out.len() ==
+    /// eqs.len()^2`). Returns `false`, with `out` partly written, when a pair
+    /// is not in the factor's pattern. Allocates nothing.
+    ///
+    /// # Panics
+    ///
+    /// As [`Self::inverse_entry`], or when `out` has the wrong length.
+    pub fn inverse_block(&self, inv: &SelectedInverse, eqs: &[usize], out: &mut [C64]) -> bool {
+        let m = eqs.len();
+        assert_eq!(out.len(), m * m, "the block must be eqs.len() x eqs.len()");
+        self.check_inverse(inv);
+        for a in 0..m {
+            for b in a..m {
+                let Some(v) = self.entry(inv, eqs[a], eqs[b]) else {
+                    return false;
+                };
+                out[a * m + b] = v;
+                out[b * m + a] = v;
+            }
+        }
+        true
+    }
+
+    /// Panics unless `inv` holds a successful selected inversion of a solver
+    /// of this size (one of another solver of the same size cannot be told
+    /// apart).
+    fn check_inverse(&self, inv: &SelectedInverse) {
+        assert!(
+            inv.ready && inv.diag.len() == self.n() && inv.lower.len() == self.factor_nnz(),
+            "no selected inverse of this solver (none made, or the last one failed)"
+        );
     }
 }
 

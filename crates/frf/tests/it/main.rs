@@ -5,5 +5,6 @@ mod lscf;
 mod modal;
 mod physics;
 mod properties;
+mod selected_inverse;
 mod solver;
 mod uff;
