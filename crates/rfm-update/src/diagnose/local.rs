@@ -30,7 +30,7 @@ use std::collections::HashMap;
 use damping::DampedSystem;
 use faer::Mat;
 use fe_model::{Assembly, Block, BlockSource, Quantity};
-use frf::{Channel, ZSolver};
+use frf::{Channel, SelectedInverse, ZSolver};
 use num_complex::Complex64 as C64;
 use rayon::prelude::*;
 
@@ -226,6 +226,8 @@ pub(crate) struct LocalData {
     picks: Vec<(usize, usize)>,
     /// The distinct `D`s.
     slots: Vec<Vec<usize>>,
+    /// Row of each equation in [`Line::w_rows`] (`usize::MAX`: none).
+    row_of: Vec<usize>,
     /// Per line: the nominal receptances needed.
     per_line: Vec<Line>,
 }
@@ -234,10 +236,45 @@ pub(crate) struct LocalData {
 struct Line {
     /// `H_0` at the channels.
     h0: Vec<C64>,
-    /// `H_0[:, W]`, `n x |W|` row-interleaved in equation order.
-    w_cols: Vec<C64>,
+    /// `H_0[:, W]` on the rows that some `D` needs (see
+    /// [`LocalData::row_of`]), `rows x |W|` row-interleaved.
+    w_rows: Vec<C64>,
     /// Per slot: `S = H_0[D, D]`, row-major.
     s: Vec<Vec<C64>>,
+}
+
+/// Every `S = H_0[D, D]` by unit solves, `CHUNK` equations at a time: the
+/// fallback when the factorisation has no selected inverse (the LU fallback).
+fn unit_solves(
+    solver: &ZSolver,
+    ws: &mut frf::Workspace,
+    slots: &[Vec<usize>],
+    x: &mut Vec<C64>,
+    f: f64,
+    s: &mut [Vec<C64>],
+) -> Result<(), frf::FrfError> {
+    // for each equation of some D: the (slot, local column) it fills
+    let mut users: HashMap<usize, Vec<(usize, usize)>> = HashMap::new();
+    for (slot, eqs) in slots.iter().enumerate() {
+        for (j, &e) in eqs.iter().enumerate() {
+            users.entry(e).or_default().push((slot, j));
+        }
+    }
+    let mut columns: Vec<usize> = users.keys().copied().collect();
+    columns.sort_unstable();
+    for chunk in columns.chunks(CHUNK) {
+        let k = chunk.len();
+        solver.solve_units_ordered(ws, chunk, x, f)?;
+        for (j, eq) in chunk.iter().enumerate() {
+            for &(slot, col) in &users[eq] {
+                let d = slots[slot].len();
+                for (row, &e) in slots[slot].iter().enumerate() {
+                    s[slot][row * d + col] = x[solver.position(e) * k + j];
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 impl LocalData {
@@ -269,52 +306,52 @@ impl LocalData {
                 slots.push(f.eqs.clone());
             }
         }
-        // for each equation of some D: the (slot, local column) it fills
-        let mut users: HashMap<usize, Vec<(usize, usize)>> = HashMap::new();
-        for (s, eqs) in slots.iter().enumerate() {
-            for (j, &e) in eqs.iter().enumerate() {
-                users.entry(e).or_default().push((s, j));
+        // the rows of H_0[:, W] that some D needs, compactly
+        let n = nominal.n();
+        let mut row_of = vec![usize::MAX; n];
+        let mut rows = 0;
+        for &e in slots.iter().flatten() {
+            if row_of[e] == usize::MAX {
+                row_of[e] = rows;
+                rows += 1;
             }
         }
-        let mut columns: Vec<usize> = users.keys().copied().collect();
-        columns.sort_unstable();
-        let solver = ZSolver::new(&nominal.assembly().pattern)?;
-        let n = nominal.n();
+        // The symbolic analysis makes each D a clique of the factor, so that
+        // the selected inverse holds every S = H_0[D, D] (about the cost of
+        // the factorisation, where a solve per equation would cost N solves).
+        let solver = ZSolver::with_cliques(&nominal.assembly().pattern, &slots)?;
         let per_line: Vec<Line> = lines
             .par_iter()
             .map_init(
-                || (solver.workspace(), Vec::new(), Vec::new()),
-                |(ws, z, x), &f| {
+                || (solver.workspace(), Vec::new(), Vec::new(), SelectedInverse::new()),
+                |(ws, z, x, inv), &f| {
                     let omega = 2.0 * std::f64::consts::PI * f;
                     z.resize(nominal.assembly().pattern.nnz(), ZERO);
                     nominal.z_values_into(omega, z);
                     solver.factorize(ws, z, f)?;
                     let k = w_eqs.len();
                     solver.solve_units_ordered(ws, &w_eqs, x, f)?;
-                    let mut w_cols = vec![ZERO; n * k];
-                    for eq in 0..n {
+                    let h0 = picks.iter().map(|&(r, c)| x[solver.position(w_eqs[r]) * k + c]).collect();
+                    let mut w_rows = vec![ZERO; rows * k];
+                    for (eq, &row) in row_of.iter().enumerate().filter(|(_, r)| **r != usize::MAX) {
                         let p = solver.position(eq);
-                        w_cols[eq * k..eq * k + k].copy_from_slice(&x[p * k..p * k + k]);
+                        w_rows[row * k..row * k + k].copy_from_slice(&x[p * k..p * k + k]);
                     }
-                    let h0 = picks.iter().map(|&(r, c)| w_cols[w_eqs[r] * k + c]).collect();
                     let mut s: Vec<Vec<C64>> = slots.iter().map(|e| vec![ZERO; e.len() * e.len()]).collect();
-                    for chunk in columns.chunks(CHUNK) {
-                        let k = chunk.len();
-                        solver.solve_units_ordered(ws, chunk, x, f)?;
-                        for (j, eq) in chunk.iter().enumerate() {
-                            for &(slot, col) in &users[eq] {
-                                for (row, &e) in slots[slot].iter().enumerate() {
-                                    let d = slots[slot].len();
-                                    s[slot][row * d + col] = x[solver.position(e) * k + j];
-                                }
-                            }
-                        }
+                    let selected = match solver.selected_inverse(ws, inv) {
+                        Ok(()) => slots.iter().zip(&mut s).all(|(eqs, s)| solver.inverse_block(inv, eqs, s)),
+                        // the LU fallback has no selected inverse
+                        Err(frf::FrfError::NoLdltFactors { .. }) => false,
+                        Err(e) => return Err(e),
+                    };
+                    if !selected {
+                        unit_solves(&solver, ws, &slots, x, f, &mut s)?;
                     }
-                    Ok(Line { h0, w_cols, s })
+                    Ok(Line { h0, w_rows, s })
                 },
             )
             .collect::<Result<_, frf::FrfError>>()?;
-        Ok(LocalData { lines: lines.to_vec(), w_eqs, picks, slots, per_line })
+        Ok(LocalData { lines: lines.to_vec(), w_eqs, picks, slots, row_of, per_line })
     }
 
     /// The model response of one candidate, starting at the values of
@@ -345,7 +382,15 @@ impl LocalData {
         let x = self
             .per_line
             .iter()
-            .map(|line| form.eqs.iter().flat_map(|&e| line.w_cols[e * k..e * k + k].iter().copied()).collect())
+            .map(|line| {
+                form.eqs
+                    .iter()
+                    .flat_map(|&e| {
+                        let r = self.row_of[e];
+                        line.w_rows[r * k..r * k + k].iter().copied()
+                    })
+                    .collect()
+            })
             .collect();
         let a = sys.assembly();
         let blocks = form.blocks.iter().map(|&b| Placed::new(&a.blocks[b], |e| form.candidate_index(e))).collect();
@@ -364,8 +409,8 @@ impl LocalData {
             x,
             blocks,
             by_block,
+            work: Work::new(n_local, d, refs.len()),
             refs,
-            work: Work::new(n_local, d, k),
         }
     }
 }
@@ -408,10 +453,13 @@ struct Work {
     c_piv: Vec<usize>,
     /// The condensed change `dZ`, `d x d`.
     dz: Vec<C64>,
+    /// The non-zeros `(column, value)` of `dZ` by row, and row pointers.
+    nz: Vec<(usize, C64)>,
+    nz_ptr: Vec<usize>,
     /// `I + S dZ` and its LU.
     m: Vec<C64>,
     m_piv: Vec<usize>,
-    /// `Y = (I + S dZ)^-1 X`, `d x |W|`.
+    /// `Y = (I + S dZ)^-1 X` at the reference columns, `d x refs`.
     y: Vec<C64>,
     /// One parameter's derivative, `(d + e)^2`, and condensed, `d x d`.
     dzi: Vec<C64>,
@@ -421,7 +469,7 @@ struct Work {
 }
 
 impl Work {
-    fn new(n_local: usize, d: usize, k: usize) -> Self {
+    fn new(n_local: usize, d: usize, refs: usize) -> Self {
         let e = n_local - d;
         Work {
             z: vec![ZERO; n_local * n_local],
@@ -429,9 +477,11 @@ impl Work {
             c: vec![ZERO; e * e],
             c_piv: vec![0; e],
             dz: vec![ZERO; d * d],
+            nz: Vec::with_capacity(d * d),
+            nz_ptr: Vec::with_capacity(d + 1),
             m: vec![ZERO; d * d],
             m_piv: vec![0; d],
-            y: vec![ZERO; d * k],
+            y: vec![ZERO; d * refs],
             dzi: vec![ZERO; n_local * n_local],
             dzi_c: vec![ZERO; d * d],
             col: vec![ZERO; d],
@@ -507,6 +557,28 @@ fn lu_solve(a: &[C64], n: usize, piv: &[usize], b: &mut [C64], k: usize) {
         }
         let inv = a[i * n + i].inv();
         bi.iter_mut().for_each(|v| *v *= inv);
+    }
+}
+
+/// Solves `A^T x = b` for one column with the LU of [`lu_in_place`]
+/// (`P A = L U`, so `A^T = U^T L^T P`); `b` is overwritten by `x`.
+fn lu_solve_transposed(a: &[C64], n: usize, piv: &[usize], b: &mut [C64]) {
+    for i in 0..n {
+        let mut v = b[i];
+        for m in 0..i {
+            v -= a[m * n + i] * b[m];
+        }
+        b[i] = v / a[i * n + i];
+    }
+    for i in (0..n).rev() {
+        let mut v = b[i];
+        for m in i + 1..n {
+            v -= a[m * n + i] * b[m];
+        }
+        b[i] = v;
+    }
+    for i in (0..n).rev() {
+        b.swap(i, piv[i]);
     }
 }
 
@@ -611,38 +683,45 @@ impl Response for LocalResponse<'_> {
                 lu_solve(&w.c, e, &w.c_piv, &mut w.g, d);
             }
             condense(&w.z, &w.g, d, e, &mut w.dz);
-            // I + S dZ, by rows of dZ that are not zero
+            // I + S dZ over the non-zeros of dZ: a row of dZ couples a DOF
+            // only to the DOFs of its elements, so this costs d nnz(dZ), not d^3
+            w.nz.clear();
+            w.nz_ptr.clear();
+            w.nz_ptr.push(0);
+            for row in w.dz.chunks_exact(d) {
+                w.nz.extend(row.iter().enumerate().filter(|(_, v)| **v != ZERO).map(|(j, &v)| (j, v)));
+                w.nz_ptr.push(w.nz.len());
+            }
             let s = &self.data.per_line[li].s[self.slot];
             w.m.fill(ZERO);
             for i in 0..d {
                 w.m[i * d + i] = C64::new(1.0, 0.0);
-            }
-            for kk in 0..d {
-                let dz_row = &w.dz[kk * d..kk * d + d];
-                if dz_row.iter().all(|v| *v == ZERO) {
-                    continue;
-                }
-                for i in 0..d {
-                    let sik = s[i * d + kk];
-                    if sik != ZERO {
-                        for (mv, &z) in w.m[i * d..i * d + d].iter_mut().zip(dz_row) {
-                            *mv += sik * z;
-                        }
+                let (s_row, m_row) = (&s[i * d..i * d + d], &mut w.m[i * d..i * d + d]);
+                for (kk, &sik) in s_row.iter().enumerate() {
+                    for &(j, v) in &w.nz[w.nz_ptr[kk]..w.nz_ptr[kk + 1]] {
+                        m_row[j] += sik * v;
                     }
                 }
             }
             if !lu_in_place(&mut w.m, d, &mut w.m_piv) {
                 return None;
             }
+            // Y = (I + S dZ)^-1 X, needed only at the reference columns:
+            // the sensitivities use the transposed system instead (below)
             let x = &self.x[li];
-            w.y.copy_from_slice(x);
-            lu_solve(&w.m, d, &w.m_piv, &mut w.y, k);
-            // H = H_0 - X^T dZ Y on the channels: (dZ Y)[:, f] per reference
+            let nr = self.refs.len();
+            for i in 0..d {
+                for (a, &fr) in self.refs.iter().enumerate() {
+                    w.y[i * nr + a] = x[i * k + fr];
+                }
+            }
+            lu_solve(&w.m, d, &w.m_piv, &mut w.y, nr);
+            // H = H_0 - X^T dZ Y on the channels
             let line = &self.data.per_line[li];
             let mut h = line.h0.clone();
-            for &fr in &self.refs {
+            for (a, &fr) in self.refs.iter().enumerate() {
                 for i in 0..d {
-                    w.col[i] = (0..d).map(|j| w.dz[i * d + j] * w.y[j * k + fr]).sum();
+                    w.col[i] = (0..d).map(|j| w.dz[i * d + j] * w.y[j * nr + a]).sum();
                 }
                 for (c, &(r, fi)) in self.data.picks.iter().enumerate() {
                     if fi == fr {
@@ -653,6 +732,9 @@ impl Response for LocalResponse<'_> {
             if h.iter().any(|v| !(v.re.is_finite() && v.im.is_finite())) {
                 return None;
             }
+            // (dH/dp_i) p_i [r, f] = -Y[:, r]^T dZ_i Y[:, f] with
+            // Y[:, r]^T = X[:, r]^T (I + S dZ)^-T: one transposed solve per
+            // parameter and reference, not one solve per response
             if let Some(sens) = sens.as_mut() {
                 let mut block = Mat::<C64>::zeros(h.len(), n_par);
                 for (pi, p) in self.params.params().iter().enumerate() {
@@ -664,13 +746,14 @@ impl Response for LocalResponse<'_> {
                         }
                     }
                     condense(&w.dzi, &w.g, d, e, &mut w.dzi_c);
-                    for &fr in &self.refs {
+                    for (a, &fr) in self.refs.iter().enumerate() {
                         for i in 0..d {
-                            w.col[i] = (0..d).map(|j| w.dzi_c[i * d + j] * w.y[j * k + fr]).sum();
+                            w.col[i] = (0..d).map(|j| w.dzi_c[i * d + j] * w.y[j * nr + a]).sum();
                         }
+                        lu_solve_transposed(&w.m, d, &w.m_piv, &mut w.col);
                         for (c, &(r, fi)) in self.data.picks.iter().enumerate() {
                             if fi == fr {
-                                block[(c, pi)] = (0..d).map(|i| w.y[i * k + r] * w.col[i]).sum();
+                                block[(c, pi)] = (0..d).map(|i| x[i * k + r] * w.col[i]).sum();
                             }
                         }
                     }
@@ -725,6 +808,17 @@ mod tests {
         let locals: Vec<Option<LocalCandidate>> = all.iter().map(|c| LocalCandidate::new(&nominal, c)).collect();
         let forms: Vec<&LocalForm> = locals.iter().flatten().map(|l| &l.form).collect();
         let data = LocalData::new(&nominal, &channels, &lines, &forms).unwrap();
+        // S from the selected inverse equals S from unit solves (the fallback)
+        let solver = ZSolver::with_cliques(&nominal.assembly().pattern, &data.slots).unwrap();
+        let mut ws = solver.workspace();
+        let z = nominal.z_values(2.0 * std::f64::consts::PI * lines[1]);
+        solver.factorize(&mut ws, &z, lines[1]).unwrap();
+        let mut s: Vec<Vec<C64>> = data.slots.iter().map(|e| vec![ZERO; e.len() * e.len()]).collect();
+        unit_solves(&solver, &mut ws, &data.slots, &mut Vec::new(), lines[1], &mut s).unwrap();
+        for (got, want) in data.per_line[1].s.iter().zip(&s) {
+            let scale = want.iter().map(|v| v.norm()).fold(0.0, f64::max);
+            assert!(got.iter().zip(want).all(|(g, w)| (g - w).norm() <= 1e-10 * scale), "S differs from unit solves");
+        }
         for (c, local) in all.iter().zip(&locals) {
             let Some(local) = local else { panic!("{} has no local form", c.description) };
             kinds.push(c.kind);
