@@ -24,6 +24,7 @@
 //! which is all the diagnosis needs to fit it (module `local`).
 
 use fe_model::{Dof, ElementId, Group, Model, ModelError, NodeId, Parameter};
+use rayon::prelude::*;
 use serde::Serialize;
 
 /// The kind of a candidate effect.
@@ -135,9 +136,8 @@ pub struct Candidate {
     /// Plausible range per parameter, with the reason shown when outside.
     pub plausible: Vec<(f64, f64, &'static str)>,
     pub(crate) edit: Edit,
-    /// The nominal nodes of [`Self::part`].
-    pub(crate) part_nodes: Vec<NodeId>,
-    /// The part of the nominal model on `part_nodes`, with the change applied.
+    /// The part of the nominal model on `part_nodes`, before and after the change.
+    pub(crate) nominal_part: Model,
     pub(crate) part: Model,
 }
 
@@ -213,10 +213,11 @@ fn regions(model: &Model, size: usize) -> Vec<Vec<usize>> {
 }
 
 /// Most elements in the region of a stiffness or mass change. A region of
-/// twelve elements in a row touches 39 equations, so its change is still a
-/// low-rank update of the nominal model (module `local`); a larger one
-/// would be fitted on its own model, a factorisation per line and iteration.
-const MAX_CHANGE_REGION: usize = 12;
+/// eight elements in a row touches 27 equations, so its change is a cheap
+/// low-rank update of the nominal model (module `local`, whose cost grows as
+/// the cube of that number); a region of more than about twenty would be
+/// fitted on its own model, a factorisation per line and iteration.
+const MAX_CHANGE_REGION: usize = 8;
 
 /// Elements per region of stiffness and mass changes on a model with more
 /// than [`CandidateOptions::per_element_limit`] elements: about half that
@@ -245,7 +246,7 @@ fn nodes_of(model: &Model, idx: &[usize]) -> Vec<u32> {
 
 /// Stiffness-change and mass-change candidates of one element or one
 /// contiguous run of elements (`unit`: beam indices).
-fn change_candidates(model: &Model, unit: &[usize]) -> Vec<Candidate> {
+fn change_candidates(model: &Model, unit: &[usize]) -> Vec<Spec> {
     let ids = element_ids(model, unit);
     let field_name = |f: &str| {
         if ids.len() == 1 {
@@ -269,8 +270,7 @@ fn change_candidates(model: &Model, unit: &[usize]) -> Vec<Candidate> {
     ] {
         let Ok(p) = model.parameter(&field_name(field)) else { continue };
         let nodes = nodes_of(model, unit);
-        out.extend(Candidate::new(
-            model,
+        out.push((
             Head {
                 kind,
                 description: format!("{} of {}", kind.label(), range_name(&ids)),
@@ -307,7 +307,13 @@ pub(crate) fn neighbourhood(model: &Model, c: &Candidate) -> Vec<usize> {
 
 /// Stiffness-change and mass-change candidates of one element each.
 pub(crate) fn per_element(model: &Model, beams: &[usize]) -> Vec<Candidate> {
-    beams.iter().flat_map(|&i| change_candidates(model, &[i])).collect()
+    build(model, beams.iter().flat_map(|&i| change_candidates(model, &[i])).collect())
+}
+
+/// Makes the candidates of `specs`, in parallel and in order: each takes its
+/// part of the model, a scan of the whole model.
+fn build(model: &Model, specs: Vec<Spec>) -> Vec<Candidate> {
+    specs.into_par_iter().filter_map(|(head, edit, fitted)| Candidate::new(model, head, edit, fitted)).collect()
 }
 
 /// What a candidate is, apart from its change and parameters.
@@ -324,13 +330,17 @@ struct Head {
 /// A parameter to fit: name, search bounds, plausible range.
 type Fitted = (String, Option<(f64, f64)>, (f64, f64, &'static str));
 
+/// A candidate before its part of the model is taken.
+type Spec = (Head, Edit, Vec<Fitted>);
+
 impl Candidate {
     /// Builds a candidate: the part of `model` it touches, with the change
     /// applied. `None` when the change does not apply (it then would not
     /// apply to the whole model either).
     fn new(model: &Model, head: Head, edit: Edit, fitted: Vec<Fitted>) -> Option<Candidate> {
         let part_nodes: Vec<NodeId> = head.part_nodes.iter().map(|&n| NodeId(n)).collect();
-        let mut part = model.part(&part_nodes);
+        let nominal_part = model.part(&part_nodes);
+        let mut part = nominal_part.clone();
         edit.apply(&mut part).ok()?;
         if fitted.iter().any(|(name, ..)| part.parameter(name).is_err()) {
             return None;
@@ -345,7 +355,7 @@ impl Candidate {
             bounds: fitted.iter().map(|f| f.1).collect(),
             plausible: fitted.iter().map(|f| f.2).collect(),
             edit,
-            part_nodes,
+            nominal_part,
             part,
         })
     }
@@ -368,15 +378,15 @@ impl Candidate {
         &self.part
     }
 
-    /// The nominal nodes of [`Self::part`].
-    pub(crate) fn part_nodes(&self) -> &[NodeId] {
-        &self.part_nodes
+    /// The part of the nominal model on the same nodes as [`Self::part`].
+    pub(crate) fn nominal_part(&self) -> &Model {
+        &self.nominal_part
     }
 }
 
 /// Generates every candidate for a model; see the module docs.
 pub fn generate(model: &Model, opts: &CandidateOptions) -> Vec<Candidate> {
-    let mut out = Vec::new();
+    let mut specs: Vec<Spec> = Vec::new();
     let w_mid = 2.0 * std::f64::consts::PI * (opts.band_hz.0 * opts.band_hz.1).sqrt();
     let w_max = 2.0 * std::f64::consts::PI * opts.band_hz.1;
     let w_min = 2.0 * std::f64::consts::PI * opts.band_hz.0;
@@ -437,7 +447,7 @@ pub fn generate(model: &Model, opts: &CandidateOptions) -> Vec<Candidate> {
             part_nodes: ring(NodeId(node)),
         };
         let edit = Edit::Support { node, dofs, name, group, k, alpha: alpha_start };
-        out.extend(Candidate::new(model, head, edit, fitted));
+        specs.push((head, edit, fitted));
     }
 
     // flexible, lossy joints where members meet at an angle
@@ -501,7 +511,7 @@ pub fn generate(model: &Model, opts: &CandidateOptions) -> Vec<Candidate> {
                 kr: 100.0 * kref,
                 alpha: alpha_start,
             };
-            out.extend(Candidate::new(model, head, edit, fitted));
+            specs.push((head, edit, fitted));
         }
     }
     // existing joint springs: their stiffness and damping as modelled
@@ -535,7 +545,7 @@ pub fn generate(model: &Model, opts: &CandidateOptions) -> Vec<Candidate> {
             dofs: Dof::ALL.iter().copied().filter(|d| sp.k[d.index()] > 0.0).collect(),
             part_nodes: vec![sp.a.0, b.0],
         };
-        out.extend(Candidate::new(model, head, Edit::Set, fitted));
+        specs.push((head, Edit::Set, fitted));
     }
 
     // lumped masses at free nodes
@@ -567,7 +577,7 @@ pub fn generate(model: &Model, opts: &CandidateOptions) -> Vec<Candidate> {
             part_nodes: vec![node.id.0],
         };
         let edit = Edit::Mass { node: node.id.0, name, group: mass_group.clone(), m: 1e-3 * total_mass };
-        out.extend(Candidate::new(model, head, edit, fitted));
+        specs.push((head, edit, fitted));
     }
 
     // stiffness and mass changes per element or per region
@@ -579,7 +589,7 @@ pub fn generate(model: &Model, opts: &CandidateOptions) -> Vec<Candidate> {
         regions(model, change_region_size(model.beams().len(), opts))
     };
     for unit in &units {
-        out.extend(change_candidates(model, unit));
+        specs.extend(change_candidates(model, unit));
     }
 
     // damping per region
@@ -608,10 +618,10 @@ pub fn generate(model: &Model, opts: &CandidateOptions) -> Vec<Candidate> {
                 dofs: Vec::new(),
             };
             let edit = Edit::Region { first: ids[0], last: ids[ids.len() - 1], group: g, viscous };
-            out.extend(Candidate::new(model, head, edit, fitted));
+            specs.push((head, edit, fitted));
         }
     }
-    out
+    build(model, specs)
 }
 
 impl Candidate {

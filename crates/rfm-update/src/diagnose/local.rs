@@ -65,7 +65,7 @@ impl LocalCandidate {
     /// The local form of `candidate` relative to `nominal` (the whole
     /// nominal system), or `None` when it has none (see [`LocalForm`]).
     pub(crate) fn new(nominal: &DampedSystem, candidate: &Candidate) -> Option<Self> {
-        let nominal_part = DampedSystem::of_part(nominal.model().part(candidate.part_nodes())).ok()?;
+        let nominal_part = DampedSystem::of_part(candidate.nominal_part().clone()).ok()?;
         let part = DampedSystem::of_part(candidate.part().clone()).ok()?;
         let params = ParameterSet::new(candidate.parameters_in(part.model()).ok()?);
         let form = LocalForm::of(nominal, &nominal_part, &part, &params)?;
@@ -644,6 +644,12 @@ pub(crate) struct LocalResponse<'a> {
 impl Response for LocalResponse<'_> {
     fn set(&mut self, values: &[f64]) -> Result<(), UpdateError> {
         self.params.set_values(&mut self.sys, values)
+    }
+
+    /// A sensitivity costs one transposed solve of a `d x d` system per
+    /// parameter, beside the factorisation the receptances need anyway.
+    fn cheap_jacobian(&self) -> bool {
+        true
     }
 
     fn evaluate(&mut self, lines: &[f64], jacobian: bool) -> Option<Evaluated> {
