@@ -86,6 +86,15 @@ pub fn estimate_noise(measured: &FrfSet) -> Option<f64> {
 pub struct DiagnoseOptions {
     /// Lines for the full fits.
     pub lines: usize,
+    /// Above this many candidates, all are first fitted briefly on a few
+    /// lines (pre-screening), and only the best `prescreen_keep` are screened.
+    pub prescreen_above: usize,
+    /// Candidates screened after pre-screening.
+    pub prescreen_keep: usize,
+    /// Lines for the pre-screening fits.
+    pub prescreen_lines: usize,
+    /// Iterations of a pre-screening fit.
+    pub prescreen_iterations: usize,
     /// Lines for the screening fits.
     pub screen_lines: usize,
     /// Iterations of a screening fit.
@@ -109,6 +118,10 @@ impl Default for DiagnoseOptions {
     fn default() -> Self {
         DiagnoseOptions {
             lines: 200,
+            prescreen_above: 600,
+            prescreen_keep: 300,
+            prescreen_lines: 20,
+            prescreen_iterations: 3,
             screen_lines: 60,
             screen_iterations: 6,
             keep: 8,
@@ -250,6 +263,9 @@ fn spread(lines: &[f64], n: usize) -> Vec<f64> {
 struct Fit {
     values: Vec<f64>,
     cost: f64,
+    /// The nominal model's cost on the same lines.
+    cost0: f64,
+    /// Number of real residuals.
     n: usize,
     relative_std: Vec<f64>,
 }
@@ -258,12 +274,13 @@ struct Fit {
 /// the nominal model (see module `local`).
 type Local<'a> = Option<(&'a LocalData, &'a LocalCandidate)>;
 
-/// Fits one candidate: by low-rank updates when `local` is given, else on
-/// its whole model (the nominal model with the candidate's change).
+/// Fits one candidate to `measured` (`cost0`: the nominal model's cost on
+/// it): by low-rank updates when `local` is given, else on its whole model
+/// (the nominal model with the candidate's change).
 fn fit(
     candidate: &Candidate,
     nominal: &fe_model::Model,
-    measured: &FrfSet,
+    (measured, cost0): (&FrfSet, f64),
     local: Local<'_>,
     iterations: usize,
     start: Option<&[f64]>,
@@ -293,7 +310,7 @@ fn fit(
         None => oe::run(&mut sys, &params, &data, &opts, |_| {}).ok()?,
     };
     let relative_std = (0..params.len()).map(|i| r.covariance[(i, i)].max(0.0).sqrt()).collect();
-    Some(Fit { values: r.values, cost: r.cost, n: r.n_data, relative_std })
+    Some(Fit { values: r.values, cost: r.cost, cost0, n: r.n_data, relative_std })
 }
 
 fn nominal_cost(sys: &DampedSystem, measured: &FrfSet) -> Result<(f64, usize), UpdateError> {
@@ -323,7 +340,7 @@ pub fn diagnose(model: &fe_model::Model, measured: &FrfSet, opts: &DiagnoseOptio
     let coarse = measured.at_frequencies(&spread(lines, opts.screen_lines))?;
     let nominal = DampedSystem::new(model.clone())?;
     let (cost0_full, n_full) = nominal_cost(&nominal, &full)?;
-    let (cost0_coarse, n_coarse) = nominal_cost(&nominal, &coarse)?;
+    let (cost0_coarse, _) = nominal_cost(&nominal, &coarse)?;
     let mut copts = opts.candidates.clone();
     copts.band_hz = (lines[0], lines[lines.len() - 1]);
     let candidates = candidates::generate(model, &copts);
@@ -337,21 +354,28 @@ pub fn diagnose(model: &fe_model::Model, measured: &FrfSet, opts: &DiagnoseOptio
         let forms: Vec<_> = locals.iter().filter_map(|l| l.as_ref().map(|l| &l.form)).collect();
         LocalData::new(&nominal, set.channels(), set.frequencies_hz(), &forms)
     };
-    let screen =
-        |candidates: &[Candidate], locals: &[Option<LocalCandidate>]| -> Result<Vec<Option<Fit>>, UpdateError> {
-            let data = local_data(&coarse, &locals.iter().collect::<Vec<_>>())?;
-            Ok(candidates
-                .par_iter()
-                .zip(locals)
-                .map(|(c, l)| {
-                    let local = l.as_ref().map(|l| (&data, l));
-                    // a low-rank update that cannot be evaluated (a singular
-                    // local system at some line) falls back to the whole model
-                    fit(c, model, &coarse, local, opts.screen_iterations, None)
-                        .or_else(|| local.and_then(|_| fit(c, model, &coarse, None, opts.screen_iterations, None)))
-                })
-                .collect())
-        };
+    // Fits `which` of `candidates` on the lines of `set` (`cost0`: the
+    // nominal model's cost there), from their starting values.
+    let screen = |set: &FrfSet,
+                  cost0: f64,
+                  iterations: usize,
+                  candidates: &[Candidate],
+                  locals: &[Option<LocalCandidate>],
+                  which: &[usize]|
+     -> Result<Vec<(usize, Option<Fit>)>, UpdateError> {
+        let data = local_data(set, &which.iter().map(|&i| &locals[i]).collect::<Vec<_>>())?;
+        Ok(which
+            .par_iter()
+            .map(|&i| {
+                let (c, local) = (&candidates[i], locals[i].as_ref().map(|l| (&data, l)));
+                // a low-rank update that cannot be evaluated (a singular
+                // local system at some line) falls back to the whole model
+                let f = fit(c, model, (set, cost0), local, iterations, None)
+                    .or_else(|| local.and_then(|_| fit(c, model, (set, cost0), None, iterations, None)));
+                (i, f)
+            })
+            .collect())
+    };
     // full fits, warm-started from screening
     let full_fit = |candidates: &[Candidate],
                     locals: &[Option<LocalCandidate>],
@@ -364,22 +388,48 @@ pub fn diagnose(model: &fe_model::Model, measured: &FrfSet, opts: &DiagnoseOptio
             .map(|&i| {
                 let local = locals[i].as_ref().map(|l| (&data, l));
                 let start = screened[i].as_ref().map(|f| f.values.as_slice());
-                let f = fit(&candidates[i], model, &full, local, opts.iterations, start)
-                    .or_else(|| fit(&candidates[i], model, &full, None, opts.iterations, start))
-                    .or_else(|| fit(&candidates[i], model, &full, None, opts.iterations, None));
+                let f = fit(&candidates[i], model, (&full, cost0_full), local, opts.iterations, start)
+                    .or_else(|| fit(&candidates[i], model, (&full, cost0_full), None, opts.iterations, start))
+                    .or_else(|| fit(&candidates[i], model, (&full, cost0_full), None, opts.iterations, None));
                 (i, f)
             })
             .collect())
     };
-
-    // screening
-    let mut screened = screen(&candidates, &locals)?;
-    let mut order: Vec<usize> = (0..candidates.len()).filter(|&i| screened[i].is_some()).collect();
-    let score = |screened: &[Option<Fit>], candidates: &[Candidate], i: usize| {
-        let f = screened[i].as_ref().expect("filtered");
-        bic(f.cost, cost0_coarse, n_coarse, candidates[i].parameters.len())
+    // fits on more residuals first (screened before pre-screened), then by dBIC
+    let by_rank = |screened: &[Option<Fit>], candidates: &[Candidate], order: &mut Vec<usize>| {
+        let key = |i: usize| {
+            let f = screened[i].as_ref().expect("only fitted candidates are ranked");
+            (f.n, bic(f.cost, f.cost0, f.n, candidates[i].parameters.len()))
+        };
+        order.sort_by(|&a, &b| {
+            let ((na, sa), (nb, sb)) = (key(a), key(b));
+            nb.cmp(&na).then(sa.total_cmp(&sb))
+        });
     };
-    order.sort_by(|&a, &b| score(&screened, &candidates, a).total_cmp(&score(&screened, &candidates, b)));
+
+    // pre-screening of many candidates, then screening
+    let all: Vec<usize> = (0..candidates.len()).collect();
+    let mut screened: Vec<Option<Fit>> = (0..candidates.len()).map(|_| None).collect();
+    let to_screen = if candidates.len() > opts.prescreen_above {
+        let pre = measured.at_frequencies(&spread(lines, opts.prescreen_lines))?;
+        let (cost0_pre, _) = nominal_cost(&nominal, &pre)?;
+        for (i, f) in screen(&pre, cost0_pre, opts.prescreen_iterations, &candidates, &locals, &all)? {
+            screened[i] = f;
+        }
+        let mut best: Vec<usize> = all.iter().copied().filter(|&i| screened[i].is_some()).collect();
+        by_rank(&screened, &candidates, &mut best);
+        best.truncate(opts.prescreen_keep);
+        best
+    } else {
+        all
+    };
+    for (i, f) in screen(&coarse, cost0_coarse, opts.screen_iterations, &candidates, &locals, &to_screen)? {
+        if f.is_some() {
+            screened[i] = f;
+        }
+    }
+    let mut order: Vec<usize> = (0..candidates.len()).filter(|&i| screened[i].is_some()).collect();
+    by_rank(&screened, &candidates, &mut order);
     let keep: Vec<usize> = order.iter().copied().take(opts.keep).collect();
     let mut full_fits = full_fit(&candidates, &locals, &screened, &keep)?;
 
@@ -403,21 +453,24 @@ pub fn diagnose(model: &fe_model::Model, measured: &FrfSet, opts: &DiagnoseOptio
     let refined_locals: Vec<Option<LocalCandidate>> =
         refined.par_iter().map(|c| LocalCandidate::new(&nominal, c)).collect();
     // screened like the others; the best few fitted fully
-    let refined_screened = screen(&refined, &refined_locals)?;
+    let all_refined: Vec<usize> = (0..refined.len()).collect();
+    let refined_screened =
+        screen(&coarse, cost0_coarse, opts.screen_iterations, &refined, &refined_locals, &all_refined)?;
     let first_refined = candidates.len();
     let mut candidates = candidates;
     candidates.extend(refined);
     locals.extend(refined_locals);
-    screened.extend(refined_screened);
+    screened.extend(refined_screened.into_iter().map(|(_, f)| f));
     let mut new: Vec<usize> = (first_refined..candidates.len()).filter(|&i| screened[i].is_some()).collect();
-    new.sort_by(|&a, &b| score(&screened, &candidates, a).total_cmp(&score(&screened, &candidates, b)));
+    by_rank(&screened, &candidates, &mut new);
     let best_new: Vec<usize> = new.iter().copied().take(REFINED_FITS).collect();
     full_fits.extend(full_fit(&candidates, &locals, &screened, &best_new)?);
     order.extend(new);
-    order.sort_by(|&a, &b| score(&screened, &candidates, a).total_cmp(&score(&screened, &candidates, b)));
+    by_rank(&screened, &candidates, &mut order);
 
-    let ranked = |i: usize, f: &Fit, cost0: f64, n: usize, fully: bool| {
+    let ranked = |i: usize, f: &Fit, n: usize, fully: bool| {
         let c = &candidates[i];
+        let cost0 = f.cost0;
         let delta_bic = bic(f.cost, cost0, n, c.parameters.len());
         let implausible_reason = c.implausible(&f.values);
         Ranked {
@@ -442,18 +495,14 @@ pub fn diagnose(model: &fe_model::Model, measured: &FrfSet, opts: &DiagnoseOptio
             candidate: i,
         }
     };
-    let mut ranking: Vec<Ranked> = full_fits
-        .iter()
-        .filter_map(|(i, f)| f.as_ref().map(|f| ranked(*i, f, cost0_full, n_full.max(f.n), true)))
-        .collect();
+    let mut ranking: Vec<Ranked> =
+        full_fits.iter().filter_map(|(i, f)| f.as_ref().map(|f| ranked(*i, f, n_full.max(f.n), true))).collect();
     ranking.sort_by(|a, b| a.delta_bic.total_cmp(&b.delta_bic));
     let fitted: Vec<usize> = ranking.iter().map(|r| r.candidate).collect();
-    ranking.extend(
-        order
-            .iter()
-            .filter(|i| !fitted.contains(i))
-            .map(|&i| ranked(i, screened[i].as_ref().expect("filtered"), cost0_coarse, n_coarse, false)),
-    );
+    ranking.extend(order.iter().filter(|i| !fitted.contains(i)).map(|&i| {
+        let f = screened[i].as_ref().expect("filtered");
+        ranked(i, f, f.n, false)
+    }));
     Ok(Diagnosis {
         noise,
         nominal_misfit: (cost0_full / (n_full as f64 / 2.0)).sqrt(),

@@ -295,3 +295,32 @@ fn a_leading_region_is_refined_to_the_element_that_changed() {
     let factor = top.parameters[0].value;
     assert!((factor / 0.6 - 1.0).abs() < 3.0 * top.parameters[0].relative_std, "fitted factor {factor}");
 }
+
+/// Large models pre-screen their many candidates on a few lines and screen
+/// only the best. Forced on the cantilever (pre-screening all, screening
+/// a fifth), each kind of hidden effect must still lead, with the same full
+/// fit as without pre-screening, and no candidate may drop out of the
+/// ranking.
+#[test]
+fn pre_screening_keeps_the_leader() {
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    for kind in [
+        EffectKind::StiffnessChange,
+        EffectKind::LumpedMass,
+        EffectKind::FlexibleSupport,
+        EffectKind::NonViscousDamping,
+    ] {
+        let h = draw(kind, &mut rng);
+        let measured = measure(&h.model, 0.01, 3);
+        let plain = diagnose(&nominal(), &measured, &DiagnoseOptions::default()).unwrap();
+        let n = plain.candidates.len();
+        let opts = DiagnoseOptions { prescreen_above: 0, prescreen_keep: n / 5, ..DiagnoseOptions::default() };
+        assert!(n > opts.prescreen_keep + opts.keep, "too few candidates ({n}) to test pre-screening");
+        let pre = diagnose(&nominal(), &measured, &opts).unwrap();
+        let (a, b) = (&plain.ranking[0], &pre.ranking[0]);
+        assert_eq!(a.kind, kind, "{}", a.description);
+        assert_eq!(a.description, b.description);
+        assert!((a.delta_bic - b.delta_bic).abs() <= 1e-6 * a.delta_bic.abs(), "{} vs {}", a.delta_bic, b.delta_bic);
+        assert_eq!(pre.ranking.len(), plain.ranking.len(), "candidates lost by pre-screening");
+    }
+}
