@@ -400,7 +400,7 @@ fn bench(args: &[String]) -> Result<(), String> {
         "{:<30} {:>6} {:>11} {:>6} {:>10} {:>9}  leader",
         "configuration", "DOFs", "candidates", "lines", "total s", "peak MiB"
     );
-    for frame in ["3x3x4", "5x5x5", "8x8x8"] {
+    for frame in ["3x3x4", "5x5x5", "8x8x8", "10x11x15"] {
         let p = bench_point(&exe, &format!("frame {frame}"), &["--frame", frame])?;
         let found = if p.json["found"].as_bool() == Some(true) { "(right)" } else { "(WRONG)" };
         println!(
