@@ -16,14 +16,25 @@
 //! Y          = (I + S dZ)^-1 X               (= H(p)[D, W])
 //! H(p)[r, f] = H_0[r, f] - X[:, r]^T dZ Y[:, f]
 //! (dH/dp_i) p_i [r, f] = -Y[:, r]^T ((dZ/dp_i) p_i) Y[:, f]
+//!                      = -X[:, r]^T (I + S dZ)^-T ((dZ/dp_i) p_i) Y[:, f]
 //! ```
 //!
-//! exactly (no linearisation): a fit of such a candidate needs, per line,
-//! one factorisation of the *nominal* `Z` and unit solves at `W` and at the
-//! union of the candidates' `D`, shared by every candidate, after which each
-//! evaluation costs a few `d x d` products (on a 750-DOF frame with 562
-//! candidates the diagnosis fell from 158 s to 5.5 s). A candidate touching more than [`MAX_LOCAL_EQS`]
-//! equations is fitted on its own model.
+//! exactly (no linearisation). `Y` is needed only at the reference columns
+//! `f`, and each sensitivity costs one solve with the transposed matrix.
+//!
+//! Everything a candidate needs is local: the part of the model it touches
+//! before and after its change ([`LocalCandidate`], from
+//! [`fe_model::Model::part`]), whose equations are matched to the whole
+//! nominal model's by DOF, and per line `S` and `X`. These come from one
+//! factorisation of the *nominal* `Z` per line, shared by every candidate:
+//! `X` from unit solves at `W`, and every `S` from the selected inverse of
+//! `Z_0` (the solver is analysed with each `D` as a clique, so that
+//! `H_0[D, D]` lies in the factor's pattern), which costs about one more
+//! factorisation, where a solve per equation of `D` would cost `N` solves
+//! per line on a large model. Each evaluation then costs a few operations on
+//! `d x d` matrices with small kernels written here (faer's dispatch costs
+//! more than the arithmetic at this size). A candidate touching more than
+//! [`MAX_LOCAL_EQS`] equations is fitted on its own model.
 
 use std::collections::HashMap;
 

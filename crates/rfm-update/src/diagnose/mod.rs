@@ -26,7 +26,13 @@
 //!
 //! To stay fast with many candidates, all are first fitted briefly on a
 //! coarse subset of lines (screening), and the leaders are then fitted fully
-//! on the updating lines; the final ranking rests on the full fits only.
+//! on the updating lines; the final ranking rests on the full fits only. A
+//! large model has thousands of candidates (a mass at every node, damping
+//! in every region): above [`DiagnoseOptions::prescreen_above`] of them, all
+//! are first fitted with fewer iterations on fewer lines (pre-screening) and
+//! only the best few hundred are screened. Screening-only entries of the
+//! ranking are scored on their own lines; screened ones come before
+//! pre-screened ones.
 //! On large models stiffness and mass changes are candidates per region; the
 //! two leaders' locations are then refined into per-element changes, which
 //! are screened and the best four fitted fully, so that one weakened element
@@ -36,8 +42,11 @@
 //! candidate changes `Z` only on the few equations it touches, so its
 //! receptances and sensitivities follow from the nominal model's by a
 //! low-rank (Woodbury) update (module `local`), and one factorisation of the
-//! nominal `Z` per line serves every candidate. A candidate touching more
-//! than a few dozen equations is fitted on its own model instead.
+//! nominal `Z` per line serves every candidate. A candidate is its change
+//! and the part of the model the change touches, never a copy of the whole
+//! model, so nothing per candidate grows with the model. A candidate
+//! touching more than a few dozen equations is fitted on its own model
+//! instead.
 
 pub mod candidates;
 mod local;
