@@ -490,10 +490,8 @@ pub fn generate(model: &Model, opts: &CandidateOptions) -> Vec<Candidate> {
                 ),
                 (format!("group.{group}.alpha"), alpha_bounds, alpha_plausible),
             ];
-            let mut part_nodes = nodes_of(model, member);
-            part_nodes.push(node.id.0);
-            part_nodes.sort_unstable();
-            part_nodes.dedup();
+            // every element at the node: splitting it checks that one stays
+            let part_nodes = ring(node.id);
             let head = Head {
                 kind: EffectKind::FlexibleJoint,
                 description: format!("flexible, lossy joint at node {} ({})", node.id, range_name(&elements)),
@@ -715,15 +713,46 @@ mod tests {
     use super::*;
     use fe_model::{Assembly, samples};
 
+    /// Two members meeting at a right angle at node 3, clamped at node 1.
+    fn l_frame() -> Model {
+        let mut m = Model::new("L-frame");
+        let g = m.add_group(Group::new("frame").rayleigh(1e-5, 0.5)).unwrap();
+        let steel = m.add_material("steel", 2.1e11, 7850.0).unwrap();
+        let sec = m.add_section(fe_model::Section::rectangle("bar", 0.02, 0.02)).unwrap();
+        for (id, x, y) in [(1, 0.0, 0.0), (2, 0.0, 0.3), (3, 0.0, 0.6), (4, 0.25, 0.6), (5, 0.5, 0.6)] {
+            m.add_node(id, x, y).unwrap();
+        }
+        for (id, a, b) in [(1, 1, 2), (2, 2, 3), (3, 3, 4), (4, 4, 5)] {
+            m.add_beam(id, [a, b], steel, sec, g).unwrap();
+        }
+        m.add_support(1, &Dof::ALL).unwrap();
+        m
+    }
+
     /// Every candidate's change applies to the whole model, which still
     /// assembles (a candidate carries no whole model that could be checked
     /// beforehand), and its parameters start at the same values there as in
     /// its part.
     #[test]
     fn every_candidate_applies_to_the_whole_model() {
-        for model in [samples::frame_grid(2, 2, 3), samples::frame_with_joint(), samples::cantilever(6)] {
+        for model in [samples::frame_grid(2, 2, 3), samples::frame_with_joint(), samples::cantilever(6), l_frame()] {
             let all = generate(&model, &CandidateOptions { per_element_limit: 8, ..CandidateOptions::default() });
             assert!(all.iter().any(|c| c.kind == EffectKind::FlexibleSupport));
+            // a change that fails on its part drops its candidate: none may
+            let new_joints = all.iter().filter(|c| matches!(c.edit, Edit::NewJoint { .. })).count();
+            let corners = model
+                .nodes()
+                .iter()
+                .filter(|n| {
+                    let at = model.beams_at(n.id);
+                    at.len() == 2 && {
+                        let (_, c0, s0) = model.beam_geometry(at[0]);
+                        let (_, c1, s1) = model.beam_geometry(at[1]);
+                        (c0 * c1 + s0 * s1).abs() < 0.5
+                    }
+                })
+                .count();
+            assert!(new_joints >= corners, "{new_joints} new joints for {corners} corners in {}", model.title);
             for c in &all {
                 let whole = c.model(&model).unwrap();
                 assert!(Assembly::new(&whole).is_ok(), "{} breaks the model", c.description);

@@ -795,12 +795,13 @@ mod tests {
     /// including those that add equations (supports, joints).
     #[test]
     fn low_rank_updates_equal_the_candidate_models() {
-        let mut kinds = Vec::new();
+        let (mut kinds, mut new_joints) = (Vec::new(), 0);
         // damped, partly non-viscous models (one with a joint spring), so
         // that every kind of local change meets damping it must replace
         for model in [samples::frame_grid(1, 2, 2), samples::frame_with_joint()] {
-            check_model(&model, &mut kinds);
+            check_model(&model, &mut kinds, &mut new_joints);
         }
+        assert!(new_joints > 0, "no new joint was checked");
         for kind in [
             EffectKind::LumpedMass,
             EffectKind::StiffnessChange,
@@ -814,7 +815,7 @@ mod tests {
         }
     }
 
-    fn check_model(model: &fe_model::Model, kinds: &mut Vec<EffectKind>) {
+    fn check_model(model: &fe_model::Model, kinds: &mut Vec<EffectKind>, new_joints: &mut usize) {
         let nominal = DampedSystem::new(model.clone()).unwrap();
         let uy: Vec<DofRef> =
             (0..nominal.n()).map(|eq| nominal.assembly().dofs.dof_of(eq)).filter(|d| d.dof == Dof::Uy).collect();
@@ -839,6 +840,8 @@ mod tests {
         for (c, local) in all.iter().zip(&locals) {
             let Some(local) = local else { panic!("{} has no local form", c.description) };
             kinds.push(c.kind);
+            // a joint the model lacks, not only one it has
+            *new_joints += usize::from(matches!(c.edit, candidates::Edit::NewJoint { .. }));
             // the truth: the candidate's whole model
             let sys = DampedSystem::new(c.model(model).unwrap()).unwrap();
             let params = ParameterSet::new(c.parameters_in(sys.model()).unwrap());
