@@ -9,47 +9,16 @@ use frf::{C64, FactorKind, FrfError, SelectedInverse, ZSolver};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
+use crate::solver::symmetric_with_diagonal;
+
 /// A random complex-symmetric matrix on a random symmetric pattern, strictly
 /// diagonally dominant (so `L D L^T` needs no pivoting and the inverse is
 /// well conditioned): random off-diagonal entries, and a diagonal of random
 /// phase whose modulus is 1.5 times its row's off-diagonal sum, plus one.
 fn dominant_symmetric(n: usize, per_col: usize, rng: &mut ChaCha8Rng) -> (Pattern, Vec<C64>) {
-    let mut cols: Vec<Vec<(usize, C64)>> = vec![Vec::new(); n];
-    for c in 0..n {
-        for _ in 0..per_col {
-            let r = rng.random_range(0..n);
-            if r != c {
-                let v = C64::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
-                cols[c].push((r, v));
-                cols[r].push((c, v));
-            }
-        }
-    }
-    let mut col_ptr = vec![0];
-    let mut row_idx = Vec::new();
-    let mut vals = Vec::new();
-    for (c, col) in cols.iter_mut().enumerate() {
-        // a pair drawn twice is merged; both columns see the same two values,
-        // so the sum stays symmetric
-        col.sort_by_key(|&(r, _)| r);
-        col.dedup_by(|a, b| {
-            if a.0 == b.0 {
-                b.1 += a.1;
-                true
-            } else {
-                false
-            }
-        });
-        let off: f64 = col.iter().map(|&(_, v)| v.norm()).sum();
-        col.push((c, C64::from_polar(1.5 * off + 1.0, rng.random_range(0.0..std::f64::consts::TAU))));
-        col.sort_by_key(|&(r, _)| r);
-        for &(r, v) in col.iter() {
-            row_idx.push(r);
-            vals.push(v);
-        }
-        col_ptr.push(row_idx.len());
-    }
-    (Pattern { n, col_ptr, row_idx }, vals)
+    symmetric_with_diagonal(n, per_col, rng, |off, rng| {
+        C64::from_polar(1.5 * off + 1.0, rng.random_range(0.0..std::f64::consts::TAU))
+    })
 }
 
 /// `Z^-1` by faer's dense LU with partial pivoting, solving against the

@@ -67,6 +67,23 @@ fn ldlt_equals_lu_on_the_sample_models() {
 /// off-diagonal entries, and a diagonal of the size of its row's
 /// off-diagonal sum times a random complex factor (not diagonally dominant).
 fn random_symmetric(n: usize, per_col: usize, rng: &mut ChaCha8Rng) -> (Pattern, Vec<C64>) {
+    symmetric_with_diagonal(n, per_col, rng, |off, rng| {
+        let phase = rng.random_range(0.0..std::f64::consts::TAU);
+        let factor = rng.random_range(0.6..1.6);
+        C64::from_polar(off.max(1.0) * factor, phase)
+    })
+}
+
+/// A random symmetric pattern with about `per_col` random off-diagonal
+/// entries per column (a pair drawn twice is merged on both sides, so the
+/// values stay symmetric), and each diagonal entry `diagonal(off, rng)`,
+/// `off` being the sum of the moduli of its column's other entries.
+pub(crate) fn symmetric_with_diagonal(
+    n: usize,
+    per_col: usize,
+    rng: &mut ChaCha8Rng,
+    mut diagonal: impl FnMut(f64, &mut ChaCha8Rng) -> C64,
+) -> (Pattern, Vec<C64>) {
     let mut cols: Vec<Vec<(usize, C64)>> = vec![Vec::new(); n];
     for c in 0..n {
         for _ in 0..per_col {
@@ -78,10 +95,12 @@ fn random_symmetric(n: usize, per_col: usize, rng: &mut ChaCha8Rng) -> (Pattern,
             }
         }
     }
+    let mut col_ptr = vec![0];
+    let mut row_idx = Vec::new();
+    let mut vals = Vec::new();
     for (c, col) in cols.iter_mut().enumerate() {
         col.sort_by_key(|&(r, _)| r);
         col.dedup_by(|a, b| {
-            // a duplicate pair was added on both sides: keep one of each, symmetric
             if a.0 == b.0 {
                 b.1 += a.1;
                 true
@@ -89,17 +108,10 @@ fn random_symmetric(n: usize, per_col: usize, rng: &mut ChaCha8Rng) -> (Pattern,
                 false
             }
         });
-        let size: f64 = col.iter().map(|&(_, v)| v.norm()).sum::<f64>().max(1.0);
-        let phase = rng.random_range(0.0..std::f64::consts::TAU);
-        let factor = rng.random_range(0.6..1.6);
-        col.push((c, C64::from_polar(size * factor, phase)));
+        let off: f64 = col.iter().map(|&(_, v)| v.norm()).sum();
+        col.push((c, diagonal(off, rng)));
         col.sort_by_key(|&(r, _)| r);
-    }
-    let mut col_ptr = vec![0];
-    let mut row_idx = Vec::new();
-    let mut vals = Vec::new();
-    for col in &cols {
-        for &(r, v) in col {
+        for &(r, v) in col.iter() {
             row_idx.push(r);
             vals.push(v);
         }
