@@ -295,17 +295,22 @@ fn load_average() -> String {
         .unwrap_or_else(|_| "unknown".into())
 }
 
-fn bench(args: &[String]) -> Result<(), String> {
-    let full = args.iter().any(|a| a == "--full");
+/// Builds an example of rfm-update in release mode; returns its path.
+fn release_example(name: &str) -> Result<PathBuf, String> {
     let status = cargo()
         .current_dir(root())
-        .args(["build", "--release", "--quiet", "-p", "rfm-update", "--example", "bench_point"])
+        .args(["build", "--release", "--quiet", "-p", "rfm-update", "--example", name])
         .status()
         .map_err(|e| format!("cannot run cargo: {e}"))?;
     if !status.success() {
-        return Err("building bench_point failed".into());
+        return Err(format!("building {name} failed"));
     }
-    let exe = root().join("target/release/examples/bench_point");
+    Ok(root().join("target/release/examples").join(name))
+}
+
+fn bench(args: &[String]) -> Result<(), String> {
+    let full = args.iter().any(|a| a == "--full");
+    let exe = release_example("bench_point")?;
     let reps = |quick: u32, more: u32| if full { more } else { quick }.to_string();
     println!("machine: {}", machine());
     println!("load average before: {}", load_average());
@@ -386,15 +391,7 @@ fn bench(args: &[String]) -> Result<(), String> {
     // over 1,000 candidate parameters; the diagnosis itself fits every
     // candidate nonlinearly (by low-rank updates of the nominal model):
     // measured here end to end
-    let status = cargo()
-        .current_dir(root())
-        .args(["build", "--release", "--quiet", "-p", "rfm-update", "--example", "diagnose_point"])
-        .status()
-        .map_err(|e| format!("cannot run cargo: {e}"))?;
-    if !status.success() {
-        return Err("building diagnose_point failed".into());
-    }
-    let exe = root().join("target/release/examples/diagnose_point");
+    let exe = release_example("diagnose_point")?;
     println!("\nwhole diagnosis (nonlinear fit of every candidate), a 40 % stiffness loss hidden in one element:");
     println!(
         "{:<30} {:>6} {:>11} {:>6} {:>10} {:>9}  leader",
