@@ -136,9 +136,9 @@ pub struct Candidate {
     /// Plausible range per parameter, with the reason shown when outside.
     pub plausible: Vec<(f64, f64, &'static str)>,
     pub(crate) edit: Edit,
-    /// The part of the nominal model on `part_nodes`, before and after the change.
-    pub(crate) nominal_part: Model,
-    pub(crate) part: Model,
+    /// The part of the nominal model the change touches, before and after it.
+    nominal_part: Model,
+    part: Model,
 }
 
 /// Options of candidate generation.

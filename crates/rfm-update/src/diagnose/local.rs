@@ -404,8 +404,10 @@ impl LocalData {
             })
             .collect();
         let a = sys.assembly();
-        let blocks = form.blocks.iter().map(|&b| Placed::new(&a.blocks[b], |e| form.candidate_index(e))).collect();
-        let by_block = form.blocks.iter().enumerate().map(|(i, &b)| (b, i)).collect();
+        let mut placed: Vec<Option<Placed>> = (0..a.blocks.len()).map(|_| None).collect();
+        for &b in &form.blocks {
+            placed[b] = Some(Placed::new(&a.blocks[b], |e| form.candidate_index(e)));
+        }
         let mut refs: Vec<usize> = self.picks.iter().map(|&(_, f)| f).collect();
         refs.sort_unstable();
         refs.dedup();
@@ -418,17 +420,14 @@ impl LocalData {
             params: &local.params,
             nominal_z,
             x,
-            blocks,
-            by_block,
+            placed,
             work: Work::new(n_local, d, refs.len()),
             refs,
         }
     }
 }
 
-/// A block's row-major pattern placed in a local matrix: for each local
-/// pair `(r, c)` of the block, the position `i * n + j` in the local
-/// matrix, computed for a given local size.
+/// A block's equations placed in a local matrix.
 struct Placed {
     /// Local index of each block equation.
     idx: Vec<usize>,
@@ -643,10 +642,8 @@ pub(crate) struct LocalResponse<'a> {
     nominal_z: Vec<Vec<C64>>,
     /// Per line: `X = H_0[D, W]`, row-major `d x |W|`.
     x: Vec<Vec<C64>>,
-    /// The changed blocks of the candidate's part, placed locally.
-    blocks: Vec<Placed>,
-    /// Position in `blocks` of each changed block of the part.
-    by_block: HashMap<usize, usize>,
+    /// Each block of the candidate's part, placed locally when it changed.
+    placed: Vec<Option<Placed>>,
     /// Distinct reference columns in `W`.
     refs: Vec<usize>,
     work: Work,
@@ -682,8 +679,8 @@ impl Response for LocalResponse<'_> {
             for (i, row) in self.nominal_z[li].chunks_exact(d).enumerate() {
                 w.z[i * n..i * n + d].copy_from_slice(row);
             }
-            for (p, &b) in self.blocks.iter().zip(&self.form.blocks) {
-                let block = &a.blocks[b];
+            for &b in &self.form.blocks {
+                let (block, p) = (&a.blocks[b], self.placed[b].as_ref().expect("changed blocks are placed"));
                 for t in block.terms.iter().filter(|t| t.value != 0.0) {
                     p.add(&t.unit, coefs[block.group].of(t.kind) * t.value, &mut w.z, n);
                 }
@@ -759,7 +756,8 @@ impl Response for LocalResponse<'_> {
                     for &q in &p.quantities {
                         for (b, t, c) in self.sys.derivative(q, omega).terms {
                             let term = &a.blocks[b].terms[t];
-                            self.blocks[self.by_block[&b]].add(&term.unit, c * term.value, &mut w.dzi, n);
+                            let p = self.placed[b].as_ref().expect("a parameter's blocks are changed blocks");
+                            p.add(&term.unit, c * term.value, &mut w.dzi, n);
                         }
                     }
                     condense(&w.dzi, &w.g, d, e, &mut w.dzi_c);
