@@ -17,6 +17,9 @@ use crate::error::{CaseError, ModelError};
 use crate::model::{Group, Model, NodeId, Section};
 use crate::quantity::{Parameter, Quantity};
 
+mod edit;
+pub use edit::CaseEditor;
+
 // ---------------------------------------------------------------- raw schema
 
 #[derive(Deserialize)]
@@ -54,6 +57,8 @@ struct RawCase {
     truth: Option<Spanned<RawTruth>>,
     update: Option<Spanned<RawUpdate>>,
     paper: Option<Spanned<RawPaper>>,
+    #[serde(default)]
+    history: Vec<Spanned<RawHistory>>,
 }
 
 #[derive(Deserialize)]
@@ -252,6 +257,14 @@ struct RawBandWeight {
     from: f64,
     to: f64,
     weight: f64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawHistory {
+    step: String,
+    misfit: f64,
+    noise: Option<f64>,
 }
 
 #[derive(Deserialize)]
@@ -466,6 +479,20 @@ pub struct PaperSpec {
     pub note: Option<String>,
 }
 
+/// One step of a case's history, written by rfm when it adds an effect or
+/// updates (`[[history]]`): what the model was and how far it was from the
+/// data, so that a later run can show the fall of the misfit from the
+/// nominal model.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HistoryEntry {
+    /// What the step did (`nominal`, `+ flexible, lossy joint at node 13`, `updated`).
+    pub step: String,
+    /// RMS of `ln(model / measured)` per complex value after the step.
+    pub misfit: f64,
+    /// The data's estimated relative noise level, when known.
+    pub noise: Option<f64>,
+}
+
 /// A loaded, validated case file.
 #[derive(Clone, Debug)]
 pub struct CaseFile {
@@ -485,6 +512,8 @@ pub struct CaseFile {
     pub update: Option<UpdateSpec>,
     /// Published values.
     pub paper: Option<PaperSpec>,
+    /// The misfit after each step that led to this case (`[[history]]`).
+    pub history: Vec<HistoryEntry>,
 }
 
 // ------------------------------------------------------------------ loading
@@ -561,6 +590,18 @@ impl CaseFile {
                 })
             })
             .transpose()?;
+        let history = raw
+            .history
+            .iter()
+            .map(|h| {
+                let r = h.get_ref();
+                let bad = |v: f64| !(v.is_finite() && v >= 0.0);
+                if bad(r.misfit) || r.noise.is_some_and(bad) {
+                    return Err(ctx.err(h.span(), "a history entry's misfit and noise must be finite and not negative"));
+                }
+                Ok(HistoryEntry { step: r.step.clone(), misfit: r.misfit, noise: r.noise })
+            })
+            .collect::<Result<Vec<_>, CaseError>>()?;
         if let (Some(m), None) = (&measurement, &truth)
             && m.data.is_none()
         {
@@ -578,132 +619,8 @@ impl CaseFile {
             truth,
             update,
             paper,
+            history,
         })
-    }
-
-    /// The case text with its top-level `[set]` table replaced by one that
-    /// holds the existing entries overridden by `values` (quantity names and
-    /// values), for writing an updated model as a new case file. The result
-    /// is re-parsed and checked to carry every value exactly.
-    pub fn with_values(&self, values: &[(String, f64)], comment: &str) -> Result<String, CaseError> {
-        let mut merged: BTreeMap<String, f64> = BTreeMap::new();
-        if let Ok(table) = self.source.parse::<toml::Table>()
-            && let Some(toml::Value::Table(set)) = table.get("set")
-        {
-            for (k, v) in set {
-                if let Some(x) = v.as_float().or_else(|| v.as_integer().map(|i| i as f64)) {
-                    merged.insert(k.clone(), x);
-                }
-            }
-        }
-        for (k, v) in values {
-            merged.insert(k.clone(), *v);
-        }
-        let mut out = String::new();
-        let mut skipping = false;
-        for line in self.source.lines() {
-            let t = line.trim_start();
-            if t.starts_with('[') {
-                let header = t.split('#').next().unwrap_or("").trim();
-                skipping = header == "[set]";
-            }
-            if !skipping {
-                out.push_str(line);
-                out.push('\n');
-            }
-        }
-        while out.ends_with("\n\n") {
-            out.pop();
-        }
-        out.push('\n');
-        for c in comment.lines() {
-            out.push_str(&format!("# {c}\n"));
-        }
-        out.push_str("[set]\n");
-        for (k, v) in &merged {
-            out.push_str(&format!("\"{k}\" = {v:e}\n"));
-        }
-        let reparsed = CaseFile::parse(&self.path, &out)?;
-        for (k, v) in &merged {
-            let q = reparsed.model.quantity(k).map_err(|e| self.error(None, e.to_string()))?;
-            let got = reparsed.model.get(q);
-            if got != *v {
-                return Err(self.error(None, format!("writing {k} = {v} gave {got} when read back")));
-            }
-        }
-        Ok(out)
-    }
-
-    /// The case text without the `[[supports]]` entries of `node` (to replace
-    /// a rigid support by springs). Fails if the node has no such entry or
-    /// the result does not load.
-    pub fn without_supports_at(&self, node: u32) -> Result<String, CaseError> {
-        let lines: Vec<&str> = self.source.lines().collect();
-        let mut out: Vec<&str> = Vec::new();
-        let mut removed = 0;
-        let mut i = 0;
-        while i < lines.len() {
-            let header = lines[i].split('#').next().unwrap_or("").trim();
-            if header == "[[supports]]" {
-                let mut j = i + 1;
-                while j < lines.len() && !lines[j].trim_start().starts_with('[') {
-                    j += 1;
-                }
-                let holds_node = lines[i + 1..j].iter().any(|l| {
-                    let code = l.split('#').next().unwrap_or("");
-                    code.split_once('=').is_some_and(|(k, v)| k.trim() == "node" && v.trim() == node.to_string())
-                });
-                if holds_node {
-                    removed += 1;
-                    i = j;
-                    continue;
-                }
-            }
-            out.push(lines[i]);
-            i += 1;
-        }
-        if removed == 0 {
-            return Err(self.error(None, format!("no [[supports]] entry for node {node} to replace")));
-        }
-        let text = out.join("\n") + "\n";
-        CaseFile::parse(&self.path, &text)?;
-        Ok(text)
-    }
-
-    /// `text` (this case's source, possibly edited) made valid at `target`:
-    /// a relative measured-data path is rewritten so that it still names the
-    /// same file from the new case file's folder.
-    pub fn relocate(&self, text: &str, target: &Path) -> String {
-        let Some(data) = self.measurement.as_ref().and_then(|m| m.data.as_ref()) else {
-            return text.to_string();
-        };
-        let here = self.path.parent().map(Path::to_path_buf).unwrap_or_default();
-        let there = target.parent().map(Path::to_path_buf).unwrap_or_default();
-        let same_dir = match (here.canonicalize(), there.canonicalize()) {
-            (Ok(a), Ok(b)) => a == b,
-            _ => here == there,
-        };
-        if same_dir {
-            return text.to_string();
-        }
-        let absolute = data.canonicalize().unwrap_or_else(|_| data.clone());
-        let mut out = String::with_capacity(text.len());
-        let mut in_measurement = false;
-        for line in text.lines() {
-            let t = line.trim_start();
-            if t.starts_with('[') {
-                in_measurement = t.split('#').next().unwrap_or("").trim() == "[measurement]";
-            }
-            let is_data = in_measurement && t.split_once('=').is_some_and(|(k, _)| k.trim() == "data");
-            if is_data {
-                let escaped = absolute.display().to_string().replace('\\', "\\\\").replace('"', "\\\"");
-                out.push_str(&format!("data = \"{escaped}\"   # relocated by rfm"));
-            } else {
-                out.push_str(line);
-            }
-            out.push('\n');
-        }
-        out
     }
 
     /// A located error about this file (for checks done by higher layers).
@@ -1432,30 +1349,6 @@ node = 1
         assert!(e.message.contains("outside its bounds"), "{e}");
         let e = parse(&text.replace("bounds = { \"group.beam.alpha\"", "bounds = { \"group.beam.beta\"")).unwrap_err();
         assert!(e.message.contains("not in the parameters list"), "{e}");
-    }
-
-    #[test]
-    fn with_values_replaces_the_set_table_and_reads_back() {
-        let text = format!("{BEAM}\n[set]\n\"group.beam.beta\" = 0.5\n\"group.beam.alpha\" = 2e-5\n");
-        let c = parse(&text).unwrap();
-        let out = c.with_values(&[("group.beam.alpha".into(), 3.141592653589793e-5)], "updated").unwrap();
-        assert_eq!(out.matches("[set]").count(), 1);
-        let back = parse(&out).unwrap();
-        let a = back.model.quantity("group.beam.alpha").unwrap();
-        let b = back.model.quantity("group.beam.beta").unwrap();
-        assert_eq!(back.model.get(a), 3.141592653589793e-5);
-        assert_eq!(back.model.get(b), 0.5);
-        assert!(out.contains("# updated\n[set]"));
-    }
-
-    #[test]
-    fn without_supports_at_removes_only_that_nodes_entry() {
-        let text = BEAM.replace("[[supports]]\nnode = 1\n", "[[supports]]\nnode = 1\n[[springs]]\nname = \"s\"\nnode = 1\nkr = 1e4\nkx = 1e9\nky = 1e9\ngroup = \"beam\"\n");
-        let c = parse(&text).unwrap();
-        let out = c.without_supports_at(1).unwrap();
-        assert!(!out.contains("[[supports]]"));
-        assert!(parse(&out).unwrap().model.supports().is_empty());
-        assert!(c.without_supports_at(3).is_err());
     }
 
     #[test]

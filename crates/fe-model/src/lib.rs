@@ -60,7 +60,7 @@ pub mod samples;
 pub mod suggest;
 
 pub use assembly::{Assembly, Block, BlockSource, MatrixKind, Pattern, Term};
-pub use case::CaseFile;
+pub use case::{CaseEditor, CaseFile, HistoryEntry};
 pub use dof::{Dof, DofMap, DofRef, Slot};
 pub use error::{CaseError, Location, ModelError};
 pub use model::{Beam, ElementId, Group, LumpedMass, Material, Model, Node, NodeId, Section, Spring};

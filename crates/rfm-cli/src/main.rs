@@ -86,6 +86,21 @@ enum Command {
         #[arg(long, default_value_t = 10)]
         top: usize,
     },
+    /// Close the loop: diagnose, add the recommended effect, update, and again
+    /// until nothing significant remains; the case after every step and a report.
+    Fix {
+        /// Case file.
+        case: PathBuf,
+        /// Folder for step-1.toml, step-2.toml, ..., results.json, report.html and figures.
+        #[arg(long)]
+        out: PathBuf,
+        /// Most effects to add.
+        #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u64).range(1..=20))]
+        steps: u64,
+        /// Print machine-readable JSON instead of tables.
+        #[arg(long)]
+        json: bool,
+    },
     /// List what a measurement file holds (UFF dataset 58 or CSV): channels,
     /// function types, units, frequency lines, data types; skipped datasets.
     Inspect {
@@ -196,6 +211,9 @@ fn main() -> ExitCode {
             out: out.as_deref(),
             top,
         }),
+        Command::Fix { case, out, steps, json } => {
+            commands::fix(&commands::FixArgs { case: &case, out: &out, steps: steps as usize, json })
+        }
         Command::Inspect { file, json } => commands::inspect(&file, json),
         Command::Update { case, out, json, method, lines, iterations } => commands::update(
             &case,

@@ -50,6 +50,7 @@
 
 pub mod diagnose;
 pub mod error;
+pub mod fix;
 pub mod freqsel;
 pub mod lstsq;
 pub mod oe;

@@ -245,6 +245,28 @@ impl Study {
         Ok(study)
     }
 
+    /// Prepares a study from a loaded case and measured receptances that the
+    /// caller holds (the loop of [`crate::fix`] keeps one data set while the
+    /// model grows). The channels must be those of the case's measurement.
+    /// The case's truth, if any, is not built: the data are given.
+    pub fn with_measured(case: CaseFile, measured: FrfSet) -> Result<Self, UpdateError> {
+        let system = DampedSystem::new(case.model.clone())?;
+        let parameters = case.update.as_ref().map(|u| u.parameters.clone()).unwrap_or_default();
+        let mut study = Study {
+            case,
+            system,
+            truth: None,
+            measured,
+            parameters,
+            update_frequencies_hz: Vec::new(),
+            masked: Vec::new(),
+        };
+        if study.case.update.is_some() {
+            study.update_frequencies_hz = study.lines_for(study.method())?;
+        }
+        Ok(study)
+    }
+
     /// The updating method the case asks for (`rfm` when it does not say).
     pub fn method(&self) -> Method {
         match self.case.update.as_ref().and_then(|u| u.method.as_ref()).map(|m| m.0.as_str()) {

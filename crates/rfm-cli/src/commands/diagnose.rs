@@ -2,7 +2,8 @@
 
 use std::path::Path;
 
-use rfm_update::diagnose::{DiagnoseOptions, Diagnosis, diagnose as run_diagnosis};
+use indicatif::ProgressBar;
+use rfm_update::diagnose::{DiagnoseOptions, Diagnosis, diagnose_with};
 use rfm_update::study::{describe_masked, read_measured_for};
 use rfm_update::{Study, UpdateError};
 
@@ -53,7 +54,14 @@ pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<()> {
             num(*measured.frequencies_hz().last().expect("lines"))
         );
     }
-    let d = run_diagnosis(&study.case.model, &measured, &DiagnoseOptions::default())?;
+    // a spinner on the terminal (hidden when stderr is not one) says which stage runs
+    let bar = if args.json { ProgressBar::hidden() } else { ProgressBar::new_spinner() };
+    bar.enable_steady_tick(std::time::Duration::from_millis(120));
+    let start = std::time::Instant::now();
+    let d = diagnose_with(&study.case.model, &measured, &DiagnoseOptions::default(), |stage| {
+        bar.set_message(format!("{stage} ({:.1} s)", start.elapsed().as_secs_f64()));
+    })?;
+    bar.finish_and_clear();
     if args.json {
         outln!("{}", serde_json::to_string_pretty(&d)?);
     } else {
@@ -61,9 +69,7 @@ pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<()> {
     }
     if let Some(rank) = args.apply {
         let out = args.out.ok_or("--apply needs --out FILE for the new case file")?;
-        let text =
-            d.case_text(&study.case, rank.checked_sub(1).ok_or("ranks start at 1")?).map_err(|e| e.to_string())?;
-        let text = study.case.relocate(&text, out);
+        let text = d.apply(&study.case, rank)?.text_at(out).map_err(|e| e.render())?;
         let _writing = crate::writing();
         frf::io::atomic_write(out, text.as_bytes(), &inputs)?;
         if !args.json {
@@ -84,7 +90,14 @@ fn print_diagnosis(d: &Diagnosis, top: usize) -> Result<()> {
         let values = r
             .parameters
             .iter()
-            .map(|p| format!("{} = {} (+-{})", p.name, num(p.value), percent(p.relative_std)))
+            .map(|p| {
+                if p.determined {
+                    format!("{} = {} (+-{})", p.name, num(p.value), percent(p.relative_std))
+                } else {
+                    format!("{} = {} (not determined)", p.name, num(p.value))
+                }
+            })
+            .chain(r.held.iter().map(|h| format!("{h} held (not determined)")))
             .collect::<Vec<_>>()
             .join(", ");
         let note = match (&r.implausible_reason, r.fully_fitted) {
@@ -103,18 +116,31 @@ fn print_diagnosis(d: &Diagnosis, top: usize) -> Result<()> {
         ]);
     }
     outln!("{}", t.render());
-    outln!("\n(dBIC: change of the Bayesian information criterion; below -10 the evidence is very strong)");
-    match d.leader() {
+    outln!(
+        "\n(dBIC: change of the Bayesian information criterion; below -10 the evidence is very strong; \
+         {} candidates tried)",
+        d.tried
+    );
+    if !d.unfitted.is_empty() {
+        outln!("{} candidates could not be fitted and are not ranked:", d.unfitted.len());
+        for u in d.unfitted.iter().take(5) {
+            outln!("    {}: {}", u.description, u.reason);
+        }
+        if d.unfitted.len() > 5 {
+            outln!("    ... ({} more in --json)", d.unfitted.len() - 5);
+        }
+    }
+    match d.recommended {
         None if d.consistent() => {
             outln!("\nNo candidate explains the misfit beyond the noise: the model is consistent with the data.")
         }
         None => outln!(
             "\nSome effects are significant, but none at plausible values: the missing effect may not be among the candidates."
         ),
-        Some(leader) => {
-            let rank = d.ranking.iter().position(|r| std::ptr::eq(r, leader)).expect("from the ranking");
-            outln!("\nMost likely missing: {}.", leader.description);
-            let (text, set) = d.proposal(rank);
+        Some(rank) => {
+            let leader = &d.ranking[rank - 1];
+            outln!("\nMost likely missing (rank {rank}): {}.", leader.description);
+            let (text, set) = d.proposal(rank)?;
             outln!("Add it to the case file with these lines:\n");
             for l in text.lines() {
                 outln!("    {l}");
@@ -125,7 +151,7 @@ fn print_diagnosis(d: &Diagnosis, top: usize) -> Result<()> {
                     outln!("    \"{k}\" = {v:e}");
                 }
             }
-            outln!("\nor let rfm write the new case: rfm diagnose CASE --apply {} --out NEW.toml", rank + 1);
+            outln!("\nor let rfm write the new case: rfm diagnose CASE --apply {rank} --out NEW.toml");
         }
     }
     Ok(())

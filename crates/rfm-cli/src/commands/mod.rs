@@ -2,6 +2,7 @@
 
 mod compare;
 mod diagnose;
+pub(crate) mod fix;
 mod inspect;
 mod simulate;
 mod update;
@@ -12,6 +13,7 @@ use fe_model::CaseFile;
 
 pub(crate) use compare::compare;
 pub(crate) use diagnose::{DiagnoseArgs, diagnose};
+pub(crate) use fix::{FixArgs, fix};
 pub(crate) use inspect::inspect;
 pub(crate) use simulate::simulate;
 pub(crate) use update::{Overrides as UpdateOverrides, update};

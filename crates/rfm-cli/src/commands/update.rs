@@ -59,6 +59,7 @@ pub(crate) fn update(case: &Path, out: Option<&Path>, json: bool, over: &Overrid
     print_masked(&rfm_update::study::describe_masked(&study.masked), json)?;
     if !json {
         outln!("{}", study.case.model.title);
+        print_history(&study.case.history)?;
         let what = match method {
             Method::Rfm => "the response function method",
             Method::OutputError => "output-error Levenberg-Marquardt",
@@ -111,17 +112,25 @@ pub(crate) fn update(case: &Path, out: Option<&Path>, json: bool, over: &Overrid
         }
     };
     bar.finish_and_clear();
+    // the misfit the case's history speaks of, after this update
+    let noise = rfm_update::diagnose::estimate_noise(&study.measured);
+    let misfit = rfm_update::diagnose::log_misfit(&outcome.system, &study.measured, HISTORY_LINES)?;
+    let step = fe_model::HistoryEntry { step: format!("updated ({})", outcome.method), misfit, noise };
     if json {
         outln!("{}", serde_json::to_string_pretty(&outcome)?);
     } else {
         print_outcome(&outcome)?;
+        if !study.case.history.is_empty() {
+            outln!("the fall of the misfit, from the case's history to this update:");
+            print_history(&[study.case.history.clone(), vec![step.clone()]].concat())?;
+        }
     }
     if let Some(dir) = out {
         let _writing = crate::writing();
         let inputs = study.case.inputs();
         let path = dir.join("results.json");
         frf::io::atomic_write(&path, serde_json::to_string_pretty(&outcome)?.as_bytes(), &inputs)?;
-        let updated = write_updated_model(&study, &outcome, dir, &inputs)?;
+        let updated = write_updated_model(&study, &outcome, &step, dir, &inputs)?;
         if !json {
             outln!("\nwrote {} and {}", path.display(), updated.display());
         }
@@ -137,6 +146,7 @@ pub(crate) fn update(case: &Path, out: Option<&Path>, json: bool, over: &Overrid
 fn write_updated_model(
     study: &Study,
     outcome: &UpdateOutcome,
+    step: &fe_model::HistoryEntry,
     dir: &Path,
     inputs: &[std::path::PathBuf],
 ) -> Result<std::path::PathBuf> {
@@ -153,11 +163,31 @@ fn write_updated_model(
         outcome.residual,
         study.case.path.display()
     );
-    let text = study.case.with_values(&values, &comment).map_err(|e| e.render())?;
     let path = dir.join("updated.toml");
-    let text = study.case.relocate(&text, &path);
+    let mut editor = study.case.editor().map_err(|e| e.render())?;
+    editor.set_values(&values, &comment).map_err(|e| e.render())?;
+    editor.push_history(step).map_err(|e| e.render())?;
+    let text = editor.text_at(&path).map_err(|e| e.render())?;
     frf::io::atomic_write(&path, text.as_bytes(), inputs)?;
     Ok(path)
+}
+
+/// Lines of the misfit in the case history (as in `rfm diagnose`).
+const HISTORY_LINES: usize = 200;
+
+/// The misfit after each step of a case's history, in dB and as a multiple
+/// of the noise.
+fn print_history(history: &[fe_model::HistoryEntry]) -> Result<()> {
+    if history.is_empty() {
+        return Ok(());
+    }
+    let mut t = Table::new(&["step", "misfit", "(dB)", "x noise"]);
+    for h in history {
+        let times = h.noise.filter(|&n| n > 0.0).map_or("-".to_string(), |n| format!("{:.1}", h.misfit / n));
+        t.row(vec![h.step.clone(), format!("{:.4e}", h.misfit), format!("{:.1}", db(h.misfit)), times]);
+    }
+    outln!("{}\n", t.render());
+    Ok(())
 }
 
 fn print_outcome(outcome: &UpdateOutcome) -> Result<()> {

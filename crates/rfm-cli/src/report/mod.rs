@@ -1,11 +1,13 @@
 //! Plots and reports: SVG figures ([`plot`]), the self-contained HTML
 //! report ([`html`]), the JSON form of an FRF correlation ([`json`]), the
 //! report sections shared by `rfm compare` and `rfm update` (this module),
-//! and the update report ([`update_report`]).
+//! the update report ([`update_report`]) and the report of the loop
+//! ([`fix_report`]).
 //!
 //! Figures are drawn to strings and written with [`frf::io::atomic_write`],
 //! which refuses to overwrite the run's inputs.
 
+pub(crate) mod fix_report;
 pub(crate) mod html;
 pub(crate) mod json;
 pub(crate) mod plot;

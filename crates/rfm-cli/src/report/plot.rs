@@ -16,6 +16,9 @@ use frf::correlation::{Band, LineError};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+mod steps;
+pub(crate) use steps::misfit_steps;
+
 /// Colour of measured data.
 pub(crate) const MEASURED: RGBColor = RGBColor(0, 0, 0);
 /// Colour of the initial model.

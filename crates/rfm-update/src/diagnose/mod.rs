@@ -33,10 +33,22 @@
 //! only the best few hundred are screened. Screening-only entries of the
 //! ranking are scored on their own lines; screened ones come before
 //! pre-screened ones.
-//! On large models stiffness and mass changes are candidates per region; the
-//! two leaders' locations are then refined into per-element changes, which
-//! are screened and the best four fitted fully, so that one weakened element
-//! is named as such and not as its region or a mass at its node.
+//! On large models stiffness, mass and damping changes are first tried in
+//! coarse windows; around the three leaders every window and in-line joint
+//! is then tried too (on small models they are candidates from the start),
+//! with the fuller variants of the leaders (a joint's translational
+//! springs, a mass's rotary inertia); the best are screened and fitted
+//! fully, so that one weakened element is named as such and not as its
+//! region or a mass at its node.
+//!
+//! A fitted parameter whose relative standard deviation exceeds one (its
+//! value could as well be e times larger), or a spring that ran to its
+//! upper bound, is *not determined* by the data. A spring of a support or
+//! joint that is not determined is held rigid, and the candidate fitted
+//! again without it: the axial spring of a clamp measured in bending says
+//! nothing about the clamp. Plausibility is judged only on determined
+//! values. The *recommended* effect is the first significant, plausible one
+//! of the ranking.
 //!
 //! Every fit is exact but none refactorises the candidate's model: a
 //! candidate changes `Z` only on the few equations it touches, so its
@@ -48,20 +60,19 @@
 //! touching more than a few dozen equations is fitted on its own model
 //! instead.
 
+mod apply;
 pub mod candidates;
 mod local;
+mod search;
 
 use damping::DampedSystem;
 use frf::FrfSet;
-use rayon::prelude::*;
 use serde::Serialize;
 
-pub use candidates::{Candidate, CandidateOptions, EffectKind};
+pub use candidates::{Candidate, CandidateOptions, EffectKind, Role};
 
-use self::local::{LocalCandidate, LocalData};
+use self::search::{LineSet, Pool};
 use crate::error::UpdateError;
-use crate::oe::{self, Misfit, OeData, OeOptions};
-use crate::params::ParameterSet;
 
 /// Relative noise level of measured FRFs (RMS of the relative error per
 /// complex value), from the roughness of `ln M` over adjacent lines; see the
@@ -108,7 +119,7 @@ pub struct DiagnoseOptions {
     pub screen_lines: usize,
     /// Iterations of a screening fit.
     pub screen_iterations: usize,
-    /// Candidates fitted fully after screening.
+    /// Candidates fitted fully after screening (besides the best of each kind).
     pub keep: usize,
     /// Iterations of a full fit.
     pub iterations: usize,
@@ -117,11 +128,6 @@ pub struct DiagnoseOptions {
     /// Candidate generation options (the band is taken from the data).
     pub candidates: CandidateOptions,
 }
-
-/// Leaders (by full-fit misfit) whose locations are refined per element.
-const REFINED_LEADERS: usize = 2;
-/// Refined candidates fitted fully after screening.
-const REFINED_FITS: usize = 4;
 
 impl Default for DiagnoseOptions {
     fn default() -> Self {
@@ -146,10 +152,15 @@ impl Default for DiagnoseOptions {
 pub struct FittedParameter {
     /// Name (in the candidate's model).
     pub name: String,
+    /// What it is.
+    pub role: Role,
     /// Fitted value.
     pub value: f64,
-    /// Relative standard deviation from the fit.
+    /// Relative standard deviation from the fit (noise only).
     pub relative_std: f64,
+    /// The data determine it (see the module docs); a value that is not
+    /// determined is shown but not judged for plausibility.
+    pub determined: bool,
 }
 
 /// One ranked candidate.
@@ -165,23 +176,41 @@ pub struct Ranked {
     pub elements: Vec<u32>,
     /// DOFs it acts on (names).
     pub dof: Vec<String>,
+    /// The damping form of its own group (`viscous`, `non-viscous`), for
+    /// joints, supports and damping windows.
+    pub damping: Option<&'static str>,
     /// Fraction of the nominal misfit it explains (`1 - cost_c / cost_0`).
     pub explained: f64,
+    /// RMS of `ln(model / measured)` per complex value with the effect
+    /// added at its fitted values, on the lines it was fitted on.
+    pub misfit: f64,
     /// Change of the information criterion (negative is better).
     pub delta_bic: f64,
     /// `delta_bic` below the significance threshold.
     pub significant: bool,
-    /// Fitted values within their plausible ranges.
+    /// Fitted values within their plausible ranges (determined values only).
     pub plausible: bool,
     /// Why not, when not plausible.
     pub implausible_reason: Option<String>,
     /// Fitted parameters.
     pub parameters: Vec<FittedParameter>,
+    /// Parameters of a fuller variant that the data did not determine,
+    /// held at their rigid or nominal value (a support's axial spring).
+    pub held: Vec<String>,
     /// Fitted on the full line set (false: screening only).
     pub fully_fitted: bool,
     /// Index of the candidate in [`Diagnosis::candidates`].
     #[serde(skip)]
     pub candidate: usize,
+}
+
+/// A candidate whose fit failed, and why.
+#[derive(Clone, Debug, Serialize)]
+pub struct Unfitted {
+    /// The candidate.
+    pub description: String,
+    /// Why its fit failed.
+    pub reason: String,
 }
 
 /// The outcome of a diagnosis.
@@ -195,62 +224,22 @@ pub struct Diagnosis {
     pub n_residuals: usize,
     /// Candidates ranked: full fits by `delta_bic`, then screening-only ones.
     pub ranking: Vec<Ranked>,
+    /// The rank (1-based) of the recommended effect: the first significant,
+    /// plausible, fully fitted one; `None` when there is none.
+    pub recommended: Option<usize>,
+    /// How many candidates were tried.
+    pub tried: usize,
+    /// Candidates that could not be fitted, with the reason.
+    pub unfitted: Vec<Unfitted>,
     /// The candidates (same indices as [`Ranked::candidate`]).
     #[serde(skip)]
     pub candidates: Vec<Candidate>,
 }
 
 impl Diagnosis {
-    /// The case-file lines that add ranked effect `rank`: the text to append
-    /// and the `[set]` entries to merge.
-    pub fn proposal(&self, rank: usize) -> (String, Vec<(String, f64)>) {
-        let r = &self.ranking[rank];
-        let values: Vec<f64> = r.parameters.iter().map(|p| p.value).collect();
-        self.candidates[r.candidate].case_lines(&values)
-    }
-
-    /// The case text with ranked effect `rank` added at its fitted values.
-    /// When the case has no `[update]` section, one is appended that updates
-    /// the effect's parameters by output error. The result is reloaded and
-    /// checked to carry the fitted values.
-    pub fn case_text(&self, case: &fe_model::CaseFile, rank: usize) -> Result<String, UpdateError> {
-        let r = self.ranking.get(rank).ok_or_else(|| UpdateError::Setup(format!("there is no rank {}", rank + 1)))?;
-        let c = &self.candidates[r.candidate];
-        let (snippet, set) = self.proposal(rank);
-        let mut text = match &c.edit {
-            candidates::Edit::Support { node, .. } => case.without_supports_at(*node)?,
-            _ => case.source.clone(),
-        };
-        if !snippet.is_empty() {
-            text.push_str(&format!(
-                "\n# Added by rfm diagnose: {} (explains {:.1} % of the misfit)\n",
-                r.description,
-                100.0 * r.explained
-            ));
-            text.push_str(&snippet);
-        }
-        if case.update.is_none() {
-            let names: Vec<String> = r.parameters.iter().map(|p| format!("\"{}\"", p.name)).collect();
-            text.push_str(&format!("\n[update]\nparameters = [{}]\nmethod = \"output-error\"\n", names.join(", ")));
-        }
-        let mut reparsed = fe_model::CaseFile::parse(&case.path, &text)?;
-        if !set.is_empty() {
-            text = reparsed.with_values(&set, &format!("{} (rfm diagnose)", r.description))?;
-            reparsed = fe_model::CaseFile::parse(&case.path, &text)?;
-        }
-        for p in &r.parameters {
-            let param = reparsed.model.parameter(&p.name)?;
-            let got = reparsed.model.get(param.quantities[0]);
-            if (got - p.value).abs() > 1e-12 * p.value.abs() {
-                return Err(UpdateError::Setup(format!("{} reads back as {got}, not {}", p.name, p.value)));
-            }
-        }
-        Ok(text)
-    }
-
-    /// The best significant, plausible candidate, if any.
+    /// The recommended effect (see [`Diagnosis::recommended`]).
     pub fn leader(&self) -> Option<&Ranked> {
-        self.ranking.iter().find(|r| r.fully_fitted && r.significant && r.plausible)
+        self.recommended.map(|r| &self.ranking[r - 1])
     }
 
     /// True when no candidate is significant: the model is consistent with the data.
@@ -259,7 +248,7 @@ impl Diagnosis {
     }
 }
 
-fn spread(lines: &[f64], n: usize) -> Vec<f64> {
+pub(crate) fn spread(lines: &[f64], n: usize) -> Vec<f64> {
     if n >= lines.len() {
         return lines.to_vec();
     }
@@ -269,254 +258,105 @@ fn spread(lines: &[f64], n: usize) -> Vec<f64> {
     idx.into_iter().map(|k| lines[k]).collect()
 }
 
-struct Fit {
-    values: Vec<f64>,
-    cost: f64,
-    /// The nominal model's cost on the same lines.
-    cost0: f64,
-    /// Number of real residuals.
-    n: usize,
-    relative_std: Vec<f64>,
-}
-
-/// The data and the local form of a candidate fitted by low-rank updates of
-/// the nominal model (see module `local`).
-type Local<'a> = Option<(&'a LocalData, &'a LocalCandidate)>;
-
-/// Fits one candidate to `measured` (`cost0`: the nominal model's cost on
-/// it): by low-rank updates when `local` is given, else on its whole model
-/// (the nominal model with the candidate's change).
-fn fit(
-    candidate: &Candidate,
-    nominal: &fe_model::Model,
-    (measured, cost0): (&FrfSet, f64),
-    local: Local<'_>,
-    iterations: usize,
-    start: Option<&[f64]>,
-) -> Option<Fit> {
-    let (mut sys, params) = match local {
-        Some((_, lc)) => (lc.part.clone(), lc.params.clone()),
-        None => {
-            let sys = DampedSystem::new(candidate.model(nominal).ok()?).ok()?;
-            let params = ParameterSet::new(candidate.parameters_in(sys.model()).ok()?);
-            (sys, params)
-        }
-    };
-    if let Some(v) = start {
-        params.set_values(&mut sys, v).ok()?;
-    }
-    // bounds must hold the start
-    let now = params.values(&sys);
-    let bounds = candidate.bounds.iter().zip(&now).map(|(b, &v)| b.map(|(lo, hi)| (lo.min(v), hi.max(v)))).collect();
-    let opts =
-        OeOptions { misfit: Misfit::Log, max_iterations: iterations, tolerance: 1e-6, bounds, ..OeOptions::default() };
-    let data = OeData { measured, weights: None };
-    let r = match local {
-        Some((ld, lc)) => {
-            let mut response = ld.response(lc, sys);
-            oe::run_with(&mut response, now, &data, &opts, |_| {}).ok()?
-        }
-        None => oe::run(&mut sys, &params, &data, &opts, |_| {}).ok()?,
-    };
-    let relative_std = (0..params.len()).map(|i| r.covariance[(i, i)].max(0.0).sqrt()).collect();
-    Some(Fit { values: r.values, cost: r.cost, cost0, n: r.n_data, relative_std })
-}
-
-fn nominal_cost(sys: &DampedSystem, measured: &FrfSet) -> Result<(f64, usize), UpdateError> {
-    let model = frf::synthesize(sys, measured.channels(), measured.frequencies_hz())?;
-    let (mut cost, mut n) = (0.0, 0);
-    for (h, m) in model.values().iter().zip(measured.values()) {
-        if m.norm() > 0.0 {
-            cost += (h / m).ln().norm_sqr();
-            n += 2;
-        }
-    }
-    Ok((cost, n))
+/// The misfit the diagnosis, `rfm fix` and the case history speak of: the
+/// RMS of `ln(H / M)` per complex value of a system's receptances `H`
+/// against measured ones `M`, on `lines` lines spread over the measured band.
+pub fn log_misfit(sys: &DampedSystem, measured: &FrfSet, lines: usize) -> Result<f64, UpdateError> {
+    let set = LineSet::new(sys, measured, lines)?;
+    Ok((set.cost0 / (set.n as f64 / 2.0)).sqrt())
 }
 
 /// Diagnoses a model against measured receptances (all measured lines; the
 /// fits use subsets of them). Candidates are fitted in parallel.
 pub fn diagnose(model: &fe_model::Model, measured: &FrfSet, opts: &DiagnoseOptions) -> Result<Diagnosis, UpdateError> {
+    diagnose_with(model, measured, opts, |_| {})
+}
+
+/// As [`diagnose`], telling `progress` in a few words when each stage of
+/// the search is done (for a long run's progress display).
+pub fn diagnose_with(
+    model: &fe_model::Model,
+    measured: &FrfSet,
+    opts: &DiagnoseOptions,
+    mut progress: impl FnMut(&str),
+) -> Result<Diagnosis, UpdateError> {
     let lines = measured.frequencies_hz();
     if lines.len() < 10 {
-        return Err(UpdateError::Setup("diagnosis needs at least 10 measured lines".into()));
+        return Err(UpdateError::Setup(format!(
+            "diagnosis needs at least 10 measured lines, the data have {}",
+            lines.len()
+        )));
     }
     let noise = estimate_noise(measured)
         .ok_or_else(|| UpdateError::Setup("too few usable measured values to estimate the noise level".into()))?;
     // a noise floor for noise-free data keeps the criterion finite
     let s2 = (noise * noise / 2.0).max(1e-20);
-    let full = measured.at_frequencies(&spread(lines, opts.lines))?;
-    let coarse = measured.at_frequencies(&spread(lines, opts.screen_lines))?;
     let nominal = DampedSystem::new(model.clone())?;
-    let (cost0_full, n_full) = nominal_cost(&nominal, &full)?;
-    let (cost0_coarse, _) = nominal_cost(&nominal, &coarse)?;
+    let full = LineSet::new(&nominal, measured, opts.lines)?;
     let mut copts = opts.candidates.clone();
     copts.band_hz = (lines[0], lines[lines.len() - 1]);
-    let candidates = candidates::generate(model, &copts);
-    let bic = |cost: f64, cost0: f64, n: usize, k: usize| (cost - cost0) / s2 + k as f64 * (n as f64).ln();
+    let mut pool = Pool::new(model, &nominal, s2);
+    search::search(&mut pool, measured, &full, opts, &copts, &mut progress)?;
+    Ok(rank(pool, noise, &full, opts))
+}
 
-    // Candidates that change Z only locally are fitted by exact low-rank
-    // updates of the nominal model (see `local`), the others on their own.
-    let mut locals: Vec<Option<LocalCandidate>> =
-        candidates.par_iter().map(|c| LocalCandidate::new(&nominal, c)).collect();
-    let local_data = |set: &FrfSet, locals: &[&Option<LocalCandidate>]| {
-        let forms: Vec<_> = locals.iter().filter_map(|l| l.as_ref().map(|l| &l.form)).collect();
-        LocalData::new(&nominal, set.channels(), set.frequencies_hz(), &forms)
-    };
-    // Fits `which` of `candidates` on the lines of `set` (`cost0`: the
-    // nominal model's cost there), from their starting values.
-    let screen = |set: &FrfSet,
-                  cost0: f64,
-                  iterations: usize,
-                  candidates: &[Candidate],
-                  locals: &[Option<LocalCandidate>],
-                  which: &[usize]|
-     -> Result<Vec<(usize, Option<Fit>)>, UpdateError> {
-        let data = local_data(set, &which.iter().map(|&i| &locals[i]).collect::<Vec<_>>())?;
-        Ok(which
-            .par_iter()
-            .map(|&i| {
-                let (c, local) = (&candidates[i], locals[i].as_ref().map(|l| (&data, l)));
-                // a low-rank update that cannot be evaluated (a singular
-                // local system at some line) falls back to the whole model
-                let f = fit(c, model, (set, cost0), local, iterations, None)
-                    .or_else(|| local.and_then(|_| fit(c, model, (set, cost0), None, iterations, None)));
-                (i, f)
-            })
-            .collect())
-    };
-    // full fits, warm-started from screening
-    let full_fit = |candidates: &[Candidate],
-                    locals: &[Option<LocalCandidate>],
-                    screened: &[Option<Fit>],
-                    which: &[usize]|
-     -> Result<Vec<(usize, Option<Fit>)>, UpdateError> {
-        let data = local_data(&full, &which.iter().map(|&i| &locals[i]).collect::<Vec<_>>())?;
-        Ok(which
-            .par_iter()
-            .map(|&i| {
-                let local = locals[i].as_ref().map(|l| (&data, l));
-                let start = screened[i].as_ref().map(|f| f.values.as_slice());
-                let f = fit(&candidates[i], model, (&full, cost0_full), local, opts.iterations, start)
-                    .or_else(|| fit(&candidates[i], model, (&full, cost0_full), None, opts.iterations, start))
-                    .or_else(|| fit(&candidates[i], model, (&full, cost0_full), None, opts.iterations, None));
-                (i, f)
-            })
-            .collect())
-    };
-    // fits on more residuals first (screened before pre-screened), then by dBIC
-    let by_rank = |screened: &[Option<Fit>], candidates: &[Candidate], order: &mut Vec<usize>| {
-        let key = |i: usize| {
-            let f = screened[i].as_ref().expect("only fitted candidates are ranked");
-            (f.n, bic(f.cost, f.cost0, f.n, candidates[i].parameters.len()))
-        };
-        order.sort_by(|&a, &b| {
-            let ((na, sa), (nb, sb)) = (key(a), key(b));
-            nb.cmp(&na).then(sa.total_cmp(&sb))
-        });
-    };
-
-    // pre-screening of many candidates, then screening
-    let all: Vec<usize> = (0..candidates.len()).collect();
-    let mut screened: Vec<Option<Fit>> = (0..candidates.len()).map(|_| None).collect();
-    let to_screen = if candidates.len() > opts.prescreen_above {
-        let pre = measured.at_frequencies(&spread(lines, opts.prescreen_lines))?;
-        let (cost0_pre, _) = nominal_cost(&nominal, &pre)?;
-        for (i, f) in screen(&pre, cost0_pre, opts.prescreen_iterations, &candidates, &locals, &all)? {
-            screened[i] = f;
-        }
-        let mut best: Vec<usize> = all.iter().copied().filter(|&i| screened[i].is_some()).collect();
-        by_rank(&screened, &candidates, &mut best);
-        best.truncate(opts.prescreen_keep);
-        best
-    } else {
-        all
-    };
-    for (i, f) in screen(&coarse, cost0_coarse, opts.screen_iterations, &candidates, &locals, &to_screen)? {
-        if f.is_some() {
-            screened[i] = f;
-        }
-    }
-    let mut order: Vec<usize> = (0..candidates.len()).filter(|&i| screened[i].is_some()).collect();
-    by_rank(&screened, &candidates, &mut order);
-    let keep: Vec<usize> = order.iter().copied().take(opts.keep).collect();
-    let mut full_fits = full_fit(&candidates, &locals, &screened, &keep)?;
-
-    // The leaders' locations are refined into per-element stiffness and mass
-    // changes (see `candidates::neighbourhood`): on large models those were
-    // tried only per region.
-    let mut by_cost: Vec<&(usize, Option<Fit>)> = full_fits.iter().filter(|(_, f)| f.is_some()).collect();
-    by_cost.sort_by(|a, b| a.1.as_ref().expect("some").cost.total_cmp(&b.1.as_ref().expect("some").cost));
-    let tried = |kind: EffectKind, e: u32| candidates.iter().any(|c| c.kind == kind && c.elements == [e]);
-    let mut beams: Vec<usize> = Vec::new();
-    for (i, _) in by_cost.into_iter().take(REFINED_LEADERS) {
-        for b in candidates::neighbourhood(model, &candidates[*i]) {
-            let id = model.beams()[b].id.0;
-            let both_tried = tried(EffectKind::StiffnessChange, id) && tried(EffectKind::MassChange, id);
-            if !beams.contains(&b) && !both_tried {
-                beams.push(b);
-            }
-        }
-    }
-    let refined = candidates::per_element(model, &beams);
-    let refined_locals: Vec<Option<LocalCandidate>> =
-        refined.par_iter().map(|c| LocalCandidate::new(&nominal, c)).collect();
-    // screened like the others; the best few fitted fully
-    let all_refined: Vec<usize> = (0..refined.len()).collect();
-    let refined_screened =
-        screen(&coarse, cost0_coarse, opts.screen_iterations, &refined, &refined_locals, &all_refined)?;
-    let first_refined = candidates.len();
-    let mut candidates = candidates;
-    candidates.extend(refined);
-    locals.extend(refined_locals);
-    screened.extend(refined_screened.into_iter().map(|(_, f)| f));
-    let mut new: Vec<usize> = (first_refined..candidates.len()).filter(|&i| screened[i].is_some()).collect();
-    by_rank(&screened, &candidates, &mut new);
-    let best_new: Vec<usize> = new.iter().copied().take(REFINED_FITS).collect();
-    full_fits.extend(full_fit(&candidates, &locals, &screened, &best_new)?);
-    order.extend(new);
-    by_rank(&screened, &candidates, &mut order);
-
-    let ranked = |i: usize, f: &Fit, n: usize, fully: bool| {
-        let c = &candidates[i];
-        let cost0 = f.cost0;
-        let delta_bic = bic(f.cost, cost0, n, c.parameters.len());
-        let implausible_reason = c.implausible(&f.values);
+/// The ranking of a finished search.
+fn rank(pool: Pool<'_>, noise: f64, full: &LineSet, opts: &DiagnoseOptions) -> Diagnosis {
+    let ranked = |i: usize, f: &search::Fit, fully: bool| {
+        let c = &pool.candidates[i];
+        let delta_bic = pool.bic(f, c.parameters.len());
+        let implausible_reason = c.implausible(&f.values, &f.determined);
         Ranked {
             kind: c.kind,
             description: c.description.clone(),
             nodes: c.nodes.clone(),
             elements: c.elements.clone(),
             dof: c.dofs.iter().map(|d| d.to_string()).collect(),
-            explained: (1.0 - f.cost / cost0).max(0.0),
+            damping: c.damping(),
+            explained: (1.0 - f.cost / f.cost0).max(0.0),
+            misfit: (f.cost / (f.n as f64 / 2.0)).sqrt(),
             delta_bic,
             significant: delta_bic < opts.significance,
             plausible: implausible_reason.is_none(),
             implausible_reason,
-            parameters: c
-                .parameters
-                .iter()
-                .zip(&f.values)
-                .zip(&f.relative_std)
-                .map(|((name, &value), &relative_std)| FittedParameter { name: name.clone(), value, relative_std })
+            parameters: (0..c.parameters.len())
+                .map(|p| FittedParameter {
+                    name: c.parameters[p].clone(),
+                    role: c.roles[p],
+                    value: f.values[p],
+                    relative_std: f.relative_std[p],
+                    determined: f.determined[p],
+                })
                 .collect(),
+            held: c.held.clone(),
             fully_fitted: fully,
             candidate: i,
         }
     };
+    let fully = pool.by_full_fit();
     let mut ranking: Vec<Ranked> =
-        full_fits.iter().filter_map(|(i, f)| f.as_ref().map(|f| ranked(*i, f, n_full.max(f.n), true))).collect();
-    ranking.sort_by(|a, b| a.delta_bic.total_cmp(&b.delta_bic));
-    let fitted: Vec<usize> = ranking.iter().map(|r| r.candidate).collect();
-    ranking.extend(order.iter().filter(|i| !fitted.contains(i)).map(|&i| {
-        let f = screened[i].as_ref().expect("filtered");
-        ranked(i, f, f.n, false)
-    }));
-    Ok(Diagnosis {
+        fully.iter().map(|&i| ranked(i, pool.full[i].as_ref().expect("fully fitted"), true)).collect();
+    let rest: Vec<usize> =
+        (0..pool.candidates.len()).filter(|&i| pool.full[i].is_none() && !pool.superseded[i]).collect();
+    ranking.extend(
+        pool.by_screening(&rest).into_iter().map(|i| ranked(i, pool.screened[i].as_ref().expect("screened"), false)),
+    );
+    let recommended = ranking.iter().position(|r| r.fully_fitted && r.significant && r.plausible).map(|r| r + 1);
+    let unfitted = (0..pool.candidates.len())
+        .filter(|&i| pool.screened[i].is_none() && pool.full[i].is_none())
+        .map(|i| Unfitted {
+            description: pool.candidates[i].description.clone(),
+            reason: pool.failure[i].clone().unwrap_or_else(|| "not fitted".into()),
+        })
+        .collect();
+    Diagnosis {
         noise,
-        nominal_misfit: (cost0_full / (n_full as f64 / 2.0)).sqrt(),
-        n_residuals: n_full,
+        nominal_misfit: (full.cost0 / (full.n as f64 / 2.0)).sqrt(),
+        n_residuals: full.n,
         ranking,
-        candidates,
-    })
+        recommended,
+        tried: pool.candidates.len(),
+        unfitted,
+        candidates: pool.candidates,
+    }
 }

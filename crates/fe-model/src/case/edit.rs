@@ -1,0 +1,399 @@
+//! Edits of a case file that keep the user's layout and comments.
+//!
+//! `rfm diagnose --apply`, `rfm update` and `rfm fix` write new case files
+//! (never over the input): the user's case with an effect added, values
+//! merged into `[set]`, the parameters to update, and the history of the
+//! misfit. The edits are made on the TOML document itself (`toml_edit`), so
+//! that comments, order and layout stay as the user wrote them; added model
+//! items are appended as text under a comment that says where they came
+//! from. The measured-data path is rewritten relative to the new file's
+//! folder, so that a written case can be moved together with its data, and
+//! every result is parsed again as a case file before it is handed back.
+
+use std::path::{Component, Path, PathBuf};
+
+use toml_edit::{ArrayOfTables, DocumentMut, Item, Table, value};
+
+use super::{CaseFile, HistoryEntry};
+use crate::error::CaseError;
+
+/// An edit of a case file's text; see the module docs.
+#[derive(Clone, Debug)]
+pub struct CaseEditor {
+    /// The case file being edited (messages; the base of its data path).
+    path: PathBuf,
+    /// Its measured-data file, resolved.
+    data: Option<PathBuf>,
+    doc: DocumentMut,
+}
+
+impl CaseFile {
+    /// An editor on this case's text.
+    pub fn editor(&self) -> Result<CaseEditor, CaseError> {
+        let doc = self.source.parse::<DocumentMut>().map_err(|e| self.error(e.span(), e.message().to_string()))?;
+        let data = self.measurement.as_ref().and_then(|m| m.data.clone());
+        Ok(CaseEditor { path: self.path.clone(), data, doc })
+    }
+}
+
+impl CaseEditor {
+    /// An error about the edit (not located in the file).
+    pub fn error(&self, message: String) -> CaseError {
+        CaseError { file: self.path.clone(), location: None, message, snippet: None }
+    }
+
+    /// Removes every support entry of `node` (`[[supports]]` tables or
+    /// inline entries); returns how many were removed.
+    pub fn remove_supports_at(&mut self, node: u32) -> usize {
+        let holds = |t: &dyn toml_edit::TableLike| {
+            t.get("node").and_then(Item::as_integer).is_some_and(|n| n == i64::from(node))
+        };
+        match self.doc.get_mut("supports") {
+            Some(Item::ArrayOfTables(a)) => {
+                let before = a.len();
+                a.retain(|t| !holds(t));
+                before - a.len()
+            }
+            Some(Item::Value(toml_edit::Value::Array(a))) => {
+                let before = a.len();
+                a.retain(|v| !v.as_inline_table().is_some_and(|t| holds(t)));
+                before - a.len()
+            }
+            _ => 0,
+        }
+    }
+
+    /// Appends TOML text (new tables and array entries) under a comment
+    /// line. Fails when the result is not valid TOML (a table defined twice).
+    pub fn append(&mut self, comment: &str, snippet: &str) -> Result<(), CaseError> {
+        let mut text = self.doc.to_string();
+        while text.ends_with("\n\n") {
+            text.pop();
+        }
+        if !text.is_empty() && !text.ends_with('\n') {
+            text.push('\n');
+        }
+        text.push('\n');
+        for line in comment.lines() {
+            text.push_str(&format!("# {line}\n"));
+        }
+        text.push_str(snippet);
+        self.doc = text.parse::<DocumentMut>().map_err(|e| {
+            self.error(format!("the lines to add do not fit into the case file: {}", e.message().trim_end()))
+        })?;
+        Ok(())
+    }
+
+    /// Merges quantity values into the top-level `[set]` table (created when
+    /// missing), with a comment above it.
+    pub fn set_values(&mut self, values: &[(String, f64)], comment: &str) -> Result<(), CaseError> {
+        if values.is_empty() {
+            return Ok(());
+        }
+        let set = self.table("set")?;
+        for (k, v) in values {
+            set.insert(k, value(*v));
+        }
+        add_comment(set, comment);
+        Ok(())
+    }
+
+    /// Sets what to update: the `[update]` table's parameters and method
+    /// (created when missing; other keys of an existing table stay). Bounds
+    /// of parameters no longer updated are removed.
+    pub fn set_update(&mut self, parameters: &[String], method: &str) -> Result<(), CaseError> {
+        let update = self.table("update")?;
+        let mut list = toml_edit::Array::new();
+        for p in parameters {
+            list.push(p.as_str());
+        }
+        update.insert("parameters", value(list));
+        update.insert("method", value(method));
+        if let Some(bounds) = update.get_mut("bounds").and_then(Item::as_table_like_mut) {
+            let stale: Vec<String> =
+                bounds.iter().map(|(k, _)| k.to_string()).filter(|k| !parameters.contains(k)).collect();
+            for k in stale {
+                bounds.remove(&k);
+            }
+        }
+        Ok(())
+    }
+
+    /// Makes the case read its measured FRFs from `path` (a file written
+    /// beside the new case, holding the data the case synthesised from its
+    /// `[truth]`), and removes the `[truth]`: once effects are added to the
+    /// model, a truth defined on top of the model would no longer describe
+    /// what was measured.
+    pub fn use_data(&mut self, path: &Path) {
+        self.data = Some(path.to_path_buf());
+        self.doc.remove("truth");
+        let measurement = self.doc.entry("measurement").or_insert(Item::Table(Table::new()));
+        if let Some(m) = measurement.as_table_like_mut() {
+            // a placeholder that `text_at` replaces by the path relative to the new file
+            m.insert("data", value(path.to_string_lossy().as_ref()));
+        }
+    }
+
+    /// Appends an entry to the `[[history]]` of the misfit.
+    pub fn push_history(&mut self, entry: &HistoryEntry) -> Result<(), CaseError> {
+        let mut t = Table::new();
+        t.insert("step", value(entry.step.as_str()));
+        t.insert("misfit", value(entry.misfit));
+        if let Some(noise) = entry.noise {
+            t.insert("noise", value(noise));
+        }
+        match self.doc.entry("history").or_insert(Item::ArrayOfTables(ArrayOfTables::new())) {
+            Item::ArrayOfTables(a) => {
+                if a.is_empty() {
+                    t.decor_mut().set_prefix(
+                        "\n# The misfit after each step (RMS of ln(model / measured) per value), written by rfm\n",
+                    );
+                }
+                a.push(t);
+                Ok(())
+            }
+            _ => Err(self.error("`history` is not a list of [[history]] tables".into())),
+        }
+    }
+
+    /// The edited text for a case file at `target`: the measured-data path
+    /// made relative to `target`'s folder, parsed again as a case file.
+    pub fn text_at(&self, target: &Path) -> Result<String, CaseError> {
+        let mut doc = self.doc.clone();
+        if let Some(data) = &self.data {
+            let rel = relative_path(data, target.parent().unwrap_or(Path::new("")));
+            let rel = rel.to_string_lossy().replace('\\', "/");
+            if let Some(m) = doc.get_mut("measurement").and_then(Item::as_table_like_mut)
+                && let Some(d) = m.get_mut("data")
+            {
+                let decor = d.as_value().map(|v| v.decor().clone());
+                *d = value(rel);
+                if let (Some(decor), Some(v)) = (decor, d.as_value_mut()) {
+                    *v.decor_mut() = decor;
+                }
+            }
+        }
+        let text = doc.to_string();
+        CaseFile::parse(target, &text)?;
+        Ok(text)
+    }
+
+    /// A top-level table, created when missing.
+    fn table(&mut self, key: &str) -> Result<&mut Table, CaseError> {
+        let err = self.error(format!("`{key}` is not a table"));
+        let item = self.doc.entry(key).or_insert(Item::Table(Table::new()));
+        if let Item::Value(toml_edit::Value::InlineTable(t)) = item {
+            *item = Item::Table(std::mem::take(t).into_table());
+        }
+        item.as_table_mut().ok_or(err)
+    }
+}
+
+/// Adds comment lines above a table, after any comment it has.
+fn add_comment(t: &mut Table, comment: &str) {
+    if comment.is_empty() {
+        return;
+    }
+    let old = t.decor().prefix().and_then(|p| p.as_str()).unwrap_or("\n").to_string();
+    let mut prefix = old.trim_end_matches(' ').to_string();
+    if !prefix.ends_with('\n') {
+        prefix.push('\n');
+    }
+    for line in comment.lines() {
+        prefix.push_str(&format!("# {line}\n"));
+    }
+    t.decor_mut().set_prefix(prefix);
+}
+
+/// `path` relative to the folder `base`, through their common ancestor;
+/// `path` itself (absolute) when they share none (another drive).
+pub(crate) fn relative_path(path: &Path, base: &Path) -> PathBuf {
+    let (path, base) = (resolved(path), resolved(base));
+    let (p, b): (Vec<Component<'_>>, Vec<Component<'_>>) = (path.components().collect(), base.components().collect());
+    let common = p.iter().zip(&b).take_while(|(x, y)| x == y).count();
+    if common == 0 {
+        return path;
+    }
+    let mut out = PathBuf::new();
+    for _ in common..b.len() {
+        out.push("..");
+    }
+    for c in &p[common..] {
+        out.push(c);
+    }
+    out
+}
+
+/// An absolute path without `.` or `..`, through symbolic links where the
+/// path (or its nearest existing ancestor) exists.
+fn resolved(path: &Path) -> PathBuf {
+    let abs = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
+    let mut clean = PathBuf::new();
+    for c in abs.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir => {
+                clean.pop();
+            }
+            other => clean.push(other),
+        }
+    }
+    // the nearest ancestor that exists, with its links resolved
+    let mut existing = clean.clone();
+    let mut rest = Vec::new();
+    while !existing.exists() {
+        match existing.file_name() {
+            Some(name) => rest.push(name.to_os_string()),
+            None => return clean,
+        }
+        if !existing.pop() {
+            return clean;
+        }
+    }
+    let mut out = existing.canonicalize().unwrap_or(existing);
+    for name in rest.into_iter().rev() {
+        out.push(name);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const CASE: &str = "\
+title = \"edit me\"   # the user's comment
+[materials]
+steel = { E = 2e11, rho = 7800 }
+[sections]
+bar = { b = 0.04, h = 0.008 }
+[groups.beam]
+alpha = 1e-5
+[[lines]]
+from = [0.0, 0.0]
+to = [1.0, 0.0]
+elements = 4
+material = \"steel\"
+section = \"bar\"
+group = \"beam\"
+[[supports]]
+node = 1
+[[supports]]
+node = 5
+dofs = [\"uy\"]
+[measurement]
+frequencies = [10.0, 20.0]
+references = [\"5:ux\"]
+responses = [\"2..5:ux\"]
+data = \"data/measured.csv\"   # from the lab
+";
+
+    fn case(dir: &Path) -> CaseFile {
+        CaseFile::parse(&dir.join("case.toml"), CASE).unwrap()
+    }
+
+    #[test]
+    fn data_paths_are_written_relative_to_the_new_file() {
+        let dir = std::env::temp_dir().join(format!("rfm-edit-{}", std::process::id()));
+        let c = case(&dir.join("study"));
+        let e = c.editor().unwrap();
+        let same = e.text_at(&dir.join("study/new.toml")).unwrap();
+        assert!(same.contains("data = \"data/measured.csv\"   # from the lab"), "{same}");
+        let deeper = e.text_at(&dir.join("study/out/step-1/new.toml")).unwrap();
+        assert!(deeper.contains("data = \"../../data/measured.csv\""), "{deeper}");
+        let beside = e.text_at(&dir.join("other/new.toml")).unwrap();
+        assert!(beside.contains("data = \"../study/data/measured.csv\""), "{beside}");
+        // the rewritten path names the same file
+        let back = CaseFile::parse(&dir.join("other/new.toml"), &beside).unwrap();
+        let got = back.measurement.unwrap().data.unwrap();
+        assert_eq!(resolved(&got), resolved(&dir.join("study/data/measured.csv")));
+        assert!(same.contains("# the user's comment"), "comments stay");
+    }
+
+    #[test]
+    fn supports_of_one_node_are_removed_and_others_stay() {
+        let c = case(Path::new("/tmp"));
+        let mut e = c.editor().unwrap();
+        assert_eq!(e.remove_supports_at(1), 1);
+        assert_eq!(e.remove_supports_at(3), 0);
+        e.append(
+            "a spring instead",
+            "[[springs]]\nname = \"s\"\nnode = 1\nkx = 1e9\nky = 1e9\nkr = 1e4\ngroup = \"beam\"\n",
+        )
+        .unwrap();
+        let text = e.text_at(Path::new("/tmp/x.toml")).unwrap();
+        let back = CaseFile::parse(Path::new("/tmp/x.toml"), &text).unwrap();
+        assert_eq!(back.model.supports().len(), 1);
+        assert_eq!(back.model.supports()[0].node.0, 5);
+        assert!(text.contains("# a spring instead\n[[springs]]"), "{text}");
+        // inline support lists are edited too
+        let inline = CASE.replace("[[supports]]\nnode = 1\n[[supports]]\nnode = 5\ndofs = [\"uy\"]\n", "").replace(
+            "title = \"edit me\"",
+            "title = \"edit me\"\nsupports = [{ node = 1 }, { node = 5, dofs = [\"uy\"] }]",
+        );
+        let c = CaseFile::parse(Path::new("/tmp/case.toml"), &inline).unwrap();
+        let mut e = c.editor().unwrap();
+        assert_eq!(e.remove_supports_at(5), 1);
+        assert!(!e.doc.to_string().contains("node = 5"));
+    }
+
+    #[test]
+    fn values_merge_into_set_and_read_back_exactly() {
+        let text = format!("{CASE}\n[set]\n\"group.beam.alpha\" = 2e-5   # measured\n");
+        let c = CaseFile::parse(Path::new("/tmp/case.toml"), &text).unwrap();
+        let mut e = c.editor().unwrap();
+        let v = 3.141592653589793e-5;
+        e.set_values(&[("group.beam.alpha".into(), v), ("group.beam.beta".into(), 0.25)], "updated by rfm").unwrap();
+        let out = e.text_at(Path::new("/tmp/x.toml")).unwrap();
+        assert_eq!(out.matches("[set]").count(), 1, "{out}");
+        let back = CaseFile::parse(Path::new("/tmp/x.toml"), &out).unwrap();
+        for (name, want) in [("group.beam.alpha", v), ("group.beam.beta", 0.25)] {
+            let q = back.model.quantity(name).unwrap();
+            assert_eq!(back.model.get(q), want, "{name}");
+        }
+        assert!(out.contains("# updated by rfm\n[set]"), "{out}");
+    }
+
+    #[test]
+    fn update_and_history_tables_are_written_and_parsed() {
+        let c = case(Path::new("/tmp"));
+        let mut e = c.editor().unwrap();
+        e.set_update(&["group.beam.alpha".to_string()], "output-error").unwrap();
+        e.push_history(&HistoryEntry { step: "nominal".into(), misfit: 1.25, noise: Some(0.01) }).unwrap();
+        e.push_history(&HistoryEntry { step: "+ a joint".into(), misfit: 0.0125, noise: None }).unwrap();
+        let out = e.text_at(Path::new("/tmp/x.toml")).unwrap();
+        let back = CaseFile::parse(Path::new("/tmp/x.toml"), &out).unwrap();
+        assert_eq!(back.update.unwrap().parameters[0].name, "group.beam.alpha");
+        assert_eq!(back.history.len(), 2);
+        assert_eq!((back.history[0].step.as_str(), back.history[0].misfit), ("nominal", 1.25));
+        assert_eq!((back.history[1].misfit, back.history[1].noise), (0.0125, None));
+    }
+
+    #[test]
+    fn a_synthesised_case_is_turned_into_one_that_reads_its_data() {
+        let text = CASE.replace("data = \"data/measured.csv\"   # from the lab\n", "") + "[truth]\nnoise = 0.01\n";
+        let c = CaseFile::parse(Path::new("/tmp/study/case.toml"), &text).unwrap();
+        assert!(c.truth.is_some());
+        let mut e = c.editor().unwrap();
+        e.use_data(Path::new("/tmp/study/out/measured.csv"));
+        let out = e.text_at(Path::new("/tmp/study/out/step-1.toml")).unwrap();
+        let back = CaseFile::parse(Path::new("/tmp/study/out/step-1.toml"), &out).unwrap();
+        assert!(back.truth.is_none(), "{out}");
+        assert!(out.contains("data = \"measured.csv\""), "{out}");
+    }
+
+    #[test]
+    fn an_addition_that_clashes_is_refused_with_its_reason() {
+        let c = case(Path::new("/tmp"));
+        let mut e = c.editor().unwrap();
+        let err = e.append("again", "[groups.beam]\nalpha = 1\n").unwrap_err();
+        assert!(err.message.contains("do not fit into the case file"), "{err}");
+    }
+
+    #[test]
+    fn relative_paths_walk_up_to_the_common_folder() {
+        assert_eq!(relative_path(Path::new("/a/b/c.csv"), Path::new("/a/b")), PathBuf::from("c.csv"));
+        assert_eq!(relative_path(Path::new("/a/b/c.csv"), Path::new("/a/d/e")), PathBuf::from("../../b/c.csv"));
+        assert_eq!(relative_path(Path::new("/a/./b/../b/c.csv"), Path::new("/a")), PathBuf::from("b/c.csv"));
+    }
+}

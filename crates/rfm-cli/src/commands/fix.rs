@@ -1,0 +1,155 @@
+//! `rfm fix`: diagnose, add the recommended effect, update, and again,
+//! until nothing significant remains; the case after every step, and a
+//! report whose headline is the fall of the misfit.
+
+use std::path::{Path, PathBuf};
+
+use rfm_update::fix::{FixOptions, FixOutcome, FixProgress, fix as run_fix};
+use rfm_update::{Study, UpdateError};
+
+use super::Result;
+use crate::table::{Table, num};
+
+/// A misfit within this many times the noise is consistent with it.
+pub(crate) const CONSISTENT: f64 = 1.5;
+
+/// Options of the fix command.
+pub(crate) struct FixArgs<'a> {
+    pub(crate) case: &'a Path,
+    pub(crate) out: &'a Path,
+    pub(crate) steps: usize,
+    pub(crate) json: bool,
+}
+
+/// The name of the case file written after step `k` (1-based).
+pub(crate) fn step_file(k: usize) -> String {
+    format!("step-{k}.toml")
+}
+
+pub(crate) fn fix(args: &FixArgs<'_>) -> Result<()> {
+    crate::files_to_write();
+    let study = Study::load(args.case).map_err(|e| match e {
+        UpdateError::Case(c) => c.render(),
+        other => other.to_string(),
+    })?;
+    let inputs = study.case.inputs();
+    // the data every written case reads: the case's own file, or the data
+    // synthesised from its [truth], written once beside the steps
+    let synthesised = study.case.measurement.as_ref().and_then(|m| m.data.as_ref()).is_none();
+    let data_file = synthesised.then(|| args.out.join("measured.csv"));
+    let mut names: Vec<PathBuf> = (1..=args.steps)
+        .map(|k| args.out.join(step_file(k)))
+        .chain(["results.json", "report.html"].map(|n| args.out.join(n)))
+        .collect();
+    names.extend(data_file.clone());
+    frf::io::refuse_inputs(&names, &inputs)?;
+    if !args.json {
+        outln!("{}", study.case.model.title);
+        outln!(
+            "closing the loop on {} channels x {} lines ({} to {} Hz), at most {} steps",
+            study.measured.channels().len(),
+            study.measured.n_freq(),
+            num(study.measured.frequencies_hz()[0]),
+            num(*study.measured.frequencies_hz().last().expect("lines")),
+            args.steps
+        );
+    }
+    let opts = FixOptions { max_steps: args.steps, ..FixOptions::default() };
+    let json = args.json;
+    let outcome = run_fix(&study.case, &study.measured, &opts, |p| {
+        if json {
+            return;
+        }
+        let line = match p {
+            FixProgress::Diagnosed { step, diagnosis } => match diagnosis.leader() {
+                Some(l) => format!("diagnosis {}: {} stands out (dBIC {:.1})", step + 1, l.description, l.delta_bic),
+                None if diagnosis.consistent() => format!("diagnosis {}: nothing significant", step + 1),
+                None => format!("diagnosis {}: significant effects, none at plausible values", step + 1),
+            },
+            FixProgress::Updated { step, misfit, status } => {
+                format!("step {}: added and updated ({status:?}); misfit {misfit:.4e}", step + 1)
+            }
+        };
+        // an error here would be the same as at the next print, which reports it
+        let _ = crate::print_line(format_args!("{line}"));
+    })?;
+    if json {
+        outln!("{}", serde_json::to_string_pretty(&outcome)?);
+    } else {
+        print_outcome(&outcome)?;
+    }
+
+    let _writing = crate::writing();
+    let mut written = Vec::new();
+    let case_with_data = |mut editor: fe_model::CaseEditor, path: &Path| -> Result<String> {
+        if let Some(data) = &data_file {
+            editor.use_data(data);
+        }
+        Ok(editor.text_at(path).map_err(|e| e.render())?)
+    };
+    let mut files: Vec<(PathBuf, Vec<u8>)> = Vec::new();
+    if let Some(data) = &data_file {
+        files.push((data.clone(), frf::io::csv::to_csv_string(&study.measured).into_bytes()));
+    }
+    for (k, s) in outcome.steps.iter().enumerate() {
+        let path = args.out.join(step_file(k + 1));
+        let text = case_with_data(s.case.clone(), &path)?;
+        files.push((path, text.into_bytes()));
+    }
+    files.push((args.out.join("results.json"), serde_json::to_string_pretty(&outcome)?.into_bytes()));
+    for (path, bytes) in &files {
+        frf::io::atomic_write(path, bytes, &inputs)?;
+        written.push(path.clone());
+    }
+    let report = crate::report::fix_report::write(&study, &outcome, args.out, inputs)?;
+    written.push(report);
+    if !json {
+        outln!("\nwrote {} files into {}", written.len(), args.out.display());
+        if let Some(last) = outcome.steps.len().checked_sub(1) {
+            outln!("the fixed model: {}", args.out.join(step_file(last + 1)).display());
+        }
+    }
+    Ok(())
+}
+
+fn print_outcome(o: &FixOutcome) -> Result<()> {
+    outln!("\nthe misfit after each step (RMS of ln(model/measured) per value):");
+    let mut t = Table::new(&["step", "misfit", "(dB)", "x noise"]);
+    for (label, m) in o.stages() {
+        t.row(vec![label, format!("{m:.4e}"), format!("{:.1}", 20.0 * m.log10()), format!("{:.1}", m / o.noise)]);
+    }
+    outln!("{}", t.render());
+    outln!("noise level estimated from the data: {:.3e}", o.noise);
+    outln!("\nstopped: {}", o.stop.describe());
+    let last = o.final_misfit();
+    if last <= CONSISTENT * o.noise {
+        outln!(
+            "the final misfit is {:.2} times the noise: the model explains the data down to their noise",
+            last / o.noise
+        );
+    } else {
+        outln!(
+            "the final misfit is {:.1} times the noise: something the candidates cannot represent remains",
+            last / o.noise
+        );
+    }
+    if let Some(s) = o.steps.last() {
+        outln!("\nparameters after the last update (relative standard deviation from the noise):");
+        let mut t = Table::new(&["parameter", "value", "+-1 sd"]);
+        for (i, p) in s.parameters.iter().enumerate() {
+            let sd = s
+                .uncertainty
+                .as_ref()
+                .and_then(|u| u.parameters.get(i))
+                .map_or("-".to_string(), |u| crate::table::percent(u.relative_std));
+            t.row(vec![p.name.clone(), num(p.updated), sd]);
+        }
+        outln!("{}", t.render());
+    }
+    if o.significant_remains
+        && let Some(r) = o.remaining.first()
+    {
+        outln!("\nstill significant in the last diagnosis: {} (dBIC {:.1})", r.description, r.delta_bic);
+    }
+    Ok(())
+}

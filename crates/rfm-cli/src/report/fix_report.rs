@@ -1,0 +1,157 @@
+//! The report of the loop (`rfm fix --out DIR`): its headline is the misfit
+//! after each step against the noise; then each step's effect and updated
+//! parameters, what still stands out, and the nominal and final models
+//! against the measured FRFs.
+
+use std::path::{Path, PathBuf};
+
+use frf::correlation::{BandSpec, correlate};
+use frf::synthesize;
+use rfm_update::Study;
+use rfm_update::fix::FixOutcome;
+
+use super::html::{Block, Report, Section, Table, Tone};
+use super::{ModelFrfs, Output, Result, plot, sig};
+use crate::commands::fix::{CONSISTENT, step_file};
+use crate::table::{num, percent};
+
+/// Overlay figures of the worst channels.
+const OVERLAYS: usize = 4;
+
+/// Writes the report files of the loop into `dir` and returns the path of
+/// `report.html`. `inputs` are protected from being overwritten.
+pub(crate) fn write(study: &Study, outcome: &FixOutcome, dir: &Path, inputs: Vec<PathBuf>) -> Result<PathBuf> {
+    let mut out = Output::new(dir, inputs);
+    let mut report = Report::new(format!("{}: closing the loop", study.case.model.title));
+    report.subtitle = Some(format!(
+        "rfm fix, case file {}: {} effect(s) added; {}",
+        study.case.path.display(),
+        outcome.steps.len(),
+        outcome.stop.describe()
+    ));
+
+    let stages = outcome.stages();
+    let mut fall = Section::new("The fall of the misfit");
+    let short: Vec<String> = std::iter::once("nominal".to_string())
+        .chain((1..=outcome.steps.len()).flat_map(|k| [format!("+ effect {k}"), format!("updated {k}")]))
+        .collect();
+    let misfits: Vec<f64> = stages.iter().map(|(_, m)| *m).collect();
+    fall.push(out.figure(
+        "misfit-steps",
+        plot::misfit_steps(&short, &misfits, outcome.noise, CONSISTENT)?,
+        format!(
+            "The misfit (RMS of ln(model / measured) per complex value, over {} lines spread across the band) of \
+             the nominal model, after adding each effect at its diagnosed values, and after updating every added \
+             parameter together. The green band runs from the noise level estimated from the data to {CONSISTENT} \
+             times it: a misfit inside it is consistent with the noise.",
+            rfm_update::diagnose::DiagnoseOptions::default().lines
+        ),
+    )?);
+    let mut t = Table::new(&["step", "misfit", "(dB)", "x noise"]);
+    for (label, m) in &stages {
+        let tone = if *m <= CONSISTENT * outcome.noise { Tone::Good } else { Tone::Plain };
+        t.row_toned(vec![
+            (label.clone(), Tone::Plain),
+            (sig(*m, 4), tone),
+            (format!("{:.1}", 20.0 * m.log10()), Tone::Plain),
+            (format!("{:.1}", m / outcome.noise), tone),
+        ]);
+    }
+    fall.push(Block::Table(t));
+    let last = outcome.final_misfit();
+    fall.push(Block::Text(if last <= CONSISTENT * outcome.noise {
+        format!(
+            "The final misfit is {:.2} times the noise: the model explains the data down to their noise.",
+            last / outcome.noise
+        )
+    } else {
+        format!(
+            "The final misfit is {:.1} times the noise: something the candidate effects cannot represent remains.",
+            last / outcome.noise
+        )
+    }));
+    fall.push(Block::Text(format!("The loop stopped because {}.", outcome.stop.describe())));
+    report.sections.push(fall);
+
+    for (k, s) in outcome.steps.iter().enumerate() {
+        let e = &s.effect;
+        let mut sec = Section::new(format!("Step {}: {}", k + 1, e.description));
+        sec.push(Block::Facts(vec![
+            ("explained".into(), format!("{:.1} % of the misfit before it", 100.0 * e.explained)),
+            ("dBIC".into(), format!("{:.1} (below -10: very strong evidence)", e.delta_bic)),
+            (
+                "misfit with it".into(),
+                format!("{} ({:.1} x noise)", sig(s.misfit_added, 4), s.misfit_added / outcome.noise),
+            ),
+            (
+                "after the update".into(),
+                format!(
+                    "{} ({:.1} x noise), {:?}",
+                    sig(s.misfit_updated, 4),
+                    s.misfit_updated / outcome.noise,
+                    s.status
+                ),
+            ),
+            ("case file".into(), step_file(k + 1)),
+        ]));
+        if !e.held.is_empty() {
+            sec.push(Block::Text(format!(
+                "Held at their rigid or nominal value because the data do not determine them: {}.",
+                e.held.join(", ")
+            )));
+        }
+        let mut t = Table::new(&["parameter", "diagnosed", "updated", "+-1 sd (noise)"])
+            .caption("Every parameter updated at this step: the effects added so far and the case's own.");
+        for (i, p) in s.parameters.iter().enumerate() {
+            let diagnosed = e.parameters.iter().find(|f| f.name == p.name).map_or("-".to_string(), |f| num(f.value));
+            let sd = s
+                .uncertainty
+                .as_ref()
+                .and_then(|u| u.parameters.get(i))
+                .map_or("-".to_string(), |u| percent(u.relative_std));
+            t.row(vec![p.name.clone(), diagnosed, num(p.updated), sd]);
+        }
+        sec.push(Block::Table(t));
+        report.sections.push(sec);
+    }
+
+    let mut rest = Section::new("What the last diagnosis finds");
+    rest.push(Block::Text(if outcome.significant_remains {
+        "Some candidates are still significant in the diagnosis of the final model:".to_string()
+    } else {
+        "No candidate is significant in the diagnosis of the final model.".to_string()
+    }));
+    let mut t = Table::new(&["effect", "explained", "dBIC", "plausible"]);
+    for r in &outcome.remaining {
+        t.row(vec![
+            r.description.clone(),
+            format!("{:.1} %", 100.0 * r.explained),
+            format!("{:.1}", r.delta_bic),
+            if r.plausible { "yes".into() } else { r.implausible_reason.clone().unwrap_or_default() },
+        ]);
+    }
+    rest.push(Block::Table(t));
+    report.sections.push(rest);
+
+    // the nominal and the final model against the data
+    let measured = &study.measured;
+    let model = |label: &str, colour, sys: &damping::DampedSystem| -> Result<ModelFrfs> {
+        let frfs = synthesize(sys, measured.channels(), measured.frequencies_hz())?;
+        let correlation = correlate(measured, &frfs, &BandSpec::Auto)?;
+        Ok(ModelFrfs { label: label.into(), colour, frfs, correlation })
+    };
+    let mut models = vec![model("nominal model", plot::INITIAL, &study.system)?];
+    if let Some(s) = outcome.steps.last() {
+        let text = s.case.text_at(&study.case.path)?;
+        let fixed = fe_model::CaseFile::parse(&study.case.path, &text)?;
+        models.push(model("fixed model", plot::UPDATED, &damping::DampedSystem::new(fixed.model)?)?);
+    }
+    let notes = vec!["The nominal model and the model after the last step against the measured FRFs.".to_string()];
+    report.sections.push(super::correlation_section(measured, &models, &mut out, notes)?);
+    let last_model = models.last().expect("the nominal model at least");
+    let worst = super::notable_channels(&last_model.correlation, 2);
+    let picks = super::representative_channels(measured, &worst, OVERLAYS);
+    report.sections.push(super::overlay_section(measured, &models, &picks, &worst, &[], &mut out)?);
+    report.sections.push(super::definitions_section());
+    out.write("report.html", report.render().as_bytes())
+}

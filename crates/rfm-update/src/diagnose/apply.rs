@@ -1,0 +1,94 @@
+//! Adding a diagnosed effect to the user's case: `rfm diagnose --apply` and
+//! every step of `rfm fix`.
+
+use fe_model::{CaseEditor, CaseFile, HistoryEntry};
+
+use super::Diagnosis;
+use crate::error::UpdateError;
+
+impl Diagnosis {
+    /// The case-file lines that add ranked effect `rank` (1-based) at its
+    /// fitted values: the text to append and the `[set]` entries to merge.
+    pub fn proposal(&self, rank: usize) -> Result<(String, Vec<(String, f64)>), UpdateError> {
+        let r = self.ranking.get(rank.wrapping_sub(1)).ok_or_else(|| self.no_rank(rank))?;
+        let c = &self.candidates[r.candidate];
+        let values: Vec<f64> = r.parameters.iter().map(|p| p.value).collect();
+        let text = c.edit.snippet(&c.parameters, &values).unwrap_or_default();
+        Ok((text, self.set_entries(rank)?))
+    }
+
+    fn no_rank(&self, rank: usize) -> UpdateError {
+        UpdateError::Setup(format!("there is no rank {rank}: the ranking holds ranks 1 to {}", self.ranking.len()))
+    }
+
+    /// The `[set]` entries of an effect that changes quantities the model
+    /// has (a stiffness factor of a window, a joint spring as modelled):
+    /// every quantity a parameter scales, at the parameter's value.
+    fn set_entries(&self, rank: usize) -> Result<Vec<(String, f64)>, UpdateError> {
+        let r = &self.ranking[rank - 1];
+        let c = &self.candidates[r.candidate];
+        if !matches!(c.edit, super::candidates::Edit::Set) {
+            return Ok(Vec::new());
+        }
+        let part = c.part();
+        let params = c.parameters_in(part)?;
+        let mut set = Vec::new();
+        for (p, fitted) in params.iter().zip(&r.parameters) {
+            for &q in &p.quantities {
+                set.push((part.quantity_name(q).to_string(), fitted.value));
+            }
+        }
+        Ok(set)
+    }
+
+    /// The case with ranked effect `rank` (1-based) added at its fitted
+    /// values, as an editor whose [`CaseEditor::text_at`] gives the new
+    /// file. The determined parameters of the effect join the case's
+    /// `[update]` (created, with the output-error method, when the case has
+    /// none), and the history records the nominal misfit (when the case has
+    /// no history yet) and the misfit with the effect, so that `rfm update`
+    /// shows the whole fall. The result is checked to load and to carry the
+    /// fitted values.
+    pub fn apply(&self, case: &CaseFile, rank: usize) -> Result<CaseEditor, UpdateError> {
+        let r = self.ranking.get(rank.wrapping_sub(1)).ok_or_else(|| self.no_rank(rank))?;
+        let c = &self.candidates[r.candidate];
+        let values: Vec<f64> = r.parameters.iter().map(|p| p.value).collect();
+        let mut editor = case.editor()?;
+        let comment =
+            format!("Added by rfm diagnose: {} (explains {:.1} % of the misfit)", r.description, 100.0 * r.explained);
+        c.edit.write(&mut editor, &c.parameters, &values, &comment)?;
+        editor.set_values(&self.set_entries(rank)?, &format!("{} (rfm diagnose)", r.description))?;
+        let mut names: Vec<String> =
+            case.update.as_ref().map(|u| u.parameters.iter().map(|p| p.name.clone()).collect()).unwrap_or_default();
+        for p in r.parameters.iter().filter(|p| p.determined) {
+            if !names.contains(&p.name) {
+                names.push(p.name.clone());
+            }
+        }
+        let method = case.update.as_ref().and_then(|u| u.method.as_ref()).map_or("output-error", |(m, _)| m.as_str());
+        editor.set_update(&names, method)?;
+        if case.history.is_empty() {
+            editor.push_history(&HistoryEntry {
+                step: "nominal".into(),
+                misfit: self.nominal_misfit,
+                noise: Some(self.noise),
+            })?;
+        }
+        editor.push_history(&HistoryEntry {
+            step: format!("+ {}", r.description),
+            misfit: r.misfit,
+            noise: Some(self.noise),
+        })?;
+        // the new case loads and reads back the fitted values
+        let text = editor.text_at(&case.path)?;
+        let back = CaseFile::parse(&case.path, &text)?;
+        for p in &r.parameters {
+            let param = back.model.parameter(&p.name)?;
+            let got = back.model.get(param.quantities[0]);
+            if got != p.value {
+                return Err(UpdateError::Setup(format!("{} reads back as {got}, not {}", p.name, p.value)));
+            }
+        }
+        Ok(editor)
+    }
+}

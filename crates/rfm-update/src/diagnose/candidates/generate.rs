@@ -1,0 +1,665 @@
+//! Which candidates a model gets: a first pass over the whole model, and a
+//! refinement around the leaders of a first ranking.
+//!
+//! Small models (up to [`CandidateOptions::per_element_limit`] elements) get
+//! every window size at every offset and an in-line joint at every interior
+//! node from the start. Large models get coarse windows first; the leaders'
+//! surroundings are then tried with every window and in-line joint
+//! ([`refine`]), as a region that explains a weakened element in part leads
+//! to that element. On every model the refinement adds the fuller variants
+//! of the leaders: translational springs for a joint, a rotary inertia for
+//! a mass.
+
+use std::collections::{HashMap, HashSet};
+
+use fe_model::{Dof, Group, Model, NodeId};
+use rayon::prelude::*;
+
+use super::edit::Edit;
+use super::{Candidate, CandidateOptions, EffectKind, Fitted, Head, Role};
+
+/// Window lengths (elements) of stiffness, mass and damping changes.
+const WINDOW_SIZES: [usize; 6] = [1, 2, 3, 4, 6, 8];
+
+/// Most elements in the window of a change. A window of eight elements in
+/// a row touches 27 equations, so its change is a cheap low-rank update of
+/// the nominal model (module `local`, whose cost grows as the cube of that
+/// number); a window of more than about twenty would be fitted on its own
+/// model, a factorisation per line and iteration.
+const MAX_WINDOW: usize = 8;
+
+/// Elements on either side of a leader within which a large model's
+/// refinement tries every window and in-line joint.
+const REFINE_REACH: usize = 8;
+
+/// Two beams at a node within this angle (cosine) form one member.
+const COLLINEAR: f64 = 0.985; // 10 degrees
+
+/// A candidate before its part of the model is taken.
+type Spec = (Head, Edit, Vec<Fitted>);
+
+/// What the generators share: the model, its adjacency, and the scales of
+/// starting values, bounds and plausible ranges.
+struct Ctx<'a> {
+    model: &'a Model,
+    /// Beams (indices) at each node id.
+    beams_at: HashMap<u32, Vec<usize>>,
+    /// Runs of consecutive elements (beam indices in id order) of one group.
+    runs: Vec<Vec<usize>>,
+    /// Run and position of each beam.
+    run_of: Vec<(usize, usize)>,
+    w_min: f64,
+    w_mid: f64,
+    w_max: f64,
+    total_mass: f64,
+    /// Largest extent of the structure (m), the scale of rotary inertias.
+    size: f64,
+    new_node: u32,
+    opts: CandidateOptions,
+}
+
+impl<'a> Ctx<'a> {
+    fn new(model: &'a Model, opts: &CandidateOptions) -> Self {
+        let mut beams_at: HashMap<u32, Vec<usize>> = HashMap::new();
+        for (i, b) in model.beams().iter().enumerate() {
+            for n in b.nodes {
+                beams_at.entry(n.0).or_default().push(i);
+            }
+        }
+        let runs = runs(model);
+        let mut run_of = vec![(0, 0); model.beams().len()];
+        for (r, run) in runs.iter().enumerate() {
+            for (p, &b) in run.iter().enumerate() {
+                run_of[b] = (r, p);
+            }
+        }
+        let (xs, ys): (Vec<f64>, Vec<f64>) = model.nodes().iter().map(|n| (n.x, n.y)).unzip();
+        let extent = |v: &[f64]| {
+            v.iter().copied().fold(f64::NEG_INFINITY, f64::max) - v.iter().copied().fold(f64::INFINITY, f64::min)
+        };
+        let size = extent(&xs).max(extent(&ys)).max(1e-3);
+        let two_pi = 2.0 * std::f64::consts::PI;
+        Ctx {
+            model,
+            beams_at,
+            runs,
+            run_of,
+            w_min: two_pi * opts.band_hz.0,
+            w_mid: two_pi * (opts.band_hz.0 * opts.band_hz.1).sqrt(),
+            w_max: two_pi * opts.band_hz.1,
+            total_mass: model.total_mass(),
+            size,
+            new_node: model.max_node_id() + 1,
+            opts: opts.clone(),
+        }
+    }
+
+    fn at(&self, node: u32) -> &[usize] {
+        self.beams_at.get(&node).map_or(&[], Vec::as_slice)
+    }
+
+    fn small(&self) -> bool {
+        self.model.beams().len() <= self.opts.per_element_limit
+    }
+
+    /// A loss factor of 1e-4 at mid band.
+    fn alpha_start(&self) -> f64 {
+        1e-4 / self.w_mid
+    }
+
+    fn alpha(&self, name: String) -> Fitted {
+        Fitted {
+            name,
+            role: Role::Alpha,
+            bounds: Some((1e-9 / self.w_max, 10.0 / self.w_min)),
+            plausible: (0.0, 1.0 / self.w_max, "a loss factor above 1 in the band"),
+        }
+    }
+
+    fn mu(&self, name: String) -> Fitted {
+        Fitted {
+            name,
+            role: Role::Mu,
+            bounds: Some((1e-3 * self.w_min, 1e3 * self.w_max)),
+            plausible: (0.0, f64::INFINITY, ""),
+        }
+    }
+
+    /// A damping group of an effect's own: viscous, or non-viscous with the
+    /// relaxation parameter at mid band.
+    fn damping_group(&self, name: &str, non_viscous: bool) -> Group {
+        let mut g = Group::new(name).rayleigh(self.alpha_start(), 0.0);
+        if non_viscous {
+            g.mu = Some(self.w_mid);
+        }
+        g
+    }
+
+    /// The nodes of the beams at `node`, and the node itself.
+    fn ring(&self, node: u32) -> Vec<u32> {
+        let mut v: Vec<u32> = self.at(node).iter().flat_map(|&i| self.model.beams()[i].nodes.map(|n| n.0)).collect();
+        v.push(node);
+        v.sort_unstable();
+        v.dedup();
+        v
+    }
+
+    /// Diagonal stiffness (for `E` and factors as modelled) of the beams at a
+    /// node, per global DOF: the scale a spring at that node competes with.
+    fn local_stiffness(&self, node: u32) -> [f64; 3] {
+        let m = self.model;
+        let mut k = [0.0; 3];
+        for &i in self.at(node) {
+            let b = &m.beams()[i];
+            let (l, c, s) = m.beam_geometry(i);
+            let sec = &m.sections()[b.section];
+            let e = m.materials()[b.material].e * b.stiffness_factor * m.groups()[b.group].stiffness;
+            let ke = fe_model::element::frame_stiffness(sec.area, sec.inertia, l, c, s) * e;
+            let o = if b.nodes[0] == NodeId(node) { 0 } else { 3 };
+            for d in 0..3 {
+                k[d] += ke[(o + d, o + d)];
+            }
+        }
+        k
+    }
+
+    /// The direction of beam `i` pointing away from `node`.
+    fn direction(&self, i: usize, node: u32) -> (f64, f64) {
+        let (_, c, s) = self.model.beam_geometry(i);
+        if self.model.beams()[i].nodes[0] == NodeId(node) { (c, s) } else { (-c, -s) }
+    }
+
+    /// The beams at `node` grouped by direction: collinear beams form one member.
+    fn members_at(&self, node: u32) -> Vec<Vec<usize>> {
+        let mut members: Vec<Vec<usize>> = Vec::new();
+        for &i in self.at(node) {
+            let (c, s) = self.direction(i, node);
+            match members.iter_mut().find(|m| {
+                let (c2, s2) = self.direction(m[0], node);
+                (c * c2 + s * s2).abs() > COLLINEAR
+            }) {
+                Some(m) => m.push(i),
+                None => members.push(vec![i]),
+            }
+        }
+        members
+    }
+
+    /// Whether `node` is an interior node of a straight member: exactly two
+    /// beams meet there, in line. Returns the beam to detach (the one of
+    /// larger id).
+    fn in_line(&self, node: u32) -> Option<usize> {
+        let at = self.at(node);
+        let [a, b] = at[..] else { return None };
+        let ((c1, s1), (c2, s2)) = (self.direction(a, node), self.direction(b, node));
+        // opposite directions away from the node
+        (c1 * c2 + s1 * s2 < -COLLINEAR)
+            .then(|| if self.model.beams()[a].id > self.model.beams()[b].id { a } else { b })
+    }
+}
+
+fn unique_name(model: &Model, base: &str) -> String {
+    let taken =
+        |n: &str| model.group_index(n).is_some() || model.spring_index(n).is_some() || model.mass_index(n).is_some();
+    if !taken(base) {
+        return base.to_string();
+    }
+    (2..).map(|i| format!("{base}_{i}")).find(|n| !taken(n)).expect("some suffix is free")
+}
+
+/// Runs of consecutive elements (by id) of the same group that share nodes.
+fn runs(model: &Model) -> Vec<Vec<usize>> {
+    let mut order: Vec<usize> = (0..model.beams().len()).collect();
+    order.sort_by_key(|&i| model.beams()[i].id);
+    let mut runs: Vec<Vec<usize>> = Vec::new();
+    for i in order {
+        let b = &model.beams()[i];
+        let continues = runs.last().and_then(|r| r.last()).is_some_and(|&j| {
+            let a = &model.beams()[j];
+            a.group == b.group && a.id.0 + 1 == b.id.0 && a.nodes.iter().any(|n| b.nodes.contains(n))
+        });
+        if continues {
+            runs.last_mut().expect("checked").push(i);
+        } else {
+            runs.push(vec![i]);
+        }
+    }
+    runs
+}
+
+/// `run` cut into chunks of at most `size`, of nearly equal length.
+fn tiles(run: &[usize], size: usize) -> Vec<Vec<usize>> {
+    let n_chunks = run.len().div_ceil(size.max(1));
+    let per = run.len().div_ceil(n_chunks.max(1)).max(1);
+    run.chunks(per).map(<[usize]>::to_vec).collect()
+}
+
+/// Elements per coarse stiffness and mass window on a model with more than
+/// [`CandidateOptions::per_element_limit`] elements: about half that many
+/// windows, each no longer than [`MAX_WINDOW`].
+fn coarse_change_size(elements: usize, opts: &CandidateOptions) -> usize {
+    elements.div_ceil((opts.per_element_limit / 2).max(1)).min(MAX_WINDOW).max(opts.region_size)
+}
+
+fn ids(model: &Model, idx: &[usize]) -> Vec<u32> {
+    idx.iter().map(|&i| model.beams()[i].id.0).collect()
+}
+
+fn range_name(ids: &[u32]) -> String {
+    match ids {
+        [one] => format!("element {one}"),
+        _ => format!("elements {}..{}", ids[0], ids[ids.len() - 1]),
+    }
+}
+
+fn nodes_of(model: &Model, idx: &[usize]) -> Vec<u32> {
+    let mut n: Vec<u32> = idx.iter().flat_map(|&i| model.beams()[i].nodes.map(|n| n.0)).collect();
+    n.sort_unstable();
+    n.dedup();
+    n
+}
+
+/// The four changes of a window of consecutive elements (beam indices):
+/// stiffness, mass, viscous and non-viscous damping.
+fn window(ctx: &Ctx<'_>, w: &[usize]) -> Vec<Spec> {
+    let model = ctx.model;
+    let ids = ids(model, w);
+    if ids.windows(2).any(|p| p[1] != p[0] + 1) {
+        return Vec::new();
+    }
+    let (first, last) = (ids[0], ids[ids.len() - 1]);
+    let field = |f: &str| {
+        if first == last { format!("element.{first}.{f}") } else { format!("element.{first}..{last}.{f}") }
+    };
+    let nodes = nodes_of(model, w);
+    let head = |kind: EffectKind| Head {
+        kind,
+        description: format!("{} of {}", kind.label(), range_name(&ids)),
+        nodes: nodes.clone(),
+        elements: ids.clone(),
+        dofs: Vec::new(),
+        part_nodes: nodes.clone(),
+    };
+    let mut out: Vec<Spec> = vec![
+        (
+            head(EffectKind::StiffnessChange),
+            Edit::Set,
+            vec![Fitted {
+                name: field("stiffness"),
+                role: Role::StiffnessFactor,
+                bounds: Some((1e-3, 100.0)),
+                plausible: (0.05, 1.5, "a change beyond -95 % .. +50 % of the nominal stiffness"),
+            }],
+        ),
+        (
+            head(EffectKind::MassChange),
+            Edit::Set,
+            vec![Fitted {
+                name: field("mass"),
+                role: Role::MassFactor,
+                bounds: Some((1e-3, 100.0)),
+                plausible: (0.5, 2.0, "a change beyond -50 % .. +100 % of the nominal mass"),
+            }],
+        ),
+    ];
+    let base = &model.groups()[model.beams()[w[0]].group];
+    for non_viscous in [false, true] {
+        let name = unique_name(model, &format!("damping_{first}_{last}"));
+        let mut g = ctx.damping_group(&name, non_viscous);
+        if base.alpha > 0.0 {
+            g.alpha = base.alpha;
+        }
+        g.beta = base.beta;
+        g.stiffness = base.stiffness;
+        g.mass = base.mass;
+        let kind = if non_viscous { EffectKind::NonViscousDamping } else { EffectKind::ViscousDamping };
+        let mut fitted = vec![ctx.alpha(format!("group.{name}.alpha"))];
+        if non_viscous {
+            fitted.push(ctx.mu(format!("group.{name}.mu")));
+        }
+        let mut h = head(kind);
+        h.description = format!("{} in {}", kind.label(), range_name(&ids));
+        out.push((h, Edit::Region { first, last, group: g }, fitted));
+    }
+    out
+}
+
+/// Every window of every size at every offset within `range` of a run.
+fn all_windows(ctx: &Ctx<'_>, run: &[usize], range: std::ops::Range<usize>) -> Vec<Spec> {
+    let mut out = Vec::new();
+    for size in WINDOW_SIZES {
+        if size > range.len() {
+            break;
+        }
+        for start in range.start..=range.end - size {
+            out.extend(window(ctx, &run[start..start + size]));
+        }
+    }
+    out
+}
+
+/// The flexible, lossy support candidates of a supported node: every fixed
+/// DOF released onto a ground spring, viscous and non-viscous.
+fn supports(ctx: &Ctx<'_>, node: u32) -> Vec<Spec> {
+    let model = ctx.model;
+    let mut fixed: Vec<Dof> =
+        model.supports().iter().filter(|s| s.node.0 == node).flat_map(|s| s.dofs.iter().copied()).collect();
+    fixed.sort();
+    fixed.dedup();
+    let kref = ctx.local_stiffness(node);
+    if fixed.is_empty() || fixed.iter().any(|d| kref[d.index()] <= 0.0) {
+        return Vec::new();
+    }
+    let mut out = Vec::new();
+    for non_viscous in [false, true] {
+        let name = unique_name(model, &format!("support_{node}"));
+        let mut k = [0.0; 3];
+        for d in &fixed {
+            k[d.index()] = 100.0 * kref[d.index()];
+        }
+        let mut fitted: Vec<Fitted> = fixed
+            .iter()
+            .map(|&d| {
+                let r = kref[d.index()];
+                Fitted {
+                    name: format!("spring.{name}.{}", ["kx", "ky", "kr"][d.index()]),
+                    role: Role::Spring(d),
+                    bounds: Some((1e-6 * r, 1e4 * r)),
+                    plausible: (0.0, 10.0 * r, "stiffer than the member it holds"),
+                }
+            })
+            .collect();
+        fitted.push(ctx.alpha(format!("group.{name}.alpha")));
+        if non_viscous {
+            fitted.push(ctx.mu(format!("group.{name}.mu")));
+        }
+        let edit = Edit::Support {
+            node,
+            fixed: fixed.clone(),
+            released: fixed.clone(),
+            name: name.clone(),
+            group: ctx.damping_group(&name, non_viscous),
+            k,
+        };
+        let head = Head {
+            kind: EffectKind::FlexibleSupport,
+            description: edit.describe(EffectKind::FlexibleSupport),
+            nodes: vec![node],
+            elements: Vec::new(),
+            dofs: fixed.clone(),
+            // the released DOFs enter every element at the node
+            part_nodes: ctx.ring(node),
+        };
+        out.push((head, edit, fitted));
+    }
+    out
+}
+
+/// A flexible, lossy joint detaching `beams` from `node`: a rotational
+/// spring (and translational springs when `translational`), viscous or not.
+fn joint(ctx: &Ctx<'_>, node: u32, beams: &[usize], in_line: bool, translational: bool, non_viscous: bool) -> Spec {
+    let model = ctx.model;
+    let elements = ids(model, beams);
+    let name = unique_name(model, &format!("joint_{node}_{}", elements[0]));
+    let kref = ctx.local_stiffness(node);
+    let sprung: Vec<Dof> = if translational { Dof::ALL.to_vec() } else { vec![Dof::Rz] };
+    let mut k = [0.0; 3];
+    let mut fitted = Vec::new();
+    for &d in &sprung {
+        let r = kref[d.index()].max(f64::MIN_POSITIVE);
+        k[d.index()] = 100.0 * r;
+        fitted.push(Fitted {
+            name: format!("spring.{name}.{}", ["kx", "ky", "kr"][d.index()]),
+            role: Role::Spring(d),
+            bounds: Some((1e-6 * r, 1e4 * r)),
+            plausible: (0.0, 10.0 * r, "stiffer than the members it joins"),
+        });
+    }
+    fitted.push(ctx.alpha(format!("group.{name}.alpha")));
+    if non_viscous {
+        fitted.push(ctx.mu(format!("group.{name}.mu")));
+    }
+    let edit = Edit::Joint {
+        node,
+        elements: elements.clone(),
+        new_node: ctx.new_node,
+        in_line,
+        name: name.clone(),
+        group: ctx.damping_group(&name, non_viscous),
+        k,
+        sprung: sprung.clone(),
+    };
+    let head = Head {
+        kind: EffectKind::FlexibleJoint,
+        description: edit.describe(EffectKind::FlexibleJoint),
+        nodes: vec![node],
+        elements,
+        dofs: sprung,
+        // every element at the node: splitting it checks that one stays
+        part_nodes: ctx.ring(node),
+    };
+    (head, edit, fitted)
+}
+
+/// A lumped mass at a node, with a rotary inertia when `inertia`.
+fn mass(ctx: &Ctx<'_>, node: u32, inertia: bool) -> Spec {
+    let model = ctx.model;
+    let name = unique_name(model, &format!("mass_{node}"));
+    let group = unique_name(model, "added_masses");
+    let m0 = 1e-3 * ctx.total_mass;
+    // a radius of gyration of a hundredth of the structure to start
+    let j0 = if inertia { m0 * (0.01 * ctx.size).powi(2) } else { 0.0 };
+    let mut fitted = vec![Fitted {
+        name: format!("mass.{name}.m"),
+        role: Role::Mass,
+        bounds: Some((1e-7 * ctx.total_mass, 10.0 * ctx.total_mass)),
+        plausible: (0.0, 0.25 * ctx.total_mass, "more than a quarter of the structure's mass"),
+    }];
+    let mut dofs = vec![Dof::Ux, Dof::Uy];
+    if inertia {
+        let j_scale = ctx.total_mass * ctx.size * ctx.size;
+        fitted.push(Fitted {
+            name: format!("mass.{name}.j"),
+            role: Role::Inertia,
+            bounds: Some((1e-12 * j_scale, 10.0 * j_scale)),
+            plausible: (
+                0.0,
+                0.25 * ctx.total_mass * (0.1 * ctx.size).powi(2),
+                "a quarter of the structure's mass at a tenth of its size",
+            ),
+        });
+        dofs.push(Dof::Rz);
+    }
+    let edit = Edit::Mass { node, name, group, m: m0, j: j0 };
+    let head = Head {
+        kind: EffectKind::LumpedMass,
+        description: edit.describe(EffectKind::LumpedMass),
+        nodes: vec![node],
+        elements: Vec::new(),
+        dofs,
+        part_nodes: vec![node],
+    };
+    (head, edit, fitted)
+}
+
+/// The existing joint springs, with their stiffness and damping as modelled.
+fn existing_joints(ctx: &Ctx<'_>) -> Vec<Spec> {
+    let model = ctx.model;
+    let mut out = Vec::new();
+    for sp in model.springs() {
+        let Some(b) = sp.b else { continue };
+        let kref = ctx.local_stiffness(sp.a.0);
+        let mut fitted: Vec<Fitted> = Dof::ALL
+            .iter()
+            .filter(|d| sp.k[d.index()] > 0.0)
+            .map(|&d| {
+                let r = kref[d.index()].max(sp.k[d.index()]);
+                Fitted {
+                    name: format!("spring.{}.{}", sp.name, ["kx", "ky", "kr"][d.index()]),
+                    role: Role::Spring(d),
+                    bounds: Some((1e-6 * r, 1e4 * r)),
+                    plausible: (0.0, 10.0 * r, "stiffer than the members it joins"),
+                }
+            })
+            .collect();
+        let g = &model.groups()[sp.group];
+        let group_only_this = model.springs().iter().filter(|o| o.group == sp.group).count() == 1
+            && model.beams().iter().all(|o| o.group != sp.group)
+            && model.masses().iter().all(|o| o.group != sp.group);
+        if group_only_this && g.alpha > 0.0 {
+            fitted.push(ctx.alpha(format!("group.{}.alpha", g.name)));
+            if g.mu.is_some() {
+                fitted.push(ctx.mu(format!("group.{}.mu", g.name)));
+            }
+        }
+        let head = Head {
+            kind: EffectKind::FlexibleJoint,
+            description: format!("joint `{}` between nodes {} and {} (as modelled)", sp.name, sp.a, b),
+            nodes: vec![sp.a.0, b.0],
+            elements: Vec::new(),
+            dofs: Dof::ALL.iter().copied().filter(|d| sp.k[d.index()] > 0.0).collect(),
+            part_nodes: vec![sp.a.0, b.0],
+        };
+        out.push((head, Edit::Set, fitted));
+    }
+    out
+}
+
+/// Nodes where a lumped mass is a candidate: free in some translation, on a beam.
+fn mass_nodes(ctx: &Ctx<'_>) -> Vec<u32> {
+    let model = ctx.model;
+    let mut fixed: HashMap<u32, usize> = HashMap::new();
+    for s in model.supports() {
+        *fixed.entry(s.node.0).or_default() += s.dofs.iter().filter(|d| d.is_translation()).count();
+    }
+    model
+        .nodes()
+        .iter()
+        .map(|n| n.id.0)
+        .filter(|n| fixed.get(n).copied().unwrap_or(0) < 2 && !ctx.at(*n).is_empty())
+        .collect()
+}
+
+/// Makes the candidates of `specs`, in parallel and in order: each takes its
+/// part of the model.
+fn build(model: &Model, specs: Vec<Spec>) -> Vec<Candidate> {
+    specs.into_par_iter().filter_map(|(head, edit, fitted)| Candidate::new(model, head, edit, fitted)).collect()
+}
+
+/// Generates the first pass of candidates for a model; see the module docs.
+pub fn generate(model: &Model, opts: &CandidateOptions) -> Vec<Candidate> {
+    let ctx = Ctx::new(model, opts);
+    let mut specs: Vec<Spec> = Vec::new();
+
+    let mut supported: Vec<u32> = model.supports().iter().map(|s| s.node.0).collect();
+    supported.sort_unstable();
+    supported.dedup();
+    for node in supported {
+        specs.extend(supports(&ctx, node));
+    }
+
+    // joints where members meet at an angle: each member but the first (the
+    // through-member keeps the node) detached
+    for node in model.nodes() {
+        let members = ctx.members_at(node.id.0);
+        if members.len() < 2 {
+            continue;
+        }
+        for member in members.iter().skip(1) {
+            for non_viscous in [false, true] {
+                specs.push(joint(&ctx, node.id.0, member, false, false, non_viscous));
+            }
+        }
+    }
+    // in-line joints at every interior node of a member (small models; on
+    // large ones around the leaders)
+    if ctx.small() {
+        for node in model.nodes() {
+            if let Some(b) = ctx.in_line(node.id.0) {
+                for non_viscous in [false, true] {
+                    specs.push(joint(&ctx, node.id.0, &[b], true, false, non_viscous));
+                }
+            }
+        }
+    }
+    specs.extend(existing_joints(&ctx));
+
+    for node in mass_nodes(&ctx) {
+        specs.push(mass(&ctx, node, false));
+    }
+
+    // windows: every size at every offset on small models; coarse tiles on large ones
+    for run in &ctx.runs {
+        if ctx.small() {
+            specs.extend(all_windows(&ctx, run, 0..run.len()));
+        } else {
+            let change = coarse_change_size(model.beams().len(), opts);
+            for t in tiles(run, change) {
+                specs.extend(window(&ctx, &t).into_iter().take(2));
+            }
+            for t in tiles(run, opts.region_size) {
+                specs.extend(window(&ctx, &t).into_iter().skip(2));
+            }
+        }
+    }
+    build(model, specs)
+}
+
+/// Candidates around the given leaders that the first pass did not try
+/// (`tried`: descriptions of the candidates already made): the fuller
+/// variants of a joint (translational springs) or a mass (rotary inertia),
+/// and on large models every window and in-line joint within
+/// [`REFINE_REACH`] elements.
+pub(crate) fn refine(
+    model: &Model,
+    opts: &CandidateOptions,
+    leaders: &[&Candidate],
+    tried: &HashSet<String>,
+) -> Vec<Candidate> {
+    let ctx = Ctx::new(model, opts);
+    let mut specs: Vec<Spec> = Vec::new();
+    for c in leaders {
+        match &c.edit {
+            Edit::Joint { node, elements, in_line, group, sprung, .. } if sprung.len() < 3 => {
+                let beams: Vec<usize> =
+                    elements.iter().filter_map(|&e| model.beam_index(fe_model::ElementId(e))).collect();
+                specs.push(joint(&ctx, *node, &beams, *in_line, true, group.mu.is_some()));
+            }
+            Edit::Mass { node, j, .. } if *j == 0.0 => specs.push(mass(&ctx, *node, true)),
+            _ => {}
+        }
+        if ctx.small() {
+            continue;
+        }
+        // the beams where the leader acts, then their runs within reach
+        let mut focus: Vec<usize> =
+            c.elements.iter().filter_map(|&e| model.beam_index(fe_model::ElementId(e))).collect();
+        for &n in &c.nodes {
+            focus.extend(ctx.at(n).iter().copied());
+        }
+        let mut ranges: HashMap<usize, (usize, usize)> = HashMap::new();
+        for b in focus {
+            let (r, p) = ctx.run_of[b];
+            let len = ctx.runs[r].len();
+            let (lo, hi) = (p.saturating_sub(REFINE_REACH), (p + REFINE_REACH + 1).min(len));
+            let e = ranges.entry(r).or_insert((lo, hi));
+            *e = (e.0.min(lo), e.1.max(hi));
+        }
+        for (r, (lo, hi)) in ranges {
+            let run = &ctx.runs[r];
+            specs.extend(all_windows(&ctx, run, lo..hi));
+            for &b in &run[lo..hi] {
+                for n in model.beams()[b].nodes {
+                    if let Some(d) = ctx.in_line(n.0) {
+                        for non_viscous in [false, true] {
+                            specs.push(joint(&ctx, n.0, &[d], true, false, non_viscous));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let mut seen = tried.clone();
+    specs.retain(|(h, ..)| seen.insert(h.description.clone()));
+    build(model, specs)
+}

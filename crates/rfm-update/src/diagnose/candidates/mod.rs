@@ -1,0 +1,344 @@
+//! Candidate effects, generated from the model without the user listing them.
+//!
+//! | kind | where | parameters |
+//! |---|---|---|
+//! | flexible, lossy support | each supported node | a ground spring per fixed DOF; its own damping group: alpha (viscous) or alpha and mu (non-viscous) |
+//! | flexible, lossy joint | where members meet at an angle, at interior nodes of members (in line: a splice, a lap joint), and existing joint springs | rotational spring (and translational springs, refined), its own damping group as for supports |
+//! | lumped mass | each node | mass (and rotary inertia, refined) |
+//! | stiffness change | windows of 1, 2, 3, 4, 6 or 8 elements at every offset along a member (on large models coarse windows, refined around the leaders) | stiffness factor |
+//! | mass change | the same windows | mass factor |
+//! | viscous damping | the same windows | alpha of the window |
+//! | non-viscous damping | the same windows | alpha and mu of the window |
+//!
+//! Each candidate is a change of the nominal model, the effect inserted at a
+//! starting value that changes little (a very stiff spring, a tiny mass, a
+//! factor of one), the parameters to fit, wide search bounds, and a
+//! plausible range: a sensor mass of a quarter of the structure's mass, or a
+//! joint stiffer than the member it connects, explains data only in a way
+//! no engineer would accept, and the ranking says so.
+//!
+//! What the data cannot determine is held rather than fitted to a bound
+//! ([`Candidate::holding`]): a support or joint spring the measured
+//! directions do not see (the axial spring of a clamp measured in bending)
+//! is made rigid again, and the candidate is fitted without it.
+//!
+//! A candidate does not carry a copy of the whole model: a large model has
+//! thousands of candidates. It carries the recipe of its change ([`Edit`]),
+//! applied to the whole model on demand ([`Candidate::model`]), and the part
+//! of the model where it acts with the change applied ([`Model::part`]),
+//! which is all the diagnosis needs to fit it (module `local`).
+
+mod edit;
+mod generate;
+
+use fe_model::{Dof, ElementId, Model, ModelError, NodeId, Parameter};
+use serde::Serialize;
+
+pub(crate) use edit::Edit;
+pub use generate::generate;
+pub(crate) use generate::refine;
+
+/// The kind of a candidate effect.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EffectKind {
+    /// A support that is flexible (and lossy) instead of rigid.
+    FlexibleSupport,
+    /// A flexible (and lossy) joint where members meet, or in line within a member.
+    FlexibleJoint,
+    /// An unmodelled lumped mass (a sensor, added mass).
+    LumpedMass,
+    /// A local stiffness change (loss or gain).
+    StiffnessChange,
+    /// A local mass change.
+    MassChange,
+    /// Local viscous damping.
+    ViscousDamping,
+    /// Local non-viscous (exponential kernel) damping.
+    NonViscousDamping,
+}
+
+impl EffectKind {
+    /// Plain-language name.
+    pub fn label(self) -> &'static str {
+        match self {
+            EffectKind::FlexibleSupport => "flexible, lossy support",
+            EffectKind::FlexibleJoint => "flexible, lossy joint",
+            EffectKind::LumpedMass => "lumped mass",
+            EffectKind::StiffnessChange => "stiffness change",
+            EffectKind::MassChange => "mass change",
+            EffectKind::ViscousDamping => "viscous damping",
+            EffectKind::NonViscousDamping => "non-viscous damping",
+        }
+    }
+}
+
+/// What a fitted parameter of a candidate is, physically.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Role {
+    /// A spring stiffness of a support or joint, in one DOF.
+    Spring(#[serde(serialize_with = "crate::serialize_display")] Dof),
+    /// The stiffness-proportional damping coefficient of the effect's group.
+    Alpha,
+    /// The relaxation parameter of the effect's group.
+    Mu,
+    /// A lumped mass.
+    Mass,
+    /// A lumped rotary inertia.
+    Inertia,
+    /// A stiffness factor.
+    StiffnessFactor,
+    /// A mass factor.
+    MassFactor,
+}
+
+impl Role {
+    /// Stiffness and mass values (as opposed to damping).
+    pub fn is_stiffness_or_mass(self) -> bool {
+        !matches!(self, Role::Alpha | Role::Mu)
+    }
+}
+
+/// A candidate effect; see the module docs.
+#[derive(Clone, Debug)]
+pub struct Candidate {
+    /// Kind.
+    pub kind: EffectKind,
+    /// Plain-language description with its location.
+    pub description: String,
+    /// Nodes where it acts.
+    pub nodes: Vec<u32>,
+    /// Elements where it acts.
+    pub elements: Vec<u32>,
+    /// DOFs it acts on, where that applies.
+    pub dofs: Vec<Dof>,
+    /// Names of the parameters to fit (resolved in [`Candidate::model`]).
+    pub parameters: Vec<String>,
+    /// What each parameter is.
+    pub roles: Vec<Role>,
+    /// Search bounds per parameter.
+    pub bounds: Vec<Option<(f64, f64)>>,
+    /// Plausible range per parameter, with the reason shown when outside.
+    pub plausible: Vec<(f64, f64, &'static str)>,
+    /// Parameters of a fuller variant that the data did not determine and
+    /// that this candidate holds at their rigid or nominal value (names).
+    pub held: Vec<String>,
+    pub(crate) edit: Edit,
+    /// The nominal nodes of every element, spring and mass the change touches.
+    part_nodes: Vec<u32>,
+    /// The part of the nominal model the change touches, before and after it.
+    nominal_part: Model,
+    part: Model,
+}
+
+/// Options of candidate generation.
+#[derive(Clone, Debug)]
+pub struct CandidateOptions {
+    /// Elements of the coarse damping windows on models above `per_element_limit`.
+    pub region_size: usize,
+    /// Up to this many elements, windows of every size and offset are
+    /// candidates from the start (and in-line joints at every interior node);
+    /// above, coarse windows are tried first and refined around the leaders.
+    pub per_element_limit: usize,
+    /// Band of the data (Hz), to scale damping starting values.
+    pub band_hz: (f64, f64),
+}
+
+impl Default for CandidateOptions {
+    fn default() -> Self {
+        CandidateOptions { region_size: 4, per_element_limit: 40, band_hz: (1.0, 1000.0) }
+    }
+}
+
+/// What a candidate is, apart from its change and parameters.
+pub(crate) struct Head {
+    pub(crate) kind: EffectKind,
+    pub(crate) description: String,
+    pub(crate) nodes: Vec<u32>,
+    pub(crate) elements: Vec<u32>,
+    pub(crate) dofs: Vec<Dof>,
+    /// Nominal nodes of every element, spring and mass the change touches.
+    pub(crate) part_nodes: Vec<u32>,
+}
+
+/// A parameter to fit: name, role, search bounds, plausible range.
+pub(crate) struct Fitted {
+    pub(crate) name: String,
+    pub(crate) role: Role,
+    pub(crate) bounds: Option<(f64, f64)>,
+    pub(crate) plausible: (f64, f64, &'static str),
+}
+
+impl Candidate {
+    /// Builds a candidate: the part of `model` it touches, with the change
+    /// applied. `None` when the change does not apply (it then would not
+    /// apply to the whole model either).
+    pub(crate) fn new(model: &Model, head: Head, edit: Edit, fitted: Vec<Fitted>) -> Option<Candidate> {
+        let part_nodes: Vec<NodeId> = head.part_nodes.iter().map(|&n| NodeId(n)).collect();
+        let nominal_part = model.part(&part_nodes);
+        let mut part = nominal_part.clone();
+        edit.apply(&mut part).ok()?;
+        if fitted.is_empty() || fitted.iter().any(|f| part.parameter(&f.name).is_err()) {
+            return None;
+        }
+        Some(Candidate {
+            kind: head.kind,
+            description: head.description,
+            nodes: head.nodes,
+            elements: head.elements,
+            dofs: head.dofs,
+            parameters: fitted.iter().map(|f| f.name.clone()).collect(),
+            roles: fitted.iter().map(|f| f.role).collect(),
+            bounds: fitted.iter().map(|f| f.bounds).collect(),
+            plausible: fitted.iter().map(|f| f.plausible).collect(),
+            held: Vec::new(),
+            edit,
+            part_nodes: head.part_nodes,
+            nominal_part,
+            part,
+        })
+    }
+
+    /// The whole nominal model with this effect inserted at its starting values.
+    pub fn model(&self, nominal: &Model) -> Result<Model, ModelError> {
+        let mut m = nominal.clone();
+        self.edit.apply(&mut m)?;
+        Ok(m)
+    }
+
+    /// The parameters to fit, resolved in `model` ([`Self::model`] or a part of it).
+    pub fn parameters_in(&self, model: &Model) -> Result<Vec<Parameter>, ModelError> {
+        self.parameters.iter().map(|n| model.parameter(n)).collect()
+    }
+
+    /// The part of the nominal model that the effect touches, with the
+    /// effect inserted (see [`Model::part`]).
+    pub(crate) fn part(&self) -> &Model {
+        &self.part
+    }
+
+    /// The part of the nominal model on the same nodes as [`Self::part`].
+    pub(crate) fn nominal_part(&self) -> &Model {
+        &self.nominal_part
+    }
+
+    /// The damping form of the effect's own group, for joints, supports and
+    /// damping windows: `viscous` or `non-viscous`.
+    pub fn damping(&self) -> Option<&'static str> {
+        match &self.edit {
+            Edit::Support { group, .. } | Edit::Joint { group, .. } | Edit::Region { group, .. } => {
+                Some(if group.mu.is_some() { "non-viscous" } else { "viscous" })
+            }
+            _ => None,
+        }
+    }
+
+    /// The candidate without the parameters at `held` (indices), held at
+    /// their rigid or nominal value: a support spring becomes the rigid
+    /// support again in its DOF, a joint's translational spring a tie, a
+    /// rotary inertia zero. `None` when none of them can be held (a
+    /// damping parameter, a joint's rotational spring) or nothing would be
+    /// left to fit; the caller then reports them as not determined.
+    pub(crate) fn holding(&self, model: &Model, held: &[usize]) -> Option<Candidate> {
+        let mut edit = self.edit.clone();
+        let mut dropped = Vec::new();
+        for &i in held {
+            let ok = match (&mut edit, self.roles[i]) {
+                (Edit::Support { released, k, .. }, Role::Spring(d)) => {
+                    released.retain(|&x| x != d);
+                    k[d.index()] = 0.0;
+                    true
+                }
+                (Edit::Joint { sprung, k, .. }, Role::Spring(d)) if d.is_translation() => {
+                    sprung.retain(|&x| x != d);
+                    k[d.index()] = 0.0;
+                    true
+                }
+                (Edit::Mass { j, .. }, Role::Inertia) => {
+                    *j = 0.0;
+                    true
+                }
+                _ => false,
+            };
+            if ok {
+                dropped.push(i);
+            }
+        }
+        if dropped.is_empty() || dropped.len() == self.parameters.len() {
+            return None;
+        }
+        if let Edit::Support { released, .. } = &edit
+            && released.is_empty()
+        {
+            return None;
+        }
+        let fitted: Vec<Fitted> = (0..self.parameters.len())
+            .filter(|i| !dropped.contains(i))
+            .map(|i| Fitted {
+                name: self.parameters[i].clone(),
+                role: self.roles[i],
+                bounds: self.bounds[i],
+                plausible: self.plausible[i],
+            })
+            .collect();
+        let head = Head {
+            kind: self.kind,
+            description: edit.describe(self.kind),
+            nodes: self.nodes.clone(),
+            elements: self.elements.clone(),
+            dofs: self.dofs.iter().copied().filter(|&d| edit.acts_on(d)).collect(),
+            part_nodes: self.part_nodes.clone(),
+        };
+        let mut c = Candidate::new(model, head, edit, fitted)?;
+        c.held = self.held.iter().cloned().chain(dropped.iter().map(|&i| self.parameters[i].clone())).collect();
+        Some(c)
+    }
+
+    /// The first plausibility problem of the given values, if any, judged
+    /// only on the parameters that `determined` marks (a value the data do
+    /// not determine says nothing about the structure).
+    pub fn implausible(&self, values: &[f64], determined: &[bool]) -> Option<String> {
+        (0..self.parameters.len()).filter(|&i| determined[i]).find_map(|i| {
+            let (lo, hi, why) = self.plausible[i];
+            let v = values[i];
+            (v < lo || v > hi).then(|| format!("{} = {v:.4e} is not plausible: {why}", self.parameters[i]))
+        })
+    }
+
+    /// True when this candidate acts at or next to the given nodes or
+    /// elements (one element or node of slack).
+    pub fn near(&self, model: &Model, nodes: &[u32], elements: &[u32]) -> bool {
+        let neighbour_nodes: Vec<u32> = nodes
+            .iter()
+            .flat_map(|&n| {
+                let mut v = vec![n];
+                for i in model.beams_at(NodeId(n)) {
+                    v.extend(model.beams()[i].nodes.map(|x| x.0));
+                }
+                v
+            })
+            .collect();
+        let neighbour_elements: Vec<u32> = elements
+            .iter()
+            .flat_map(|&e| {
+                let mut v = vec![e];
+                if let Some(i) = model.beam_index(ElementId(e)) {
+                    for n in model.beams()[i].nodes {
+                        v.extend(model.beams_at(n).into_iter().map(|j| model.beams()[j].id.0));
+                    }
+                }
+                v
+            })
+            .collect();
+        self.nodes.iter().any(|n| neighbour_nodes.contains(n))
+            || self.elements.iter().any(|e| neighbour_elements.contains(e))
+            || self
+                .nodes
+                .iter()
+                .any(|&n| model.beams_at(NodeId(n)).into_iter().any(|i| elements.contains(&model.beams()[i].id.0)))
+    }
+}
+
+#[cfg(test)]
+mod tests;

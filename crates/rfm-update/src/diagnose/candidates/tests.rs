@@ -1,0 +1,113 @@
+use super::*;
+use fe_model::{Assembly, Group, samples};
+
+/// Two members meeting at a right angle at node 3, clamped at node 1.
+fn l_frame() -> Model {
+    let mut m = Model::new("L-frame");
+    let g = m.add_group(Group::new("frame").rayleigh(1e-5, 0.5)).unwrap();
+    let steel = m.add_material("steel", 2.1e11, 7850.0).unwrap();
+    let sec = m.add_section(fe_model::Section::rectangle("bar", 0.02, 0.02)).unwrap();
+    for (id, x, y) in [(1, 0.0, 0.0), (2, 0.0, 0.3), (3, 0.0, 0.6), (4, 0.25, 0.6), (5, 0.5, 0.6)] {
+        m.add_node(id, x, y).unwrap();
+    }
+    for (id, a, b) in [(1, 1, 2), (2, 2, 3), (3, 3, 4), (4, 4, 5)] {
+        m.add_beam(id, [a, b], steel, sec, g).unwrap();
+    }
+    m.add_support(1, &Dof::ALL).unwrap();
+    m
+}
+
+/// Every candidate's change applies to the whole model, which still
+/// assembles (a candidate carries no whole model that could be checked
+/// beforehand), and its parameters start at the same values there as in
+/// its part; so do the variants that hold a spring rigid.
+#[test]
+fn every_candidate_applies_to_the_whole_model() {
+    for model in [samples::frame_grid(2, 2, 3), samples::frame_with_joint(), samples::cantilever(6), l_frame()] {
+        let all = generate(&model, &CandidateOptions { per_element_limit: 40, ..CandidateOptions::default() });
+        assert!(all.iter().any(|c| c.kind == EffectKind::FlexibleSupport));
+        // a change that fails on its part drops its candidate: none may
+        let new_joints = all.iter().filter(|c| matches!(c.edit, Edit::Joint { in_line: false, .. })).count();
+        let corners = model
+            .nodes()
+            .iter()
+            .filter(|n| {
+                let at = model.beams_at(n.id);
+                at.len() == 2 && {
+                    let (_, c0, s0) = model.beam_geometry(at[0]);
+                    let (_, c1, s1) = model.beam_geometry(at[1]);
+                    (c0 * c1 + s0 * s1).abs() < 0.5
+                }
+            })
+            .count();
+        assert!(new_joints >= corners, "{new_joints} new joints for {corners} corners in {}", model.title);
+        let mut held = 0;
+        for c in &all {
+            check(&model, c);
+            // hold every spring that can be held
+            let springs: Vec<usize> =
+                (0..c.roles.len()).filter(|&i| matches!(c.roles[i], Role::Spring(d) if d.is_translation())).collect();
+            if let Some(h) = c.holding(&model, &springs) {
+                held += 1;
+                assert!(h.parameters.len() < c.parameters.len() && !h.held.is_empty(), "{}", h.description);
+                check(&model, &h);
+            }
+        }
+        assert!(held > 0, "no candidate of {} held a spring", model.title);
+    }
+}
+
+fn check(model: &Model, c: &Candidate) {
+    let whole = c.model(model).unwrap();
+    assert!(Assembly::new(&whole).is_ok(), "{} breaks the model", c.description);
+    let (pw, pp) = (c.parameters_in(&whole).unwrap(), c.parameters_in(c.part()).unwrap());
+    for (w, p) in pw.iter().zip(&pp) {
+        assert_eq!(whole.get(w.quantities[0]), c.part().get(p.quantities[0]), "{}", w.name);
+    }
+}
+
+/// On a straight member every interior node gets an in-line joint, every
+/// window size fits at every offset, and each window carries the four
+/// changes.
+#[test]
+fn small_models_get_in_line_joints_and_windows_at_every_offset() {
+    let model = samples::cantilever(10);
+    let all = generate(&model, &CandidateOptions::default());
+    let in_line: Vec<u32> = all
+        .iter()
+        .filter(|c| matches!(c.edit, Edit::Joint { in_line: true, .. }) && c.damping() == Some("viscous"))
+        .map(|c| c.nodes[0])
+        .collect();
+    let interior = model.nodes().iter().filter(|n| model.beams_at(n.id).len() == 2).count();
+    assert_eq!(in_line.len(), interior, "{in_line:?}");
+    for size in [1usize, 2, 3, 4, 6, 8] {
+        let n = all.iter().filter(|c| c.kind == EffectKind::StiffnessChange && c.elements.len() == size).count();
+        assert_eq!(n, 10 - size + 1, "stiffness windows of {size}");
+        for kind in [EffectKind::MassChange, EffectKind::ViscousDamping, EffectKind::NonViscousDamping] {
+            assert_eq!(all.iter().filter(|c| c.kind == kind && c.elements.len() == size).count(), n, "{kind:?}");
+        }
+    }
+    // descriptions name a candidate uniquely
+    let mut seen = std::collections::HashSet::new();
+    for c in &all {
+        assert!(seen.insert(c.description.clone()), "{} twice", c.description);
+    }
+}
+
+/// Large models get coarse windows, and the refinement around a leader
+/// adds every window and in-line joint near it, and the fuller variants.
+#[test]
+fn large_models_refine_windows_and_variants_around_the_leaders() {
+    let model = samples::cantilever(30);
+    let opts = CandidateOptions { per_element_limit: 10, ..CandidateOptions::default() };
+    let first = generate(&model, &opts);
+    assert!(!first.iter().any(|c| matches!(c.edit, Edit::Joint { in_line: true, .. })));
+    let tried: std::collections::HashSet<String> = first.iter().map(|c| c.description.clone()).collect();
+    let leader = first.iter().find(|c| c.kind == EffectKind::StiffnessChange && c.elements.contains(&15)).unwrap();
+    let mass = first.iter().find(|c| c.kind == EffectKind::LumpedMass && c.nodes == [20]).unwrap();
+    let refined = refine(&model, &opts, &[leader, mass], &tried);
+    assert!(refined.iter().any(|c| c.kind == EffectKind::StiffnessChange && c.elements == [15]));
+    assert!(refined.iter().any(|c| matches!(c.edit, Edit::Joint { in_line: true, node: 16, .. })));
+    assert!(refined.iter().any(|c| c.description == "lumped mass with rotary inertia at node 20"));
+    assert!(refined.iter().all(|c| !tried.contains(&c.description)));
+}

@@ -1,0 +1,425 @@
+//! The stages of the diagnosis over a pool of candidates: pre-screening,
+//! screening, full fits, refinement around the leaders, and holding what the
+//! data cannot determine. [`super::diagnose`] runs them in that order.
+
+use std::collections::HashSet;
+
+use damping::DampedSystem;
+use frf::FrfSet;
+use rayon::prelude::*;
+
+use super::candidates::{self, Candidate, CandidateOptions, EffectKind, Role};
+use super::local::{LocalCandidate, LocalData};
+use super::{DiagnoseOptions, spread};
+use crate::error::UpdateError;
+use crate::oe::{self, Misfit, OeData, OeOptions};
+use crate::params::ParameterSet;
+
+/// The relative standard deviation (of the log-parameter) above which a
+/// fitted value is not determined by the data: it could as well be e times
+/// larger or smaller.
+pub(crate) const UNDETERMINED_STD: f64 = 1.0;
+
+/// One fit of one candidate.
+#[derive(Clone, Debug)]
+pub(crate) struct Fit {
+    pub(crate) values: Vec<f64>,
+    pub(crate) cost: f64,
+    /// The nominal model's cost on the same lines.
+    pub(crate) cost0: f64,
+    /// Number of real residuals.
+    pub(crate) n: usize,
+    pub(crate) relative_std: Vec<f64>,
+    /// Per parameter: the data determine it (see [`determined`]).
+    pub(crate) determined: Vec<bool>,
+}
+
+/// A line set with the nominal model's cost on it.
+pub(crate) struct LineSet {
+    pub(crate) data: FrfSet,
+    pub(crate) cost0: f64,
+    /// Real residuals.
+    pub(crate) n: usize,
+}
+
+impl LineSet {
+    pub(crate) fn new(nominal: &DampedSystem, measured: &FrfSet, n_lines: usize) -> Result<Self, UpdateError> {
+        let data = measured.at_frequencies(&spread(measured.frequencies_hz(), n_lines))?;
+        let model = frf::synthesize(nominal, data.channels(), data.frequencies_hz())?;
+        let (mut cost, mut n) = (0.0, 0);
+        for (h, m) in model.values().iter().zip(data.values()) {
+            if m.norm() > 0.0 {
+                cost += (h / m).ln().norm_sqr();
+                n += 2;
+            }
+        }
+        if !cost.is_finite() {
+            return Err(UpdateError::Setup("the nominal model's misfit is not finite at the measured lines".into()));
+        }
+        Ok(LineSet { data, cost0: cost, n })
+    }
+}
+
+/// Per parameter, whether the data determine it: a finite relative standard
+/// deviation below [`UNDETERMINED_STD`], and for a spring not at its upper
+/// bound (where it is as good as rigid and its sensitivity vanishes).
+fn determined(c: &Candidate, r: &oe::OeResult, relative_std: &[f64]) -> Vec<bool> {
+    (0..c.parameters.len())
+        .map(|i| {
+            let rigid = matches!(c.roles[i], Role::Spring(_))
+                && r.at_bound[i]
+                && c.bounds[i].is_some_and(|(_, hi)| r.values[i] >= 0.5 * hi);
+            relative_std[i].is_finite() && relative_std[i] <= UNDETERMINED_STD && !rigid
+        })
+        .collect()
+}
+
+/// The data and the local form of a candidate fitted by low-rank updates of
+/// the nominal model (see module `local`).
+type Local<'a> = Option<(&'a LocalData, &'a LocalCandidate)>;
+
+/// Fits one candidate to a line set: by low-rank updates when `local` is
+/// given, else on its whole model (the nominal model with the candidate's
+/// change). The error says why the fit failed.
+fn fit(
+    candidate: &Candidate,
+    nominal: &fe_model::Model,
+    lines: &LineSet,
+    local: Local<'_>,
+    iterations: usize,
+    start: Option<&[f64]>,
+) -> Result<Fit, String> {
+    let (mut sys, params) = match local {
+        Some((_, lc)) => (lc.part.clone(), lc.params.clone()),
+        None => {
+            let model = candidate.model(nominal).map_err(|e| e.to_string())?;
+            let sys = DampedSystem::new(model).map_err(|e| e.to_string())?;
+            let params = ParameterSet::new(candidate.parameters_in(sys.model()).map_err(|e| e.to_string())?);
+            (sys, params)
+        }
+    };
+    if let Some(v) = start {
+        params.set_values(&mut sys, v).map_err(|e| e.to_string())?;
+    }
+    // bounds must hold the start
+    let now = params.values(&sys);
+    let bounds = candidate.bounds.iter().zip(&now).map(|(b, &v)| b.map(|(lo, hi)| (lo.min(v), hi.max(v)))).collect();
+    let opts =
+        OeOptions { misfit: Misfit::Log, max_iterations: iterations, tolerance: 1e-6, bounds, ..OeOptions::default() };
+    let data = OeData { measured: &lines.data, weights: None };
+    let r = match local {
+        Some((ld, lc)) => {
+            let mut response = ld.response(lc, sys);
+            oe::run_with(&mut response, now, &data, &opts, |_| {})
+        }
+        None => oe::run(&mut sys, &params, &data, &opts, |_| {}),
+    }
+    .map_err(|e| e.to_string())?;
+    if !r.cost.is_finite() {
+        return Err("its misfit is not finite".into());
+    }
+    let relative_std: Vec<f64> = (0..params.len()).map(|i| r.covariance[(i, i)].max(0.0).sqrt()).collect();
+    let determined = determined(candidate, &r, &relative_std);
+    Ok(Fit { values: r.values, cost: r.cost, cost0: lines.cost0, n: r.n_data, relative_std, determined })
+}
+
+/// The candidates of a diagnosis with their fits so far.
+pub(crate) struct Pool<'a> {
+    model: &'a fe_model::Model,
+    nominal: &'a DampedSystem,
+    pub(crate) candidates: Vec<Candidate>,
+    locals: Vec<Option<LocalCandidate>>,
+    /// The latest screening fit of each candidate.
+    pub(crate) screened: Vec<Option<Fit>>,
+    /// The full fit of each candidate, when it had one.
+    pub(crate) full: Vec<Option<Fit>>,
+    /// Why a candidate could not be fitted (its last attempt).
+    pub(crate) failure: Vec<Option<String>>,
+    /// Candidates superseded by a variant that holds what the data did not determine.
+    pub(crate) superseded: Vec<bool>,
+    /// Noise variance per real residual.
+    s2: f64,
+}
+
+impl<'a> Pool<'a> {
+    pub(crate) fn new(model: &'a fe_model::Model, nominal: &'a DampedSystem, s2: f64) -> Self {
+        Pool {
+            model,
+            nominal,
+            candidates: Vec::new(),
+            locals: Vec::new(),
+            screened: Vec::new(),
+            full: Vec::new(),
+            failure: Vec::new(),
+            superseded: Vec::new(),
+            s2,
+        }
+    }
+
+    /// Adds candidates; returns their indices.
+    pub(crate) fn add(&mut self, new: Vec<Candidate>) -> Vec<usize> {
+        let first = self.candidates.len();
+        let locals: Vec<Option<LocalCandidate>> =
+            new.par_iter().map(|c| LocalCandidate::new(self.nominal, c)).collect();
+        self.candidates.extend(new);
+        self.locals.extend(locals);
+        let n = self.candidates.len();
+        self.screened.resize(n, None);
+        self.full.resize(n, None);
+        self.failure.resize(n, None);
+        self.superseded.resize(n, false);
+        (first..n).collect()
+    }
+
+    /// The descriptions of every candidate so far.
+    pub(crate) fn descriptions(&self) -> HashSet<String> {
+        self.candidates.iter().map(|c| c.description.clone()).collect()
+    }
+
+    /// `dBIC = (cost - cost0) / s^2 + k ln(n)`.
+    pub(crate) fn bic(&self, f: &Fit, k: usize) -> f64 {
+        (f.cost - f.cost0) / self.s2 + k as f64 * (f.n as f64).ln()
+    }
+
+    /// Fits `which` on `lines` with `iterations`, from their starting values
+    /// (or `starts`); returns the fits in the order of `which`.
+    fn fit_all(
+        &self,
+        lines: &LineSet,
+        iterations: usize,
+        which: &[usize],
+        starts: &[Option<Vec<f64>>],
+    ) -> Result<Vec<Result<Fit, String>>, UpdateError> {
+        let forms: Vec<_> = which.iter().filter_map(|&i| self.locals[i].as_ref().map(|l| &l.form)).collect();
+        let data = LocalData::new(self.nominal, lines.data.channels(), lines.data.frequencies_hz(), &forms)?;
+        Ok(which
+            .par_iter()
+            .zip(starts)
+            .map(|(&i, start)| {
+                let c = &self.candidates[i];
+                let local = self.locals[i].as_ref().map(|l| (&data, l));
+                let start = start.as_deref();
+                // a low-rank update that cannot be evaluated (a singular
+                // local system at some line) falls back to the whole model
+                fit(c, self.model, lines, local, iterations, start)
+                    .or_else(
+                        |e| if local.is_some() { fit(c, self.model, lines, None, iterations, start) } else { Err(e) },
+                    )
+                    .or_else(
+                        |e| if start.is_some() { fit(c, self.model, lines, None, iterations, None) } else { Err(e) },
+                    )
+            })
+            .collect())
+    }
+
+    /// Screens `which`: a short fit on `lines` from the starting values.
+    pub(crate) fn screen(&mut self, lines: &LineSet, iterations: usize, which: &[usize]) -> Result<(), UpdateError> {
+        let starts = vec![None; which.len()];
+        for (&i, f) in which.iter().zip(self.fit_all(lines, iterations, which, &starts)?) {
+            match f {
+                Ok(f) => {
+                    self.screened[i] = Some(f);
+                    self.failure[i] = None;
+                }
+                Err(why) => self.failure[i] = Some(why),
+            }
+        }
+        Ok(())
+    }
+
+    /// Fits `which` fully on `lines`, each warm-started from its screening
+    /// fit (or from `starts` where given).
+    pub(crate) fn full_fit(
+        &mut self,
+        lines: &LineSet,
+        iterations: usize,
+        which: &[usize],
+        starts: Option<Vec<Option<Vec<f64>>>>,
+    ) -> Result<(), UpdateError> {
+        let starts = starts
+            .unwrap_or_else(|| which.iter().map(|&i| self.screened[i].as_ref().map(|f| f.values.clone())).collect());
+        for (&i, f) in which.iter().zip(self.fit_all(lines, iterations, which, &starts)?) {
+            match f {
+                Ok(f) => {
+                    self.full[i] = Some(f);
+                    self.failure[i] = None;
+                }
+                Err(why) => self.failure[i] = Some(why),
+            }
+        }
+        Ok(())
+    }
+
+    /// `which` ordered by their screening: fits on more residuals first
+    /// (screened before pre-screened), then by `dBIC`. Unscreened ones are left out.
+    pub(crate) fn by_screening(&self, which: &[usize]) -> Vec<usize> {
+        let mut order: Vec<usize> = which.iter().copied().filter(|&i| self.screened[i].is_some()).collect();
+        let key = |i: usize| {
+            let f = self.screened[i].as_ref().expect("filtered");
+            (f.n, self.bic(f, self.candidates[i].parameters.len()))
+        };
+        order.sort_by(|&a, &b| {
+            let ((na, sa), (nb, sb)) = (key(a), key(b));
+            nb.cmp(&na).then(sa.total_cmp(&sb))
+        });
+        order
+    }
+
+    /// The fully fitted candidates (not superseded), by `dBIC`.
+    pub(crate) fn by_full_fit(&self) -> Vec<usize> {
+        let mut order: Vec<usize> =
+            (0..self.candidates.len()).filter(|&i| self.full[i].is_some() && !self.superseded[i]).collect();
+        let key = |i: usize| self.bic(self.full[i].as_ref().expect("filtered"), self.candidates[i].parameters.len());
+        order.sort_by(|&a, &b| key(a).total_cmp(&key(b)));
+        order
+    }
+
+    /// The leaders to fit fully: the best `keep` by screening, and the best
+    /// of each kind not among them, so that one effect's many windows
+    /// cannot crowd out every other kind.
+    pub(crate) fn leaders(&self, order: &[usize], keep: usize) -> Vec<usize> {
+        let mut out: Vec<usize> = order.iter().copied().take(keep).collect();
+        let mut kinds: HashSet<EffectKind> = out.iter().map(|&i| self.candidates[i].kind).collect();
+        for &i in order {
+            if kinds.insert(self.candidates[i].kind) {
+                out.push(i);
+            }
+        }
+        out
+    }
+
+    /// Candidates around the best fully fitted ones (see
+    /// [`candidates::refine`]), added to the pool; returns their indices.
+    pub(crate) fn refine(&mut self, opts: &CandidateOptions, leaders: usize) -> Vec<usize> {
+        let order = self.by_full_fit();
+        let best: Vec<&Candidate> = order.iter().take(leaders).map(|&i| &self.candidates[i]).collect();
+        let new = candidates::refine(self.model, opts, &best, &self.descriptions());
+        self.add(new)
+    }
+
+    /// The candidates of the same kind as the best fully fitted windows
+    /// (stiffness, mass or damping changes) whose windows overlap them or
+    /// lie within [`WINDOW_SLACK`] elements, not yet fully fitted: the
+    /// screening's short fits on fewer lines do not separate windows that
+    /// differ by an element or two, the full fits do.
+    pub(crate) fn window_neighbours(&self, leaders: usize) -> Vec<usize> {
+        let order = self.by_full_fit();
+        let mut out = Vec::new();
+        for &l in order.iter().take(leaders) {
+            let c = &self.candidates[l];
+            let (Some(&lo), Some(&hi)) = (c.elements.iter().min(), c.elements.iter().max()) else { continue };
+            if !matches!(
+                c.kind,
+                EffectKind::StiffnessChange
+                    | EffectKind::MassChange
+                    | EffectKind::ViscousDamping
+                    | EffectKind::NonViscousDamping
+            ) {
+                continue;
+            }
+            for (i, o) in self.candidates.iter().enumerate() {
+                let near = o.elements.iter().any(|&e| e + WINDOW_SLACK >= lo && e <= hi + WINDOW_SLACK);
+                if o.kind == c.kind && near && self.full[i].is_none() && self.screened[i].is_some() && !out.contains(&i)
+                {
+                    out.push(i);
+                }
+            }
+        }
+        out
+    }
+
+    /// For every full fit with parameters the data do not determine, the
+    /// variant that holds them (see [`Candidate::holding`]) is fitted fully
+    /// from the determined values and supersedes the fuller one.
+    pub(crate) fn hold_undetermined(&mut self, lines: &LineSet, iterations: usize) -> Result<(), UpdateError> {
+        let mut fits: Vec<(usize, Vec<f64>)> = Vec::new();
+        let mut new: Vec<(Candidate, Vec<f64>)> = Vec::new();
+        for i in self.by_full_fit() {
+            let f = self.full[i].as_ref().expect("fully fitted");
+            let held: Vec<usize> = (0..f.determined.len()).filter(|&p| !f.determined[p]).collect();
+            if held.is_empty() {
+                continue;
+            }
+            let Some(h) = self.candidates[i].holding(self.model, &held) else { continue };
+            let original = &self.candidates[i].parameters;
+            let start: Vec<f64> = h
+                .parameters
+                .iter()
+                .map(|n| f.values[original.iter().position(|p| p == n).expect("the held variant fits a subset")])
+                .collect();
+            // the held variant may be a candidate of its own already (a plain mass)
+            match self.candidates.iter().position(|c| c.description == h.description) {
+                Some(j) if self.full[j].is_none() && !fits.iter().any(|(k, _)| *k == j) => fits.push((j, start)),
+                Some(_) => {}
+                None if new.iter().any(|(c, _)| c.description == h.description) => {}
+                None => new.push((h, start)),
+            }
+            self.superseded[i] = true;
+        }
+        for (h, start) in new {
+            let j = self.add(vec![h])[0];
+            fits.push((j, start));
+        }
+        let (which, starts): (Vec<usize>, Vec<Option<Vec<f64>>>) = fits.into_iter().map(|(j, s)| (j, Some(s))).unzip();
+        if !which.is_empty() {
+            self.full_fit(lines, iterations, &which, Some(starts))?;
+        }
+        Ok(())
+    }
+}
+
+/// The pre-screening, screening and full fits of a first pass of
+/// candidates, then the refinement and the holding; see the module docs of
+/// [`super`].
+pub(crate) fn search(
+    pool: &mut Pool<'_>,
+    measured: &FrfSet,
+    full: &LineSet,
+    opts: &DiagnoseOptions,
+    copts: &CandidateOptions,
+    trace: &mut dyn FnMut(&str),
+) -> Result<(), UpdateError> {
+    let coarse = LineSet::new(pool.nominal, measured, opts.screen_lines)?;
+    let all = pool.add(candidates::generate(pool.model, copts));
+    let to_screen = if all.len() > opts.prescreen_above {
+        let pre = LineSet::new(pool.nominal, measured, opts.prescreen_lines)?;
+        pool.screen(&pre, opts.prescreen_iterations, &all)?;
+        trace(&format!("pre-screened {} candidates on {} lines", all.len(), pre.data.n_freq()));
+        let mut best = pool.by_screening(&all);
+        best.truncate(opts.prescreen_keep);
+        best
+    } else {
+        all.clone()
+    };
+    pool.screen(&coarse, opts.screen_iterations, &to_screen)?;
+    trace(&format!("screened {} candidates on {} lines", to_screen.len(), coarse.data.n_freq()));
+    let order = pool.by_screening(&all);
+    let keep = pool.leaders(&order, opts.keep);
+    pool.full_fit(full, opts.iterations, &keep, None)?;
+    trace(&format!("fitted the best {} on {} lines", keep.len(), full.data.n_freq()));
+
+    // around the leaders: fuller variants, and on large models finer windows
+    let refined = pool.refine(copts, REFINED_LEADERS);
+    if !refined.is_empty() {
+        pool.screen(&coarse, opts.screen_iterations, &refined)?;
+        let best: Vec<usize> = pool.by_screening(&refined).into_iter().take(REFINED_FITS).collect();
+        pool.full_fit(full, opts.iterations, &best, None)?;
+        trace(&format!("refined around the leaders: {} candidates, {} fitted", refined.len(), best.len()));
+    }
+    let neighbours = pool.window_neighbours(REFINED_LEADERS);
+    if !neighbours.is_empty() {
+        pool.full_fit(full, opts.iterations, &neighbours, None)?;
+        trace(&format!("fitted {} windows next to the leading ones", neighbours.len()));
+    }
+    pool.hold_undetermined(full, opts.iterations)?;
+    trace("held what the data do not determine");
+    Ok(())
+}
+
+/// Elements beyond a leading window within which other windows of its kind
+/// are fitted fully.
+const WINDOW_SLACK: u32 = 2;
+/// Leaders (by full-fit `dBIC`) around which candidates are refined.
+const REFINED_LEADERS: usize = 3;
+/// Refined candidates fitted fully after screening.
+const REFINED_FITS: usize = 6;

@@ -1,0 +1,242 @@
+//! Closing the loop: diagnose, add the recommended effect, update every
+//! added parameter, and again, until nothing significant remains.
+//!
+//! This is what `rfm fix` runs. Each step
+//!
+//! 1. diagnoses the current model against the data ([`crate::diagnose`]),
+//! 2. adds the recommended effect (the first significant, plausible one) at
+//!    its fitted values ([`Diagnosis::apply`]),
+//! 3. updates, by output error on the diagnosis's lines, every parameter of
+//!    the case's `[update]`, which now holds the parameters of every effect
+//!    added so far: an effect fitted while another was still missing is
+//!    biased, and the joint update removes that bias,
+//!
+//! and records the misfit after 2 and after 3 in the case's history. The
+//! loop stops when no candidate is significant (the model is consistent
+//! with the data), when the significant ones are all implausible (the
+//! missing effect is not among the candidates), when an update does not
+//! lower the misfit, or after the given number of steps. A last diagnosis of
+//! the final model says what, if anything, still stands out.
+
+use fe_model::{CaseEditor, CaseFile, HistoryEntry};
+use frf::FrfSet;
+use serde::Serialize;
+
+use crate::diagnose::{self, DiagnoseOptions, Diagnosis, Ranked};
+use crate::error::UpdateError;
+use crate::rfm::Status;
+use crate::study::{ParameterReport, Study};
+use crate::uncertainty::UncertaintyReport;
+
+/// Options of the loop.
+#[derive(Clone, Debug)]
+pub struct FixOptions {
+    /// Most effects to add.
+    pub max_steps: usize,
+    /// Options of each diagnosis (its `lines` are also the update's).
+    pub diagnose: DiagnoseOptions,
+    /// Iteration limit of each update.
+    pub update_iterations: usize,
+}
+
+impl Default for FixOptions {
+    fn default() -> Self {
+        FixOptions { max_steps: 3, diagnose: DiagnoseOptions::default(), update_iterations: 100 }
+    }
+}
+
+/// One step of the loop: the effect added and the update after it.
+#[derive(Clone, Debug, Serialize)]
+pub struct FixStep {
+    /// The effect added, as the diagnosis ranked it.
+    pub effect: Ranked,
+    /// The misfit with the effect at its diagnosed values (RMS of
+    /// `ln(model / measured)` per value; see [`diagnose::log_misfit`]).
+    pub misfit_added: f64,
+    /// The misfit after the update.
+    pub misfit_updated: f64,
+    /// How the update ended.
+    pub status: Status,
+    /// The updated parameters (every effect added so far, and the case's own).
+    pub parameters: Vec<ParameterReport>,
+    /// Their uncertainty.
+    pub uncertainty: Option<UncertaintyReport>,
+    /// The case after this step (write it with [`CaseEditor::text_at`]).
+    #[serde(skip)]
+    pub case: CaseEditor,
+}
+
+/// Why the loop stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FixStop {
+    /// No candidate explains the remaining misfit beyond the noise.
+    NothingSignificant,
+    /// Significant candidates remain, but none at plausible values: the
+    /// missing effect is not among the candidates.
+    NoPlausibleCandidate,
+    /// The last update did not lower the misfit.
+    NoImprovement,
+    /// The number of steps asked for was done; something significant may remain.
+    StepsDone,
+}
+
+impl FixStop {
+    /// Plain-language reason.
+    pub fn describe(self) -> &'static str {
+        match self {
+            FixStop::NothingSignificant => "nothing significant remains: the model is consistent with the data",
+            FixStop::NoPlausibleCandidate => {
+                "significant effects remain, but none at plausible values: the missing effect may not be among the candidates"
+            }
+            FixStop::NoImprovement => "the last update did not lower the misfit",
+            FixStop::StepsDone => "the number of steps asked for is done",
+        }
+    }
+}
+
+/// The outcome of the loop.
+#[derive(Clone, Debug, Serialize)]
+pub struct FixOutcome {
+    /// The data's estimated relative noise (RMS per value).
+    pub noise: f64,
+    /// The nominal model's misfit.
+    pub nominal_misfit: f64,
+    /// The steps, in order.
+    pub steps: Vec<FixStep>,
+    /// Why the loop stopped.
+    pub stop: FixStop,
+    /// The diagnosis of the final model (top of its ranking only).
+    pub remaining: Vec<Ranked>,
+    /// Whether something significant remains in the final diagnosis.
+    pub significant_remains: bool,
+}
+
+impl FixOutcome {
+    /// The misfit after every stage: the nominal model, then per step with
+    /// the effect added and after the update, labelled.
+    pub fn stages(&self) -> Vec<(String, f64)> {
+        let mut v = vec![("nominal".to_string(), self.nominal_misfit)];
+        for (k, s) in self.steps.iter().enumerate() {
+            v.push((format!("+ {}", s.effect.description), s.misfit_added));
+            v.push((format!("updated after step {}", k + 1), s.misfit_updated));
+        }
+        v
+    }
+
+    /// The final misfit.
+    pub fn final_misfit(&self) -> f64 {
+        self.steps.last().map_or(self.nominal_misfit, |s| s.misfit_updated)
+    }
+}
+
+/// What the loop reports as it goes.
+#[derive(Clone, Debug)]
+pub enum FixProgress<'a> {
+    /// A diagnosis is done.
+    Diagnosed {
+        /// Effects added before it.
+        step: usize,
+        /// The diagnosis.
+        diagnosis: &'a Diagnosis,
+    },
+    /// The update after adding an effect is done.
+    Updated {
+        /// Effects added before this one.
+        step: usize,
+        /// The misfit after the update.
+        misfit: f64,
+        /// How the update ended.
+        status: &'a Status,
+    },
+}
+
+/// Runs the loop on a case against its measured receptances (all lines).
+/// The case's own `[update]` parameters, if any, are updated together with
+/// the added effects' at every step.
+pub fn fix(
+    case: &CaseFile,
+    measured: &FrfSet,
+    opts: &FixOptions,
+    mut progress: impl FnMut(FixProgress<'_>),
+) -> Result<FixOutcome, UpdateError> {
+    if opts.max_steps == 0 {
+        return Err(UpdateError::Setup("the loop needs at least one step".into()));
+    }
+    let lines = opts.diagnose.lines;
+    let mut current = case.clone();
+    let mut steps: Vec<FixStep> = Vec::new();
+    let (mut noise, mut nominal_misfit) = (f64::NAN, f64::NAN);
+    let stop = loop {
+        let d = diagnose::diagnose(&current.model, measured, &opts.diagnose)?;
+        progress(FixProgress::Diagnosed { step: steps.len(), diagnosis: &d });
+        if steps.is_empty() {
+            (noise, nominal_misfit) = (d.noise, d.nominal_misfit);
+        }
+        let Some(rank) = d.recommended else {
+            let stop = if d.consistent() { FixStop::NothingSignificant } else { FixStop::NoPlausibleCandidate };
+            break (stop, Some(d));
+        };
+        if steps.len() == opts.max_steps {
+            break (FixStop::StepsDone, Some(d));
+        }
+        let effect = d.ranking[rank - 1].clone();
+        let mut editor = d.apply(&current, rank)?;
+        let added = CaseFile::parse(&current.path, &editor.text_at(&current.path)?)?;
+        let misfit_added = effect.misfit;
+        // update every parameter of the case's [update] by output error on
+        // the diagnosis's lines
+        let mut study = Study::with_measured(added, measured.clone())?;
+        if let Some(u) = study.case.update.as_mut() {
+            u.frequencies = Some(fe_model::case::FrequencyChoice::Lines(lines));
+        }
+        let mut oe_opts = study.output_error_options()?;
+        oe_opts.max_iterations = opts.update_iterations;
+        let outcome = study.run_output_error(&oe_opts, |_| {})?;
+        let misfit_updated = diagnose::log_misfit(&outcome.system, measured, lines)?;
+        progress(FixProgress::Updated { step: steps.len(), misfit: misfit_updated, status: &outcome.status });
+        let model = outcome.system.model();
+        let values: Vec<(String, f64)> = study
+            .parameters
+            .iter()
+            .flat_map(|p| p.quantities.iter().map(|&q| (model.quantity_name(q).to_string(), model.get(q))))
+            .collect();
+        editor.set_values(&values, &format!("updated by rfm fix, step {}", steps.len() + 1))?;
+        editor.push_history(&HistoryEntry {
+            step: format!("updated after step {}", steps.len() + 1),
+            misfit: misfit_updated,
+            noise: Some(noise),
+        })?;
+        current = CaseFile::parse(&current.path, &editor.text_at(&current.path)?)?;
+        let improved = misfit_updated < steps.last().map_or(nominal_misfit, |s: &FixStep| s.misfit_updated);
+        steps.push(FixStep {
+            effect,
+            misfit_added,
+            misfit_updated,
+            status: outcome.status,
+            parameters: outcome.parameters,
+            uncertainty: outcome.uncertainty,
+            case: editor,
+        });
+        if !improved {
+            break (FixStop::NoImprovement, None);
+        }
+    };
+    let (stop, last) = stop;
+    let last = match last {
+        Some(d) => d,
+        None => {
+            let d = diagnose::diagnose(&current.model, measured, &opts.diagnose)?;
+            progress(FixProgress::Diagnosed { step: steps.len(), diagnosis: &d });
+            d
+        }
+    };
+    Ok(FixOutcome {
+        noise,
+        nominal_misfit,
+        steps,
+        stop,
+        significant_remains: !last.consistent(),
+        remaining: last.ranking.into_iter().filter(|r| r.fully_fitted).take(5).collect(),
+    })
+}
