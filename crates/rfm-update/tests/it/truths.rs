@@ -44,6 +44,12 @@ pub(crate) const VISIBLE: f64 = 0.10;
 /// joint is so soft that the structure is close to a mechanism.
 const LOWEST_MODE_HZ: f64 = 0.5;
 
+/// How far, in half-power peak widths `2 zeta f` of the nominal model, a
+/// joint or splice must move at least one mode in the band: its rotational
+/// spring is meant to be soft enough to be seen as a stiffness, not only
+/// through its damping.
+const JOINT_SHIFT_WIDTHS: f64 = 3.0;
+
 /// Redraws allowed before the generator gives up (a bug, not bad luck).
 const MAX_REDRAWS: u32 = 500;
 
@@ -103,6 +109,7 @@ impl Family {
 pub(crate) struct Truth {
     /// What is hidden, in words (for tables and messages).
     pub(crate) label: String,
+    /// Which nominal structure the trial is on.
     pub(crate) structure: Structure,
     /// Case-file text of the nominal model (what the user has).
     pub(crate) nominal: String,
@@ -187,13 +194,8 @@ impl Truth {
     /// [`Truth::nominal`] when the measurement is written to a file.
     pub(crate) fn measurement_table(&self, data: &str) -> String {
         let geo = Geometry::of(self.structure);
-        let refs: Vec<&str> = self.channels.iter().map(|(_, e)| e.as_str()).collect();
-        let mut references: Vec<&str> = Vec::new();
-        for r in refs {
-            if !references.contains(&r) {
-                references.push(r);
-            }
-        }
+        let mut references: Vec<&str> = self.channels.iter().map(|(_, e)| e.as_str()).collect();
+        references.dedup();
         let responses: Vec<&str> = self.channels.iter().map(|(r, _)| r.as_str()).collect();
         let quoted = |v: &[&str]| v.iter().map(|s| format!("\"{s}\"")).collect::<Vec<_>>().join(", ");
         let (from, to, step) = geo.band;
@@ -315,7 +317,7 @@ impl Geometry {
         self.b * self.h.powi(3) / 12.0
     }
 
-    /// Element length (every member has 0.05 m elements, but compute it).
+    /// Element length of a member.
     fn le(&self, member: &Member) -> f64 {
         let (a, b) = (self.node(member.nodes[0]), self.node(*member.nodes.last().unwrap()));
         (b.1 - a.1).hypot(b.2 - a.2) / member.elements.len() as f64
@@ -656,6 +658,9 @@ fn draw_recipe(rng: &mut ChaCha8Rng, geo: &Geometry, family: Family, avoid: &[us
             if !far(&[geo.position(geo.clamp)]) {
                 return None;
             }
+            // sized on the member the clamp holds: kr against the root
+            // element's bending stiffness 4EI/Le, ky against its shear-like
+            // 12EI/Le^3, the axial spring stiff against EA/Le
             let member = &geo.members[0];
             let le = geo.le(member);
             let kr = log_uniform(rng, 0.05, 2.0) * 4.0 * ei / le;
@@ -695,7 +700,14 @@ fn draw_recipe(rng: &mut ChaCha8Rng, geo: &Geometry, family: Family, avoid: &[us
             let (node, moved, mi) = places[rng.random_range(0..places.len())];
             let member = &geo.members[mi];
             let le = geo.le(member);
-            let kr = log_uniform(rng, 0.2, 8.0) * ei / le;
+            // The joint's rotational compliance 1/kr adds to the member's
+            // bending compliance, L/EI = 10 to 20 Le/EI here: kr = 0.2 EI/Le
+            // adds 25-50 % to it, 8 EI/Le 0.6-1.3 %, against peak widths
+            // 2 zeta of about 1 %. A splice near the free end bends little
+            // in every mode, so it gets the softer part of the range;
+            // draws that move no mode by JOINT_SHIFT_WIDTHS are redrawn.
+            let stiffest = if family == Family::Joint { 8.0 } else { 3.0 };
+            let kr = log_uniform(rng, 0.2, stiffest) * ei / le;
             let transverse = 10f64.powf(rng.random_range(0.0..2.0)) * 12.0 * ei / le.powi(3);
             let axial = 10f64.powf(rng.random_range(0.0..2.0)) * ea / le;
             let (kx, ky) = global(member.along_x, axial, transverse);
@@ -724,8 +736,9 @@ fn draw_recipe(rng: &mut ChaCha8Rng, geo: &Geometry, family: Family, avoid: &[us
                     by_section: rng.random_bool(0.5),
                 });
             }
-            // a loss factor of 2-20 % in the patch, three times or more the
-            // structure's own at f_ref, with a relaxation in or near the band
+            // a loss factor of 2-20 % in the patch at f_ref (the structure's
+            // own is 0.7 % on the cantilever, 0.3 % on the L-frame), with a
+            // relaxation from a twentieth of the band's top to 1.5 times it
             let eta = log_uniform(rng, 0.02, 0.2);
             let mu = (!rng.random_bool(0.25)).then(|| 2.0 * PI * log_uniform(rng, 0.05, 1.5) * geo.band.1);
             Some(Recipe::Patch { elements, damp: damp_for_loss(eta, mu, geo.f_ref) })
@@ -749,7 +762,7 @@ fn draw_recipe(rng: &mut ChaCha8Rng, geo: &Geometry, family: Family, avoid: &[us
     }
 }
 
-/// Counter of the ids and names a truth adds.
+/// The ids of the nodes a truth adds, in the order it adds them.
 struct Extra {
     next_node: u32,
 }
@@ -934,7 +947,11 @@ impl Recipe {
         };
         match self {
             Recipe::Support { node, k, layout, .. } => {
-                format!("lossy support at node {node} (kr = {:.3e}, ky = {:.3e}; {})", k[2], k[1], springs(layout))
+                let [kx, ky, kr] = k;
+                format!(
+                    "lossy support at node {node} (kr = {kr:.3e}, kx = {kx:.3e}, ky = {ky:.3e}; {})",
+                    springs(layout)
+                )
             }
             Recipe::Joint { family, node, k, layout, .. } => {
                 let what = if *family == Family::Joint { "corner joint" } else { "splice" };
@@ -1003,15 +1020,41 @@ fn relative_rms(a: &FrfSet, b: &FrfSet) -> f64 {
     (a.values().iter().zip(b.values()).map(|(x, y)| ((x - y) / x.norm()).norm_sqr()).sum::<f64>() / n).sqrt()
 }
 
+/// The largest shift of a mode in the band between the nominal model and a
+/// truth, in half-power peak widths of the nominal mode (the modes are
+/// paired in order; the nominal damping is Rayleigh, `zeta = (alpha w +
+/// beta / w) / 2`).
+fn largest_shift_in_widths(geo: &Geometry, truth_hz: &[f64]) -> f64 {
+    let nominal = normal_modes(system(&geo.frame().to_toml()).unwrap().assembly()).unwrap().frequencies_hz;
+    let (lo, hi) = (geo.band.0, geo.band.1);
+    nominal
+        .iter()
+        .zip(truth_hz)
+        .filter(|(f, _)| (lo..=hi).contains(*f))
+        .map(|(&f, &t)| {
+            let w = 2.0 * PI * f;
+            let zeta = (geo.alpha * w + geo.beta / w) / 2.0;
+            (t - f).abs() / (2.0 * zeta * f)
+        })
+        .fold(0.0, f64::max)
+}
+
 /// A drawn truth's misfit to the nominal model, or why it is refused: it
 /// does not assemble, is not positive definite, has a mode below
-/// [`LOWEST_MODE_HZ`], or is not visible above the noise.
-fn check(structure: Structure, text: &str) -> Result<f64, String> {
+/// [`LOWEST_MODE_HZ`], is not visible above the noise, or (when `joint`)
+/// moves no mode by [`JOINT_SHIFT_WIDTHS`] peak widths.
+fn check(structure: Structure, text: &str, joint: bool) -> Result<f64, String> {
     let sys = system(text)?;
     let modes = normal_modes(sys.assembly()).map_err(|e| e.to_string())?;
     let lowest = modes.frequencies_hz.first().copied().unwrap_or(0.0);
     if !(lowest >= LOWEST_MODE_HZ) {
         return Err(format!("lowest mode {lowest:.3} Hz"));
+    }
+    if joint {
+        let shift = largest_shift_in_widths(&Geometry::of(structure), &modes.frequencies_hz);
+        if shift < JOINT_SHIFT_WIDTHS {
+            return Err(format!("a joint that moves the modes by {shift:.1} peak widths at most"));
+        }
     }
     let misfit = misfit_of(structure, &sys)?;
     if misfit < VISIBLE {
@@ -1098,11 +1141,15 @@ pub(crate) fn draw_on(rng: &mut ChaCha8Rng, structure: Structure, family: Option
             recipes.push(second);
         }
         let truth = truth_text(&geo, &recipes);
-        // each effect of a pair must be visible on its own, or "both found"
-        // could not be asked of the diagnosis
-        let alone =
-            |r: &Recipe| recipes.len() == 1 || check(structure, &truth_text(&geo, std::slice::from_ref(r))).is_ok();
-        if check(structure, &truth).is_err() || !recipes.iter().all(alone) {
+        // each effect of a pair must pass on its own, or "both found" could
+        // not be asked of the diagnosis
+        let is_joint = |r: &Recipe| matches!(r, Recipe::Joint { .. });
+        let alone = |r: &Recipe| check(structure, &truth_text(&geo, std::slice::from_ref(r)), is_joint(r)).is_ok();
+        let passes = match recipes.as_slice() {
+            [single] => check(structure, &truth, is_joint(single)).is_ok(),
+            _ => check(structure, &truth, false).is_ok() && recipes.iter().all(alone),
+        };
+        if !passes {
             redraws += 1;
             continue;
         }
@@ -1372,6 +1419,22 @@ mod tests {
         }
     }
 
+    /// The largest shift of a mode in the band from the nominal model to the
+    /// truth, in peak widths, from the parsed models: the nominal
+    /// structure's group is Rayleigh-damped, so `zeta = (alpha w + beta / w) / 2`.
+    fn shift_in_widths(t: &Truth) -> f64 {
+        let nominal = t.nominal_case().model;
+        let g = nominal.groups()[nominal.beams()[0].group].clone();
+        let modes = |m: Model| normal_modes(DampedSystem::new(m).unwrap().assembly()).unwrap().frequencies_hz;
+        let (before, after) = (modes(nominal), modes(t.truth_case().model));
+        let band = t.lines_hz[0]..=*t.lines_hz.last().unwrap();
+        let widths = before.iter().zip(&after).filter(|(f, _)| band.contains(*f)).map(|(&f, &a)| {
+            let w = 2.0 * PI * f;
+            (a - f).abs() / ((g.alpha * w + g.beta / w) * f)
+        });
+        widths.fold(0.0, f64::max)
+    }
+
     /// Draws `per` truths of every family on a structure, checks each, and
     /// returns them.
     fn family_truths(structure: Structure, seed: u64, per: usize) -> Vec<Truth> {
@@ -1386,6 +1449,10 @@ mod tests {
                 check_truth(&t);
                 let v = visibility(&t);
                 assert!(v >= VISIBLE, "{}: visible at {v}, below {VISIBLE}", t.label);
+                if matches!(f, Family::Joint | Family::Splice) {
+                    let shift = shift_in_widths(&t);
+                    assert!(shift >= JOINT_SHIFT_WIDTHS, "{}: modes move by {shift} peak widths", t.label);
+                }
                 redraws += t.redraws;
                 all.push(t);
             }
