@@ -6,3 +6,4 @@ mod numerics;
 mod output_error;
 mod paper_cases;
 mod sensitivity;
+mod truths;
