@@ -61,9 +61,22 @@ pub struct FixStep {
     pub parameters: Vec<ParameterReport>,
     /// Their uncertainty.
     pub uncertainty: Option<UncertaintyReport>,
+    /// The first effects tried by looking one step ahead (when the best
+    /// single effect left more than three times the noise), with the misfit
+    /// each left after its best follower; empty when there was no need.
+    pub alternatives: Vec<LookAhead>,
     /// The case after this step (write it with [`CaseEditor::text_at`]).
     #[serde(skip)]
     pub case: CaseEditor,
+}
+
+/// A first effect tried by looking one step ahead.
+#[derive(Clone, Debug, Serialize)]
+pub struct LookAhead {
+    /// The effect.
+    pub effect: String,
+    /// The misfit after it, its update and its best follower.
+    pub misfit_ahead: f64,
 }
 
 /// Why the loop stopped.
@@ -140,10 +153,19 @@ pub enum FixProgress<'a> {
         /// The diagnosis.
         diagnosis: &'a Diagnosis,
     },
+    /// A first effect was tried by looking one step ahead.
+    LookedAhead {
+        /// Effects added before it.
+        step: usize,
+        /// The effect and the misfit after it and its best follower.
+        ahead: &'a LookAhead,
+    },
     /// The update after adding an effect is done.
     Updated {
         /// Effects added before this one.
         step: usize,
+        /// The effect added.
+        effect: &'a str,
         /// The misfit after the update.
         misfit: f64,
         /// How the update ended.
@@ -151,9 +173,93 @@ pub enum FixProgress<'a> {
     },
 }
 
+/// Above this multiple of the noise, the misfit the best single effect
+/// leaves suggests that more than one effect is missing, and the first is
+/// chosen by looking one step ahead.
+const LOOK_AHEAD_ABOVE: f64 = 3.0;
+
+/// How many distinct first effects the look-ahead tries.
+const LOOK_AHEAD_WIDTH: usize = 4;
+
+/// An effect added to a case and every parameter updated.
+struct Added {
+    effect: Ranked,
+    editor: CaseEditor,
+    case: CaseFile,
+    misfit_updated: f64,
+    outcome: crate::study::UpdateOutcome,
+}
+
+/// Adds ranked effect `rank` of `d` to `current` and updates every parameter
+/// of the case's `[update]` by output error on the diagnosis's lines; the
+/// updated values and the misfit go into the case's history as step `step`.
+fn add_and_update(
+    current: &CaseFile,
+    d: &Diagnosis,
+    rank: usize,
+    measured: &FrfSet,
+    opts: &FixOptions,
+    step: usize,
+) -> Result<Added, UpdateError> {
+    let lines = opts.diagnose.lines;
+    let mut editor = d.apply(current, rank)?;
+    let added = CaseFile::parse(&current.path, &editor.text_at(&current.path)?)?;
+    let mut study = Study::with_measured(added, measured.clone())?;
+    if let Some(u) = study.case.update.as_mut() {
+        u.frequencies = Some(fe_model::case::FrequencyChoice::Lines(lines));
+    }
+    let mut oe_opts = study.output_error_options()?;
+    oe_opts.max_iterations = opts.update_iterations;
+    let outcome = study.run_output_error(&oe_opts, |_| {})?;
+    let misfit_updated = diagnose::log_misfit(&outcome.system, measured, lines)?;
+    let model = outcome.system.model();
+    let values: Vec<(String, f64)> = study
+        .parameters
+        .iter()
+        .flat_map(|p| p.quantities.iter().map(|&q| (model.quantity_name(q).to_string(), model.get(q))))
+        .collect();
+    editor.set_values(&values, &format!("updated by rfm fix, step {step}"))?;
+    editor.push_history(&HistoryEntry {
+        step: format!("updated after step {step}"),
+        misfit: misfit_updated,
+        noise: Some(d.noise),
+    })?;
+    let case = CaseFile::parse(&current.path, &editor.text_at(&current.path)?)?;
+    Ok(Added { effect: d.ranking[rank - 1].clone(), editor, case, misfit_updated, outcome })
+}
+
+/// The ranks of up to `width` recommendable effects (significant, plausible,
+/// fully fitted) that differ from each other in kind or place, best first.
+fn distinct_leaders(d: &Diagnosis, model: &fe_model::Model, width: usize) -> Vec<usize> {
+    let mut out: Vec<usize> = Vec::new();
+    for (i, r) in d.ranking.iter().enumerate() {
+        if out.len() == width {
+            break;
+        }
+        if !(r.fully_fitted && r.significant && r.plausible) {
+            continue;
+        }
+        let c = &d.candidates[r.candidate];
+        let same = out.iter().any(|&k| {
+            let o = &d.ranking[k - 1];
+            o.kind == r.kind && c.near(model, &o.nodes, &o.elements)
+        });
+        if !same {
+            out.push(i + 1);
+        }
+    }
+    out
+}
+
 /// Runs the loop on a case against its measured receptances (all lines).
 /// The case's own `[update]` parameters, if any, are updated together with
 /// the added effects' at every step.
+///
+/// When the best single effect would leave more than three times the noise
+/// (two effects may hide at once, and a single candidate that mimics both
+/// may lead), the first effect is chosen by looking one step ahead: each of
+/// a few distinct leaders is added and updated, the data diagnosed again,
+/// and the leader whose best follower leaves the smallest misfit is kept.
 pub fn fix(
     case: &CaseFile,
     measured: &FrfSet,
@@ -163,13 +269,19 @@ pub fn fix(
     if opts.max_steps == 0 {
         return Err(UpdateError::Setup("the loop needs at least one step".into()));
     }
-    let lines = opts.diagnose.lines;
     let mut current = case.clone();
     let mut steps: Vec<FixStep> = Vec::new();
     let (mut noise, mut nominal_misfit) = (f64::NAN, f64::NAN);
+    let mut next: Option<Diagnosis> = None;
     let stop = loop {
-        let d = diagnose::diagnose(&current.model, measured, &opts.diagnose)?;
-        progress(FixProgress::Diagnosed { step: steps.len(), diagnosis: &d });
+        let d = match next.take() {
+            Some(d) => d,
+            None => {
+                let d = diagnose::diagnose(&current.model, measured, &opts.diagnose)?;
+                progress(FixProgress::Diagnosed { step: steps.len(), diagnosis: &d });
+                d
+            }
+        };
         if steps.is_empty() {
             (noise, nominal_misfit) = (d.noise, d.nominal_misfit);
         }
@@ -180,46 +292,50 @@ pub fn fix(
         if steps.len() == opts.max_steps {
             break (FixStop::StepsDone, Some(d));
         }
-        let effect = d.ranking[rank - 1].clone();
-        let mut editor = d.apply(&current, rank)?;
-        let added = CaseFile::parse(&current.path, &editor.text_at(&current.path)?)?;
-        let misfit_added = effect.misfit;
-        // update every parameter of the case's [update] by output error on
-        // the diagnosis's lines
-        let mut study = Study::with_measured(added, measured.clone())?;
-        if let Some(u) = study.case.update.as_mut() {
-            u.frequencies = Some(fe_model::case::FrequencyChoice::Lines(lines));
+        let step = steps.len() + 1;
+        let leader_misfit = d.ranking[rank - 1].misfit;
+        let mut alternatives = Vec::new();
+        let added = if leader_misfit > LOOK_AHEAD_ABOVE * noise && steps.len() + 2 <= opts.max_steps {
+            let mut best: Option<(f64, Added, Diagnosis)> = None;
+            for r in distinct_leaders(&d, &current.model, LOOK_AHEAD_WIDTH) {
+                let a = add_and_update(&current, &d, r, measured, opts, step)?;
+                let ahead = diagnose::diagnose(&a.case.model, measured, &opts.diagnose)?;
+                let score = ahead.leader().map_or(a.misfit_updated, |l| l.misfit.min(a.misfit_updated));
+                alternatives.push(LookAhead { effect: a.effect.description.clone(), misfit_ahead: score });
+                progress(FixProgress::LookedAhead { step: steps.len(), ahead: alternatives.last().expect("pushed") });
+                if best.as_ref().is_none_or(|(b, ..)| score < *b) {
+                    best = Some((score, a, ahead));
+                }
+            }
+            let (_, a, ahead) = best.expect("the recommended effect is among the distinct leaders");
+            next = Some(ahead);
+            a
+        } else {
+            add_and_update(&current, &d, rank, measured, opts, step)?
+        };
+        progress(FixProgress::Updated {
+            step: steps.len(),
+            effect: &added.effect.description,
+            misfit: added.misfit_updated,
+            status: &added.outcome.status,
+        });
+        if let Some(ahead) = &next {
+            progress(FixProgress::Diagnosed { step: steps.len() + 1, diagnosis: ahead });
         }
-        let mut oe_opts = study.output_error_options()?;
-        oe_opts.max_iterations = opts.update_iterations;
-        let outcome = study.run_output_error(&oe_opts, |_| {})?;
-        let misfit_updated = diagnose::log_misfit(&outcome.system, measured, lines)?;
-        progress(FixProgress::Updated { step: steps.len(), misfit: misfit_updated, status: &outcome.status });
-        let model = outcome.system.model();
-        let values: Vec<(String, f64)> = study
-            .parameters
-            .iter()
-            .flat_map(|p| p.quantities.iter().map(|&q| (model.quantity_name(q).to_string(), model.get(q))))
-            .collect();
-        editor.set_values(&values, &format!("updated by rfm fix, step {}", steps.len() + 1))?;
-        editor.push_history(&HistoryEntry {
-            step: format!("updated after step {}", steps.len() + 1),
-            misfit: misfit_updated,
-            noise: Some(noise),
-        })?;
-        current = CaseFile::parse(&current.path, &editor.text_at(&current.path)?)?;
-        let improved = misfit_updated < steps.last().map_or(nominal_misfit, |s: &FixStep| s.misfit_updated);
+        current = added.case;
+        let improved = added.misfit_updated < steps.last().map_or(nominal_misfit, |s: &FixStep| s.misfit_updated);
         steps.push(FixStep {
-            effect,
-            misfit_added,
-            misfit_updated,
-            status: outcome.status,
-            parameters: outcome.parameters,
-            uncertainty: outcome.uncertainty,
-            case: editor,
+            misfit_added: added.effect.misfit,
+            effect: added.effect,
+            misfit_updated: added.misfit_updated,
+            status: added.outcome.status,
+            parameters: added.outcome.parameters,
+            uncertainty: added.outcome.uncertainty,
+            alternatives,
+            case: added.editor,
         });
         if !improved {
-            break (FixStop::NoImprovement, None);
+            break (FixStop::NoImprovement, next.take());
         }
     };
     let (stop, last) = stop;

@@ -66,8 +66,12 @@ pub(crate) fn fix(args: &FixArgs<'_>) -> Result<()> {
                 None if diagnosis.consistent() => format!("diagnosis {}: nothing significant", step + 1),
                 None => format!("diagnosis {}: significant effects, none at plausible values", step + 1),
             },
-            FixProgress::Updated { step, misfit, status } => {
-                format!("step {}: added and updated ({status:?}); misfit {misfit:.4e}", step + 1)
+            FixProgress::LookedAhead { ahead, .. } => format!(
+                "  looking one step ahead from {}: misfit {:.4e} after it and its best follower",
+                ahead.effect, ahead.misfit_ahead
+            ),
+            FixProgress::Updated { step, effect, misfit, status } => {
+                format!("step {}: added {effect} and updated ({status:?}); misfit {misfit:.4e}", step + 1)
             }
         };
         // an error here would be the same as at the next print, which reports it

@@ -94,6 +94,18 @@ pub(crate) fn write(study: &Study, outcome: &FixOutcome, dir: &Path, inputs: Vec
             ),
             ("case file".into(), step_file(k + 1)),
         ]));
+        if !s.alternatives.is_empty() {
+            let mut t = Table::new(&["first effect tried", "misfit after it and its best follower", "x noise"])
+                .caption(
+                    "The best single effect left more than three times the noise, so two effects may hide at once: \
+                 each of these was added and updated, the data diagnosed again, and the one whose best follower \
+                 left the smallest misfit was kept.",
+                );
+            for a in &s.alternatives {
+                t.row(vec![a.effect.clone(), sig(a.misfit_ahead, 4), format!("{:.1}", a.misfit_ahead / outcome.noise)]);
+            }
+            sec.push(Block::Table(t));
+        }
         if !e.held.is_empty() {
             sec.push(Block::Text(format!(
                 "Held at their rigid or nominal value because the data do not determine them: {}.",

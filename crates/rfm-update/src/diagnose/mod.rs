@@ -295,7 +295,7 @@ pub fn diagnose_with(
     let full = LineSet::new(&nominal, measured, opts.lines)?;
     let mut copts = opts.candidates.clone();
     copts.band_hz = (lines[0], lines[lines.len() - 1]);
-    let mut pool = Pool::new(model, &nominal, s2);
+    let mut pool = Pool::new(model, &nominal, s2, copts.band_hz);
     search::search(&mut pool, measured, &full, opts, &copts, &mut progress)?;
     Ok(rank(pool, noise, &full, opts))
 }

@@ -123,6 +123,45 @@ fn fit(
     Ok(Fit { values: r.values, cost: r.cost, cost0: lines.cost0, n: r.n_data, relative_std, determined })
 }
 
+/// Fits from `start` and, for a candidate with a relaxation parameter, also
+/// from each of `mu_starts` in its place (the other parameters as in
+/// `start`); keeps the fit of lowest cost. The misfit of a relaxation
+/// parameter has local minima: a kernel relaxing below the band acts as a
+/// stiffening, one above it as viscous damping, and a fit started on the
+/// wrong side stays there.
+fn fit_from_starts(
+    candidate: &Candidate,
+    nominal: &fe_model::Model,
+    lines: &LineSet,
+    local: Local<'_>,
+    iterations: usize,
+    start: Option<&[f64]>,
+    mu_starts: &[f64],
+) -> Result<Fit, String> {
+    let first = fit(candidate, nominal, lines, local, iterations, start);
+    let mu: Vec<usize> = (0..candidate.roles.len()).filter(|&i| candidate.roles[i] == Role::Mu).collect();
+    if mu.is_empty() || mu_starts.is_empty() {
+        return first;
+    }
+    let base: Vec<f64> = match start {
+        Some(s) => s.to_vec(),
+        None => candidate.start_values(),
+    };
+    let mut best = first;
+    for &m in mu_starts {
+        let mut s = base.clone();
+        for &i in &mu {
+            s[i] = m;
+        }
+        if let Ok(f) = fit(candidate, nominal, lines, local, iterations, Some(&s))
+            && best.as_ref().map_or(true, |b| f.cost < b.cost)
+        {
+            best = Ok(f);
+        }
+    }
+    best
+}
+
 /// The candidates of a diagnosis with their fits so far.
 pub(crate) struct Pool<'a> {
     model: &'a fe_model::Model,
@@ -139,10 +178,15 @@ pub(crate) struct Pool<'a> {
     pub(crate) superseded: Vec<bool>,
     /// Noise variance per real residual.
     s2: f64,
+    /// Starting values of relaxation parameters tried in full fits (rad/s).
+    mu_starts: Vec<f64>,
 }
 
 impl<'a> Pool<'a> {
-    pub(crate) fn new(model: &'a fe_model::Model, nominal: &'a DampedSystem, s2: f64) -> Self {
+    pub(crate) fn new(model: &'a fe_model::Model, nominal: &'a DampedSystem, s2: f64, band_hz: (f64, f64)) -> Self {
+        let (w_lo, w_hi) = (2.0 * std::f64::consts::PI * band_hz.0, 2.0 * std::f64::consts::PI * band_hz.1);
+        // below, inside and above the band's middle, log-spaced
+        let mu_starts = vec![3.0 * w_lo, (w_lo * w_hi).sqrt(), w_hi / 3.0];
         Pool {
             model,
             nominal,
@@ -153,6 +197,7 @@ impl<'a> Pool<'a> {
             failure: Vec::new(),
             superseded: Vec::new(),
             s2,
+            mu_starts,
         }
     }
 
@@ -189,6 +234,7 @@ impl<'a> Pool<'a> {
         iterations: usize,
         which: &[usize],
         starts: &[Option<Vec<f64>>],
+        mu_starts: &[f64],
     ) -> Result<Vec<Result<Fit, String>>, UpdateError> {
         let forms: Vec<_> = which.iter().filter_map(|&i| self.locals[i].as_ref().map(|l| &l.form)).collect();
         let data = LocalData::new(self.nominal, lines.data.channels(), lines.data.frequencies_hz(), &forms)?;
@@ -201,13 +247,10 @@ impl<'a> Pool<'a> {
                 let start = start.as_deref();
                 // a low-rank update that cannot be evaluated (a singular
                 // local system at some line) falls back to the whole model
-                fit(c, self.model, lines, local, iterations, start)
-                    .or_else(
-                        |e| if local.is_some() { fit(c, self.model, lines, None, iterations, start) } else { Err(e) },
-                    )
-                    .or_else(
-                        |e| if start.is_some() { fit(c, self.model, lines, None, iterations, None) } else { Err(e) },
-                    )
+                let attempt = |local, start| fit_from_starts(c, self.model, lines, local, iterations, start, mu_starts);
+                attempt(local, start)
+                    .or_else(|e| if local.is_some() { attempt(None, start) } else { Err(e) })
+                    .or_else(|e| if start.is_some() { attempt(None, None) } else { Err(e) })
             })
             .collect())
     }
@@ -215,7 +258,7 @@ impl<'a> Pool<'a> {
     /// Screens `which`: a short fit on `lines` from the starting values.
     pub(crate) fn screen(&mut self, lines: &LineSet, iterations: usize, which: &[usize]) -> Result<(), UpdateError> {
         let starts = vec![None; which.len()];
-        for (&i, f) in which.iter().zip(self.fit_all(lines, iterations, which, &starts)?) {
+        for (&i, f) in which.iter().zip(self.fit_all(lines, iterations, which, &starts, &[])?) {
             match f {
                 Ok(f) => {
                     self.screened[i] = Some(f);
@@ -238,7 +281,7 @@ impl<'a> Pool<'a> {
     ) -> Result<(), UpdateError> {
         let starts = starts
             .unwrap_or_else(|| which.iter().map(|&i| self.screened[i].as_ref().map(|f| f.values.clone())).collect());
-        for (&i, f) in which.iter().zip(self.fit_all(lines, iterations, which, &starts)?) {
+        for (&i, f) in which.iter().zip(self.fit_all(lines, iterations, which, &starts, &self.mu_starts)?) {
             match f {
                 Ok(f) => {
                     self.full[i] = Some(f);

@@ -1,6 +1,7 @@
 //! Integration tests of rfm-update.
 
 mod fast_vs_naive;
+mod held_out;
 mod hidden_effects;
 mod numerics;
 mod output_error;

@@ -112,7 +112,8 @@ impl<'a> Ctx<'a> {
             name,
             role: Role::Alpha,
             bounds: Some((1e-9 / self.w_max, 10.0 / self.w_min)),
-            plausible: (0.0, 1.0 / self.w_max, "a loss factor above 1 in the band"),
+            // judged with mu by `Candidate::implausible`
+            plausible: (0.0, f64::INFINITY, ""),
         }
     }
 
@@ -365,7 +366,8 @@ fn supports(ctx: &Ctx<'_>, node: u32) -> Vec<Spec> {
                     name: format!("spring.{name}.{}", ["kx", "ky", "kr"][d.index()]),
                     role: Role::Spring(d),
                     bounds: Some((1e-6 * r, 1e4 * r)),
-                    plausible: (0.0, 10.0 * r, "stiffer than the member it holds"),
+                    // a spring far stiffer than the member is as good as rigid, not implausible
+                    plausible: (0.0, f64::INFINITY, ""),
                 }
             })
             .collect();
@@ -412,7 +414,7 @@ fn joint(ctx: &Ctx<'_>, node: u32, beams: &[usize], in_line: bool, translational
             name: format!("spring.{name}.{}", ["kx", "ky", "kr"][d.index()]),
             role: Role::Spring(d),
             bounds: Some((1e-6 * r, 1e4 * r)),
-            plausible: (0.0, 10.0 * r, "stiffer than the members it joins"),
+            plausible: (0.0, f64::INFINITY, ""),
         });
     }
     fitted.push(ctx.alpha(format!("group.{name}.alpha")));
@@ -498,7 +500,7 @@ fn existing_joints(ctx: &Ctx<'_>) -> Vec<Spec> {
                     name: format!("spring.{}.{}", sp.name, ["kx", "ky", "kr"][d.index()]),
                     role: Role::Spring(d),
                     bounds: Some((1e-6 * r, 1e4 * r)),
-                    plausible: (0.0, 10.0 * r, "stiffer than the members it joins"),
+                    plausible: (0.0, f64::INFINITY, ""),
                 }
             })
             .collect();
@@ -542,8 +544,16 @@ fn mass_nodes(ctx: &Ctx<'_>) -> Vec<u32> {
 
 /// Makes the candidates of `specs`, in parallel and in order: each takes its
 /// part of the model.
-fn build(model: &Model, specs: Vec<Spec>) -> Vec<Candidate> {
-    specs.into_par_iter().filter_map(|(head, edit, fitted)| Candidate::new(model, head, edit, fitted)).collect()
+fn build(ctx: &Ctx<'_>, specs: Vec<Spec>) -> Vec<Candidate> {
+    let band = (ctx.w_min, ctx.w_max);
+    specs
+        .into_par_iter()
+        .filter_map(|(head, edit, fitted)| {
+            let mut c = Candidate::new(ctx.model, head, edit, fitted)?;
+            c.band_rad = band;
+            Some(c)
+        })
+        .collect()
 }
 
 /// Generates the first pass of candidates for a model; see the module docs.
@@ -602,7 +612,7 @@ pub fn generate(model: &Model, opts: &CandidateOptions) -> Vec<Candidate> {
             }
         }
     }
-    build(model, specs)
+    build(&ctx, specs)
 }
 
 /// Candidates around the given leaders that the first pass did not try
@@ -661,5 +671,5 @@ pub(crate) fn refine(
     }
     let mut seen = tried.clone();
     specs.retain(|(h, ..)| seen.insert(h.description.clone()));
-    build(model, specs)
+    build(&ctx, specs)
 }

@@ -124,6 +124,8 @@ pub struct Candidate {
     /// Parameters of a fuller variant that the data did not determine and
     /// that this candidate holds at their rigid or nominal value (names).
     pub held: Vec<String>,
+    /// The band of the data (rad/s), where damping is judged for plausibility.
+    pub(crate) band_rad: (f64, f64),
     pub(crate) edit: Edit,
     /// The nominal nodes of every element, spring and mass the change touches.
     part_nodes: Vec<u32>,
@@ -193,6 +195,7 @@ impl Candidate {
             bounds: fitted.iter().map(|f| f.bounds).collect(),
             plausible: fitted.iter().map(|f| f.plausible).collect(),
             held: Vec::new(),
+            band_rad: (0.0, f64::INFINITY),
             edit,
             part_nodes: head.part_nodes,
             nominal_part,
@@ -210,6 +213,12 @@ impl Candidate {
     /// The parameters to fit, resolved in `model` ([`Self::model`] or a part of it).
     pub fn parameters_in(&self, model: &Model) -> Result<Vec<Parameter>, ModelError> {
         self.parameters.iter().map(|n| model.parameter(n)).collect()
+    }
+
+    /// The parameters' starting values (those of [`Self::part`]).
+    pub(crate) fn start_values(&self) -> Vec<f64> {
+        let params = self.parameters_in(&self.part).expect("resolved when the candidate was made");
+        params.iter().map(|p| self.part.get(p.quantities[0])).collect()
     }
 
     /// The part of the nominal model that the effect touches, with the
@@ -291,17 +300,31 @@ impl Candidate {
             part_nodes: self.part_nodes.clone(),
         };
         let mut c = Candidate::new(model, head, edit, fitted)?;
+        c.band_rad = self.band_rad;
         c.held = self.held.iter().cloned().chain(dropped.iter().map(|&i| self.parameters[i].clone())).collect();
         Some(c)
     }
 
     /// The first plausibility problem of the given values, if any, judged
     /// only on the parameters that `determined` marks (a value the data do
-    /// not determine says nothing about the structure).
+    /// not determine says nothing about the structure). Damping is judged by
+    /// its largest loss factor in the band, which for an exponential kernel
+    /// depends on alpha and mu together: `alpha w mu^2 / (mu^2 + w^2)`, at
+    /// most `alpha mu / 2`, reached at `w = mu`.
     pub fn implausible(&self, values: &[f64], determined: &[bool]) -> Option<String> {
+        let mu = self.roles.iter().position(|&r| r == Role::Mu).map(|i| values[i]);
         (0..self.parameters.len()).filter(|&i| determined[i]).find_map(|i| {
-            let (lo, hi, why) = self.plausible[i];
             let v = values[i];
+            if self.roles[i] == Role::Alpha {
+                let eta = max_loss_factor(v, mu, self.band_rad);
+                return (eta > 1.0).then(|| {
+                    format!(
+                        "{} = {v:.4e} is not plausible: a loss factor of {eta:.2} (above 1) in the band",
+                        self.parameters[i]
+                    )
+                });
+            }
+            let (lo, hi, why) = self.plausible[i];
             (v < lo || v > hi).then(|| format!("{} = {v:.4e} is not plausible: {why}", self.parameters[i]))
         })
     }
@@ -337,6 +360,20 @@ impl Candidate {
                 .nodes
                 .iter()
                 .any(|&n| model.beams_at(NodeId(n)).into_iter().any(|i| elements.contains(&model.beams()[i].id.0)))
+    }
+}
+
+/// The largest loss factor of damping `alpha` (with relaxation parameter
+/// `mu`, viscous when `None`) over the band `(w_lo, w_hi)` (rad/s): the
+/// ratio of the imaginary to the real part of `1 + j w h(w) alpha`, to first
+/// order, `alpha w mu^2 / (mu^2 + w^2)`, which rises to `w = mu` and falls after.
+pub(crate) fn max_loss_factor(alpha: f64, mu: Option<f64>, (w_lo, w_hi): (f64, f64)) -> f64 {
+    match mu {
+        None => alpha * w_hi,
+        Some(mu) => {
+            let w = mu.clamp(w_lo, w_hi);
+            alpha * w * mu * mu / (mu * mu + w * w)
+        }
     }
 }
 

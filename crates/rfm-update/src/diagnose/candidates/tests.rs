@@ -111,3 +111,27 @@ fn large_models_refine_windows_and_variants_around_the_leaders() {
     assert!(refined.iter().any(|c| c.description == "lumped mass with rotary inertia at node 20"));
     assert!(refined.iter().all(|c| !tried.contains(&c.description)));
 }
+
+/// The largest loss factor over the band equals a brute-force search of
+/// `Im / Re` of the kernel factor `1 + j w h(w) alpha` to first order, for
+/// relaxation parameters below, inside and above the band and viscous.
+#[test]
+fn the_largest_loss_factor_is_found_over_the_band() {
+    let band = (2.0 * std::f64::consts::PI * 5.0, 2.0 * std::f64::consts::PI * 500.0);
+    let alpha = 2e-4;
+    for mu in [Some(3.0), Some(100.0), Some(1000.0), Some(1e5), None] {
+        let brute = (0..=20000)
+            .map(|k| band.0 * (band.1 / band.0).powf(k as f64 / 20000.0))
+            .map(|w| {
+                let h = match mu {
+                    Some(m) => num_complex::Complex64::new(m, 0.0) / num_complex::Complex64::new(m, w),
+                    None => num_complex::Complex64::new(1.0, 0.0),
+                };
+                // the imaginary part of j w h alpha is the loss factor to first order
+                (num_complex::Complex64::new(0.0, w) * h * alpha).im
+            })
+            .fold(0.0, f64::max);
+        let got = max_loss_factor(alpha, mu, band);
+        assert!((got / brute - 1.0).abs() < 1e-6, "mu {mu:?}: {got} vs {brute}");
+    }
+}

@@ -1,0 +1,270 @@
+//! The hidden-effect test that cannot be tuned to the candidate generator:
+//! truths written as case files by [`crate::truths`] (which shares no code
+//! with the diagnosis), drawn from families wider than the candidates,
+//! measured with 1 % noise as receptance or accelerance at translational
+//! DOFs, and put through the whole loop of `rfm fix`
+//! ([`rfm_update::fix::fix`]): diagnose, add the recommended effect, update,
+//! again until nothing significant remains.
+//!
+//! Criteria (issue "Close the loop on the effects the paper is about"),
+//! printed with a confusion table:
+//!
+//! - the first recommended effect is of the right kind at the right place
+//!   (one node or element either side allowed) in at least 90 % of the
+//!   trials with effects (in a pair trial, either effect counts);
+//! - after the loop the misfit is within 1.5 times the noise in at least 85 %;
+//! - the true stiffness and mass values lie within 3 reported standard
+//!   deviations in at least 85 % of the trials that have such values and
+//!   whose effect was found at exactly its place;
+//! - in pair trials both effects are found in at least 80 %;
+//! - in null trials (2 % noise) nothing is significant in at least 95 %.
+//!
+//! `HELD_OUT_SINGLE` (per family, default 12), `HELD_OUT_PAIRS` (default
+//! 16) and `HELD_OUT_NULL` (default 20) change the numbers of trials.
+
+use std::collections::BTreeMap;
+
+use fe_model::{CaseFile, Model};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rfm_update::diagnose::{self, DiagnoseOptions, EffectKind, Ranked, Role};
+use rfm_update::fix::{FixOptions, FixOutcome, fix};
+
+use crate::truths::{self, Family, HiddenEffect, Truth};
+
+/// The relative noise of the measurements.
+const NOISE: f64 = 0.01;
+
+fn count(var: &str, default: usize) -> usize {
+    std::env::var(var).ok().and_then(|v| v.parse().ok()).unwrap_or(default)
+}
+
+/// The candidate kinds that represent a hidden family.
+fn kinds_of(f: Family) -> &'static [EffectKind] {
+    match f {
+        Family::Support => &[EffectKind::FlexibleSupport],
+        Family::Joint | Family::Splice => &[EffectKind::FlexibleJoint],
+        Family::DampingPatch => &[EffectKind::ViscousDamping, EffectKind::NonViscousDamping],
+        Family::Mass => &[EffectKind::LumpedMass],
+        Family::StiffnessLoss => &[EffectKind::StiffnessChange],
+    }
+}
+
+/// Whether a ranked effect is of the hidden effect's kind at its place (one
+/// node or element of slack, through the nominal model's connectivity).
+fn matches(r: &Ranked, h: &HiddenEffect, model: &Model) -> bool {
+    kinds_of(h.family).contains(&r.kind) && near(r, h, model)
+}
+
+fn near(r: &Ranked, h: &HiddenEffect, model: &Model) -> bool {
+    let beams_at = |n: u32| model.beams_at(fe_model::NodeId(n));
+    let ends = |e: u32| model.beam_index(fe_model::ElementId(e)).map(|i| model.beams()[i].nodes.map(|n| n.0));
+    // the hidden effect's nodes and elements, and their neighbours
+    let mut nodes: Vec<u32> = h.nodes.clone();
+    let mut elements: Vec<u32> = h.elements.clone();
+    for &n in &h.nodes {
+        for i in beams_at(n) {
+            elements.push(model.beams()[i].id.0);
+            nodes.extend(model.beams()[i].nodes.map(|x| x.0));
+        }
+    }
+    for &e in &h.elements {
+        for n in ends(e).into_iter().flatten() {
+            nodes.push(n);
+            elements.extend(beams_at(n).into_iter().map(|i| model.beams()[i].id.0));
+        }
+    }
+    r.nodes.iter().any(|n| nodes.contains(n)) || r.elements.iter().any(|e| elements.contains(e))
+}
+
+/// Whether the ranked effect sits exactly where the hidden one does.
+fn exact(r: &Ranked, h: &HiddenEffect) -> bool {
+    if h.elements.is_empty() {
+        r.nodes.first() == h.nodes.first()
+    } else {
+        let mut a = r.elements.clone();
+        a.sort_unstable();
+        a == h.elements
+    }
+}
+
+/// The true value of a fitted parameter's role, when the hidden effect has one.
+fn truth_of(role: Role, h: &HiddenEffect) -> Option<f64> {
+    match role {
+        Role::Spring(d) => h.value(["kx", "ky", "kr"][d.index()]),
+        Role::Mass => h.value("m"),
+        Role::Inertia => h.value("j"),
+        Role::StiffnessFactor => h.value("factor"),
+        Role::MassFactor | Role::Alpha | Role::Mu => None,
+    }
+}
+
+struct Trial {
+    label: String,
+    family: String,
+    first: Option<Ranked>,
+    first_ok: bool,
+    outcome: FixOutcome,
+    found: Vec<bool>,
+    /// `None`: no comparable stiffness or mass value.
+    values_ok: Option<bool>,
+    detail: String,
+}
+
+fn run(truth: &Truth, seed: u64, opts: &FixOptions) -> Trial {
+    let case_text = format!("{}{}", truth.nominal, truth.measurement_table("measured.csv"));
+    let case = CaseFile::parse(std::path::Path::new("held-out/nominal.toml"), &case_text).expect("nominal case");
+    let data = truth.measure(NOISE, seed);
+    // HELD_OUT_DUMP=DIR writes each trial as a case with its data, to run rfm on
+    if let Ok(dir) = std::env::var("HELD_OUT_DUMP") {
+        let dir = std::path::Path::new(&dir).join(format!("trial-{seed}"));
+        std::fs::create_dir_all(&dir).expect("dump folder");
+        std::fs::write(dir.join("nominal.toml"), &case_text).expect("dump");
+        std::fs::write(dir.join("truth.toml"), &truth.truth).expect("dump");
+        std::fs::write(dir.join("measured.csv"), frf::io::csv::to_csv_string(&data)).expect("dump");
+    }
+    let measured = data.to_receptance();
+    let mut first: Option<Ranked> = None;
+    let outcome = fix(&case, &measured, opts, |p| {
+        if let rfm_update::fix::FixProgress::Diagnosed { step: 0, diagnosis } = p {
+            first = diagnosis.leader().cloned();
+        }
+    })
+    .expect("the loop runs");
+    let model = &case.model;
+    let first_ok = first.as_ref().is_some_and(|r| truth.effects.iter().any(|h| matches(r, h, model)));
+    let found: Vec<bool> =
+        truth.effects.iter().map(|h| outcome.steps.iter().any(|s| matches(&s.effect, h, model))).collect();
+    // true stiffness and mass values against the final update's, for the
+    // effects found at exactly their place
+    let mut values_ok: Option<bool> = None;
+    let mut detail = String::new();
+    if let Some(last) = outcome.steps.last() {
+        for h in &truth.effects {
+            let Some(step) = outcome.steps.iter().find(|s| matches(&s.effect, h, model) && exact(&s.effect, h)) else {
+                continue;
+            };
+            for p in step.effect.parameters.iter().filter(|p| p.role.is_stiffness_or_mass()) {
+                let Some(t) = truth_of(p.role, h) else { continue };
+                let Some(i) = last.parameters.iter().position(|q| q.name == p.name) else { continue };
+                let value = last.parameters[i].updated;
+                let sd = last.uncertainty.as_ref().map_or(f64::NAN, |u| u.parameters[i].relative_std);
+                let z = (value / t).ln().abs() / sd;
+                let ok = z <= 3.0;
+                values_ok = Some(values_ok.unwrap_or(true) && ok);
+                detail.push_str(&format!(" {}: {value:.4e} vs {t:.4e} ({z:.1} sd)", p.name));
+            }
+        }
+    }
+    Trial {
+        label: truth.label.clone(),
+        family: if truth.effects.len() == 2 { "pair".into() } else { format!("{:?}", truth.effects[0].family) },
+        first,
+        first_ok,
+        outcome,
+        found,
+        values_ok,
+        detail,
+    }
+}
+
+fn kind_name(r: &Option<Ranked>) -> String {
+    r.as_ref().map_or("none".into(), |r| format!("{:?}", r.kind))
+}
+
+#[test]
+fn the_loop_finds_and_fixes_held_out_effects() {
+    let singles = count("HELD_OUT_SINGLE", 12);
+    let pairs = count("HELD_OUT_PAIRS", 16);
+    let opts = FixOptions { max_steps: 3, ..FixOptions::default() };
+    let mut rng = ChaCha8Rng::seed_from_u64(2611);
+    let mut trials: Vec<Trial> = Vec::new();
+    let mut draws: Vec<Truth> = Vec::new();
+    for family in Family::ALL {
+        for _ in 0..singles {
+            draws.push(truths::draw(&mut rng, Some(family), false));
+        }
+    }
+    for _ in 0..pairs {
+        draws.push(truths::draw(&mut rng, None, true));
+    }
+    for (i, t) in draws.iter().enumerate() {
+        let trial = run(t, 7000 + i as u64, &opts);
+        let o = &trial.outcome;
+        println!(
+            "{:>3} {:<60} first: {:<58} ok {} | steps {} misfit {:.2} x noise | found {:?} | values {:?}{}",
+            i,
+            trial.label,
+            trial.first.as_ref().map_or("none".into(), |r| r.description.clone()),
+            trial.first_ok,
+            o.steps.len(),
+            o.final_misfit() / NOISE,
+            trial.found,
+            trial.values_ok,
+            trial.detail
+        );
+        trials.push(trial);
+    }
+
+    // the confusion table: hidden family against the first recommended kind
+    let mut table: BTreeMap<String, BTreeMap<String, usize>> = BTreeMap::new();
+    for t in &trials {
+        *table.entry(t.family.clone()).or_default().entry(kind_name(&t.first)).or_default() += 1;
+    }
+    let columns: Vec<String> = {
+        let mut c: Vec<String> = table.values().flat_map(|r| r.keys().cloned()).collect();
+        c.sort();
+        c.dedup();
+        c
+    };
+    println!("\nfirst recommendation by hidden family (rows) and recommended kind (columns):");
+    println!("{:<14}{}", "", columns.iter().map(|c| format!("{c:>20}")).collect::<String>());
+    for (f, row) in &table {
+        println!(
+            "{f:<14}{}",
+            columns.iter().map(|c| format!("{:>20}", row.get(c).copied().unwrap_or(0))).collect::<String>()
+        );
+    }
+
+    let n = trials.len();
+    let first_ok = trials.iter().filter(|t| t.first_ok).count();
+    let fixed = trials.iter().filter(|t| t.outcome.final_misfit() <= 1.5 * NOISE).count();
+    let with_values: Vec<bool> = trials.iter().filter_map(|t| t.values_ok).collect();
+    let values_ok = with_values.iter().filter(|&&v| v).count();
+    let pair_trials: Vec<&Trial> = trials.iter().filter(|t| t.found.len() == 2).collect();
+    let both = pair_trials.iter().filter(|t| t.found.iter().all(|&f| f)).count();
+    println!("\nright kind at the right place first: {first_ok}/{n}");
+    println!("misfit within 1.5 x noise after the loop: {fixed}/{n}");
+    println!("true stiffness and mass within 3 sd: {values_ok}/{}", with_values.len());
+    println!("both effects found in pair trials: {both}/{}", pair_trials.len());
+    let rate = |k: usize, n: usize| k as f64 / n.max(1) as f64;
+    assert!(n >= 80 || std::env::var("HELD_OUT_SINGLE").is_ok(), "at least 80 trials with effects");
+    assert!(rate(first_ok, n) >= 0.90, "right kind and place first in {first_ok}/{n}");
+    assert!(rate(fixed, n) >= 0.85, "misfit within 1.5 x noise in {fixed}/{n}");
+    assert!(rate(values_ok, with_values.len()) >= 0.85, "values within 3 sd in {values_ok}/{}", with_values.len());
+    assert!(rate(both, pair_trials.len()) >= 0.80, "both effects found in {both}/{}", pair_trials.len());
+}
+
+#[test]
+fn null_trials_find_nothing_significant() {
+    let trials = count("HELD_OUT_NULL", 20);
+    let mut rng = ChaCha8Rng::seed_from_u64(2612);
+    let mut quiet = 0;
+    for i in 0..trials {
+        let t = truths::null(&mut rng);
+        let measured = t.measure(2.0 * NOISE, 9000 + i as u64).to_receptance();
+        let d = diagnose::diagnose(&t.nominal_case().model, &measured, &DiagnoseOptions::default()).unwrap();
+        let top = &d.ranking[0];
+        println!(
+            "null {i:>2} ({:?}): noise estimate {:.4}, top {} (dBIC {:.1}), consistent {}",
+            t.structure,
+            d.noise,
+            top.description,
+            top.delta_bic,
+            d.consistent()
+        );
+        quiet += usize::from(d.consistent());
+    }
+    println!("null trials without a significant candidate: {quiet}/{trials}");
+    assert!(quiet as f64 >= 0.95 * trials as f64, "false alarms in {} of {trials} null trials", trials - quiet);
+}
