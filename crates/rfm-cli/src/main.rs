@@ -85,6 +85,9 @@ enum Command {
         /// Rows of the ranking to print.
         #[arg(long, default_value_t = 10)]
         top: usize,
+        /// Print each stage of the search with its time on standard error.
+        #[arg(long)]
+        verbose: bool,
     },
     /// Close the loop: diagnose, add the recommended effect, update, and again
     /// until nothing significant remains; the case after every step and a report.
@@ -203,14 +206,17 @@ fn main() -> ExitCode {
         Command::Compare { case, measured, out, json, bands } => {
             commands::compare(&case, &measured, out.as_deref(), json, &bands)
         }
-        Command::Diagnose { case, measured, json, apply, out, top } => commands::diagnose(&commands::DiagnoseArgs {
-            case: &case,
-            measured: measured.as_deref(),
-            json,
-            apply,
-            out: out.as_deref(),
-            top,
-        }),
+        Command::Diagnose { case, measured, json, apply, out, top, verbose } => {
+            commands::diagnose(&commands::DiagnoseArgs {
+                case: &case,
+                measured: measured.as_deref(),
+                json,
+                apply,
+                out: out.as_deref(),
+                top,
+                verbose,
+            })
+        }
         Command::Fix { case, out, steps, json } => {
             commands::fix(&commands::FixArgs { case: &case, out: &out, steps: steps as usize, json })
         }

@@ -18,6 +18,7 @@ pub(crate) struct DiagnoseArgs<'a> {
     pub(crate) apply: Option<usize>,
     pub(crate) out: Option<&'a Path>,
     pub(crate) top: usize,
+    pub(crate) verbose: bool,
 }
 
 pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<()> {
@@ -59,7 +60,11 @@ pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<()> {
     bar.enable_steady_tick(std::time::Duration::from_millis(120));
     let start = std::time::Instant::now();
     let d = diagnose_with(&study.case.model, &measured, &DiagnoseOptions::default(), |stage| {
-        bar.set_message(format!("{stage} ({:.1} s)", start.elapsed().as_secs_f64()));
+        let line = format!("{stage} ({:.2} s)", start.elapsed().as_secs_f64());
+        if args.verbose {
+            bar.suspend(|| eprintln!("{line}"));
+        }
+        bar.set_message(line);
     })?;
     bar.finish_and_clear();
     if args.json {

@@ -10,7 +10,7 @@ use rayon::prelude::*;
 
 use super::candidates::{self, Candidate, CandidateOptions, EffectKind, Role};
 use super::local::{LocalCandidate, LocalData};
-use super::{DiagnoseOptions, spread};
+use super::{DiagnoseOptions, informative};
 use crate::error::UpdateError;
 use crate::oe::{self, Misfit, OeData, OeOptions};
 use crate::params::ParameterSet;
@@ -44,7 +44,7 @@ pub(crate) struct LineSet {
 
 impl LineSet {
     pub(crate) fn new(nominal: &DampedSystem, measured: &FrfSet, n_lines: usize) -> Result<Self, UpdateError> {
-        let data = measured.at_frequencies(&spread(measured.frequencies_hz(), n_lines))?;
+        let data = measured.at_frequencies(&informative(measured, n_lines))?;
         let model = frf::synthesize(nominal, data.channels(), data.frequencies_hz())?;
         let (mut cost, mut n) = (0.0, 0);
         for (h, m) in model.values().iter().zip(data.values()) {

@@ -132,6 +132,11 @@ fn run(truth: &Truth, seed: u64, opts: &FixOptions) -> Trial {
     })
     .expect("the loop runs");
     let model = &case.model;
+    // the loop's first effect (it may look one step ahead past the first
+    // diagnosis's leader), else what the first diagnosis recommended
+    if let Some(s) = outcome.steps.first() {
+        first = Some(s.effect.clone());
+    }
     let first_ok = first.as_ref().is_some_and(|r| truth.effects.iter().any(|h| matches(r, h, model)));
     let found: Vec<bool> =
         truth.effects.iter().map(|h| outcome.steps.iter().any(|s| matches(&s.effect, h, model))).collect();
