@@ -305,16 +305,6 @@ pub(crate) fn informative(measured: &FrfSet, n: usize) -> Vec<f64> {
     lines.to_vec()
 }
 
-#[cfg(test)]
-pub(crate) fn spread(lines: &[f64], n: usize) -> Vec<f64> {
-    if n >= lines.len() {
-        return lines.to_vec();
-    }
-    let mut idx: Vec<usize> =
-        (0..n).map(|i| (i as f64 * (lines.len() - 1) as f64 / (n - 1).max(1) as f64).round() as usize).collect();
-    idx.dedup();
-    idx.into_iter().map(|k| lines[k]).collect()
-}
 
 /// The misfit the diagnosis, `rfm fix` and the case history speak of: the
 /// RMS of `ln(H / M)` per complex value of a system's receptances `H`
