@@ -147,12 +147,53 @@ pub(crate) fn non_finite_word(token: &str) -> Option<f64> {
     if matches!(bare.as_str(), "nan" | "inf" | "infinity") { token.to_ascii_lowercase().parse().ok() } else { None }
 }
 
+/// What makes a file the same file however it is reached: its device and
+/// inode on unix, so that a second mount point, a hard link or a symlink
+/// to an input is still recognised as that input (comparing resolved paths
+/// misses the first two); elsewhere its canonical path, the best std offers.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct FileId {
+    #[cfg(unix)]
+    dev: u64,
+    #[cfg(unix)]
+    ino: u64,
+    #[cfg(not(unix))]
+    path: PathBuf,
+}
+
+impl FileId {
+    /// The identity of the file at `path` (following symlinks), or `None`
+    /// when there is no such file.
+    pub fn of(path: &Path) -> Option<FileId> {
+        let meta = std::fs::metadata(path).ok()?;
+        Some(FileId::from_metadata(path, &meta))
+    }
+
+    /// The identity of an open file.
+    pub fn of_file(file: &std::fs::File, path: &Path) -> Option<FileId> {
+        let meta = file.metadata().ok()?;
+        Some(FileId::from_metadata(path, &meta))
+    }
+
+    #[cfg(unix)]
+    fn from_metadata(_path: &Path, meta: &std::fs::Metadata) -> FileId {
+        use std::os::unix::fs::MetadataExt;
+        FileId { dev: meta.dev(), ino: meta.ino() }
+    }
+
+    #[cfg(not(unix))]
+    fn from_metadata(path: &Path, _meta: &std::fs::Metadata) -> FileId {
+        FileId { path: path.canonicalize().unwrap_or_else(|_| path.to_path_buf()) }
+    }
+}
+
 /// Fails if one of `outputs` is one of `inputs` (the same file, however
-/// named), so that a command can refuse before it does any work.
+/// named: see [`FileId`]), so that a command can refuse before it does any
+/// work. Outputs that do not exist yet cannot be inputs.
 pub fn refuse_inputs(outputs: &[PathBuf], inputs: &[PathBuf]) -> Result<(), FrfError> {
+    let inputs: Vec<FileId> = inputs.iter().filter_map(|p| FileId::of(p)).collect();
     for path in outputs {
-        let Ok(target) = path.canonicalize() else { continue };
-        if inputs.iter().any(|input| input.canonicalize().is_ok_and(|i| i == target)) {
+        if FileId::of(path).is_some_and(|id| inputs.contains(&id)) {
             return Err(FrfError::Io {
                 path: path.to_path_buf(),
                 message: "refusing to overwrite an input file; choose another output path".into(),
@@ -203,5 +244,24 @@ mod tests {
         assert_eq!(std::fs::read_to_string(&out).unwrap(), "two");
         // no temporary files are left behind
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    /// A hard link is another path to the same file: comparing resolved
+    /// paths would let an output replace the input through it (as a second
+    /// mount point of the same folder would); device and inode do not.
+    #[test]
+    fn an_input_reached_through_a_hard_link_is_recognised() {
+        let dir = tempfile::tempdir().unwrap();
+        let input = dir.path().join("case.toml");
+        std::fs::write(&input, "x").unwrap();
+        let link = dir.path().join("other-name.toml");
+        std::fs::hard_link(&input, &link).unwrap();
+        assert_ne!(link.canonicalize().unwrap(), input.canonicalize().unwrap());
+        let e = refuse_inputs(std::slice::from_ref(&link), std::slice::from_ref(&input)).unwrap_err();
+        assert!(e.to_string().contains("other-name.toml: refusing to overwrite an input"), "{e}");
+        let e = atomic_write(&link, b"y", std::slice::from_ref(&input)).unwrap_err();
+        assert!(e.to_string().contains("refusing to overwrite an input"), "{e}");
+        assert_eq!(std::fs::read_to_string(&input).unwrap(), "x");
+        refuse_inputs(&[dir.path().join("new.toml")], std::slice::from_ref(&input)).unwrap();
     }
 }

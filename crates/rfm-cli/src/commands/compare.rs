@@ -17,9 +17,11 @@ use rfm_update::{Study, UpdateError};
 use serde::Serialize;
 
 use super::{Result, load_case, print_masked};
+use crate::exit::Exit;
+use crate::output::Outputs;
 use crate::report::html::{self, Block, Report, Section, Tone};
 use crate::report::json::CorrelationJson;
-use crate::report::{self, ModelFrfs, Output, plot, sig, signed};
+use crate::report::{self, ModelFrfs, plot, sig, signed};
 use crate::table::Table;
 
 /// Number of overlay figures.
@@ -283,17 +285,12 @@ pub(crate) fn compare(
     out: Option<&Path>,
     json: bool,
     bands: &str,
-) -> Result<()> {
-    if out.is_some() {
-        crate::files_to_write();
-    }
+) -> Result<Exit> {
     let spec = parse_bands(bands)?;
     let case = load_case(case_path)?;
     let mut inputs = case.inputs();
     inputs.extend(measured_files.iter().cloned());
-    if let Some(dir) = out {
-        frf::io::refuse_inputs(&[dir.join("compare.json"), dir.join("report.html")], &inputs)?;
-    }
+    let output = out.map(|dir| Outputs::folder(dir, &inputs, &["compare.json", "report.html"])).transpose()?;
     let system = DampedSystem::new(case.model.clone())?;
     let (case, measured, source, masked) = measured_data(case, &system, measured_files)?;
     print_masked(&masked, json)?;
@@ -325,20 +322,19 @@ pub(crate) fn compare(
             Err(e) => outln!("\nmodes not compared: {e}"),
         }
     }
-    if let Some(dir) = out {
-        let _writing = crate::writing();
-        let mut output = Output::new(dir, inputs);
+    if let Some(mut output) = output {
         let path = output.write("compare.json", serde_json::to_string_pretty(&doc)?.as_bytes())?;
         let model = ModelFrfs { label: "model".into(), colour: plot::UPDATED, frfs, correlation };
         let mut report = Report::new(format!("{}: model against measurement", case.model.title));
         report.subtitle = Some(format!("rfm compare, case file {}", case_path.display()));
         report.sections = report_sections(&case, &measured, &source, &model, &doc.modes, &mut output)?;
         let html = output.write("report.html", report.render().as_bytes())?;
+        let written = output.commit()?;
         if !json {
-            outln!("\nwrote {}, {} and {} figures", path.display(), html.display(), output.written().len() - 2);
+            outln!("\nwrote {}, {} and {} figures", path.display(), html.display(), written.len() - 2);
         }
     }
-    Ok(())
+    Ok(Exit::Success)
 }
 
 /// The report's sections, in order. A modal comparison goes in before the
@@ -349,7 +345,7 @@ fn report_sections(
     source: &str,
     model: &ModelFrfs,
     modes: &std::result::Result<ModesJson, String>,
-    out: &mut Output,
+    out: &mut Outputs,
 ) -> Result<Vec<Section>> {
     let c = &model.correlation;
     let mut sections = vec![summary(case, measured, source, c)];

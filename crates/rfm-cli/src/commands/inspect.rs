@@ -7,9 +7,10 @@ use frf::io::uff::{self, Record58};
 use serde_json::{Value, json};
 
 use super::Result;
+use crate::exit::Exit;
 use crate::table::{Table, num};
 
-pub(crate) fn inspect(file: &Path, json: bool) -> Result<()> {
+pub(crate) fn inspect(file: &Path, json: bool) -> Result<Exit> {
     let report = match frf::io::detect_format(file)? {
         MeasuredFormat::Uff => uff_report(file)?,
         MeasuredFormat::Csv => csv_report(file)?,
@@ -19,7 +20,7 @@ pub(crate) fn inspect(file: &Path, json: bool) -> Result<()> {
     } else {
         print_report(&report)?;
     }
-    Ok(())
+    Ok(Exit::Success)
 }
 
 fn uff_report(file: &Path) -> Result<Value> {

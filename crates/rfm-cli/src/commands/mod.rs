@@ -10,16 +10,19 @@ use std::path::Path;
 
 use fe_model::CaseFile;
 
+use crate::exit::Failure;
+
 pub(crate) use compare::compare;
 pub(crate) use diagnose::{DiagnoseArgs, diagnose};
 pub(crate) use inspect::inspect;
 pub(crate) use simulate::simulate;
 pub(crate) use update::{Overrides as UpdateOverrides, update};
 
-pub(crate) type Result<T> = std::result::Result<T, Box<dyn std::error::Error>>;
+/// A command's result: its exit code, or why it failed (see [`crate::exit`]).
+pub(crate) type Result<T> = std::result::Result<T, Failure>;
 
 pub(crate) fn load_case(path: &Path) -> Result<CaseFile> {
-    CaseFile::load(path).map_err(|e| e.render().into())
+    Ok(CaseFile::load(path)?)
 }
 
 /// Tells what the case's `[measurement] mask` left out of the measured data:

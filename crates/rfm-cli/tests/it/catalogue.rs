@@ -54,7 +54,15 @@ struct Entry {
     /// `file:LINE:` with the line of the first occurrence of `text` in
     /// that file.
     expect: Vec<&'static str>,
+    /// The exit code (see `rfm --help`): 3 for invalid input, 4 for failed
+    /// numerics.
+    code: i32,
 }
+
+/// Exit code of invalid input.
+const INVALID_INPUT: i32 = 3;
+/// Exit code of failed numerics.
+const NUMERICS: i32 = 4;
 
 fn replaced(from: &str, to: &str) -> String {
     assert!(BEAM.contains(from), "{from}");
@@ -67,7 +75,13 @@ fn case(text: String) -> Vec<(&'static str, Vec<u8>)> {
 
 /// A case file entry run with `rfm simulate`.
 fn bad_case(what: &'static str, text: String, expect: Vec<&'static str>) -> Entry {
-    Entry { what, files: case(text), args: vec!["simulate", "{dir}/cat.toml", "--out", "{dir}/h.csv"], expect }
+    Entry {
+        what,
+        files: case(text),
+        args: vec!["simulate", "{dir}/cat.toml", "--out", "{dir}/h.csv"],
+        expect,
+        code: INVALID_INPUT,
+    }
 }
 
 /// Measured receptances of the beam at 10, 20, ... 100 Hz, for the 3:uy
@@ -94,7 +108,7 @@ fn bad_data(what: &'static str, name: &'static str, data: String, extra: &str, e
     let text = format!("{BEAM}data = \"{name}\"\n{extra}");
     let mut files = case(text);
     files.push((name, data.into_bytes()));
-    Entry { what, files, args: vec!["compare", "{dir}/cat.toml"], expect }
+    Entry { what, files, args: vec!["compare", "{dir}/cat.toml"], expect, code: INVALID_INPUT }
 }
 
 /// Line `n` (1-based) of `text` replaced by `f(line)`.
@@ -277,6 +291,7 @@ fn catalogue() -> Vec<Entry> {
             )),
             args: vec!["simulate", "{dir}/cat.toml", "--out", "{dir}/h.csv"],
             expect: vec!["singular at 15.915494309189533 Hz"],
+            code: NUMERICS,
         },
         // ------------------------------------------------------------ measured data
         bad_data(
@@ -383,6 +398,7 @@ fn catalogue() -> Vec<Entry> {
             files: case(format!("{BEAM}data = \"absent.uff\"\n")),
             args: vec!["compare", "{dir}/cat.toml"],
             expect: vec!["absent.uff", "cannot read"],
+            code: INVALID_INPUT,
         },
     ]
 }
@@ -398,7 +414,7 @@ fn run(entry: &Entry, dir: &Path) -> Result<(), String> {
     if out.status.success() {
         return Err(format!("succeeded; stderr: {stderr}"));
     }
-    if out.status.code() != Some(1) {
+    if out.status.code() != Some(entry.code) {
         return Err(format!("exit code {:?}: {stderr}", out.status.code()));
     }
     for e in &entry.expect {
