@@ -129,6 +129,7 @@ impl fmt::Display for Failure {
 pub(crate) fn frf_exit(e: &FrfError) -> Exit {
     match e {
         FrfError::Singular { .. }
+        | FrfError::NonFiniteZ { .. }
         | FrfError::Factorization(_)
         | FrfError::NoLdltFactors { .. }
         | FrfError::CliqueOutOfRange { .. } => Exit::Numerics,

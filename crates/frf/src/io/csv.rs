@@ -105,9 +105,14 @@ pub struct CsvFrfs {
 /// Reads a CSV FRF file, leaving out what `rules` allow (non-finite values,
 /// repeated lines; see [`MaskRule`]).
 pub fn read_csv_with(path: &Path, rules: &[MaskRule]) -> Result<CsvFrfs, FrfError> {
-    let text = std::fs::read_to_string(path)
+    let bytes = std::fs::read(path)
         .map_err(|e| FrfError::Io { path: path.to_path_buf(), message: format!("cannot read: {e}") })?;
-    parse_csv_with(path, &text, rules)
+    let text = fe_model::text::decode(&bytes).map_err(|e| FrfError::Parse {
+        path: path.to_path_buf(),
+        line: e.line,
+        message: e.to_string(),
+    })?;
+    parse_csv_with(path, text, rules)
 }
 
 /// Parses CSV text; `path` is used in messages.
@@ -127,6 +132,7 @@ pub fn parse_csv_with(path: &Path, text: &str, rules: &[MaskRule]) -> Result<Csv
     let mut kind = FrfKind::Receptance;
     let mut header: Option<(usize, Vec<String>, char)> = None;
     let mut rows: Vec<(usize, Vec<f64>)> = Vec::new();
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     for (i, raw) in text.lines().enumerate() {
         let line_no = i + 1;
         let line = raw.trim();

@@ -95,6 +95,13 @@ impl Measured {
     /// `rules` hold [`MaskRule::UnmodelledChannels`].
     pub fn check_channels(self, path: &Path, dofs: &DofMap, rules: &[MaskRule]) -> Result<Measured, FrfError> {
         let (set, origins, masked) = check_channels(path, self.set, &self.origins, dofs, rules)?;
+        if set.channels().is_empty() {
+            return Err(FrfError::Parse {
+                path: path.to_path_buf(),
+                line: 1,
+                message: "no channel is left: every channel is at a node the model lacks or at a supported DOF".into(),
+            });
+        }
         let mut all = self.masked;
         all.extend(masked);
         Ok(Measured { set, format: self.format, notes: self.notes, origins, masked: all })
@@ -115,6 +122,24 @@ pub fn load_measured(path: &Path, map: &[ChannelMap]) -> Result<Measured, FrfErr
 /// the file; [`Measured::masked`] lists what was left out. Channel rules
 /// need the model: see [`Measured::check_channels`].
 pub fn load_measured_with(path: &Path, map: &[ChannelMap], rules: &[MaskRule]) -> Result<Measured, FrfError> {
+    let measured = read_format(path, map, rules)?;
+    // The readers refuse an empty record or table where they see it; this
+    // is the last guard, so that no command ever indexes an empty set.
+    if measured.set.n_freq() == 0 || measured.set.channels().is_empty() {
+        return Err(FrfError::Parse {
+            path: path.to_path_buf(),
+            line: 1,
+            message: format!(
+                "the file holds {} frequency lines and {} channels: nothing to compare",
+                measured.set.n_freq(),
+                measured.set.channels().len()
+            ),
+        });
+    }
+    Ok(measured)
+}
+
+fn read_format(path: &Path, map: &[ChannelMap], rules: &[MaskRule]) -> Result<Measured, FrfError> {
     match detect_format(path)? {
         MeasuredFormat::Csv => {
             let c = csv::read_csv_with(path, rules)?;

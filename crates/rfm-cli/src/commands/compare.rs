@@ -12,11 +12,11 @@ use damping::DampedSystem;
 use fe_model::CaseFile;
 use frf::correlation::{BandSpec, Correlation, correlate};
 use frf::{FrfSet, synthesize};
+use rfm_update::Study;
 use rfm_update::study::{describe_masked, read_measured_for};
-use rfm_update::{Study, UpdateError};
 use serde::Serialize;
 
-use super::{Result, load_case, print_masked};
+use super::{Result, load_case, print_masked, print_notes};
 use crate::exit::Exit;
 use crate::output::Outputs;
 use crate::report::html::{self, Block, Report, Section, Tone};
@@ -41,6 +41,10 @@ struct CompareJson {
     correlation: CorrelationJson,
     /// Measured (LSCF) against model modes, or why they could not be compared.
     modes: std::result::Result<ModesJson, String>,
+    /// What the case's mask rules left out of the measured data.
+    masked: Vec<String>,
+    /// What reading the measured data changed or passed over.
+    notes: Vec<String>,
 }
 
 /// One measured mode and its model partner.
@@ -198,18 +202,15 @@ pub(crate) fn parse_bands(s: &str) -> std::result::Result<BandSpec, String> {
     }
 }
 
-/// The measured FRFs, a description of where they came from, and what the
-/// case's mask rules left out of them.
+/// The measured FRFs, a description of where they came from, what the
+/// case's mask rules left out of them and what reading them changed.
 fn measured_data(
     case: CaseFile,
     system: &DampedSystem,
     files: &[PathBuf],
-) -> Result<(CaseFile, FrfSet, String, Vec<String>)> {
+) -> Result<(CaseFile, FrfSet, String, Vec<String>, Vec<String>)> {
     if files.is_empty() {
-        let study = Study::from_case(case).map_err(|e| match e {
-            UpdateError::Case(c) => c.render(),
-            other => other.to_string(),
-        })?;
+        let study = Study::from_case(case)?;
         let source = match (study.case.measurement.as_ref().and_then(|m| m.data.as_ref()), &study.case.truth) {
             (Some(p), _) => format!("measured file {} (from the case)", p.display()),
             (None, Some(t)) if t.noise > 0.0 => format!(
@@ -221,17 +222,19 @@ fn measured_data(
             (None, None) => "the case's data".into(),
         };
         let masked = describe_masked(&study.masked);
-        return Ok((study.case, study.measured, source, masked));
+        return Ok((study.case, study.measured, source, masked, study.notes));
     }
     let mut sets = Vec::new();
     let mut masked = Vec::new();
+    let mut notes = Vec::new();
     for f in files {
         let read = read_measured_for(system, f, case.measurement.as_ref())?;
         masked.extend(describe_masked(&read.masked).into_iter().map(|m| format!("{}: {m}", f.display())));
+        notes.extend(read.notes.iter().map(|n| format!("{}: {n}", f.display())));
         sets.push((f.clone(), read.set));
     }
     let names = files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(", ");
-    Ok((case, merge(sets)?, format!("measured file(s) {names}"), masked))
+    Ok((case, merge(sets)?, format!("measured file(s) {names}"), masked, notes))
 }
 
 /// Joins the channels of several measured files on the same lines, in the
@@ -292,7 +295,8 @@ pub(crate) fn compare(
     inputs.extend(measured_files.iter().cloned());
     let output = out.map(|dir| Outputs::folder(dir, &inputs, &["compare.json", "report.html"])).transpose()?;
     let system = DampedSystem::new(case.model.clone())?;
-    let (case, measured, source, masked) = measured_data(case, &system, measured_files)?;
+    let (case, measured, source, masked, notes) = measured_data(case, &system, measured_files)?;
+    print_notes(&notes, json)?;
     print_masked(&masked, json)?;
     let frfs = synthesize(&system, measured.channels(), measured.frequencies_hz())?;
     let correlation = correlate(&measured, &frfs, &spec)?;
@@ -305,6 +309,8 @@ pub(crate) fn compare(
         bands: bands.to_string(),
         correlation: CorrelationJson::from(&correlation),
         modes,
+        masked,
+        notes,
     };
     if json {
         outln!("{}", serde_json::to_string_pretty(&doc)?);

@@ -6,7 +6,7 @@ use rfm_update::Study;
 use rfm_update::diagnose::{DiagnoseOptions, Diagnosis, diagnose as run_diagnosis};
 use rfm_update::study::{describe_masked, read_measured_for};
 
-use super::{Result, print_masked};
+use super::{Result, print_masked, print_notes};
 use crate::exit::Exit;
 use crate::output::Outputs;
 use crate::table::{Table, num, percent};
@@ -32,10 +32,12 @@ pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
     let measured = match args.measured {
         Some(path) => {
             let read = read_measured_for(&study.system, path, study.case.measurement.as_ref())?;
+            print_notes(&read.notes, args.json)?;
             print_masked(&describe_masked(&read.masked), args.json)?;
             read.set.to_receptance()
         }
         None => {
+            print_notes(&study.notes, args.json)?;
             print_masked(&describe_masked(&study.masked), args.json)?;
             study.measured.clone()
         }

@@ -48,3 +48,22 @@ pub(crate) fn print_masked(masked: &[String], json: bool) -> Result<()> {
     }
     Ok(())
 }
+
+/// Tells what reading the measured data changed or passed over (lines at
+/// 0 Hz dropped, units scaled, kinds converted, datasets skipped), where
+/// [`print_masked`] tells what the mask left out.
+pub(crate) fn print_notes(notes: &[String], json: bool) -> Result<()> {
+    if notes.is_empty() {
+        return Ok(());
+    }
+    let mut text = format!("read from the measured data ({}):", notes.len());
+    for n in notes {
+        text.push_str(&format!("\n  - {n}"));
+    }
+    if json {
+        eprintln!("{text}");
+    } else {
+        outln!("{text}");
+    }
+    Ok(())
+}

@@ -6,8 +6,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 use rfm_update::rfm::{IterationRecord, RfmOptions, Status};
 use rfm_update::{Method, Study, UpdateOutcome};
 
-use super::{Result, print_masked};
-use crate::exit::Exit;
+use super::{Result, print_masked, print_notes};
+use crate::exit::{Exit, Failure};
 use crate::output::Outputs;
 use crate::table::{Table, num};
 
@@ -32,7 +32,7 @@ pub(crate) fn update(case: &Path, out: Option<&Path>, json: bool, over: &Overrid
         .map(|dir| Outputs::folder(dir, &study.case.inputs(), &["results.json", "updated.toml", "report.html"]))
         .transpose()?;
     if over.lines == Some(0) {
-        return Err("--lines 0: give at least one measured line to fit".into());
+        return Err(Failure::new(Exit::Usage, "--lines 0: give at least one measured line to fit"));
     }
     if let Some(n) = over.lines
         && let Some(u) = study.case.update.as_mut()
@@ -50,6 +50,7 @@ pub(crate) fn update(case: &Path, out: Option<&Path>, json: bool, over: &Overrid
         Method::Rfm => spec.max_iterations.map_or(RfmOptions::default().max_iterations, |n| n as usize),
         Method::OutputError => study.output_error_options()?.max_iterations,
     });
+    print_notes(&study.notes, json)?;
     print_masked(&rfm_update::study::describe_masked(&study.masked), json)?;
     if !json {
         outln!("{}", study.case.model.title);
