@@ -228,15 +228,18 @@ impl Study {
                 masked = read.masked;
                 notes = read.notes.iter().map(|n| format!("{}: {n}", path.display())).collect();
                 let set = read.set.to_receptance();
-                for c in &channels {
-                    if set.find(*c).is_none() {
-                        return Err(UpdateError::Setup(format!(
-                            "{}: the data has no channel {c} that the case lists",
-                            path.display()
-                        )));
-                    }
-                }
-                let idx: Vec<usize> = channels.iter().map(|c| set.find(*c).unwrap()).collect();
+                let index = set.channel_indices();
+                let idx = channels
+                    .iter()
+                    .map(|c| {
+                        index.get(c).copied().ok_or_else(|| {
+                            UpdateError::Setup(format!(
+                                "{}: the data has no channel {c} that the case lists",
+                                path.display()
+                            ))
+                        })
+                    })
+                    .collect::<Result<Vec<usize>, _>>()?;
                 set.select_channels(&idx)
             }
             (None, Some(spec_t), Some(truth)) => {

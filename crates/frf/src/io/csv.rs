@@ -194,6 +194,8 @@ pub fn parse_csv_with(path: &Path, text: &str, rules: &[MaskRule]) -> Result<Csv
     let mut channels = Vec::new();
     let mut pairs = Vec::new();
     let mut origins = Vec::new();
+    // where each channel was seen, so that a repeat is found in linear time
+    let mut seen: std::collections::HashMap<Channel, usize> = std::collections::HashMap::new();
     for j in (1..cols.len()).step_by(2) {
         let (c1, p1) = parse_channel(&cols[j]).ok_or_else(|| {
             err(hline, format!("column {} `{}` is not a channel name like H(31:uy,31:uy).re", j + 1, cols[j]))
@@ -214,9 +216,10 @@ pub fn parse_csv_with(path: &Path, text: &str, rules: &[MaskRule]) -> Result<Csv
                 ));
             }
         };
-        if let Some(other) = channels.iter().position(|c| *c == c1) {
+        if let Some(&other) = seen.get(&c1) {
             return Err(err(hline, format!("channel {c1} appears twice (columns {} and {})", 2 * other + 2, j + 1)));
         }
+        seen.insert(c1, channels.len());
         channels.push(c1);
         pairs.push(pair);
         origins.push(Origin { line: hline, label: format!("columns {}-{}", j + 1, j + 2) });

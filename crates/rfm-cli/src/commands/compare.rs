@@ -250,6 +250,7 @@ fn merge(sets: Vec<(PathBuf, FrfSet)>) -> Result<FrfSet> {
     }
     let f = first.frequencies_hz().to_vec();
     let mut channels = first.channels().to_vec();
+    let mut seen: std::collections::HashSet<frf::Channel> = channels.iter().copied().collect();
     for (path, set) in &rest {
         let same = set.n_freq() == f.len()
             && set.frequencies_hz().iter().zip(&f).all(|(a, b)| (a - b).abs() <= 1e-6 * b.abs());
@@ -264,7 +265,7 @@ fn merge(sets: Vec<(PathBuf, FrfSet)>) -> Result<FrfSet> {
             .into());
         }
         for c in set.channels() {
-            if channels.contains(c) {
+            if !seen.insert(*c) {
                 return Err(format!("{}: channel {c} appears in an earlier file too", path.display()).into());
             }
             channels.push(*c);

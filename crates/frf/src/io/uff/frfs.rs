@@ -213,7 +213,9 @@ pub fn frfs_from_uff_with(
         return Err(err(1, "no frequency response function (dataset 58, function type 4)".into()));
     };
     let (freqs, kind) = (first.freqs.clone(), first.kind);
-    for f in frfs.iter().skip(1) {
+    let mut seen: std::collections::HashMap<Channel, usize> = std::collections::HashMap::new();
+    seen.insert(first.channel, 0);
+    for (i, f) in frfs.iter().enumerate().skip(1) {
         if !same_lines(&f.freqs, &freqs) {
             return Err(err(
                 f.line,
@@ -229,7 +231,7 @@ pub fn frfs_from_uff_with(
                 ),
             ));
         }
-        if let Some(other) = frfs.iter().take_while(|o| o.record != f.record).find(|o| o.channel == f.channel) {
+        if let Some(other) = seen.get(&f.channel).map(|&i| &frfs[i]) {
             return Err(err(
                 f.line,
                 format!(
@@ -238,6 +240,7 @@ pub fn frfs_from_uff_with(
                 ),
             ));
         }
+        seen.insert(f.channel, i);
     }
     let converted: Vec<usize> = frfs.iter().filter(|f| f.kind != kind).map(|f| f.record).collect();
     if !converted.is_empty() {
@@ -313,6 +316,7 @@ fn attach_coherence(
 ) -> Result<(), FrfError> {
     let nf = set.n_freq();
     let nc = set.channels().len();
+    let index = set.channel_indices();
     let mut coh: Vec<Option<Vec<f64>>> = vec![None; nc];
     for r in file.records.iter().filter(|r| r.function.header.function_type == FUNCTION_COHERENCE) {
         let h = &r.function.header;
@@ -327,7 +331,7 @@ fn attach_coherence(
                 continue;
             }
         };
-        let Some(c) = set.find(channel) else {
+        let Some(&c) = index.get(&channel) else {
             notes.push(format!("{label}: coherence of {channel} ignored: the file has no FRF for it"));
             continue;
         };
