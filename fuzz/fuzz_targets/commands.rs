@@ -48,7 +48,8 @@ fuzz_target!(|bytes: &[u8]| {
         }
     }
     let Ok(case) = fe_model::CaseFile::parse(&dir.join("fuzz.toml"), case) else { return };
-    let values = case.measurement.as_ref().map_or(0, |m| m.frequencies_hz.len() * m.references.len() * m.responses.len());
+    let values =
+        case.measurement.as_ref().map_or(0, |m| m.frequencies_hz.len() * m.references.len() * m.responses.len());
     if case.model.nodes().len() * 3 > MAX_EQUATIONS || values > MAX_VALUES {
         return;
     }

@@ -1552,7 +1552,10 @@ node = 1
         let e = parse(&format!("{with_data}mask = [\"non-finit\"]\n")).unwrap_err();
         assert!(e.message.contains("unknown mask `non-finit`; did you mean `non-finite`?"), "{e}");
         let e = parse(&format!("{with_data}mask = [\"nan\", \"x\"]\n")).unwrap_err();
-        assert!(e.message.contains("(available: non-finite, duplicate-lines, unmodelled-channels)"), "{e}");
+        assert!(
+            e.message.contains("(available: non-finite, duplicate-lines, unmodelled-channels, bad-coherence)"),
+            "{e}"
+        );
         let e = parse(&format!("{with_data}mask = [\"non-finite\", \"non-finite\"]\n")).unwrap_err();
         assert!(e.message.contains("listed twice"), "{e}");
         let e = parse(&format!("{base}mask = [\"non-finite\"]\n")).unwrap_err();

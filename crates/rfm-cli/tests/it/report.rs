@@ -160,7 +160,8 @@ fn update_out_writes_figures_parameters_and_a_self_contained_report() {
 
     let html = read(&d.join("report.html"));
     check_self_contained(&html);
-    let svg_files = std::fs::read_dir(d).unwrap().filter(|e| e.as_ref().unwrap().path().extension().unwrap() == "svg");
+    let svg_files =
+        std::fs::read_dir(d).unwrap().filter(|e| e.as_ref().unwrap().path().extension().is_some_and(|x| x == "svg"));
     assert_eq!(html.matches("<svg").count(), svg_files.count(), "every figure is inline in the report");
     for heading in ["Summary", "Convergence", "Parameters", "FRF correlation", "FRF overlays"] {
         assert!(html.contains(&format!("<h2>{heading}</h2>")), "report.html lacks the section {heading}");
