@@ -15,7 +15,6 @@
 //! Timing belongs here, never in a test.
 
 use std::fmt::Write as _;
-use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 

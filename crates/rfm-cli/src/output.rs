@@ -680,7 +680,7 @@ mod tests {
         // a name found only while writing: refused at the commit, nothing changed
         let mut out = Outputs::folder(&dir, &inputs, &[]).unwrap();
         out.write("updated.toml", b"new").unwrap();
-        let e = out.commit().err().expect("refused");
+        let e = out.commit().expect_err("refused");
         assert!(e.to_string().contains("refusing to overwrite an input"), "{e}");
         assert_eq!(fs::read_to_string(&case).unwrap(), "case");
         // not replaced: carried into the new folder as the same file

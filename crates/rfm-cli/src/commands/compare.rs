@@ -202,13 +202,22 @@ pub(crate) fn parse_bands(s: &str) -> std::result::Result<BandSpec, String> {
     }
 }
 
-/// The measured FRFs, a description of where they came from, what the
-/// case's mask rules left out of them and what reading them changed.
-fn measured_data(
+/// The measured FRFs and what is known of them.
+struct MeasuredData {
+    /// The case (returned by the study that read the data).
     case: CaseFile,
-    system: &DampedSystem,
-    files: &[PathBuf],
-) -> Result<(CaseFile, FrfSet, String, Vec<String>, Vec<String>)> {
+    /// The FRFs.
+    set: FrfSet,
+    /// Where they came from.
+    source: String,
+    /// What the case's mask rules left out of them.
+    masked: Vec<String>,
+    /// What reading them changed or passed over.
+    notes: Vec<String>,
+}
+
+/// The measured FRFs: the case's data or truth, or the `--measured` files.
+fn measured_data(case: CaseFile, system: &DampedSystem, files: &[PathBuf]) -> Result<MeasuredData> {
     if files.is_empty() {
         let study = Study::from_case(case)?;
         let source = match (study.case.measurement.as_ref().and_then(|m| m.data.as_ref()), &study.case.truth) {
@@ -222,7 +231,7 @@ fn measured_data(
             (None, None) => "the case's data".into(),
         };
         let masked = describe_masked(&study.masked);
-        return Ok((study.case, study.measured, source, masked, study.notes));
+        return Ok(MeasuredData { case: study.case, set: study.measured, source, masked, notes: study.notes });
     }
     let mut sets = Vec::new();
     let mut masked = Vec::new();
@@ -234,7 +243,7 @@ fn measured_data(
         sets.push((f.clone(), read.set));
     }
     let names = files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(", ");
-    Ok((case, merge(sets)?, format!("measured file(s) {names}"), masked, notes))
+    Ok(MeasuredData { case, set: merge(sets)?, source: format!("measured file(s) {names}"), masked, notes })
 }
 
 /// Joins the channels of several measured files on the same lines, in the
@@ -296,7 +305,7 @@ pub(crate) fn compare(
     inputs.extend(measured_files.iter().cloned());
     let output = out.map(|dir| Outputs::folder(dir, &inputs, &["compare.json", "report.html"])).transpose()?;
     let system = DampedSystem::new(case.model.clone())?;
-    let (case, measured, source, masked, notes) = measured_data(case, &system, measured_files)?;
+    let MeasuredData { case, set: measured, source, masked, notes } = measured_data(case, &system, measured_files)?;
     print_notes(&notes, json)?;
     print_masked(&masked, json)?;
     let frfs = synthesize(&system, measured.channels(), measured.frequencies_hz())?;

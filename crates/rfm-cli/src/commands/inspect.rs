@@ -109,7 +109,7 @@ fn csv_report(file: &Path) -> Result<Value> {
 /// The JSON of [`csv_report`], written record by record: a file of
 /// 500,000 channels would otherwise hold a JSON tree of several gigabytes.
 fn csv_json(file: &Path) -> Result<Exit> {
-    use serde::ser::{SerializeSeq as _, Serializer as _};
+    use serde::ser::SerializeSeq as _;
     use std::io::Write as _;
 
     /// The records, serialised one at a time from the set.

@@ -181,7 +181,7 @@ pub fn frfs_from_uff_with(
             ));
         }
         if freqs.is_empty() {
-            let why = if r.function.len() == 0 {
+            let why = if r.function.is_empty() {
                 "it declares no values (record 7 gives 0 data points)".to_string()
             } else {
                 format!(
