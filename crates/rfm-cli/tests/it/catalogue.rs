@@ -747,3 +747,32 @@ fn a_full_standard_output_is_named() {
     assert_eq!(out.status.code(), Some(6), "{stderr}");
     assert!(stderr.contains("standard output: cannot write") && stderr.contains("No space left"), "{stderr}");
 }
+
+/// A measured file of a single line goes through every command without a
+/// panic: each either works or says why it cannot (diagnosis needs more
+/// lines).
+#[test]
+fn a_single_measured_line_never_panics_any_command() {
+    let dir = tempfile::tempdir().unwrap();
+    let one_line: String = csv().lines().take(3).map(|l| format!("{l}\n")).collect();
+    std::fs::write(dir.path().join("m.csv"), one_line).unwrap();
+    let text = format!("{BEAM}data = \"m.csv\"\n\n[update]\nparameters = [\"group.beam.alpha\"]\n");
+    std::fs::write(dir.path().join("cat.toml"), text.replace("[truth]\n", "")).unwrap();
+    let case = dir.path().join("cat.toml");
+    let out = dir.path().join("out");
+    let runs: [(&[&str], i32); 5] = [
+        (&["compare"], 0),
+        (&["compare", "--out", out.to_str().unwrap()], 0),
+        (&["update"], 0),
+        (&["update", "--method", "output-error"], 0),
+        (&["diagnose"], INVALID_INPUT),
+    ];
+    for (args, code) in runs {
+        let result = Command::new(env!("CARGO_BIN_EXE_rfm")).arg(args[0]).arg(&case).args(&args[1..]).output().unwrap();
+        let stderr = String::from_utf8_lossy(&result.stderr);
+        assert_eq!(result.status.code(), Some(code), "{args:?}: {stderr}");
+        if code == INVALID_INPUT {
+            assert!(stderr.contains("diagnosis needs at least 10 measured lines"), "{stderr}");
+        }
+    }
+}
