@@ -313,11 +313,16 @@ pub enum MaskRule {
     /// `unmodelled-channels`: a channel whose response or reference is at a
     /// node the model lacks, or at a DOF it holds fixed, is left out.
     UnmodelledChannels,
+    /// `bad-coherence`: a coherence record with a value outside 0..1 (or
+    /// not a number) is left out; its channel is weighted as if its
+    /// coherence were 1.
+    BadCoherence,
 }
 
 impl MaskRule {
     /// Every rule, in the order of the documentation.
-    pub const ALL: [MaskRule; 3] = [MaskRule::NonFinite, MaskRule::DuplicateLines, MaskRule::UnmodelledChannels];
+    pub const ALL: [MaskRule; 4] =
+        [MaskRule::NonFinite, MaskRule::DuplicateLines, MaskRule::UnmodelledChannels, MaskRule::BadCoherence];
 
     /// The name used in case files.
     pub fn name(self) -> &'static str {
@@ -325,6 +330,7 @@ impl MaskRule {
             MaskRule::NonFinite => "non-finite",
             MaskRule::DuplicateLines => "duplicate-lines",
             MaskRule::UnmodelledChannels => "unmodelled-channels",
+            MaskRule::BadCoherence => "bad-coherence",
         }
     }
 
@@ -543,13 +549,19 @@ impl CaseFile {
     /// Reads and validates a case file.
     pub fn load(path: impl AsRef<Path>) -> Result<Self, CaseError> {
         let path = path.as_ref();
-        let source = std::fs::read_to_string(path).map_err(|e| CaseError {
+        let bytes = std::fs::read(path).map_err(|e| CaseError {
             file: path.to_path_buf(),
             location: None,
             message: format!("cannot read the case file: {e}"),
             snippet: None,
         })?;
-        Self::parse(path, &source)
+        let source = crate::text::decode(&bytes).map_err(|e| CaseError {
+            file: path.to_path_buf(),
+            location: Some(crate::error::Location { line: e.line, column: e.column }),
+            message: e.to_string(),
+            snippet: None,
+        })?;
+        Self::parse(path, source)
     }
 
     /// The files a run of this case reads: the case file itself and its
@@ -676,7 +688,10 @@ fn raw_group(ctx: &Ctx<'_>, name: &str, g: &Spanned<RawGroup>) -> Result<Group, 
     {
         return Err(ctx.err(
             g.span(),
-            format!("group `{name}`: mu must be positive (use `inf` or omit it for viscous damping), got {mu}"),
+            format!(
+                "group `{name}`: mu must be positive (use `inf` or omit it for viscous damping), got {}",
+                crate::show(mu)
+            ),
         ));
     }
     Ok(Group {
@@ -955,7 +970,17 @@ fn add_line(ctx: &Ctx<'_>, model: &mut Model, line: &Spanned<RawLine>) -> Result
 }
 
 /// Parses `31:uy` or a range `2..31:uy` (inclusive) into DOF references.
+/// The range is expanded here, so a caller that knows the model should use
+/// [`parse_dof_range`] and check each node as it goes, before a range of
+/// four billion nodes is allocated.
 pub fn parse_dof_list(text: &str) -> Result<Vec<DofRef>, String> {
+    let (a, b, dof) = parse_dof_range(text)?;
+    Ok((a..=b).map(|n| DofRef::new(n, dof)).collect())
+}
+
+/// Parses `31:uy` (the range `31..31`) or `2..31:uy` into its first and
+/// last node and its DOF, without expanding it.
+pub fn parse_dof_range(text: &str) -> Result<(u32, u32, Dof), String> {
     let (nodes, dof) = text
         .split_once(':')
         .ok_or_else(|| format!("`{text}` is not of the form node:dof or first..last:dof (for example 2..31:uy)"))?;
@@ -966,10 +991,10 @@ pub fn parse_dof_list(text: &str) -> Result<Vec<DofRef>, String> {
         if b < a {
             return Err(format!("range `{text}` is empty (last node before first)"));
         }
-        Ok((a..=b).map(|n| DofRef::new(n, dof)).collect())
+        Ok((a, b, dof))
     } else {
         let n: u32 = nodes.trim().parse().map_err(|_| format!("`{nodes}` in `{text}` is not a node id"))?;
-        Ok(vec![DofRef::new(n, dof)])
+        Ok((n, n, dof))
     }
 }
 
@@ -1031,20 +1056,25 @@ fn parse_frequencies(ctx: &Ctx<'_>, v: &Spanned<toml::Value>) -> Result<Vec<f64>
         }
     }
     if let Some(f) = freqs.iter().find(|f| !(f.is_finite() && **f > 0.0)) {
-        return Err(ctx.err(v.span(), format!("frequencies must be positive and finite (Hz), got {f}")));
+        return Err(ctx.err(v.span(), format!("frequencies must be positive and finite (Hz), got {}", crate::show(*f))));
     }
     Ok(freqs)
 }
 
 fn parse_dof_refs(ctx: &Ctx<'_>, list: &[Spanned<String>], model: &Model) -> Result<Vec<DofRef>, CaseError> {
     let mut out = Vec::new();
+    // a set, so that listing a hundred thousand DOFs stays linear
+    let mut seen = std::collections::HashSet::new();
     for s in list {
-        let refs = parse_dof_list(s.get_ref()).map_err(|e| ctx.err(s.span(), e))?;
-        for r in refs {
-            if model.node(r.node).is_none() {
-                return Err(ctx.err(s.span(), format!("node {} does not exist in the model", r.node)));
+        let (first, last, dof) = parse_dof_range(s.get_ref()).map_err(|e| ctx.err(s.span(), e))?;
+        // Every node of the range must exist, so the walk stops at the first
+        // missing one: it never goes further than the model has nodes.
+        for node in first..=last {
+            let r = DofRef::new(node, dof);
+            if model.node(NodeId(node)).is_none() {
+                return Err(ctx.err(s.span(), format!("node {node} does not exist in the model")));
             }
-            if out.contains(&r) {
+            if !seen.insert(r) {
                 return Err(ctx.err(s.span(), format!("{r} is listed twice")));
             }
             out.push(r);
@@ -1415,7 +1445,10 @@ node = 1
         let e = parse(&format!("{with_data}mask = [\"non-finit\"]\n")).unwrap_err();
         assert!(e.message.contains("unknown mask `non-finit`; did you mean `non-finite`?"), "{e}");
         let e = parse(&format!("{with_data}mask = [\"nan\", \"x\"]\n")).unwrap_err();
-        assert!(e.message.contains("(available: non-finite, duplicate-lines, unmodelled-channels)"), "{e}");
+        assert!(
+            e.message.contains("(available: non-finite, duplicate-lines, unmodelled-channels, bad-coherence)"),
+            "{e}"
+        );
         let e = parse(&format!("{with_data}mask = [\"non-finite\", \"non-finite\"]\n")).unwrap_err();
         assert!(e.message.contains("listed twice"), "{e}");
         let e = parse(&format!("{base}mask = [\"non-finite\"]\n")).unwrap_err();

@@ -58,6 +58,7 @@ pub mod model;
 pub mod quantity;
 pub mod samples;
 pub mod suggest;
+pub mod text;
 
 pub use assembly::{Assembly, Block, BlockSource, MatrixKind, Pattern, Term};
 pub use case::{CaseEditor, CaseFile, HistoryEntry};
@@ -65,3 +66,10 @@ pub use dof::{Dof, DofMap, DofRef, Slot};
 pub use error::{CaseError, Location, ModelError};
 pub use model::{Beam, ElementId, Group, LumpedMass, Material, Model, Node, NodeId, Section, Spring};
 pub use quantity::{Parameter, Quantity, QuantityKind};
+
+/// A number for a message: as written for ordinary magnitudes, in exponent
+/// notation when huge or tiny, so that `1e300` is not printed as a
+/// 301-digit integer.
+pub fn show(v: f64) -> String {
+    if v != 0.0 && v.is_finite() && !(1e-4..1e15).contains(&v.abs()) { format!("{v:e}") } else { format!("{v}") }
+}

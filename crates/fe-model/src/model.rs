@@ -220,7 +220,7 @@ fn positive(what: String, v: f64) -> Result<(), ModelError> {
     if v.is_finite() && v > 0.0 {
         Ok(())
     } else {
-        Err(ModelError::Invalid { what, reason: format!("must be positive and finite, got {v}") })
+        Err(ModelError::Invalid { what, reason: format!("must be positive and finite, got {}", crate::show(v)) })
     }
 }
 
@@ -228,7 +228,10 @@ fn non_negative(what: String, v: f64) -> Result<(), ModelError> {
     if v.is_finite() && v >= 0.0 {
         Ok(())
     } else {
-        Err(ModelError::Invalid { what, reason: format!("must be zero or positive and finite, got {v}") })
+        Err(ModelError::Invalid {
+            what,
+            reason: format!("must be zero or positive and finite, got {}", crate::show(v)),
+        })
     }
 }
 
@@ -524,6 +527,21 @@ impl Model {
         self.require_node(NodeId(b), "tie")?;
         if a == b {
             return Err(ModelError::Invalid { what: format!("tie {a}-{b}"), reason: "ties a node to itself".into() });
+        }
+        // A tie makes two nodes share displacements and rotation, which is
+        // only kinematically sound where they coincide (a joint, as in the
+        // paper); between distant nodes it silently makes a wrong model.
+        let (p, q) = (&self.nodes[self.node_index[&NodeId(a)]], &self.nodes[self.node_index[&NodeId(b)]]);
+        let gap = (p.x - q.x).hypot(p.y - q.y);
+        let extent = self.nodes.iter().map(|n| n.x.abs().max(n.y.abs())).fold(0.0, f64::max);
+        if !(gap <= 1e-9 * extent.max(1e-300)) {
+            return Err(ModelError::Invalid {
+                what: format!("tie {a}-{b}"),
+                reason: format!(
+                    "joins nodes {gap:.6e} m apart; a tie couples coincident nodes (a joint), \
+                     join distant nodes with a beam or a spring"
+                ),
+            });
         }
         self.ties.push(Tie { nodes: [NodeId(a), NodeId(b)], dofs: dofs.to_vec() });
         Ok(())

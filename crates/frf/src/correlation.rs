@@ -443,10 +443,11 @@ pub fn correlate(measured: &FrfSet, model: &FrfSet, spec: &BandSpec) -> Result<C
         )));
     }
     let model = if model.kind() == measured.kind() { model.clone() } else { model.converted(measured.kind()) };
+    let index = model.channel_indices();
     let idx: Vec<usize> = measured
         .channels()
         .iter()
-        .map(|&c| model.find(c).ok_or_else(|| FrfError::Mismatch(format!("the model FRFs have no channel {c}"))))
+        .map(|c| index.get(c).copied().ok_or_else(|| FrfError::Mismatch(format!("the model FRFs have no channel {c}"))))
         .collect::<Result<_, _>>()?;
     let bands = bands(spec, measured)?;
     let n_ch = measured.channels().len();

@@ -51,6 +51,20 @@ pub enum FrfError {
     /// The sparse factorisation failed for another reason.
     #[error("sparse factorisation failed: {0}")]
     Factorization(String),
+    /// `Z(w)` has an entry that is not finite at a (valid) frequency: some
+    /// value of the model overflows when stiffness, mass and damping are
+    /// combined.
+    #[error(
+        "the dynamic stiffness at {freq_hz} Hz has an entry that is not a finite number (equation {equation}): a \
+         value of the model (a modulus, density, stiffness, mass or damping coefficient) is so large that K, M or \
+         the damping overflow; check the case's values"
+    )]
+    NonFiniteZ {
+        /// The frequency.
+        freq_hz: f64,
+        /// The first equation (row of `Z`) with a non-finite entry.
+        equation: usize,
+    },
     /// A frequency that is not positive and finite.
     #[error("frequency {freq_hz} Hz is not positive and finite")]
     BadFrequency {

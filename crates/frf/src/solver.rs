@@ -531,10 +531,15 @@ fn is_finite(v: C64) -> bool {
 /// Checks that every value is finite; returns the largest `|Z_ij|`.
 fn check_values(solver: &ZSolver, values: &[C64], freq_hz: f64) -> Result<f64, FrfError> {
     assert_eq!(values.len(), solver.pattern.row_idx().len(), "values must lie on the solver's pattern");
-    if values.iter().all(|&v| is_finite(v)) {
-        Ok(largest_norm(values))
-    } else {
-        Err(FrfError::BadFrequency { freq_hz })
+    match values.iter().position(|&v| !is_finite(v)) {
+        None => Ok(largest_norm(values)),
+        Some(_) if !(freq_hz.is_finite() && freq_hz > 0.0) => Err(FrfError::BadFrequency { freq_hz }),
+        Some(i) => {
+            // the column of entry i (the pattern is symmetric: its row too)
+            let col_ptr = solver.pattern.col_ptr();
+            let equation = col_ptr.partition_point(|&p| p <= i).saturating_sub(1);
+            Err(FrfError::NonFiniteZ { freq_hz, equation })
+        }
     }
 }
 

@@ -10,6 +10,8 @@ macro_rules! outln {
 }
 
 mod commands;
+mod exit;
+mod output;
 mod report;
 mod table;
 
@@ -19,7 +21,9 @@ use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Mutex, MutexGuard, PoisonError};
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory as _, FromArgMatches as _, Parser, Subcommand};
+
+use exit::Exit;
 
 /// FE model updating of damped structures from measured FRFs (response
 /// function method with exponential non-viscous damping).
@@ -176,32 +180,58 @@ impl Drop for Writing {
     }
 }
 
-/// Marks the output phase of a command: an interrupt (Ctrl-C, SIGTERM,
-/// SIGHUP) waits until the guard is dropped, so that a run stops either
-/// before it writes anything or after all its outputs, never between two of
-/// them (each file is written to a temporary and renamed, see
-/// [`frf::io::atomic_write`]).
+/// Marks the output phase of a command (the commit of its
+/// [`output::Outputs`]): an interrupt (Ctrl-C, SIGTERM, SIGHUP) waits until
+/// the guard is dropped, so that a run stops either before its outputs move
+/// into place or after, never while they do.
 pub(crate) fn writing() -> Writing {
     Writing { _guard: WRITING.lock().unwrap_or_else(PoisonError::into_inner) }
 }
 
 fn main() -> ExitCode {
-    // Without a handler the signal would end the process at once, possibly
-    // between two output files of one run.
+    // Without a handler the signal would end the process at once, leaving
+    // its staging folder behind for the next run to clean.
     let interrupt = ctrlc::set_handler(|| {
         let _held = WRITING.lock().unwrap_or_else(PoisonError::into_inner);
+        output::abandon_all();
         if WRITTEN.load(Ordering::Relaxed) {
             eprintln!("interrupted after this run's outputs were written");
         } else {
             eprintln!("interrupted: the outputs of this run were not written (earlier ones are untouched)");
         }
-        std::process::exit(130);
+        std::process::exit(i32::from(Exit::Interrupted.code()));
     });
     if let Err(e) = interrupt {
-        eprintln!("warning: cannot handle Ctrl-C ({e}); an interrupt may stop a run between two output files");
+        eprintln!(
+            "warning: cannot handle Ctrl-C ({e}); an interrupt may leave a staging folder for the next run to remove"
+        );
     }
-    let cli = Cli::parse();
-    let result = match cli.command {
+    // clap exits with 2 (Exit::Usage) on a wrong command line, 0 for --help
+    let matches = Cli::command().after_help(Exit::help()).get_matches();
+    let cli = match Cli::from_arg_matches(&matches) {
+        Ok(cli) => cli,
+        Err(e) => e.exit(),
+    };
+    // A panic is a bug; it must still end with the documented code, after
+    // the default hook has printed where it happened (unwinding has removed
+    // any staging folder on the way).
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(cli))).unwrap_or_else(|_| {
+        Err(exit::Failure::new(
+            Exit::Internal,
+            "internal error (a bug in rfm): please report it with the command and its input files",
+        ))
+    });
+    match result {
+        Ok(exit) => ExitCode::from(exit.code()),
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(e.exit.code())
+        }
+    }
+}
+
+fn run(cli: Cli) -> commands::Result<Exit> {
+    match cli.command {
         Command::Simulate { case, out, truth, noise, seed } => commands::simulate(&case, &out, truth, noise, seed),
         Command::Compare { case, measured, out, json, bands } => {
             commands::compare(&case, &measured, out.as_deref(), json, &bands)
@@ -227,12 +257,5 @@ fn main() -> ExitCode {
             json,
             &commands::UpdateOverrides { method, lines, max_iterations: iterations },
         ),
-    };
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::FAILURE
-        }
     }
 }

@@ -15,6 +15,10 @@ pub enum UpdateError {
     /// An FRF computation or data error.
     #[error(transparent)]
     Frf(#[from] FrfError),
+    /// The numbers went wrong: a misfit or a model response that is not
+    /// finite, with where it happened.
+    #[error("{0}")]
+    Numerics(String),
     /// Something the case asks for that this method cannot do.
     #[error("{0}")]
     Setup(String),

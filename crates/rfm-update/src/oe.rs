@@ -449,9 +449,13 @@ pub(crate) fn run_with(
     if opts.gains {
         // start each gain at its least-squares value for the initial model
         ev.apply(src, &x)?;
-        let (model, _) = src
-            .evaluate(measured.frequencies_hz(), false)
-            .ok_or_else(|| UpdateError::Setup("the initial model cannot be evaluated".into()))?;
+        let (model, _) = src.evaluate(measured.frequencies_hz(), false).ok_or_else(|| {
+            UpdateError::Numerics(
+                "the initial model cannot be evaluated at the updating lines (a singular or non-finite dynamic \
+                     stiffness)"
+                    .into(),
+            )
+        })?;
         for v in 0..ev.refs.len() {
             let (mut num, mut den) = (C64::new(0.0, 0.0), 0.0);
             for c in (0..measured.channels().len()).filter(|&c| ev.ref_of[c] == v) {
@@ -469,8 +473,18 @@ pub(crate) fn run_with(
             }
         }
     }
-    let mut point =
-        ev.eval(src, &x, true).ok_or_else(|| UpdateError::Setup("the initial model cannot be evaluated".into()))?;
+    let mut point = ev.eval(src, &x, true).ok_or_else(|| {
+        UpdateError::Numerics(
+            "the initial model cannot be evaluated at the updating lines (a singular or non-finite dynamic stiffness)"
+                .into(),
+        )
+    })?;
+    if !point.cost.is_finite() {
+        return Err(UpdateError::Numerics(format!(
+            "the misfit of the initial model is {}: its receptances or the measured ones are not finite numbers",
+            point.cost
+        )));
+    }
     let record = |iteration: usize, p: &Point, x: &[f64], max_step: f64, lambda: f64, rank: usize| IterationRecord {
         iteration,
         residual: (p.cost_data / (n_data as f64 / 2.0)).sqrt(),
@@ -558,7 +572,7 @@ pub(crate) fn run_with(
     let final_point = match point.jacobian {
         Some(_) => point,
         None => {
-            ev.eval(src, &x, true).ok_or_else(|| UpdateError::Setup("the final model cannot be evaluated".into()))?
+            ev.eval(src, &x, true).ok_or_else(|| UpdateError::Numerics("the final model cannot be evaluated".into()))?
         }
     };
     ev.apply(src, &x)?;

@@ -234,6 +234,17 @@ pub fn run(
                 }
             };
         let residual = relative_residual(&blocks, measured);
+        if !residual.is_finite() {
+            // a NaN misfit must never pass for convergence (its step may be zero)
+            if iteration == 0 {
+                return Err(UpdateError::Numerics(format!(
+                    "the misfit of the initial model is {residual}: its receptances or the measured ones are not \
+                     finite numbers at the updating lines"
+                )));
+            }
+            status = Status::Failed(format!("the misfit became {residual} at iteration {iteration}"));
+            break;
+        }
         let (max_correction, limited, rank, step_lambda) = last_step;
         let record = IterationRecord {
             iteration,
@@ -268,6 +279,11 @@ pub fn run(
         }
         let (a, b) = stack(&blocks, measured, params);
         let sol = crate::lstsq::solve(&a, &b, opts.rcond);
+        if sol.rank == 0 {
+            // a zero step would pass for convergence
+            status = Status::Failed("the misfit does not change with any parameter (zero sensitivity)".into());
+            break;
+        }
         if at_best {
             best_svd = (sol.singular_values.clone(), sol.v.clone());
         }

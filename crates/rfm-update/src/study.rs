@@ -62,6 +62,10 @@ pub struct Study {
     pub update_frequencies_hz: Vec<f64>,
     /// What the case's `[measurement] mask` left out of the measured file.
     pub masked: Vec<frf::io::Masked>,
+    /// What reading the measured file changed or passed over (lines at
+    /// 0 Hz dropped, units scaled, kinds converted, datasets skipped), one
+    /// line each, to be shown and stored with the results.
+    pub notes: Vec<String>,
 }
 
 /// One parameter's values for reporting.
@@ -155,6 +159,9 @@ pub struct UpdateOutcome {
     /// What the case's mask rules left out of the measured data, one line
     /// each (`non-finite: line 17, columns 4-5: H(3:uy,2:uy) at 20 Hz is NaN`).
     pub masked: Vec<String>,
+    /// What reading the measured data changed or passed over, one line each
+    /// (see [`Study::notes`]).
+    pub notes: Vec<String>,
     /// What the data leave undetermined, for methods without an uncertainty
     /// report (the RFM): parameters that ended on a bound, the combination
     /// of parameters the sensitivity cannot separate.
@@ -214,20 +221,25 @@ impl Study {
             }
         }
         let mut masked = Vec::new();
+        let mut notes = Vec::new();
         let measured = match (&spec.data, &case.truth, &truth) {
             (Some(path), _, _) => {
                 let read = read_measured_for(&system, path, Some(spec))?;
                 masked = read.masked;
+                notes = read.notes.iter().map(|n| format!("{}: {n}", path.display())).collect();
                 let set = read.set.to_receptance();
-                for c in &channels {
-                    if set.find(*c).is_none() {
-                        return Err(UpdateError::Setup(format!(
-                            "{}: the data has no channel {c} that the case lists",
-                            path.display()
-                        )));
-                    }
-                }
-                let idx: Vec<usize> = channels.iter().map(|c| set.find(*c).unwrap()).collect();
+                let index = set.channel_indices();
+                let idx = channels
+                    .iter()
+                    .map(|c| {
+                        index.get(c).copied().ok_or_else(|| {
+                            UpdateError::Setup(format!(
+                                "{}: the data has no channel {c} that the case lists",
+                                path.display()
+                            ))
+                        })
+                    })
+                    .collect::<Result<Vec<usize>, _>>()?;
                 set.select_channels(&idx)
             }
             (None, Some(spec_t), Some(truth)) => {
@@ -238,7 +250,8 @@ impl Study {
             _ => unreachable!("the case loader requires data or a truth"),
         };
         let parameters = case.update.as_ref().map(|u| u.parameters.clone()).unwrap_or_default();
-        let mut study = Study { case, system, truth, measured, parameters, update_frequencies_hz: Vec::new(), masked };
+        let mut study =
+            Study { case, system, truth, measured, parameters, update_frequencies_hz: Vec::new(), masked, notes };
         if study.case.update.is_some() {
             study.update_frequencies_hz = study.lines_for(study.method())?;
         }
@@ -260,6 +273,7 @@ impl Study {
             parameters,
             update_frequencies_hz: Vec::new(),
             masked: Vec::new(),
+            notes: Vec::new(),
         };
         if study.case.update.is_some() {
             study.update_frequencies_hz = study.lines_for(study.method())?;
@@ -296,7 +310,14 @@ impl Study {
             Method::Rfm => FrequencyChoice::Auto(2 * self.parameters.len().max(5)),
             Method::OutputError => FrequencyChoice::Lines(200),
         });
-        self.choose_lines(&choice)
+        let lines = self.choose_lines(&choice)?;
+        if lines.is_empty() {
+            return Err(UpdateError::Setup(format!(
+                "no measured line to fit: the [update] frequencies designate none of the {} measured lines",
+                self.measured.n_freq()
+            )));
+        }
+        Ok(lines)
     }
 
     /// The measured lines a frequency choice designates.
@@ -362,6 +383,7 @@ impl Study {
         }
         let lines = self.lines_for(Method::Rfm)?;
         let measured = self.measured.at_frequencies(&lines)?;
+        self.check_initial(&measured)?;
         let mut sys = self.system.clone();
         let mut opts = opts.clone();
         if let Some(spec) = &self.case.update {
@@ -384,6 +406,7 @@ impl Study {
             gains: Vec::new(),
             noise_estimate: crate::diagnose::estimate_noise(&self.measured),
             masked: describe_masked(&self.masked),
+            notes: self.notes.clone(),
             warnings,
             method: "rfm".into(),
             status: result.status,
@@ -393,6 +416,49 @@ impl Study {
             frequencies_hz: lines,
             system: sys,
         })
+    }
+
+    /// Evaluates the initial model at the lines of `measured`, so that a
+    /// model that cannot be evaluated is refused with the reason and the
+    /// line before any iteration (the solvers would only see that the
+    /// misfit is not a number).
+    pub fn check_initial(&self, measured: &FrfSet) -> Result<(), UpdateError> {
+        let model = frf::synthesize(&self.system, measured.channels(), measured.frequencies_hz())?;
+        for (c, channel) in model.channels().iter().enumerate() {
+            if let Some(k) = model.channel(c).iter().position(|v| !(v.re.is_finite() && v.im.is_finite())) {
+                return Err(UpdateError::Numerics(format!(
+                    "the initial model's receptance {channel} at {} Hz is {}: a value of the model is out of the \
+                     range double precision holds (a modulus, density, stiffness or damping coefficient many \
+                     orders of magnitude off?)",
+                    model.frequencies_hz()[k],
+                    model.get(c, k)
+                )));
+            }
+        }
+        if model.values().iter().all(|v| v.norm_sqr() == 0.0) {
+            return Err(UpdateError::Numerics(format!(
+                "the initial model's receptances are zero at every updating line ({} to {} Hz): a value of the \
+                 model is out of the range double precision holds (a modulus or stiffness many orders of \
+                 magnitude too large?)",
+                model.frequencies_hz()[0],
+                model.frequencies_hz()[model.n_freq() - 1]
+            )));
+        }
+        let synthesised = self.case.measurement.as_ref().is_some_and(|m| m.data.is_none());
+        for (c, channel) in measured.channels().iter().enumerate() {
+            if synthesised && measured.channel(c).iter().all(|v| v.norm_sqr() == 0.0) {
+                return Err(UpdateError::Numerics(format!(
+                    "the FRF {channel} synthesised from the case's truth model is zero at every updating line: a \
+                     value of the truth model is out of the range double precision holds"
+                )));
+            }
+            if measured.channel(c).iter().all(|v| v.norm_sqr() == 0.0) {
+                return Err(UpdateError::Setup(format!(
+                    "the measured FRF {channel} is zero at every updating line: a relative misfit cannot be formed"
+                )));
+            }
+        }
+        Ok(())
     }
 
     /// Line weights for the measured data at `lines` (band weights and
@@ -437,6 +503,7 @@ impl Study {
         }
         let lines = self.lines_for(Method::OutputError)?;
         let measured = self.measured.at_frequencies(&lines)?;
+        self.check_initial(&measured)?;
         let weights = self.weights(&measured)?;
         let params = self.parameter_set();
         let mut sys = self.system.clone();
@@ -457,6 +524,7 @@ impl Study {
             gains: result.gains,
             noise_estimate: crate::diagnose::estimate_noise(&self.measured),
             masked: describe_masked(&self.masked),
+            notes: self.notes.clone(),
             warnings: Vec::new(),
             system: sys,
         })

@@ -105,9 +105,14 @@ pub struct CsvFrfs {
 /// Reads a CSV FRF file, leaving out what `rules` allow (non-finite values,
 /// repeated lines; see [`MaskRule`]).
 pub fn read_csv_with(path: &Path, rules: &[MaskRule]) -> Result<CsvFrfs, FrfError> {
-    let text = std::fs::read_to_string(path)
+    let bytes = std::fs::read(path)
         .map_err(|e| FrfError::Io { path: path.to_path_buf(), message: format!("cannot read: {e}") })?;
-    parse_csv_with(path, &text, rules)
+    let text = fe_model::text::decode(&bytes).map_err(|e| FrfError::Parse {
+        path: path.to_path_buf(),
+        line: e.line,
+        message: e.to_string(),
+    })?;
+    parse_csv_with(path, text, rules)
 }
 
 /// Parses CSV text; `path` is used in messages.
@@ -127,6 +132,7 @@ pub fn parse_csv_with(path: &Path, text: &str, rules: &[MaskRule]) -> Result<Csv
     let mut kind = FrfKind::Receptance;
     let mut header: Option<(usize, Vec<String>, char)> = None;
     let mut rows: Vec<(usize, Vec<f64>)> = Vec::new();
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     for (i, raw) in text.lines().enumerate() {
         let line_no = i + 1;
         let line = raw.trim();
@@ -188,6 +194,8 @@ pub fn parse_csv_with(path: &Path, text: &str, rules: &[MaskRule]) -> Result<Csv
     let mut channels = Vec::new();
     let mut pairs = Vec::new();
     let mut origins = Vec::new();
+    // where each channel was seen, so that a repeat is found in linear time
+    let mut seen: std::collections::HashMap<Channel, usize> = std::collections::HashMap::new();
     for j in (1..cols.len()).step_by(2) {
         let (c1, p1) = parse_channel(&cols[j]).ok_or_else(|| {
             err(hline, format!("column {} `{}` is not a channel name like H(31:uy,31:uy).re", j + 1, cols[j]))
@@ -208,9 +216,10 @@ pub fn parse_csv_with(path: &Path, text: &str, rules: &[MaskRule]) -> Result<Csv
                 ));
             }
         };
-        if let Some(other) = channels.iter().position(|c| *c == c1) {
+        if let Some(&other) = seen.get(&c1) {
             return Err(err(hline, format!("channel {c1} appears twice (columns {} and {})", 2 * other + 2, j + 1)));
         }
+        seen.insert(c1, channels.len());
         channels.push(c1);
         pairs.push(pair);
         origins.push(Origin { line: hline, label: format!("columns {}-{}", j + 1, j + 2) });

@@ -95,6 +95,13 @@ impl Measured {
     /// `rules` hold [`MaskRule::UnmodelledChannels`].
     pub fn check_channels(self, path: &Path, dofs: &DofMap, rules: &[MaskRule]) -> Result<Measured, FrfError> {
         let (set, origins, masked) = check_channels(path, self.set, &self.origins, dofs, rules)?;
+        if set.channels().is_empty() {
+            return Err(FrfError::Parse {
+                path: path.to_path_buf(),
+                line: 1,
+                message: "no channel is left: every channel is at a node the model lacks or at a supported DOF".into(),
+            });
+        }
         let mut all = self.masked;
         all.extend(masked);
         Ok(Measured { set, format: self.format, notes: self.notes, origins, masked: all })
@@ -115,6 +122,24 @@ pub fn load_measured(path: &Path, map: &[ChannelMap]) -> Result<Measured, FrfErr
 /// the file; [`Measured::masked`] lists what was left out. Channel rules
 /// need the model: see [`Measured::check_channels`].
 pub fn load_measured_with(path: &Path, map: &[ChannelMap], rules: &[MaskRule]) -> Result<Measured, FrfError> {
+    let measured = read_format(path, map, rules)?;
+    // The readers refuse an empty record or table where they see it; this
+    // is the last guard, so that no command ever indexes an empty set.
+    if measured.set.n_freq() == 0 || measured.set.channels().is_empty() {
+        return Err(FrfError::Parse {
+            path: path.to_path_buf(),
+            line: 1,
+            message: format!(
+                "the file holds {} frequency lines and {} channels: nothing to compare",
+                measured.set.n_freq(),
+                measured.set.channels().len()
+            ),
+        });
+    }
+    Ok(measured)
+}
+
+fn read_format(path: &Path, map: &[ChannelMap], rules: &[MaskRule]) -> Result<Measured, FrfError> {
     match detect_format(path)? {
         MeasuredFormat::Csv => {
             let c = csv::read_csv_with(path, rules)?;
@@ -147,12 +172,53 @@ pub(crate) fn non_finite_word(token: &str) -> Option<f64> {
     if matches!(bare.as_str(), "nan" | "inf" | "infinity") { token.to_ascii_lowercase().parse().ok() } else { None }
 }
 
+/// What makes a file the same file however it is reached: its device and
+/// inode on unix, so that a second mount point, a hard link or a symlink
+/// to an input is still recognised as that input (comparing resolved paths
+/// misses the first two); elsewhere its canonical path, the best std offers.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct FileId {
+    #[cfg(unix)]
+    dev: u64,
+    #[cfg(unix)]
+    ino: u64,
+    #[cfg(not(unix))]
+    path: PathBuf,
+}
+
+impl FileId {
+    /// The identity of the file at `path` (following symlinks), or `None`
+    /// when there is no such file.
+    pub fn of(path: &Path) -> Option<FileId> {
+        let meta = std::fs::metadata(path).ok()?;
+        Some(FileId::from_metadata(path, &meta))
+    }
+
+    /// The identity of an open file.
+    pub fn of_file(file: &std::fs::File, path: &Path) -> Option<FileId> {
+        let meta = file.metadata().ok()?;
+        Some(FileId::from_metadata(path, &meta))
+    }
+
+    #[cfg(unix)]
+    fn from_metadata(_path: &Path, meta: &std::fs::Metadata) -> FileId {
+        use std::os::unix::fs::MetadataExt;
+        FileId { dev: meta.dev(), ino: meta.ino() }
+    }
+
+    #[cfg(not(unix))]
+    fn from_metadata(path: &Path, _meta: &std::fs::Metadata) -> FileId {
+        FileId { path: path.canonicalize().unwrap_or_else(|_| path.to_path_buf()) }
+    }
+}
+
 /// Fails if one of `outputs` is one of `inputs` (the same file, however
-/// named), so that a command can refuse before it does any work.
+/// named: see [`FileId`]), so that a command can refuse before it does any
+/// work. Outputs that do not exist yet cannot be inputs.
 pub fn refuse_inputs(outputs: &[PathBuf], inputs: &[PathBuf]) -> Result<(), FrfError> {
+    let inputs: Vec<FileId> = inputs.iter().filter_map(|p| FileId::of(p)).collect();
     for path in outputs {
-        let Ok(target) = path.canonicalize() else { continue };
-        if inputs.iter().any(|input| input.canonicalize().is_ok_and(|i| i == target)) {
+        if FileId::of(path).is_some_and(|id| inputs.contains(&id)) {
             return Err(FrfError::Io {
                 path: path.to_path_buf(),
                 message: "refusing to overwrite an input file; choose another output path".into(),
@@ -203,5 +269,24 @@ mod tests {
         assert_eq!(std::fs::read_to_string(&out).unwrap(), "two");
         // no temporary files are left behind
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    /// A hard link is another path to the same file: comparing resolved
+    /// paths would let an output replace the input through it (as a second
+    /// mount point of the same folder would); device and inode do not.
+    #[test]
+    fn an_input_reached_through_a_hard_link_is_recognised() {
+        let dir = tempfile::tempdir().unwrap();
+        let input = dir.path().join("case.toml");
+        std::fs::write(&input, "x").unwrap();
+        let link = dir.path().join("other-name.toml");
+        std::fs::hard_link(&input, &link).unwrap();
+        assert_ne!(link.canonicalize().unwrap(), input.canonicalize().unwrap());
+        let e = refuse_inputs(std::slice::from_ref(&link), std::slice::from_ref(&input)).unwrap_err();
+        assert!(e.to_string().contains("other-name.toml: refusing to overwrite an input"), "{e}");
+        let e = atomic_write(&link, b"y", std::slice::from_ref(&input)).unwrap_err();
+        assert!(e.to_string().contains("refusing to overwrite an input"), "{e}");
+        assert_eq!(std::fs::read_to_string(&input).unwrap(), "x");
+        refuse_inputs(&[dir.path().join("new.toml")], std::slice::from_ref(&input)).unwrap();
     }
 }

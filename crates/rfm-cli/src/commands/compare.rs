@@ -12,14 +12,16 @@ use damping::DampedSystem;
 use fe_model::CaseFile;
 use frf::correlation::{BandSpec, Correlation, correlate};
 use frf::{FrfSet, synthesize};
+use rfm_update::Study;
 use rfm_update::study::{describe_masked, read_measured_for};
-use rfm_update::{Study, UpdateError};
 use serde::Serialize;
 
-use super::{Result, load_case, print_masked};
+use super::{Result, load_case, print_masked, print_notes};
+use crate::exit::Exit;
+use crate::output::Outputs;
 use crate::report::html::{self, Block, Report, Section, Tone};
 use crate::report::json::CorrelationJson;
-use crate::report::{self, ModelFrfs, Output, plot, sig, signed};
+use crate::report::{self, ModelFrfs, plot, sig, signed};
 use crate::table::Table;
 
 /// Number of overlay figures.
@@ -39,6 +41,10 @@ struct CompareJson {
     correlation: CorrelationJson,
     /// Measured (LSCF) against model modes, or why they could not be compared.
     modes: std::result::Result<ModesJson, String>,
+    /// What the case's mask rules left out of the measured data.
+    masked: Vec<String>,
+    /// What reading the measured data changed or passed over.
+    notes: Vec<String>,
 }
 
 /// One measured mode and its model partner.
@@ -196,18 +202,24 @@ pub(crate) fn parse_bands(s: &str) -> std::result::Result<BandSpec, String> {
     }
 }
 
-/// The measured FRFs, a description of where they came from, and what the
-/// case's mask rules left out of them.
-fn measured_data(
+/// The measured FRFs and what is known of them.
+struct MeasuredData {
+    /// The case (returned by the study that read the data).
     case: CaseFile,
-    system: &DampedSystem,
-    files: &[PathBuf],
-) -> Result<(CaseFile, FrfSet, String, Vec<String>)> {
+    /// The FRFs.
+    set: FrfSet,
+    /// Where they came from.
+    source: String,
+    /// What the case's mask rules left out of them.
+    masked: Vec<String>,
+    /// What reading them changed or passed over.
+    notes: Vec<String>,
+}
+
+/// The measured FRFs: the case's data or truth, or the `--measured` files.
+fn measured_data(case: CaseFile, system: &DampedSystem, files: &[PathBuf]) -> Result<MeasuredData> {
     if files.is_empty() {
-        let study = Study::from_case(case).map_err(|e| match e {
-            UpdateError::Case(c) => c.render(),
-            other => other.to_string(),
-        })?;
+        let study = Study::from_case(case)?;
         let source = match (study.case.measurement.as_ref().and_then(|m| m.data.as_ref()), &study.case.truth) {
             (Some(p), _) => format!("measured file {} (from the case)", p.display()),
             (None, Some(t)) if t.noise > 0.0 => format!(
@@ -219,17 +231,19 @@ fn measured_data(
             (None, None) => "the case's data".into(),
         };
         let masked = describe_masked(&study.masked);
-        return Ok((study.case, study.measured, source, masked));
+        return Ok(MeasuredData { case: study.case, set: study.measured, source, masked, notes: study.notes });
     }
     let mut sets = Vec::new();
     let mut masked = Vec::new();
+    let mut notes = Vec::new();
     for f in files {
         let read = read_measured_for(system, f, case.measurement.as_ref())?;
         masked.extend(describe_masked(&read.masked).into_iter().map(|m| format!("{}: {m}", f.display())));
+        notes.extend(read.notes.iter().map(|n| format!("{}: {n}", f.display())));
         sets.push((f.clone(), read.set));
     }
     let names = files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(", ");
-    Ok((case, merge(sets)?, format!("measured file(s) {names}"), masked))
+    Ok(MeasuredData { case, set: merge(sets)?, source: format!("measured file(s) {names}"), masked, notes })
 }
 
 /// Joins the channels of several measured files on the same lines, in the
@@ -245,6 +259,7 @@ fn merge(sets: Vec<(PathBuf, FrfSet)>) -> Result<FrfSet> {
     }
     let f = first.frequencies_hz().to_vec();
     let mut channels = first.channels().to_vec();
+    let mut seen: std::collections::HashSet<frf::Channel> = channels.iter().copied().collect();
     for (path, set) in &rest {
         let same = set.n_freq() == f.len()
             && set.frequencies_hz().iter().zip(&f).all(|(a, b)| (a - b).abs() <= 1e-6 * b.abs());
@@ -259,7 +274,7 @@ fn merge(sets: Vec<(PathBuf, FrfSet)>) -> Result<FrfSet> {
             .into());
         }
         for c in set.channels() {
-            if channels.contains(c) {
+            if !seen.insert(*c) {
                 return Err(format!("{}: channel {c} appears in an earlier file too", path.display()).into());
             }
             channels.push(*c);
@@ -283,19 +298,15 @@ pub(crate) fn compare(
     out: Option<&Path>,
     json: bool,
     bands: &str,
-) -> Result<()> {
-    if out.is_some() {
-        crate::files_to_write();
-    }
+) -> Result<Exit> {
     let spec = parse_bands(bands)?;
     let case = load_case(case_path)?;
     let mut inputs = case.inputs();
     inputs.extend(measured_files.iter().cloned());
-    if let Some(dir) = out {
-        frf::io::refuse_inputs(&[dir.join("compare.json"), dir.join("report.html")], &inputs)?;
-    }
+    let output = out.map(|dir| Outputs::folder(dir, &inputs, &["compare.json", "report.html"])).transpose()?;
     let system = DampedSystem::new(case.model.clone())?;
-    let (case, measured, source, masked) = measured_data(case, &system, measured_files)?;
+    let MeasuredData { case, set: measured, source, masked, notes } = measured_data(case, &system, measured_files)?;
+    print_notes(&notes, json)?;
     print_masked(&masked, json)?;
     let frfs = synthesize(&system, measured.channels(), measured.frequencies_hz())?;
     let correlation = correlate(&measured, &frfs, &spec)?;
@@ -308,6 +319,8 @@ pub(crate) fn compare(
         bands: bands.to_string(),
         correlation: CorrelationJson::from(&correlation),
         modes,
+        masked,
+        notes,
     };
     if json {
         outln!("{}", serde_json::to_string_pretty(&doc)?);
@@ -325,20 +338,19 @@ pub(crate) fn compare(
             Err(e) => outln!("\nmodes not compared: {e}"),
         }
     }
-    if let Some(dir) = out {
-        let _writing = crate::writing();
-        let mut output = Output::new(dir, inputs);
+    if let Some(mut output) = output {
         let path = output.write("compare.json", serde_json::to_string_pretty(&doc)?.as_bytes())?;
         let model = ModelFrfs { label: "model".into(), colour: plot::UPDATED, frfs, correlation };
         let mut report = Report::new(format!("{}: model against measurement", case.model.title));
         report.subtitle = Some(format!("rfm compare, case file {}", case_path.display()));
         report.sections = report_sections(&case, &measured, &source, &model, &doc.modes, &mut output)?;
         let html = output.write("report.html", report.render().as_bytes())?;
+        let written = output.commit()?;
         if !json {
-            outln!("\nwrote {}, {} and {} figures", path.display(), html.display(), output.written().len() - 2);
+            outln!("\nwrote {}, {} and {} figures", path.display(), html.display(), written.len() - 2);
         }
     }
-    Ok(())
+    Ok(Exit::Success)
 }
 
 /// The report's sections, in order. A modal comparison goes in before the
@@ -349,7 +361,7 @@ fn report_sections(
     source: &str,
     model: &ModelFrfs,
     modes: &std::result::Result<ModesJson, String>,
-    out: &mut Output,
+    out: &mut Outputs,
 ) -> Result<Vec<Section>> {
     let c = &model.correlation;
     let mut sections = vec![summary(case, measured, source, c)];

@@ -3,11 +3,13 @@
 use std::path::Path;
 
 use indicatif::ProgressBar;
+use rfm_update::Study;
 use rfm_update::diagnose::{DiagnoseOptions, Diagnosis, diagnose_with};
 use rfm_update::study::{describe_masked, read_measured_for};
-use rfm_update::{Study, UpdateError};
 
-use super::{Result, print_masked};
+use super::{Result, print_masked, print_notes};
+use crate::exit::Exit;
+use crate::output::Outputs;
 use crate::table::{Table, num, percent};
 
 /// Options of the diagnose command.
@@ -21,26 +23,23 @@ pub(crate) struct DiagnoseArgs<'a> {
     pub(crate) verbose: bool,
 }
 
-pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<()> {
-    if args.apply.is_some() {
-        crate::files_to_write();
-    }
-    let study = Study::load(args.case).map_err(|e| match e {
-        UpdateError::Case(c) => c.render(),
-        other => other.to_string(),
-    })?;
+pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
+    let study = Study::load(args.case)?;
     let mut inputs = study.case.inputs();
     inputs.extend(args.measured.map(Path::to_path_buf));
-    if let Some(out) = args.out {
-        frf::io::refuse_inputs(&[out.to_path_buf()], &inputs)?;
-    }
+    let mut output = match (args.apply, args.out) {
+        (Some(_), Some(out)) => Some(Outputs::file(out, &inputs)?),
+        _ => None,
+    };
     let measured = match args.measured {
         Some(path) => {
             let read = read_measured_for(&study.system, path, study.case.measurement.as_ref())?;
+            print_notes(&read.notes, args.json)?;
             print_masked(&describe_masked(&read.masked), args.json)?;
             read.set.to_receptance()
         }
         None => {
+            print_notes(&study.notes, args.json)?;
             print_masked(&describe_masked(&study.masked), args.json)?;
             study.measured.clone()
         }
@@ -74,14 +73,15 @@ pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<()> {
     }
     if let Some(rank) = args.apply {
         let out = args.out.ok_or("--apply needs --out FILE for the new case file")?;
-        let text = d.apply(&study.case, rank)?.text_at(out).map_err(|e| e.render())?;
-        let _writing = crate::writing();
-        frf::io::atomic_write(out, text.as_bytes(), &inputs)?;
+        let text = d.apply(&study.case, rank)?.text_at(out)?;
+        let mut output = output.take().ok_or("--apply needs --out FILE for the new case file")?;
+        output.write_file(text.as_bytes())?;
+        output.commit()?;
         if !args.json {
             outln!("\nwrote {} with effect {rank} added", out.display());
         }
     }
-    Ok(())
+    Ok(Exit::Success)
 }
 
 fn print_diagnosis(d: &Diagnosis, top: usize) -> Result<()> {

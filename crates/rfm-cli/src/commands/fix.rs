@@ -2,13 +2,18 @@
 //! until nothing significant remains; the case after every step, and a
 //! report whose headline is the fall of the misfit.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use rfm_update::fix::{FixOptions, FixOutcome, FixProgress, fix as run_fix};
-use rfm_update::{Study, UpdateError};
+use rfm_update::Study;
+use rfm_update::fix::{FixOptions, FixOutcome, FixProgress, FixStop, fix as run_fix};
 
-use super::Result;
+use super::{Result, print_masked, print_notes};
+use crate::exit::Exit;
+use crate::output::Outputs;
 use crate::table::{Table, num};
+
+/// The data a case synthesised from its `[truth]`, written beside the steps.
+const DATA_FILE: &str = "measured.csv";
 
 /// A misfit within this many times the noise is consistent with it.
 pub(crate) const CONSISTENT: f64 = 1.5;
@@ -26,23 +31,21 @@ pub(crate) fn step_file(k: usize) -> String {
     format!("step-{k}.toml")
 }
 
-pub(crate) fn fix(args: &FixArgs<'_>) -> Result<()> {
-    crate::files_to_write();
-    let study = Study::load(args.case).map_err(|e| match e {
-        UpdateError::Case(c) => c.render(),
-        other => other.to_string(),
-    })?;
+pub(crate) fn fix(args: &FixArgs<'_>) -> Result<Exit> {
+    let study = Study::load(args.case)?;
     let inputs = study.case.inputs();
     // the data every written case reads: the case's own file, or the data
     // synthesised from its [truth], written once beside the steps
     let synthesised = study.case.measurement.as_ref().and_then(|m| m.data.as_ref()).is_none();
-    let data_file = synthesised.then(|| args.out.join("measured.csv"));
-    let mut names: Vec<PathBuf> = (1..=args.steps)
-        .map(|k| args.out.join(step_file(k)))
-        .chain(["results.json", "report.html"].map(|n| args.out.join(n)))
-        .collect();
-    names.extend(data_file.clone());
-    frf::io::refuse_inputs(&names, &inputs)?;
+    let mut names: Vec<String> = (1..=args.steps).map(step_file).collect();
+    names.extend(["results.json", "report.html"].map(String::from));
+    if synthesised {
+        names.push(DATA_FILE.into());
+    }
+    let known: Vec<&str> = names.iter().map(String::as_str).collect();
+    let mut output = Outputs::folder(args.out, &inputs, &known)?;
+    print_notes(&study.notes, args.json)?;
+    print_masked(&rfm_update::study::describe_masked(&study.masked), args.json)?;
     if !args.json {
         outln!("{}", study.case.model.title);
         outln!(
@@ -83,37 +86,31 @@ pub(crate) fn fix(args: &FixArgs<'_>) -> Result<()> {
         print_outcome(&outcome)?;
     }
 
-    let _writing = crate::writing();
-    let mut written = Vec::new();
-    let case_with_data = |mut editor: fe_model::CaseEditor, path: &Path| -> Result<String> {
+    let data_file = synthesised.then(|| output.path(DATA_FILE));
+    if synthesised {
+        output.write(DATA_FILE, frf::io::csv::to_csv_string(&study.measured).as_bytes())?;
+    }
+    for (k, s) in outcome.steps.iter().enumerate() {
+        let name = step_file(k + 1);
+        let mut editor = s.case.clone();
         if let Some(data) = &data_file {
             editor.use_data(data);
         }
-        Ok(editor.text_at(path).map_err(|e| e.render())?)
-    };
-    let mut files: Vec<(PathBuf, Vec<u8>)> = Vec::new();
-    if let Some(data) = &data_file {
-        files.push((data.clone(), frf::io::csv::to_csv_string(&study.measured).into_bytes()));
+        let text = editor.text_at(&output.path(&name))?;
+        output.write(&name, text.as_bytes())?;
     }
-    for (k, s) in outcome.steps.iter().enumerate() {
-        let path = args.out.join(step_file(k + 1));
-        let text = case_with_data(s.case.clone(), &path)?;
-        files.push((path, text.into_bytes()));
-    }
-    files.push((args.out.join("results.json"), serde_json::to_string_pretty(&outcome)?.into_bytes()));
-    for (path, bytes) in &files {
-        frf::io::atomic_write(path, bytes, &inputs)?;
-        written.push(path.clone());
-    }
-    let report = crate::report::fix_report::write(&study, &outcome, args.out, inputs)?;
-    written.push(report);
+    output.write("results.json", serde_json::to_string_pretty(&outcome)?.as_bytes())?;
+    crate::report::fix_report::write(&study, &outcome, &mut output)?;
+    let written = output.commit()?;
     if !json {
         outln!("\nwrote {} files into {}", written.len(), args.out.display());
         if let Some(last) = outcome.steps.len().checked_sub(1) {
             outln!("the fixed model: {}", args.out.join(step_file(last + 1)).display());
         }
     }
-    Ok(())
+    // success only when the loop ended with the data explained down to their noise
+    let explained = outcome.stop == FixStop::NothingSignificant && outcome.final_misfit() <= CONSISTENT * outcome.noise;
+    Ok(if explained { Exit::Success } else { Exit::NotConverged })
 }
 
 fn print_outcome(o: &FixOutcome) -> Result<()> {

@@ -11,6 +11,8 @@ use std::path::Path;
 
 use fe_model::CaseFile;
 
+use crate::exit::Failure;
+
 pub(crate) use compare::compare;
 pub(crate) use diagnose::{DiagnoseArgs, diagnose};
 pub(crate) use fix::{FixArgs, fix};
@@ -18,10 +20,11 @@ pub(crate) use inspect::inspect;
 pub(crate) use simulate::simulate;
 pub(crate) use update::{Overrides as UpdateOverrides, update};
 
-pub(crate) type Result<T> = std::result::Result<T, Box<dyn std::error::Error>>;
+/// A command's result: its exit code, or why it failed (see [`crate::exit`]).
+pub(crate) type Result<T> = std::result::Result<T, Failure>;
 
 pub(crate) fn load_case(path: &Path) -> Result<CaseFile> {
-    CaseFile::load(path).map_err(|e| e.render().into())
+    Ok(CaseFile::load(path)?)
 }
 
 /// Tells what the case's `[measurement] mask` left out of the measured data:
@@ -39,6 +42,25 @@ pub(crate) fn print_masked(masked: &[String], json: bool) -> Result<()> {
     }
     if masked.len() > SHOWN {
         text.push_str(&format!("\n  ... and {} more", masked.len() - SHOWN));
+    }
+    if json {
+        eprintln!("{text}");
+    } else {
+        outln!("{text}");
+    }
+    Ok(())
+}
+
+/// Tells what reading the measured data changed or passed over (lines at
+/// 0 Hz dropped, units scaled, kinds converted, datasets skipped), where
+/// [`print_masked`] tells what the mask left out.
+pub(crate) fn print_notes(notes: &[String], json: bool) -> Result<()> {
+    if notes.is_empty() {
+        return Ok(());
+    }
+    let mut text = format!("read from the measured data ({}):", notes.len());
+    for n in notes {
+        text.push_str(&format!("\n  - {n}"));
     }
     if json {
         eprintln!("{text}");

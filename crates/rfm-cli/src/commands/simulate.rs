@@ -6,10 +6,12 @@ use damping::DampedSystem;
 use frf::{Channel, NoiseModel};
 
 use super::{Result, load_case};
+use crate::exit::Exit;
+use crate::output::Outputs;
 
-pub(crate) fn simulate(case: &Path, out: &Path, truth: bool, noise: f64, seed: u64) -> Result<()> {
-    crate::files_to_write();
+pub(crate) fn simulate(case: &Path, out: &Path, truth: bool, noise: f64, seed: u64) -> Result<Exit> {
     let case_file = load_case(case)?;
+    let mut output = Outputs::file(out, &case_file.inputs())?;
     let spec =
         case_file.measurement.as_ref().ok_or("the case has no [measurement] section (which channels and lines?)")?;
     let model = if truth {
@@ -22,8 +24,8 @@ pub(crate) fn simulate(case: &Path, out: &Path, truth: bool, noise: f64, seed: u
         spec.references.iter().flat_map(|&r| spec.responses.iter().map(move |&m| Channel::new(m, r))).collect();
     let mut set = frf::synthesize(&sys, &channels, &spec.frequencies_hz)?;
     NoiseModel { relative: noise, floor: 0.0, seed }.apply(&mut set);
-    let _writing = crate::writing();
-    frf::io::atomic_write(out, frf::io::csv::to_csv_string(&set).as_bytes(), &case_file.inputs())?;
+    output.write_file(frf::io::csv::to_csv_string(&set).as_bytes())?;
+    output.commit()?;
     outln!("wrote {} channels x {} lines ({}) to {}", set.channels().len(), set.n_freq(), set.kind(), out.display());
-    Ok(())
+    Ok(Exit::Success)
 }

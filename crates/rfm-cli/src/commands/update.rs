@@ -4,20 +4,15 @@ use std::path::Path;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use rfm_update::rfm::{IterationRecord, RfmOptions, Status};
-use rfm_update::{Method, Study, UpdateError, UpdateOutcome};
+use rfm_update::{Method, Study, UpdateOutcome};
 
-use super::{Result, print_masked};
+use super::{Result, print_masked, print_notes};
+use crate::exit::{Exit, Failure};
+use crate::output::Outputs;
 use crate::table::{Table, num};
 
 fn db(x: f64) -> f64 {
     20.0 * x.log10()
-}
-
-fn load_study(case: &Path) -> Result<Study> {
-    Study::load(case).map_err(|e| match e {
-        UpdateError::Case(c) => c.render().into(),
-        other => other.to_string().into(),
-    })
 }
 
 /// Command-line overrides of the case's `[update]` settings.
@@ -31,14 +26,13 @@ pub(crate) struct Overrides {
     pub(crate) max_iterations: Option<usize>,
 }
 
-pub(crate) fn update(case: &Path, out: Option<&Path>, json: bool, over: &Overrides) -> Result<()> {
-    if out.is_some() {
-        crate::files_to_write();
-    }
-    let mut study = load_study(case)?;
-    if let Some(dir) = out {
-        let outputs = ["results.json", "updated.toml", "report.html"].map(|name| dir.join(name));
-        frf::io::refuse_inputs(&outputs, &study.case.inputs())?;
+pub(crate) fn update(case: &Path, out: Option<&Path>, json: bool, over: &Overrides) -> Result<Exit> {
+    let mut study = Study::load(case)?;
+    let mut output = out
+        .map(|dir| Outputs::folder(dir, &study.case.inputs(), &["results.json", "updated.toml", "report.html"]))
+        .transpose()?;
+    if over.lines == Some(0) {
+        return Err(Failure::new(Exit::Usage, "--lines 0: give at least one measured line to fit"));
     }
     if let Some(n) = over.lines
         && let Some(u) = study.case.update.as_mut()
@@ -56,6 +50,7 @@ pub(crate) fn update(case: &Path, out: Option<&Path>, json: bool, over: &Overrid
         Method::Rfm => spec.max_iterations.map_or(RfmOptions::default().max_iterations, |n| n as usize),
         Method::OutputError => study.output_error_options()?.max_iterations,
     });
+    print_notes(&study.notes, json)?;
     print_masked(&rfm_update::study::describe_masked(&study.masked), json)?;
     if !json {
         outln!("{}", study.case.model.title);
@@ -125,21 +120,21 @@ pub(crate) fn update(case: &Path, out: Option<&Path>, json: bool, over: &Overrid
             print_history(&[study.case.history.clone(), vec![step.clone()]].concat())?;
         }
     }
-    if let Some(dir) = out {
-        let _writing = crate::writing();
-        let inputs = study.case.inputs();
-        let path = dir.join("results.json");
-        frf::io::atomic_write(&path, serde_json::to_string_pretty(&outcome)?.as_bytes(), &inputs)?;
-        let updated = write_updated_model(&study, &outcome, &step, dir, &inputs)?;
+    if let Some(mut output) = output.take() {
+        let path = output.write("results.json", serde_json::to_string_pretty(&outcome)?.as_bytes())?;
+        let updated = write_updated_model(&study, &outcome, &step, &mut output)?;
+        let report = crate::report::update_report::write(&study, &outcome, &mut output, case)?;
+        output.commit()?;
         if !json {
             outln!("\nwrote {} and {}", path.display(), updated.display());
-        }
-        let report = crate::report::update_report::write(&study, &outcome, dir, case, inputs)?;
-        if !json {
             outln!("wrote {} (figures beside it)", report.display());
         }
     }
-    Ok(())
+    let exit = Exit::of_status(&outcome.status);
+    if exit != Exit::Success {
+        eprintln!("exit code {}: {}", exit.code(), exit.meaning());
+    }
+    Ok(exit)
 }
 
 /// Writes the case with the updated values as `DIR/updated.toml`.
@@ -147,8 +142,7 @@ fn write_updated_model(
     study: &Study,
     outcome: &UpdateOutcome,
     step: &fe_model::HistoryEntry,
-    dir: &Path,
-    inputs: &[std::path::PathBuf],
+    output: &mut Outputs,
 ) -> Result<std::path::PathBuf> {
     let model = outcome.system.model();
     let values: Vec<(String, f64)> = study
@@ -163,13 +157,11 @@ fn write_updated_model(
         outcome.residual,
         study.case.path.display()
     );
-    let path = dir.join("updated.toml");
-    let mut editor = study.case.editor().map_err(|e| e.render())?;
-    editor.set_values(&values, &comment).map_err(|e| e.render())?;
-    editor.push_history(step).map_err(|e| e.render())?;
-    let text = editor.text_at(&path).map_err(|e| e.render())?;
-    frf::io::atomic_write(&path, text.as_bytes(), inputs)?;
-    Ok(path)
+    let mut editor = study.case.editor()?;
+    editor.set_values(&values, &comment)?;
+    editor.push_history(step)?;
+    let text = editor.text_at(&output.path("updated.toml"))?;
+    Ok(output.write("updated.toml", text.as_bytes())?)
 }
 
 /// Lines of the misfit in the case history (as in `rfm diagnose`).

@@ -3,7 +3,7 @@
 //! parameters, what still stands out, and the nominal and final models
 //! against the measured FRFs.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use frf::correlation::{BandSpec, correlate};
 use frf::synthesize;
@@ -11,17 +11,17 @@ use rfm_update::Study;
 use rfm_update::fix::FixOutcome;
 
 use super::html::{Block, Report, Section, Table, Tone};
-use super::{ModelFrfs, Output, Result, plot, sig};
+use super::{ModelFrfs, Result, plot, sig};
 use crate::commands::fix::{CONSISTENT, step_file};
+use crate::output::Outputs;
 use crate::table::{num, percent};
 
 /// Overlay figures of the worst channels.
 const OVERLAYS: usize = 4;
 
-/// Writes the report files of the loop into `dir` and returns the path of
-/// `report.html`. `inputs` are protected from being overwritten.
-pub(crate) fn write(study: &Study, outcome: &FixOutcome, dir: &Path, inputs: Vec<PathBuf>) -> Result<PathBuf> {
-    let mut out = Output::new(dir, inputs);
+/// Writes the report files of the loop through `out` and returns where
+/// `report.html` will be.
+pub(crate) fn write(study: &Study, outcome: &FixOutcome, out: &mut Outputs) -> Result<PathBuf> {
     let mut report = Report::new(format!("{}: closing the loop", study.case.model.title));
     report.subtitle = Some(format!(
         "rfm fix, case file {}: {} effect(s) added; {}",
@@ -159,11 +159,11 @@ pub(crate) fn write(study: &Study, outcome: &FixOutcome, dir: &Path, inputs: Vec
         models.push(model("fixed model", plot::UPDATED, &damping::DampedSystem::new(fixed.model)?)?);
     }
     let notes = vec!["The nominal model and the model after the last step against the measured FRFs.".to_string()];
-    report.sections.push(super::correlation_section(measured, &models, &mut out, notes)?);
+    report.sections.push(super::correlation_section(measured, &models, out, notes)?);
     let last_model = models.last().expect("the nominal model at least");
     let worst = super::notable_channels(&last_model.correlation, 2);
     let picks = super::representative_channels(measured, &worst, OVERLAYS);
-    report.sections.push(super::overlay_section(measured, &models, &picks, &worst, &[], &mut out)?);
+    report.sections.push(super::overlay_section(measured, &models, &picks, &worst, &[], out)?);
     report.sections.push(super::definitions_section());
-    out.write("report.html", report.render().as_bytes())
+    Ok(out.write("report.html", report.render().as_bytes())?)
 }

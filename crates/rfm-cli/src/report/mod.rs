@@ -4,8 +4,8 @@
 //! the update report ([`update_report`]) and the report of the loop
 //! ([`fix_report`]).
 //!
-//! Figures are drawn to strings and written with [`frf::io::atomic_write`],
-//! which refuses to overwrite the run's inputs.
+//! Figures are drawn to strings and written through the run's
+//! [`Outputs`], all or nothing.
 
 pub(crate) mod fix_report;
 pub(crate) mod html;
@@ -13,47 +13,21 @@ pub(crate) mod json;
 pub(crate) mod plot;
 pub(crate) mod update_report;
 
-use std::path::{Path, PathBuf};
-
 use frf::correlation::Correlation;
 use frf::{Channel, FrfSet};
 use plotters::style::RGBColor;
 
 use html::{Block, Figure, Section, Table, Tone};
 
-pub(crate) type Result<T> = std::result::Result<T, Box<dyn std::error::Error>>;
+use crate::output::Outputs;
 
-/// Where a run's files go: figures and the report are written into `dir`
-/// atomically, never over one of `inputs`.
-pub(crate) struct Output {
-    dir: PathBuf,
-    inputs: Vec<PathBuf>,
-    written: Vec<PathBuf>,
-}
+pub(crate) type Result<T> = crate::commands::Result<T>;
 
-impl Output {
-    /// Output into `dir`, protecting `inputs`.
-    pub(crate) fn new(dir: &Path, inputs: Vec<PathBuf>) -> Self {
-        Output { dir: dir.to_path_buf(), inputs, written: Vec::new() }
-    }
-
-    /// Writes `DIR/name`.
-    pub(crate) fn write(&mut self, name: &str, bytes: &[u8]) -> Result<PathBuf> {
-        let path = self.dir.join(name);
-        frf::io::atomic_write(&path, bytes, &self.inputs)?;
-        self.written.push(path.clone());
-        Ok(path)
-    }
-
-    /// Writes a figure as `DIR/name.svg` and returns it as a report block.
+impl Outputs {
+    /// Writes a figure as `name.svg` and returns it as a report block.
     pub(crate) fn figure(&mut self, name: &str, svg: String, caption: impl Into<String>) -> Result<Block> {
         self.write(&format!("{name}.svg"), svg.as_bytes())?;
         Ok(Block::Figure(Figure { svg, caption: caption.into() }))
-    }
-
-    /// Files written so far.
-    pub(crate) fn written(&self) -> &[PathBuf] {
-        &self.written
     }
 }
 
@@ -190,7 +164,7 @@ fn short_label(label: &str) -> &str {
 pub(crate) fn correlation_section(
     measured: &FrfSet,
     models: &[ModelFrfs],
-    out: &mut Output,
+    out: &mut Outputs,
     notes: Vec<String>,
 ) -> Result<Section> {
     let mut s = Section::new("FRF correlation");
@@ -352,7 +326,7 @@ pub(crate) fn overlay_section(
     channels: &[usize],
     priority: &[usize],
     marks_hz: &[f64],
-    out: &mut Output,
+    out: &mut Outputs,
 ) -> Result<Section> {
     let mut s = Section::new("FRF overlays");
     s.push(Block::Text(format!(

@@ -14,7 +14,8 @@ use rfm_update::study::FrequencyTable;
 use rfm_update::{Study, UpdateOutcome};
 
 use super::html::{Block, Report, Section, Table, Tone};
-use super::{ModelFrfs, Output, Result, plot, sig};
+use super::{ModelFrfs, Result, plot, sig};
+use crate::output::Outputs;
 use crate::table::num;
 
 /// At most this many iterations are re-evaluated over the measured band for the
@@ -24,16 +25,9 @@ const MAX_ITERATIONS_EVALUATED: usize = 30;
 /// Number of overlay figures.
 const OVERLAYS: usize = 4;
 
-/// Writes the report files of an updating run into `dir` and returns the
-/// path of `report.html`. `inputs` are protected from being overwritten.
-pub(crate) fn write(
-    study: &Study,
-    outcome: &UpdateOutcome,
-    dir: &Path,
-    case_path: &Path,
-    inputs: Vec<PathBuf>,
-) -> Result<PathBuf> {
-    let mut out = Output::new(dir, inputs);
+/// Writes the report files of an updating run into the run's outputs and
+/// returns where `report.html` will be.
+pub(crate) fn write(study: &Study, outcome: &UpdateOutcome, out: &mut Outputs, case_path: &Path) -> Result<PathBuf> {
     let measured = &study.measured;
     let channels = measured.channels();
     let freqs = measured.frequencies_hz();
@@ -124,13 +118,13 @@ pub(crate) fn write(
         freqs.len(),
         outcome.frequencies_hz.len()
     )];
-    report.sections.push(super::correlation_section(measured, &models, &mut out, notes)?);
+    report.sections.push(super::correlation_section(measured, &models, out, notes)?);
 
     let worst = super::notable_channels(&models[1].correlation, 2);
     let picks = super::representative_channels(measured, &worst, OVERLAYS);
-    report.sections.push(super::overlay_section(measured, &models, &picks, &worst, &outcome.frequencies_hz, &mut out)?);
+    report.sections.push(super::overlay_section(measured, &models, &picks, &worst, &outcome.frequencies_hz, out)?);
     report.sections.push(super::definitions_section());
-    out.write("report.html", report.render().as_bytes())
+    Ok(out.write("report.html", report.render().as_bytes())?)
 }
 
 fn method_name(m: &str) -> String {

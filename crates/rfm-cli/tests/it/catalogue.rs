@@ -54,7 +54,15 @@ struct Entry {
     /// `file:LINE:` with the line of the first occurrence of `text` in
     /// that file.
     expect: Vec<&'static str>,
+    /// The exit code (see `rfm --help`): 3 for invalid input, 4 for failed
+    /// numerics.
+    code: i32,
 }
+
+/// Exit code of invalid input.
+const INVALID_INPUT: i32 = 3;
+/// Exit code of failed numerics.
+const NUMERICS: i32 = 4;
 
 fn replaced(from: &str, to: &str) -> String {
     assert!(BEAM.contains(from), "{from}");
@@ -67,7 +75,13 @@ fn case(text: String) -> Vec<(&'static str, Vec<u8>)> {
 
 /// A case file entry run with `rfm simulate`.
 fn bad_case(what: &'static str, text: String, expect: Vec<&'static str>) -> Entry {
-    Entry { what, files: case(text), args: vec!["simulate", "{dir}/cat.toml", "--out", "{dir}/h.csv"], expect }
+    Entry {
+        what,
+        files: case(text),
+        args: vec!["simulate", "{dir}/cat.toml", "--out", "{dir}/h.csv"],
+        expect,
+        code: INVALID_INPUT,
+    }
 }
 
 /// Measured receptances of the beam at 10, 20, ... 100 Hz, for the 3:uy
@@ -94,7 +108,7 @@ fn bad_data(what: &'static str, name: &'static str, data: String, extra: &str, e
     let text = format!("{BEAM}data = \"{name}\"\n{extra}");
     let mut files = case(text);
     files.push((name, data.into_bytes()));
-    Entry { what, files, args: vec!["compare", "{dir}/cat.toml"], expect }
+    Entry { what, files, args: vec!["compare", "{dir}/cat.toml"], expect, code: INVALID_INPUT }
 }
 
 /// Line `n` (1-based) of `text` replaced by `f(line)`.
@@ -115,6 +129,50 @@ nodes = [[1, 0.0, 0.0]]
 
 [groups.g]
 "#;
+
+/// The universal-file fixture of the frf tests: an accelerance from test
+/// point 101:+Z to 1:-Z at 2.5, 5, ... 20 Hz (record 1, lines 1-18) and its
+/// coherence (record 2, lines 19-34).
+const OSC_UFF: &str = include_str!("../../../frf/tests/data/oscillator_z_ascii.uff");
+
+/// The fixture with line `n` (1-based) replaced, and only lines
+/// `..=last` kept (then closed with `-1`).
+fn osc_uff(edits: &[(usize, &str)], last: usize) -> Vec<u8> {
+    let mut lines: Vec<String> = OSC_UFF.lines().take(last).map(str::to_string).collect();
+    for &(n, text) in edits {
+        lines[n - 1] = text.to_string();
+    }
+    if lines.last().is_none_or(|l| l.trim() != "-1") {
+        lines.push("    -1".into());
+    }
+    (lines.join("\n") + "\n").into_bytes()
+}
+
+/// The beam case reading the fixture as `m.uff`, its test points mapped to
+/// the tip (5:uy) and node 4; with `extra` appended, run with `args`.
+fn osc_entry(
+    what: &'static str,
+    uff: Vec<u8>,
+    extra: &str,
+    args: &[&'static str],
+    expect: Vec<&'static str>,
+    code: i32,
+) -> Entry {
+    let text = BEAM.replace("responses = [\"3:uy\", \"5:uy\"]", "responses = [\"4:uy\"]").replace("[truth]\n", "")
+        + "data = \"m.uff\"\n[[measurement.map]]\ntest = \"101:+Z\"\nmodel = \"4:uy\"\n[[measurement.map]]\ntest = \"1:+Z\"\nmodel = \"5:uy\"\nsign = -1\n"
+        + extra;
+    let mut files = case(text);
+    files.push(("m.uff", uff));
+    Entry { what, files, args: args.to_vec(), expect, code }
+}
+
+/// The beam case (truth data) with an `[update]` of its damping.
+fn beam_update(replace: (&str, &str)) -> String {
+    replaced(replace.0, replace.1) + "\n[update]\nparameters = [\"group.beam.alpha\", \"group.beam.beta\"]\n"
+}
+
+/// Exit code of a wrong command line.
+const USAGE: i32 = 2;
 
 fn catalogue() -> Vec<Entry> {
     let csv = csv();
@@ -277,6 +335,7 @@ fn catalogue() -> Vec<Entry> {
             )),
             args: vec!["simulate", "{dir}/cat.toml", "--out", "{dir}/h.csv"],
             expect: vec!["singular at 15.915494309189533 Hz"],
+            code: NUMERICS,
         },
         // ------------------------------------------------------------ measured data
         bad_data(
@@ -378,11 +437,165 @@ fn catalogue() -> Vec<Entry> {
             "",
             vec!["m.uff:", "record 1", "no node 93"],
         ),
+        // ------------------------------------------------ issue 14: empty, huge and degenerate inputs
+        osc_entry(
+            "UFF whose record declares 0 values",
+            osc_uff(&[(9, "         6         0         1 2.500000E+00 2.500000E+00 0.000000E+00")], 13),
+            "",
+            &["compare", "{dir}/cat.toml"],
+            vec!["m.uff:2:", "record 1 (line 2)", "no frequency line to compare", "declares no values"],
+            INVALID_INPUT,
+        ),
+        osc_entry(
+            "UFF whose only line is at 0 Hz (update)",
+            osc_uff(
+                &[
+                    (9, "         6         1         1 0.000000E+00 2.500000E+00 0.000000E+00"),
+                    (14, " 1.0E+00 0.0E+00"),
+                ],
+                14,
+            ),
+            "\n[update]\nparameters = [\"group.beam.alpha\"]\n",
+            &["update", "{dir}/cat.toml"],
+            vec!["m.uff:2:", "no frequency line to compare", "all at 0 Hz or below"],
+            INVALID_INPUT,
+        ),
+        osc_entry(
+            "UFF whose only line is at 0 Hz (diagnose)",
+            osc_uff(
+                &[
+                    (9, "         6         1         1 0.000000E+00 2.500000E+00 0.000000E+00"),
+                    (14, " 1.0E+00 0.0E+00"),
+                ],
+                14,
+            ),
+            "",
+            &["diagnose", "{dir}/cat.toml"],
+            vec!["m.uff:2:", "no frequency line to compare", "all at 0 Hz or below"],
+            INVALID_INPUT,
+        ),
+        osc_entry(
+            "UFF abscissa going backwards",
+            osc_uff(&[(9, "         6         8         1 2.000000E+01-2.500000E+00 0.000000E+00")], 34),
+            "",
+            &["compare", "{dir}/cat.toml"],
+            vec!["m.uff:", "record 1", "below the one before it", "must increase"],
+            INVALID_INPUT,
+        ),
+        osc_entry(
+            "UFF coherence of 7",
+            osc_uff(&[(32, " 7.000000E+00 9.000000E-01 9.333333E-01 9.500000E-01 9.600000E-01 9.666666E-01")], 34),
+            "",
+            &["compare", "{dir}/cat.toml"],
+            vec![
+                "m.uff:20:",
+                "record 2 (line 20)",
+                "coherence of H(4:uy,5:uy) at 2.5 Hz is 7, outside 0..1",
+                "bad-coherence",
+            ],
+            INVALID_INPUT,
+        ),
+        osc_entry(
+            "UFF coherence NaN",
+            osc_uff(&[(33, "          NaN 9.750000E-01")], 34),
+            "",
+            &["compare", "{dir}/cat.toml"],
+            vec!["m.uff:20:", "coherence of H(4:uy,5:uy) at 17.5 Hz is NaN", "bad-coherence"],
+            INVALID_INPUT,
+        ),
+        osc_entry(
+            "UFF units rfm cannot read",
+            osc_uff(&[(11, "        12    0    0    0 Acceleration         furlong             ")], 34),
+            "",
+            &["compare", "{dir}/cat.toml"],
+            vec!["m.uff:2:", "record 1", "the ordinate units `furlong` are not units rfm can read", "NONE"],
+            INVALID_INPUT,
+        ),
+        Entry {
+            what: "update --lines 0",
+            files: case(beam_update(("alpha = 1e-5", "alpha = 1e-5"))),
+            args: vec!["update", "{dir}/cat.toml", "--lines", "0"],
+            expect: vec!["--lines 0", "at least one measured line"],
+            code: USAGE,
+        },
+        bad_case(
+            "a response range of four billion nodes (checked before it is allocated)",
+            replaced("\"3:uy\", \"5:uy\"]", "\"2..4000000000:uy\"]"),
+            vec!["@cat.toml:2..4000000000", "node 6 does not exist in the model"],
+        ),
+        bad_case(
+            "E = -1e300 printed as a number, not 301 digits",
+            replaced("E = 2.0e11", "E = -1e300"),
+            vec!["@cat.toml:E = -1e300", "material `steel`: E must be positive and finite, got -1e300"],
+        ),
+        bad_case(
+            "a tie between distant nodes",
+            format!("{BEAM}\n[[ties]]\nnodes = [2, 4]\ndofs = [\"uy\"]\n"),
+            vec!["cat.toml", "tie 2-4", "joins nodes 5.000000e-1 m apart", "coincident"],
+        ),
+        Entry {
+            what: "alpha = 1e300: the dynamic stiffness overflows (not a bad frequency)",
+            files: case(replaced("alpha = 1e-5", "alpha = 1e300")),
+            args: vec!["simulate", "{dir}/cat.toml", "--out", "{dir}/h.csv"],
+            expect: vec![
+                "dynamic stiffness at 10 Hz has an entry that is not a finite number",
+                "check the case's values",
+            ],
+            code: NUMERICS,
+        },
+        Entry {
+            what: "E = 1e300 against measured data: no NaN 'converged'",
+            files: {
+                let text = beam_update(("E = 2.0e11", "E = 1e300"))
+                    .replace("[truth]\n", "")
+                    .replace("responses = [\"3:uy\", \"5:uy\"]", "responses = [\"3:uy\", \"5:uy\"]\ndata = \"m.csv\"");
+                vec![("cat.toml", text.into_bytes()), ("m.csv", csv.clone().into_bytes())]
+            },
+            args: vec!["update", "{dir}/cat.toml"],
+            expect: vec!["receptances are zero at every updating line", "out of the range double precision holds"],
+            code: NUMERICS,
+        },
+        Entry {
+            what: "an update whose initial model is singular at a line",
+            files: case(format!(
+                "{OSCILLATOR}\n[[springs]]\nname = \"k\"\nnode = 1\nkx = 1e4\nky = 1e4\nkr = 1e4\ngroup = \"g\"\n\n[[masses]]\nname = \"m\"\nnode = 1\nm = 1.0\nj = 1.0\ngroup = \"g\"\n\n[truth]\n[truth.set]\n\"spring.k.ky\" = 2e4\n\n[measurement]\nfrequencies = [10.0, 15.915494309189533]\nreferences = [\"1:uy\"]\nresponses = [\"1:uy\"]\n\n[update]\nparameters = [\"spring.k.ky\"]\nfrequencies = \"all\"\n"
+            )),
+            args: vec!["update", "{dir}/cat.toml"],
+            expect: vec!["singular at 15.915494309189533 Hz"],
+            code: NUMERICS,
+        },
+        {
+            let mut e = bad_data(
+                "CSV bytes that are not UTF-8",
+                "m.csv",
+                String::new(),
+                "",
+                vec!["m.csv:4:", "column 4: byte 0xff is not UTF-8 text"],
+            );
+            let mut bytes = csv.clone().into_bytes();
+            let line4 = csv.match_indices('\n').nth(2).unwrap().0 + 1;
+            bytes[line4 + 3] = 0xff;
+            e.files[1].1 = bytes;
+            e
+        },
+        Entry {
+            what: "case file bytes that are not UTF-8",
+            files: vec![("cat.toml", {
+                let mut b = BEAM.as_bytes().to_vec();
+                let at = BEAM.find("steel = ").unwrap();
+                b[at + 2] = 0xe9;
+                b
+            })],
+            args: vec!["simulate", "{dir}/cat.toml", "--out", "{dir}/h.csv"],
+            expect: vec!["cat.toml:4:3:", "byte 0xe9 is not UTF-8 text"],
+            code: INVALID_INPUT,
+        },
         Entry {
             what: "measured file missing",
             files: case(format!("{BEAM}data = \"absent.uff\"\n")),
             args: vec!["compare", "{dir}/cat.toml"],
             expect: vec!["absent.uff", "cannot read"],
+            code: INVALID_INPUT,
         },
     ]
 }
@@ -398,7 +611,7 @@ fn run(entry: &Entry, dir: &Path) -> Result<(), String> {
     if out.status.success() {
         return Err(format!("succeeded; stderr: {stderr}"));
     }
-    if out.status.code() != Some(1) {
+    if out.status.code() != Some(entry.code) {
         return Err(format!("exit code {:?}: {stderr}", out.status.code()));
     }
     for e in &entry.expect {
@@ -467,4 +680,99 @@ fn masked_defects_are_left_out_and_reported() {
         stdout.contains("unmodelled-channels: columns 6-7: H(99:uy,5:uy): its response the model has no node 99"),
         "{stdout}"
     );
+}
+
+/// Lines dropped while reading (here a line at 0 Hz) are said on the
+/// terminal and kept in results.json, not passed over in silence.
+#[test]
+fn lines_dropped_while_reading_are_printed_and_stored() {
+    let uff = osc_uff(&[(9, "         6         8         1 0.000000E+00 2.500000E+00 0.000000E+00")], 34);
+    let e = osc_entry("0 Hz line", uff, "\n[update]\nparameters = [\"group.beam.alpha\"]\n", &[], vec![], 0);
+    let dir = tempfile::tempdir().unwrap();
+    for (name, bytes) in &e.files {
+        std::fs::write(dir.path().join(name), bytes).unwrap();
+    }
+    let out_dir = dir.path().join("out");
+    let out = Command::new(env!("CARGO_BIN_EXE_rfm"))
+        .args(["update", dir.path().join("cat.toml").to_str().unwrap(), "--out", out_dir.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    // the fit of a beam to an oscillator's data need not converge; its outputs are written either way
+    assert!(matches!(out.status.code(), Some(0 | 5)), "{}", String::from_utf8_lossy(&out.stderr));
+    let note = "record 1 (line 2): dropped 1 line(s) at 0 Hz or below";
+    assert!(stdout.contains("read from the measured data") && stdout.contains(note), "{stdout}");
+    let results: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("results.json")).unwrap()).unwrap();
+    let notes = results["notes"].as_array().unwrap();
+    assert!(notes.iter().any(|n| n.as_str().unwrap().contains(note)), "{notes:?}");
+    // compare --json keeps them in its document, and says them on standard error
+    let out = Command::new(env!("CARGO_BIN_EXE_rfm"))
+        .args(["compare", dir.path().join("cat.toml").to_str().unwrap(), "--json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(doc["notes"].as_array().unwrap().iter().any(|n| n.as_str().unwrap().contains(note)), "{doc}");
+    assert!(String::from_utf8_lossy(&out.stderr).contains(note));
+}
+
+/// A byte-order mark (as Excel's "CSV UTF-8" and Windows editors write) is
+/// not part of the first field or key: the files read as without it.
+#[test]
+fn a_byte_order_mark_is_read_as_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = format!("\u{feff}{BEAM}data = \"m.csv\"\n");
+    std::fs::write(dir.path().join("cat.toml"), text).unwrap();
+    std::fs::write(dir.path().join("m.csv"), format!("\u{feff}{}", csv())).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_rfm"))
+        .args(["compare", dir.path().join("cat.toml").to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+}
+
+/// A full standard output is named as such, with the output error code.
+#[test]
+fn a_full_standard_output_is_named() {
+    let full = std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("cat.toml"), BEAM).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_rfm"))
+        .args(["compare", dir.path().join("cat.toml").to_str().unwrap()])
+        .stdout(full)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(6), "{stderr}");
+    assert!(stderr.contains("standard output: cannot write") && stderr.contains("No space left"), "{stderr}");
+}
+
+/// A measured file of a single line goes through every command without a
+/// panic: each either works or says why it cannot (diagnosis needs more
+/// lines).
+#[test]
+fn a_single_measured_line_never_panics_any_command() {
+    let dir = tempfile::tempdir().unwrap();
+    let one_line: String = csv().lines().take(3).map(|l| format!("{l}\n")).collect();
+    std::fs::write(dir.path().join("m.csv"), one_line).unwrap();
+    let text = format!("{BEAM}data = \"m.csv\"\n\n[update]\nparameters = [\"group.beam.alpha\"]\n");
+    std::fs::write(dir.path().join("cat.toml"), text.replace("[truth]\n", "")).unwrap();
+    let case = dir.path().join("cat.toml");
+    let out = dir.path().join("out");
+    let runs: [(&[&str], i32); 5] = [
+        (&["compare"], 0),
+        (&["compare", "--out", out.to_str().unwrap()], 0),
+        (&["update"], 0),
+        (&["update", "--method", "output-error"], 0),
+        (&["diagnose"], INVALID_INPUT),
+    ];
+    for (args, code) in runs {
+        let result = Command::new(env!("CARGO_BIN_EXE_rfm")).arg(args[0]).arg(&case).args(&args[1..]).output().unwrap();
+        let stderr = String::from_utf8_lossy(&result.stderr);
+        assert_eq!(result.status.code(), Some(code), "{args:?}: {stderr}");
+        if code == INVALID_INPUT {
+            assert!(stderr.contains("diagnosis needs at least 10 measured lines"), "{stderr}");
+        }
+    }
 }

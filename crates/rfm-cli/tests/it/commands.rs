@@ -82,3 +82,40 @@ fn outputs_never_overwrite_the_case_file() {
     assert_eq!(std::fs::read(&copy).unwrap(), before);
     assert!(Path::new(&copy).exists());
 }
+
+/// The exit codes are documented once, in `docs/reliability.md`, and must
+/// be the ones `rfm --help` prints from the binary's own table.
+#[test]
+fn the_documented_exit_codes_are_the_binarys() {
+    let help = text(&rfm(&["--help"]).stdout);
+    let from_help: Vec<(String, String)> = help
+        .lines()
+        .skip_while(|l| !l.starts_with("Exit codes:"))
+        .skip(1)
+        .filter_map(|l| l.trim().split_once("  ").map(|(c, m)| (c.to_string(), m.trim().to_string())))
+        .collect();
+    let doc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/reliability.md")).unwrap();
+    let table = &doc[doc.find("## Exit codes").unwrap()..];
+    let from_doc: Vec<(String, String)> = table
+        .lines()
+        .skip_while(|l| !l.starts_with("| code"))
+        .skip(2)
+        .take_while(|l| l.starts_with("| "))
+        .map(|l| {
+            let cells: Vec<&str> = l.trim_matches('|').split(" | ").map(str::trim).collect();
+            (cells[0].to_string(), cells[1].to_string())
+        })
+        .collect();
+    assert!(from_help.len() >= 9, "{help}");
+    assert_eq!(from_doc, from_help);
+    let codes: Vec<&str> = from_help.iter().map(|(c, _)| c.as_str()).collect();
+    assert_eq!(codes, ["0", "1", "2", "3", "4", "5", "6", "7", "130"]);
+}
+
+/// A wrong command line exits with 2, the usage code of the table.
+#[test]
+fn a_wrong_command_line_exits_with_the_usage_code() {
+    let out = rfm(&["update", "--no-such-flag"]);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out.stderr));
+    assert!(text(&out.stderr).contains("--no-such-flag"));
+}

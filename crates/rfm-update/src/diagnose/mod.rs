@@ -305,7 +305,6 @@ pub(crate) fn informative(measured: &FrfSet, n: usize) -> Vec<f64> {
     lines.to_vec()
 }
 
-
 /// The misfit the diagnosis, `rfm fix` and the case history speak of: the
 /// RMS of `ln(H / M)` per complex value of a system's receptances `H`
 /// against measured ones `M`, on `lines` lines spread over the measured band.

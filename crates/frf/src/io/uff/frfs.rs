@@ -151,7 +151,6 @@ pub fn frfs_from_uff_with(
 
     let mut frfs: Vec<Frf> = Vec::new();
     let mut masked: Vec<Masked> = Vec::new();
-    let mut dropped_zero = false;
     let mut unstated_hz = Vec::new();
     for r in file.records.iter().filter(|r| r.function.header.function_type == FUNCTION_FRF) {
         let h = &r.function.header;
@@ -175,7 +174,23 @@ pub fn frfs_from_uff_with(
             notes.push(format!("{}: values in {} scaled by {} to SI", r.label(), units.basis, units.scale));
         }
         let (freqs, values, dropped) = positive_lines(r, to_hz, |v| v * factor);
-        dropped_zero |= dropped;
+        if dropped > 0 && !freqs.is_empty() {
+            notes.push(format!(
+                "{}: dropped {dropped} line(s) at 0 Hz or below (FRFs are compared at positive frequencies)",
+                r.label()
+            ));
+        }
+        if freqs.is_empty() {
+            let why = if r.function.is_empty() {
+                "it declares no values (record 7 gives 0 data points)".to_string()
+            } else {
+                format!(
+                    "its {} line(s) are all at 0 Hz or below, and FRFs are compared at positive frequencies",
+                    dropped
+                )
+            };
+            return Err(at(format!("no frequency line to compare: {why}")));
+        }
         let place = |_: usize| (r.line, format!("{}: ", r.label()));
         let (keep, repeats) = mask::duplicate_lines(path, &freqs, &place, rules.contains(&MaskRule::DuplicateLines))?;
         let (freqs, values) = if repeats.is_empty() {
@@ -192,16 +207,15 @@ pub fn frfs_from_uff_with(
     if !unstated_hz.is_empty() {
         notes.push(format!("record(s) {} do not state the abscissa units; Hz assumed", unstated_hz.join(", ")));
     }
-    if dropped_zero {
-        notes.push("dropped the lines at 0 Hz: FRFs are compared at positive frequencies".into());
-    }
 
     // common lines, one kind, distinct channels
     let Some(first) = frfs.first() else {
         return Err(err(1, "no frequency response function (dataset 58, function type 4)".into()));
     };
     let (freqs, kind) = (first.freqs.clone(), first.kind);
-    for f in frfs.iter().skip(1) {
+    let mut seen: std::collections::HashMap<Channel, usize> = std::collections::HashMap::new();
+    seen.insert(first.channel, 0);
+    for (i, f) in frfs.iter().enumerate().skip(1) {
         if !same_lines(&f.freqs, &freqs) {
             return Err(err(
                 f.line,
@@ -217,7 +231,7 @@ pub fn frfs_from_uff_with(
                 ),
             ));
         }
-        if let Some(other) = frfs.iter().take_while(|o| o.record != f.record).find(|o| o.channel == f.channel) {
+        if let Some(other) = seen.get(&f.channel).map(|&i| &frfs[i]) {
             return Err(err(
                 f.line,
                 format!(
@@ -226,6 +240,7 @@ pub fn frfs_from_uff_with(
                 ),
             ));
         }
+        seen.insert(f.channel, i);
     }
     let converted: Vec<usize> = frfs.iter().filter(|f| f.kind != kind).map(|f| f.record).collect();
     if !converted.is_empty() {
@@ -251,7 +266,7 @@ pub fn frfs_from_uff_with(
         }
     }
 
-    attach_coherence(file, map, &mut set, &mut notes);
+    attach_coherence(path, file, map, &mut set, &mut notes, &mut masked, rules.contains(&MaskRule::BadCoherence))?;
     let locate = |c: usize, _: usize| (frfs[c].line, format!("record {} (line {})", frfs[c].record, frfs[c].line));
     let (set, more) = mask::non_finite_lines(path, set, rules.contains(&MaskRule::NonFinite), &locate)?;
     masked.extend(more);
@@ -260,11 +275,11 @@ pub fn frfs_from_uff_with(
 }
 
 /// The record's positive-frequency lines (Hz) and its values through `f`;
-/// whether lines were dropped.
-fn positive_lines(r: &Record58, to_hz: f64, f: impl Fn(C64) -> C64) -> (Vec<f64>, Vec<C64>, bool) {
+/// how many lines were dropped.
+fn positive_lines(r: &Record58, to_hz: f64, f: impl Fn(C64) -> C64) -> (Vec<f64>, Vec<C64>, usize) {
     let mut freqs = Vec::with_capacity(r.function.len());
     let mut values = Vec::with_capacity(r.function.len());
-    let mut dropped = false;
+    let mut dropped = 0;
     for k in 0..r.function.len() {
         let (Some(x), Some(v)) = (r.function.abscissa_at(k), r.function.ordinates.get(k)) else { continue };
         let hz = x * to_hz;
@@ -273,7 +288,7 @@ fn positive_lines(r: &Record58, to_hz: f64, f: impl Fn(C64) -> C64) -> (Vec<f64>
             freqs.push(hz);
             values.push(f(v));
         } else {
-            dropped = true;
+            dropped += 1;
         }
     }
     (freqs, values, dropped)
@@ -290,9 +305,18 @@ fn span(f: &[f64]) -> String {
     }
 }
 
-fn attach_coherence(file: &UffFile, map: &[ChannelMap], set: &mut FrfSet, notes: &mut Vec<String>) {
+fn attach_coherence(
+    path: &Path,
+    file: &UffFile,
+    map: &[ChannelMap],
+    set: &mut FrfSet,
+    notes: &mut Vec<String>,
+    masked: &mut Vec<Masked>,
+    allow_bad: bool,
+) -> Result<(), FrfError> {
     let nf = set.n_freq();
     let nc = set.channels().len();
+    let index = set.channel_indices();
     let mut coh: Vec<Option<Vec<f64>>> = vec![None; nc];
     for r in file.records.iter().filter(|r| r.function.header.function_type == FUNCTION_COHERENCE) {
         let h = &r.function.header;
@@ -307,7 +331,7 @@ fn attach_coherence(file: &UffFile, map: &[ChannelMap], set: &mut FrfSet, notes:
                 continue;
             }
         };
-        let Some(c) = set.find(channel) else {
+        let Some(&c) = index.get(&channel) else {
             notes.push(format!("{label}: coherence of {channel} ignored: the file has no FRF for it"));
             continue;
         };
@@ -318,8 +342,23 @@ fn attach_coherence(file: &UffFile, map: &[ChannelMap], set: &mut FrfSet, notes:
             continue;
         }
         let values: Vec<f64> = values.iter().map(|v| v.re).collect();
-        if values.iter().any(|&g| !(-1e-6..=1.0 + 1e-6).contains(&g)) {
-            notes.push(format!("{label}: coherence of {channel} ignored: values outside 0..1"));
+        // a coherence is a squared correlation: anything outside 0..1 (beyond
+        // the rounding of a written file) or NaN is not one
+        if let Some(k) = values.iter().position(|g| !(-1e-6..=1.0 + 1e-6).contains(g)) {
+            let detail = format!("{label}: coherence of {channel} at {} Hz is {}, outside 0..1", freqs[k], values[k]);
+            if !allow_bad {
+                return Err(FrfError::Parse {
+                    path: path.to_path_buf(),
+                    line: r.line,
+                    message: format!("{detail}; {}", mask::hint(MaskRule::BadCoherence, "such coherence records")),
+                });
+            }
+            masked.push(Masked {
+                rule: MaskRule::BadCoherence,
+                freq_hz: Some(freqs[k]),
+                channel: Some(channel),
+                detail,
+            });
             continue;
         }
         if coh[c].is_some() {
@@ -330,7 +369,7 @@ fn attach_coherence(file: &UffFile, map: &[ChannelMap], set: &mut FrfSet, notes:
     }
     let have = coh.iter().filter(|c| c.is_some()).count();
     if have == 0 {
-        return;
+        return Ok(());
     }
     if have < nc {
         let missing: Vec<String> =
@@ -342,4 +381,5 @@ fn attach_coherence(file: &UffFile, map: &[ChannelMap], set: &mut FrfSet, notes:
     if let Err(e) = set.set_coherence(values) {
         notes.push(format!("coherence not attached: {e}"));
     }
+    Ok(())
 }

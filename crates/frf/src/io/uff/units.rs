@@ -80,7 +80,16 @@ fn units_kind(h: &Header58) -> Result<Option<FrfUnits>, String> {
     if is_none(num) {
         return Ok(None);
     }
-    let Some(n) = parse_units(num) else { return Ok(None) };
+    // A label rfm cannot read is refused rather than passed over: the data
+    // types would then decide with SI assumed, and a file in mm or lbf
+    // would be read a thousand or four times off without a word.
+    let unknown = |which: &str, label: &str| {
+        format!(
+            "the {which} units `{label}` are not units rfm can read (such as m, mm, m/s, m/s^2, g, in, N, lbf); \
+             correct them in the file, or write NONE to let the data types decide (SI is then assumed)"
+        )
+    };
+    let Some(n) = parse_units(num) else { return Err(unknown("ordinate", num)) };
     // numerator units of a response alone (`m/s^2`) with no denominator units: per newton
     // (per newton metre for a moment), stated by a force data type or else assumed
     let per_force_assumed = is_none(den) && n.f == 0;
@@ -97,7 +106,7 @@ fn units_kind(h: &Header58) -> Result<Option<FrfUnits>, String> {
     } else {
         parse_units(den)
     };
-    let Some(d) = d else { return Ok(None) };
+    let Some(d) = d else { return Err(unknown("denominator", den)) };
     let dim = n.div(d);
     let basis = match (is_none(den), assumed_si) {
         (true, true) => format!("`{num}` (per N assumed)"),

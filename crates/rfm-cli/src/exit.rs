@@ -1,0 +1,245 @@
+//! The exit codes of `rfm`, in one table ([`Exit::TABLE`]) that every
+//! command returns through, that `rfm --help` prints and that
+//! `docs/reliability.md` copies (a test keeps the two equal).
+//!
+//! Errors are classified where they are turned into a [`Failure`]: the
+//! `From` conversions below say which library error means bad input and
+//! which failed numerics. An updating run's [`Status`] maps to a code in
+//! one function, [`Exit::of_status`].
+
+use std::fmt;
+
+use fe_model::{CaseError, ModelError};
+use frf::FrfError;
+use rfm_update::UpdateError;
+use rfm_update::rfm::Status;
+
+use crate::output::OutputError;
+
+/// How a run of `rfm` ended, as its exit code.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Exit {
+    /// The command did what was asked (an update converged).
+    Success,
+    /// An error rfm did not foresee: a bug, please report it.
+    Internal,
+    /// The command line is wrong (clap's own code for usage errors).
+    Usage,
+    /// A case file or measured file is unreadable, malformed or
+    /// inconsistent with the model; the message locates it.
+    InvalidInput,
+    /// The model could not be evaluated or the fit produced non-finite
+    /// numbers (a singular dynamic stiffness at a line, a NaN misfit).
+    Numerics,
+    /// An update ended without converging (stalled, iteration limit); its
+    /// outputs hold the best iterate. Statuses that say why a fit did not
+    /// converge will map here too.
+    NotConverged,
+    /// The outputs could not be written (a full disk, no permission, an
+    /// output that would replace an input); none of them were.
+    Output,
+    /// Another run is writing into the same output; nothing was done.
+    Busy,
+    /// Ctrl-C, SIGTERM or SIGHUP stopped the run (128 + SIGINT).
+    Interrupted,
+}
+
+impl Exit {
+    /// Every code with its meaning, in order: printed by `rfm --help` and
+    /// copied in `docs/reliability.md`.
+    pub(crate) const TABLE: [(Exit, &'static str); 9] = [
+        (Exit::Success, "success (for update: the fit converged)"),
+        (Exit::Internal, "internal error (a bug in rfm; please report it)"),
+        (Exit::Usage, "wrong command line"),
+        (Exit::InvalidInput, "invalid input: a case file or measured file is malformed or inconsistent"),
+        (Exit::Numerics, "failed numerics: the model cannot be evaluated, or the fit gave non-finite numbers"),
+        (Exit::NotConverged, "not converged: the update stopped without converging (best iterate written)"),
+        (Exit::Output, "outputs not written: cannot write, or an output would replace an input"),
+        (Exit::Busy, "busy: another rfm run is writing into the same output"),
+        (Exit::Interrupted, "interrupted by Ctrl-C, SIGTERM or SIGHUP (outputs all old or all new)"),
+    ];
+
+    /// The process exit code.
+    pub(crate) fn code(self) -> u8 {
+        match self {
+            Exit::Success => 0,
+            Exit::Internal => 1,
+            Exit::Usage => 2,
+            Exit::InvalidInput => 3,
+            Exit::Numerics => 4,
+            Exit::NotConverged => 5,
+            Exit::Output => 6,
+            Exit::Busy => 7,
+            Exit::Interrupted => 130,
+        }
+    }
+
+    /// What the code means, from [`Exit::TABLE`].
+    pub(crate) fn meaning(self) -> &'static str {
+        Exit::TABLE.iter().find(|(e, _)| *e == self).map_or("", |(_, m)| m)
+    }
+
+    /// The code for how an updating run ended: 0 only when it converged.
+    pub(crate) fn of_status(status: &Status) -> Exit {
+        match status {
+            Status::Converged | Status::WithinNoise => Exit::Success,
+            Status::Stalled | Status::MaxIterations => Exit::NotConverged,
+            Status::Failed(_) => Exit::Numerics,
+        }
+    }
+
+    /// The table as `rfm --help` shows it.
+    pub(crate) fn help() -> String {
+        let mut text = String::from("Exit codes:\n");
+        for (exit, meaning) in Exit::TABLE {
+            text.push_str(&format!("  {:>3}  {meaning}\n", exit.code()));
+        }
+        text
+    }
+}
+
+/// Why a command failed, with the exit code that tells a script so.
+#[derive(Debug)]
+pub(crate) struct Failure {
+    /// The exit code.
+    pub(crate) exit: Exit,
+    /// The message for standard error.
+    pub(crate) message: String,
+}
+
+impl Failure {
+    /// A failure of the given kind.
+    pub(crate) fn new(exit: Exit, message: impl Into<String>) -> Failure {
+        Failure { exit, message: message.into() }
+    }
+
+    /// Invalid input, with the message that locates it.
+    pub(crate) fn input(message: impl Into<String>) -> Failure {
+        Failure::new(Exit::InvalidInput, message)
+    }
+}
+
+impl fmt::Display for Failure {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+/// What a library error means for the user.
+pub(crate) fn frf_exit(e: &FrfError) -> Exit {
+    match e {
+        FrfError::Singular { .. }
+        | FrfError::NonFiniteZ { .. }
+        | FrfError::Factorization(_)
+        | FrfError::NoLdltFactors { .. }
+        | FrfError::CliqueOutOfRange { .. } => Exit::Numerics,
+        FrfError::Unwritable { .. } => Exit::Output,
+        FrfError::UnknownDof { .. }
+        | FrfError::FixedDof { .. }
+        | FrfError::BadFrequency { .. }
+        | FrfError::Io { .. }
+        | FrfError::Parse { .. }
+        | FrfError::Mismatch(_) => Exit::InvalidInput,
+    }
+}
+
+impl From<FrfError> for Failure {
+    fn from(e: FrfError) -> Self {
+        Failure::new(frf_exit(&e), e.to_string())
+    }
+}
+
+impl From<UpdateError> for Failure {
+    fn from(e: UpdateError) -> Self {
+        match e {
+            UpdateError::Case(c) => Failure::input(c.render()),
+            UpdateError::Frf(f) => f.into(),
+            UpdateError::Numerics(m) => Failure::new(Exit::Numerics, m),
+            UpdateError::Model(_) | UpdateError::Setup(_) => Failure::input(e.to_string()),
+        }
+    }
+}
+
+impl From<ModelError> for Failure {
+    fn from(e: ModelError) -> Self {
+        Failure::input(e.to_string())
+    }
+}
+
+impl From<CaseError> for Failure {
+    fn from(e: CaseError) -> Self {
+        Failure::input(e.render())
+    }
+}
+
+impl From<OutputError> for Failure {
+    fn from(e: OutputError) -> Self {
+        let exit = if matches!(e, OutputError::Busy { .. }) { Exit::Busy } else { Exit::Output };
+        Failure::new(exit, e.to_string())
+    }
+}
+
+/// A failed print: standard output is full or broken (a closed pipe is
+/// handled before, see [`crate::print_line`]).
+impl From<std::io::Error> for Failure {
+    fn from(e: std::io::Error) -> Self {
+        Failure::new(Exit::Output, format!("standard output: cannot write: {e}"))
+    }
+}
+
+/// A figure that cannot be drawn is rfm's fault, not the data's.
+impl From<crate::report::plot::PlotError> for Failure {
+    fn from(e: crate::report::plot::PlotError) -> Self {
+        Failure::new(Exit::Internal, e.to_string())
+    }
+}
+
+impl From<serde_json::Error> for Failure {
+    fn from(e: serde_json::Error) -> Self {
+        Failure::new(Exit::Internal, format!("cannot serialise the results: {e}"))
+    }
+}
+
+/// The messages commands give for a setup they cannot work with (`the case
+/// has no [update] section`) are about the input.
+impl From<String> for Failure {
+    fn from(message: String) -> Self {
+        Failure::input(message)
+    }
+}
+
+impl From<&str> for Failure {
+    fn from(message: &str) -> Self {
+        Failure::input(message)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn codes_are_distinct_and_listed_in_order() {
+        let codes: Vec<u8> = Exit::TABLE.iter().map(|(e, _)| e.code()).collect();
+        assert!(codes.windows(2).all(|w| w[0] < w[1]), "{codes:?}");
+        assert_eq!(Exit::Success.code(), 0);
+        assert_eq!(Exit::Interrupted.code(), 130);
+    }
+
+    #[test]
+    fn only_a_converged_update_exits_with_zero() {
+        assert_eq!(Exit::of_status(&Status::Converged), Exit::Success);
+        assert_eq!(Exit::of_status(&Status::WithinNoise), Exit::Success);
+        assert_eq!(Exit::of_status(&Status::Stalled), Exit::NotConverged);
+        assert_eq!(Exit::of_status(&Status::MaxIterations), Exit::NotConverged);
+        assert_eq!(Exit::of_status(&Status::Failed("singular".into())), Exit::Numerics);
+    }
+
+    #[test]
+    fn a_singular_line_is_failed_numerics_and_a_parse_error_invalid_input() {
+        let singular: Failure = FrfError::Singular { freq_hz: 15.9 }.into();
+        assert_eq!(singular.exit, Exit::Numerics);
+        let parse: Failure = FrfError::Parse { path: "m.csv".into(), line: 3, message: "x".into() }.into();
+        assert_eq!((parse.exit, parse.message.as_str()), (Exit::InvalidInput, "m.csv:3: x"));
+    }
+}

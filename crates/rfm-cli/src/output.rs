@@ -1,0 +1,707 @@
+//! All-or-nothing outputs: a run's files appear together or not at all.
+//!
+//! A command that writes files opens an [`Outputs`] for its target (a
+//! folder given with `--out`, or a single file) *before* it computes
+//! anything, writes every file through [`Outputs::write`], and calls
+//! [`Outputs::commit`] at the end:
+//!
+//! ```text
+//! let mut out = Outputs::folder(dir, &inputs, &["results.json", "report.html"])?;  // lock, checks
+//! ... compute ...
+//! out.write("results.json", &json)?;                                                 // into staging
+//! out.write("figure.svg", &svg)?;
+//! let written = out.commit()?;                                                       // one rename
+//! ```
+//!
+//! - **Lock.** Opening takes an exclusive lock on `.NAME.rfm-lock` beside
+//!   the target, so a second run into the same target refuses at once
+//!   ([`OutputError::Busy`]) instead of mixing its files with the first's.
+//!   The lock is the operating system's (`flock`), so a run killed with
+//!   SIGKILL does not leave it held; the file itself is removed at the end.
+//! - **Inputs.** Every input is recognised by device and inode
+//!   ([`frf::io::FileId`]), so a hard link or a second mount point of the
+//!   same folder does not hide it. The names a command declares are checked
+//!   when it opens, every written name again before the commit; an input
+//!   inside the folder under another name is carried into the new folder.
+//! - **Staging.** Files are written into `.NAME.rfm-staging-PID` beside the
+//!   target, on the same file system, each synced.
+//! - **Commit.** A folder is swapped with its staging folder in one
+//!   `renameat2(RENAME_EXCHANGE)` (Linux; `renamex_np(RENAME_SWAP)` on
+//!   macOS), so that at every instant the target is either the complete old
+//!   folder or the complete new one, whatever kills the process. Files in
+//!   the old folder that this run does not write are carried over by hard
+//!   link, except those the previous run wrote (listed in `.rfm-outputs`),
+//!   which the new set replaces. A single file is renamed over its target.
+//!   Where the swap is not supported, the old folder is renamed aside to
+//!   `.NAME.rfm-old-PID` and the new one into place; the next run restores
+//!   the old one if it finds the target missing.
+//! - **Leftovers.** A run that dies before its commit leaves its staging
+//!   folder. The next run into the same target (holding the lock, so no
+//!   other run can own it) removes it and says so on standard error. Ctrl-C,
+//!   SIGTERM and SIGHUP remove it at once ([`abandon_all`]).
+
+use std::ffi::OsString;
+use std::fs::{self, File};
+use std::io::{Read as _, Write as _};
+use std::path::{Component, Path, PathBuf};
+use std::sync::{Mutex, PoisonError};
+
+use frf::io::FileId;
+
+/// The file in a folder target that lists the names the last run wrote,
+/// so that the next run can replace them without touching other files.
+pub(crate) const MANIFEST: &str = ".rfm-outputs";
+
+/// Why a run's outputs could not be written. In every case the target is
+/// as it was before the run.
+#[derive(Debug, thiserror::Error)]
+pub(crate) enum OutputError {
+    /// Another run holds the target's lock.
+    #[error(
+        "{}: another rfm run ({holder}) is writing into it; wait until it ends, or choose another output path",
+        target.display()
+    )]
+    Busy {
+        /// The target.
+        target: PathBuf,
+        /// Who holds the lock (`process 1234`).
+        holder: String,
+    },
+    /// An output would replace one of the run's inputs.
+    #[error("{}: refusing to overwrite an input file; choose another output path", path.display())]
+    Input {
+        /// The output path that is an input.
+        path: PathBuf,
+    },
+    /// The target cannot take the outputs.
+    #[error("{}: {message}", target.display())]
+    Target {
+        /// The target.
+        target: PathBuf,
+        /// Why.
+        message: String,
+    },
+    /// A file system operation failed.
+    #[error("{}: cannot {what}: {source}; nothing of this run was written", path.display())]
+    Io {
+        /// The path the operation was on.
+        path: PathBuf,
+        /// What was being done (`write`, `create the staging folder`).
+        what: String,
+        /// The error.
+        source: std::io::Error,
+    },
+}
+
+fn io(path: &Path, what: impl Into<String>) -> impl FnOnce(std::io::Error) -> OutputError {
+    let path = path.to_path_buf();
+    let what = what.into();
+    move |source| OutputError::Io { path, what, source }
+}
+
+/// Whether the target is a folder of files or one file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Kind {
+    Folder,
+    File,
+}
+
+/// Staging folders and lock files of the runs in this process, removed by
+/// [`abandon_all`] when a signal ends the process before their commit.
+static ACTIVE: Mutex<Vec<(PathBuf, PathBuf)>> = Mutex::new(Vec::new());
+
+fn register(staging: &Path, lock: &Path) {
+    ACTIVE.lock().unwrap_or_else(PoisonError::into_inner).push((staging.to_path_buf(), lock.to_path_buf()));
+}
+
+fn deregister(staging: &Path) {
+    ACTIVE.lock().unwrap_or_else(PoisonError::into_inner).retain(|(s, _)| s != staging);
+}
+
+/// Removes the staging folders (and lock files) of every uncommitted
+/// output of this process. The signal handler calls it while it holds the
+/// output phase ([`crate::writing`]), so no commit is under way.
+pub(crate) fn abandon_all() {
+    for (staging, lock) in ACTIVE.lock().unwrap_or_else(PoisonError::into_inner).drain(..) {
+        let _ = fs::remove_dir_all(&staging);
+        let _ = fs::remove_file(&lock);
+    }
+}
+
+/// An exclusive lock on `.NAME.rfm-lock` beside a target, held while the
+/// value lives; the file is removed when it is dropped.
+struct Lock {
+    path: PathBuf,
+    _file: File,
+}
+
+impl Lock {
+    fn take(path: &Path, target: &Path) -> Result<Lock, OutputError> {
+        // A run that removes the lock file at its end may do so between our
+        // opening and locking it; we would then hold a lock on a file no
+        // one else can find. Locking, then checking that the path still
+        // names the locked file, closes that gap.
+        for _ in 0..100 {
+            let mut file = File::options()
+                .read(true)
+                .write(true)
+                .create(true)
+                .truncate(false)
+                .open(path)
+                .map_err(io(path, "create the lock file"))?;
+            match file.try_lock() {
+                Ok(()) => {}
+                Err(fs::TryLockError::WouldBlock) => {
+                    let mut holder = String::new();
+                    let _ = file.read_to_string(&mut holder);
+                    let holder = match holder.trim() {
+                        "" => "lock file ".to_string() + &path.display().to_string(),
+                        pid => format!("process {pid}"),
+                    };
+                    return Err(OutputError::Busy { target: target.to_path_buf(), holder });
+                }
+                Err(fs::TryLockError::Error(e)) => return Err(io(path, "lock")(e)),
+            }
+            if FileId::of(path) != FileId::of_file(&file, path) {
+                continue;
+            }
+            // who holds it, for the message of a second run
+            file.set_len(0).map_err(io(path, "write the lock file"))?;
+            file.write_all(std::process::id().to_string().as_bytes()).map_err(io(path, "write the lock file"))?;
+            return Ok(Lock { path: path.to_path_buf(), _file: file });
+        }
+        Err(OutputError::Target { target: target.to_path_buf(), message: "its lock file keeps changing".into() })
+    }
+}
+
+impl Drop for Lock {
+    fn drop(&mut self) {
+        // removed while still locked (the file closes after this), see `take`
+        let _ = fs::remove_file(&self.path);
+    }
+}
+
+/// The outputs of one run into one target, written all or nothing; see the
+/// module documentation.
+pub(crate) struct Outputs {
+    target: PathBuf,
+    kind: Kind,
+    staging: PathBuf,
+    inputs: Vec<FileId>,
+    written: Vec<String>,
+    committed: bool,
+    lock: Option<Lock>,
+}
+
+impl Outputs {
+    /// Outputs into the folder `dir` (created if needed). `names` are the
+    /// files the command will write that it knows now: each is checked
+    /// against `inputs` here, before any work.
+    pub(crate) fn folder(dir: &Path, inputs: &[PathBuf], names: &[&str]) -> Result<Outputs, OutputError> {
+        let out = Outputs::open(dir, Kind::Folder, inputs)?;
+        for name in names {
+            out.check_name(name)?;
+            out.refuse_input_at(&out.target.join(name))?;
+        }
+        Ok(out)
+    }
+
+    /// Output of the single file `path`, checked against `inputs` here.
+    pub(crate) fn file(path: &Path, inputs: &[PathBuf]) -> Result<Outputs, OutputError> {
+        let out = Outputs::open(path, Kind::File, inputs)?;
+        out.refuse_input_at(&out.target)?;
+        Ok(out)
+    }
+
+    fn open(target: &Path, kind: Kind, inputs: &[PathBuf]) -> Result<Outputs, OutputError> {
+        crate::files_to_write();
+        let target = resolve(target, kind)?;
+        let (parent, name) = split(&target)?;
+        let lock = Lock::take(&parent.join(format!(".{}.rfm-lock", name.to_string_lossy())), &target)?;
+        clean_leftovers(&parent, &name, &target, kind)?;
+        let staging = parent.join(format!(".{}.rfm-staging-{}", name.to_string_lossy(), std::process::id()));
+        fs::create_dir(&staging).map_err(io(&staging, "create the staging folder"))?;
+        register(&staging, &lock.path);
+        Ok(Outputs {
+            target,
+            kind,
+            staging,
+            inputs: inputs.iter().filter_map(|p| FileId::of(p)).collect(),
+            written: Vec::new(),
+            committed: false,
+            lock: Some(lock),
+        })
+    }
+
+    /// Where `name` will be once committed.
+    pub(crate) fn path(&self, name: &str) -> PathBuf {
+        match self.kind {
+            Kind::Folder => self.target.join(name),
+            Kind::File => self.target.clone(),
+        }
+    }
+
+    /// Writes `name` (a path relative to the folder; for a single-file
+    /// target, its file name) into the staging folder, synced. Returns
+    /// where it will be once committed.
+    pub(crate) fn write(&mut self, name: &str, bytes: &[u8]) -> Result<PathBuf, OutputError> {
+        self.check_name(name)?;
+        let staged = self.staging.join(name);
+        if let Some(dir) = staged.parent() {
+            fs::create_dir_all(dir).map_err(io(&self.path(name), "write"))?;
+        }
+        let result = (|| {
+            let mut f = File::create(&staged)?;
+            f.write_all(bytes)?;
+            f.sync_all()
+        })();
+        result.map_err(io(&self.path(name), "write"))?;
+        if !self.written.iter().any(|w| w == name) {
+            self.written.push(name.to_string());
+        }
+        Ok(self.path(name))
+    }
+
+    /// Writes the single file of a single-file target.
+    pub(crate) fn write_file(&mut self, bytes: &[u8]) -> Result<PathBuf, OutputError> {
+        let name = self.target.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        self.write(&name, bytes)
+    }
+
+    /// Where the files written so far will be once committed.
+    pub(crate) fn written(&self) -> Vec<PathBuf> {
+        self.written.iter().map(|n| self.path(n)).collect()
+    }
+
+    fn check_name(&self, name: &str) -> Result<(), OutputError> {
+        let plain = !name.is_empty()
+            && Path::new(name).components().all(|c| matches!(c, Component::Normal(_)))
+            && name != MANIFEST;
+        let fits = match self.kind {
+            Kind::Folder => plain,
+            Kind::File => plain && self.target.file_name().is_some_and(|n| n == name),
+        };
+        if fits {
+            Ok(())
+        } else {
+            Err(OutputError::Target {
+                target: self.target.clone(),
+                message: format!("`{name}` is not a name this output can take (a bug in rfm)"),
+            })
+        }
+    }
+
+    /// Fails if `path`, or a file under it, is one of the inputs.
+    fn refuse_input_at(&self, path: &Path) -> Result<(), OutputError> {
+        match find_input(path, &self.inputs) {
+            Some(p) => Err(OutputError::Input { path: p }),
+            None => Ok(()),
+        }
+    }
+
+    /// Moves every written file into place at once and returns where they
+    /// are. An interrupt waits for it ([`crate::writing`]).
+    pub(crate) fn commit(mut self) -> Result<Vec<PathBuf>, OutputError> {
+        let _writing = crate::writing();
+        for name in &self.written {
+            self.refuse_input_at(&self.path(name))?;
+        }
+        match self.kind {
+            Kind::File => {
+                let name = self.target.file_name().unwrap_or_default().to_os_string();
+                if self.written.is_empty() {
+                    // a run that wrote nothing leaves the target as it was
+                } else {
+                    fs::rename(self.staging.join(&name), &self.target).map_err(io(&self.target, "move into place"))?;
+                }
+                let _ = fs::remove_dir_all(&self.staging);
+            }
+            Kind::Folder => self.swap_folder()?,
+        }
+        if let Ok((parent, _)) = split(&self.target) {
+            sync_dir(&parent);
+        }
+        deregister(&self.staging);
+        self.committed = true;
+        Ok(self.written())
+    }
+
+    fn swap_folder(&self) -> Result<(), OutputError> {
+        let top: Vec<OsString> = self
+            .written
+            .iter()
+            .filter_map(|n| Path::new(n).components().next().map(|c| c.as_os_str().to_os_string()))
+            .collect();
+        let exists = self.target.is_dir();
+        if exists {
+            let previous: Vec<OsString> = fs::read_to_string(self.target.join(MANIFEST))
+                .map(|t| t.lines().map(OsString::from).collect())
+                .unwrap_or_default();
+            let entries = fs::read_dir(&self.target).map_err(io(&self.target, "list"))?;
+            for entry in entries {
+                let entry = entry.map_err(io(&self.target, "list"))?;
+                let name = entry.file_name();
+                let path = entry.path();
+                if name == MANIFEST || is_legacy_temporary(&name) {
+                    continue;
+                }
+                let replaced = top.contains(&name);
+                let stale = previous.contains(&name);
+                let input = find_input(&path, &self.inputs);
+                match (replaced, stale, input) {
+                    (true, _, Some(p)) => return Err(OutputError::Input { path: p }),
+                    (true, _, None) | (false, true, None) => {}
+                    (false, _, _) => carry(&path, &self.staging.join(&name))?,
+                }
+            }
+            if let Ok(meta) = fs::metadata(&self.target) {
+                let _ = fs::set_permissions(&self.staging, meta.permissions());
+            }
+        }
+        let mut manifest: Vec<String> = top.iter().map(|n| n.to_string_lossy().into_owned()).collect();
+        manifest.sort();
+        manifest.dedup();
+        let listing = self.staging.join(MANIFEST);
+        fs::write(&listing, manifest.join("\n") + "\n").map_err(io(&self.path(MANIFEST), "write"))?;
+        File::open(&listing).and_then(|f| f.sync_all()).map_err(io(&self.path(MANIFEST), "write"))?;
+        sync_dir(&self.staging);
+        if !exists {
+            return fs::rename(&self.staging, &self.target).map_err(io(&self.target, "move into place"));
+        }
+        match exchange(&self.staging, &self.target) {
+            Ok(()) => {
+                // the staging path now holds the old folder
+                let _ = fs::remove_dir_all(&self.staging);
+                Ok(())
+            }
+            Err(_) => self.swap_by_two_renames(),
+        }
+    }
+
+    /// The swap where the file system cannot exchange two folders: the old
+    /// folder goes aside first, so a crash between the two renames leaves
+    /// it complete under `.NAME.rfm-old-PID`, which the next run restores.
+    fn swap_by_two_renames(&self) -> Result<(), OutputError> {
+        let (parent, name) = split(&self.target)?;
+        let old = parent.join(format!(".{}.rfm-old-{}", name.to_string_lossy(), std::process::id()));
+        fs::rename(&self.target, &old).map_err(io(&self.target, "move the old outputs aside"))?;
+        if let Err(e) = fs::rename(&self.staging, &self.target) {
+            let _ = fs::rename(&old, &self.target);
+            return Err(io(&self.target, "move into place")(e));
+        }
+        let _ = fs::remove_dir_all(&old);
+        Ok(())
+    }
+}
+
+impl Drop for Outputs {
+    fn drop(&mut self) {
+        if !self.committed {
+            let _ = fs::remove_dir_all(&self.staging);
+            deregister(&self.staging);
+        }
+        drop(self.lock.take());
+    }
+}
+
+/// The absolute target, through a final symlink (so that the folder it
+/// points to is replaced, not the link), its parent created.
+fn resolve(target: &Path, kind: Kind) -> Result<PathBuf, OutputError> {
+    let bad = |message: &str| OutputError::Target { target: target.to_path_buf(), message: message.into() };
+    let cwd = std::env::current_dir().map_err(io(Path::new("."), "find the current folder"))?;
+    let mut path = cwd.join(target);
+    if path.file_name().is_none() || path.components().next_back() == Some(Component::CurDir) {
+        path = path.canonicalize().map_err(io(target, "resolve"))?;
+    }
+    let (parent, name) = split(&path)?;
+    fs::create_dir_all(&parent).map_err(io(&parent, "create the folder"))?;
+    let mut path = parent.canonicalize().map_err(io(&parent, "resolve"))?.join(name);
+    if fs::symlink_metadata(&path).is_ok_and(|m| m.file_type().is_symlink()) {
+        path = path.canonicalize().map_err(io(target, "resolve the symlink"))?;
+    }
+    match (kind, fs::metadata(&path)) {
+        (Kind::Folder, Ok(m)) if !m.is_dir() => return Err(bad("is a file, not a folder for the outputs")),
+        (Kind::File, Ok(m)) if m.is_dir() => return Err(bad("is a folder; give a file name")),
+        _ => {}
+    }
+    // Replacing the folder a shell is in would leave that shell in a
+    // removed folder: outputs go into a folder of their own.
+    if kind == Kind::Folder && cwd.canonicalize().is_ok_and(|c| c.starts_with(&path)) {
+        return Err(bad("is the current folder (or holds it); give a folder for the outputs, such as `--out results`"));
+    }
+    Ok(path)
+}
+
+fn split(path: &Path) -> Result<(PathBuf, OsString), OutputError> {
+    match (path.parent(), path.file_name()) {
+        (Some(parent), Some(name)) => Ok((parent.to_path_buf(), name.to_os_string())),
+        _ => Err(OutputError::Target { target: path.to_path_buf(), message: "is not a path rfm can write to".into() }),
+    }
+}
+
+/// Removes what runs into this target left behind when they were killed:
+/// staging folders and (from older versions of rfm) temporary files; puts
+/// back an old folder that a killed two-rename swap left aside. Called with
+/// the lock held, so none of it belongs to a running process.
+fn clean_leftovers(parent: &Path, name: &OsString, target: &Path, kind: Kind) -> Result<(), OutputError> {
+    let name = name.to_string_lossy();
+    let staging = format!(".{name}.rfm-staging-");
+    let old = format!(".{name}.rfm-old-");
+    let legacy = format!(".{name}.tmp-");
+    let entries = fs::read_dir(parent).map_err(io(parent, "list"))?;
+    for entry in entries.flatten() {
+        let file = entry.file_name().to_string_lossy().into_owned();
+        let path = entry.path();
+        if file.starts_with(&staging) || file.starts_with(&legacy) {
+            remove_all(&path).map_err(io(&path, "remove the unfinished outputs of an earlier run"))?;
+            eprintln!(
+                "note: removed {}, the unfinished outputs of an earlier run that was stopped before it ended",
+                path.display()
+            );
+        } else if file.starts_with(&old) {
+            if fs::symlink_metadata(target).is_err() {
+                fs::rename(&path, target).map_err(io(&path, "restore the earlier outputs"))?;
+                eprintln!(
+                    "note: restored {} from {}, where a run stopped while replacing it had left it",
+                    target.display(),
+                    path.display()
+                );
+            } else {
+                remove_all(&path).map_err(io(&path, "remove the old outputs of an earlier run"))?;
+            }
+        }
+    }
+    if kind == Kind::Folder && target.is_dir() {
+        for entry in fs::read_dir(target).map_err(io(target, "list"))?.flatten() {
+            if is_legacy_temporary(&entry.file_name()) {
+                let path = entry.path();
+                fs::remove_file(&path).map_err(io(&path, "remove a temporary file of an earlier run"))?;
+                eprintln!("note: removed {}, a temporary file of an earlier run that was stopped", path.display());
+            }
+        }
+    }
+    Ok(())
+}
+
+/// `.NAME.tmp-PID`, the temporary file of an atomic write by earlier
+/// versions of rfm.
+fn is_legacy_temporary(name: &std::ffi::OsStr) -> bool {
+    let name = name.to_string_lossy();
+    name.starts_with('.')
+        && name.rsplit_once(".tmp-").is_some_and(|(_, pid)| !pid.is_empty() && pid.bytes().all(|b| b.is_ascii_digit()))
+}
+
+fn remove_all(path: &Path) -> std::io::Result<()> {
+    if fs::symlink_metadata(path)?.is_dir() { fs::remove_dir_all(path) } else { fs::remove_file(path) }
+}
+
+/// The first input at `path` or under it (a folder), if any.
+fn find_input(path: &Path, inputs: &[FileId]) -> Option<PathBuf> {
+    let meta = fs::symlink_metadata(path).ok()?;
+    if meta.is_dir() {
+        let entries = fs::read_dir(path).ok()?;
+        return entries.flatten().find_map(|e| find_input(&e.path(), inputs));
+    }
+    FileId::of(path).filter(|id| inputs.contains(id)).map(|_| path.to_path_buf())
+}
+
+/// Puts `from` (a file, a folder or a symlink of the old folder) at `to` in
+/// the new one without copying data: a hard link shares the file, so an
+/// input stays the same file; a copy where links are not possible.
+fn carry(from: &Path, to: &Path) -> Result<(), OutputError> {
+    let meta = fs::symlink_metadata(from).map_err(io(from, "read"))?;
+    if meta.file_type().is_symlink() {
+        let link = fs::read_link(from).map_err(io(from, "read the symlink"))?;
+        #[cfg(unix)]
+        return std::os::unix::fs::symlink(link, to).map_err(io(to, "carry over the symlink"));
+        #[cfg(not(unix))]
+        return fs::copy(from, to).map(drop).map_err(io(to, format!("carry over (symlink to {})", link.display())));
+    }
+    if meta.is_dir() {
+        fs::create_dir(to).map_err(io(to, "carry over the folder"))?;
+        for entry in fs::read_dir(from).map_err(io(from, "list"))? {
+            let entry = entry.map_err(io(from, "list"))?;
+            carry(&entry.path(), &to.join(entry.file_name()))?;
+        }
+        let _ = fs::set_permissions(to, meta.permissions());
+        return Ok(());
+    }
+    if fs::hard_link(from, to).is_ok() {
+        return Ok(());
+    }
+    fs::copy(from, to).map(drop).map_err(io(from, "carry over into the new outputs"))
+}
+
+/// Makes a folder's entries durable (renames in it survive a power cut).
+fn sync_dir(dir: &Path) {
+    // Not every platform can open a folder for syncing; the data files are
+    // synced already, so this only narrows the window of a power cut.
+    if let Ok(f) = File::open(dir) {
+        let _ = f.sync_all();
+    }
+}
+
+/// Swaps two folders in one step.
+#[cfg(any(target_os = "linux", target_os = "macos"))]
+fn exchange(a: &Path, b: &Path) -> std::io::Result<()> {
+    use rustix::fs::{CWD, RenameFlags, renameat_with};
+    renameat_with(CWD, a, CWD, b, RenameFlags::EXCHANGE).map_err(std::io::Error::from)
+}
+
+/// Swaps two folders in one step: not available here, see
+/// [`Outputs::swap_by_two_renames`].
+#[cfg(not(any(target_os = "linux", target_os = "macos")))]
+fn exchange(_a: &Path, _b: &Path) -> std::io::Result<()> {
+    Err(std::io::ErrorKind::Unsupported.into())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn contents(dir: &Path) -> Vec<(String, String)> {
+        let mut v: Vec<(String, String)> = fs::read_dir(dir)
+            .unwrap()
+            .flatten()
+            .map(|e| (e.file_name().to_string_lossy().into_owned(), fs::read_to_string(e.path()).unwrap_or_default()))
+            .collect();
+        v.sort();
+        v
+    }
+
+    fn siblings(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = fs::read_dir(dir.parent().unwrap())
+            .unwrap()
+            .flatten()
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
+
+    #[test]
+    fn a_folder_appears_complete_at_the_commit_and_not_before() {
+        let root = tempfile::tempdir().unwrap();
+        let dir = root.path().join("out");
+        let mut out = Outputs::folder(&dir, &[], &["a.txt"]).unwrap();
+        out.write("a.txt", b"one").unwrap();
+        out.write("sub/b.txt", b"two").unwrap();
+        assert!(!dir.exists(), "nothing appears before the commit");
+        let written = out.commit().unwrap();
+        assert_eq!(written, vec![dir.join("a.txt"), dir.join("sub/b.txt")]);
+        assert_eq!(fs::read_to_string(dir.join("sub/b.txt")).unwrap(), "two");
+        assert_eq!(siblings(&dir), vec!["out"], "no staging folder or lock file is left");
+    }
+
+    #[test]
+    fn a_second_run_replaces_the_first_runs_files_and_keeps_the_users() {
+        let root = tempfile::tempdir().unwrap();
+        let dir = root.path().join("out");
+        let mut out = Outputs::folder(&dir, &[], &[]).unwrap();
+        out.write("a.txt", b"one").unwrap();
+        out.write("old-figure.svg", b"<svg/>").unwrap();
+        out.commit().unwrap();
+        fs::write(dir.join("notes.md"), "mine").unwrap();
+        let mut out = Outputs::folder(&dir, &[], &[]).unwrap();
+        out.write("a.txt", b"two").unwrap();
+        out.commit().unwrap();
+        let names: Vec<String> = contents(&dir).into_iter().map(|(n, _)| n).collect();
+        assert_eq!(names, vec![MANIFEST, "a.txt", "notes.md"]);
+        assert_eq!(fs::read_to_string(dir.join("a.txt")).unwrap(), "two");
+        assert_eq!(fs::read_to_string(dir.join("notes.md")).unwrap(), "mine");
+    }
+
+    #[test]
+    fn an_uncommitted_run_leaves_the_old_folder_and_nothing_else() {
+        let root = tempfile::tempdir().unwrap();
+        let dir = root.path().join("out");
+        fs::create_dir(&dir).unwrap();
+        fs::write(dir.join("a.txt"), "old").unwrap();
+        let before = contents(&dir);
+        {
+            let mut out = Outputs::folder(&dir, &[], &[]).unwrap();
+            out.write("a.txt", b"new").unwrap();
+            // dropped on an error path
+        }
+        assert_eq!(contents(&dir), before);
+        assert_eq!(siblings(&dir), vec!["out"]);
+    }
+
+    #[test]
+    fn a_second_run_into_the_same_target_is_refused_while_the_first_holds_it() {
+        let root = tempfile::tempdir().unwrap();
+        let dir = root.path().join("out");
+        let first = Outputs::folder(&dir, &[], &[]).unwrap();
+        let e = Outputs::folder(&dir, &[], &[]).err().expect("refused");
+        assert!(matches!(e, OutputError::Busy { .. }), "{e:?}");
+        assert!(e.to_string().contains(&format!("another rfm run (process {})", std::process::id())), "{e}");
+        drop(first);
+        Outputs::folder(&dir, &[], &[]).unwrap();
+    }
+
+    #[test]
+    fn a_stale_staging_folder_is_removed_by_the_next_run() {
+        let root = tempfile::tempdir().unwrap();
+        let dir = root.path().join("out");
+        let stale = root.path().join(".out.rfm-staging-999999");
+        fs::create_dir(&stale).unwrap();
+        fs::write(stale.join("half.json"), "{").unwrap();
+        fs::write(root.path().join(".out.rfm-lock"), "999999").unwrap();
+        let out = Outputs::folder(&dir, &[], &[]).unwrap();
+        assert!(!stale.exists());
+        out.commit().unwrap();
+        assert_eq!(siblings(&dir), vec!["out"]);
+    }
+
+    #[test]
+    fn an_old_folder_left_aside_by_a_killed_swap_is_restored() {
+        let root = tempfile::tempdir().unwrap();
+        let dir = root.path().join("out");
+        let aside = root.path().join(".out.rfm-old-999999");
+        fs::create_dir(&aside).unwrap();
+        fs::write(aside.join("a.txt"), "old").unwrap();
+        drop(Outputs::folder(&dir, &[], &[]).unwrap());
+        assert_eq!(fs::read_to_string(dir.join("a.txt")).unwrap(), "old");
+        assert_eq!(siblings(&dir), vec!["out"]);
+    }
+
+    #[test]
+    fn inputs_are_refused_by_identity_and_carried_over_when_not_replaced() {
+        let root = tempfile::tempdir().unwrap();
+        let dir = root.path().join("out");
+        fs::create_dir(&dir).unwrap();
+        let case = root.path().join("case.toml");
+        fs::write(&case, "case").unwrap();
+        // the case reached under another name inside the output folder
+        fs::hard_link(&case, dir.join("updated.toml")).unwrap();
+        let inputs = vec![case.clone()];
+        let e = Outputs::folder(&dir, &inputs, &["updated.toml"]).err().expect("refused");
+        assert!(matches!(e, OutputError::Input { .. }), "{e:?}");
+        // a name found only while writing: refused at the commit, nothing changed
+        let mut out = Outputs::folder(&dir, &inputs, &[]).unwrap();
+        out.write("updated.toml", b"new").unwrap();
+        let e = out.commit().expect_err("refused");
+        assert!(e.to_string().contains("refusing to overwrite an input"), "{e}");
+        assert_eq!(fs::read_to_string(&case).unwrap(), "case");
+        // not replaced: carried into the new folder as the same file
+        let mut out = Outputs::folder(&dir, &inputs, &[]).unwrap();
+        out.write("results.json", b"{}").unwrap();
+        out.commit().unwrap();
+        assert_eq!(FileId::of(&dir.join("updated.toml")), FileId::of(&case));
+    }
+
+    #[test]
+    fn a_single_file_is_replaced_whole_and_never_when_it_is_an_input() {
+        let root = tempfile::tempdir().unwrap();
+        let path = root.path().join("h.csv");
+        fs::write(&path, "old").unwrap();
+        let mut out = Outputs::file(&path, &[]).unwrap();
+        out.write_file(b"new").unwrap();
+        assert_eq!(fs::read_to_string(&path).unwrap(), "old");
+        out.commit().unwrap();
+        assert_eq!(fs::read_to_string(&path).unwrap(), "new");
+        assert_eq!(siblings(&path), vec!["h.csv"]);
+        let e = Outputs::file(&path, std::slice::from_ref(&path)).err().expect("refused");
+        assert!(matches!(e, OutputError::Input { .. }), "{e:?}");
+    }
+}
