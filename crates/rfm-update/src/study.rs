@@ -440,6 +440,21 @@ impl Study {
         })
     }
 
+    /// RFM options from the case's `[update]` section (iteration limit,
+    /// tolerance; [`Self::run_rfm`] adds the bounds).
+    pub fn rfm_options(&self) -> RfmOptions {
+        let mut opts = RfmOptions::default();
+        if let Some(spec) = self.case.update.as_ref() {
+            if let Some(n) = spec.max_iterations {
+                opts.max_iterations = n as usize;
+            }
+            if let Some(t) = spec.tolerance {
+                opts.tolerance = t;
+            }
+        }
+        opts
+    }
+
     /// Output-error options from the case's `[update]` section.
     pub fn output_error_options(&self) -> Result<OeOptions, UpdateError> {
         let mut opts = OeOptions::default();
