@@ -45,8 +45,9 @@
 //! When the full step lowers the misfit, as it does near the solution, the
 //! iteration is exactly the paper's.
 //!
-//! Bounds from the case (`[update] bounds`) clip each new value; a parameter
-//! that ends on one is flagged in [`RfmResult::at_bound`]. At the returned
+//! Bounds from the case (`[update] bounds`), or else a factor of
+//! [`DEFAULT_RANGE`] either way from the initial value, clip each new value;
+//! a parameter that ends on one is flagged in [`RfmResult::at_bound`]. At the returned
 //! iterate the column-scaled sensitivity's singular values tell whether the
 //! data determine every parameter: [`RfmResult::unresolved`] names the
 //! combination along the weakest direction when its singular value is below
@@ -73,7 +74,8 @@ pub struct RfmOptions {
     /// Stalled when this many iterations in a row fail to lower the best
     /// residual by 1 %.
     pub stall_iterations: usize,
-    /// Bounds per parameter in physical units (`None` or missing: unbounded).
+    /// Bounds per parameter in physical units (`None` or missing: within a
+    /// factor of [`DEFAULT_RANGE`] of the initial value).
     pub bounds: Vec<Option<(f64, f64)>>,
 }
 
@@ -137,6 +139,9 @@ pub struct RfmResult {
     pub residual: f64,
     /// Parameters whose final value lies on one of their bounds.
     pub at_bound: Vec<bool>,
+    /// The bounds each parameter was kept within: its own, or a factor of
+    /// [`DEFAULT_RANGE`] either way from its initial value.
+    pub bounds: Vec<(f64, f64)>,
     /// Singular values of the column-scaled sensitivity at the returned
     /// iterate, descending (empty if it was never solved for).
     pub singular_values: Vec<f64>,
@@ -145,12 +150,27 @@ pub struct RfmResult {
     pub unresolved: Option<String>,
 }
 
+/// Without bounds of its own, a parameter stays within this factor of its
+/// initial value either way, as in the output-error estimator: one that the
+/// data do not determine cannot run off to 1e16 (where `Z` is singular to
+/// working precision and no FRF of the result can be computed), and it is
+/// reported on that bound.
+pub const DEFAULT_RANGE: f64 = 1e6;
+
+/// The bounds each parameter is kept within: its own, or a factor of
+/// [`DEFAULT_RANGE`] around its initial value.
+fn effective_bounds(initial: &[f64], given: &[Option<(f64, f64)>]) -> Vec<(f64, f64)> {
+    initial
+        .iter()
+        .enumerate()
+        .map(|(i, &p)| given.get(i).copied().flatten().unwrap_or((p / DEFAULT_RANGE, p * DEFAULT_RANGE)))
+        .collect()
+}
+
 /// Clips each value into its bounds.
-fn clip(values: &mut [f64], bounds: &[Option<(f64, f64)>]) {
-    for (v, b) in values.iter_mut().zip(bounds) {
-        if let Some((lo, hi)) = *b {
-            *v = v.clamp(lo, hi);
-        }
+fn clip(values: &mut [f64], bounds: &[(f64, f64)]) {
+    for (v, &(lo, hi)) in values.iter_mut().zip(bounds) {
+        *v = v.clamp(lo, hi);
     }
 }
 
@@ -260,6 +280,7 @@ pub fn run(
     let values = |sys: &DampedSystem| params.values(sys);
     let mut history: Vec<IterationRecord> = Vec::new();
     let mut best: (f64, Vec<f64>) = (f64::INFINITY, values(sys));
+    let bounds = effective_bounds(&best.1, &opts.bounds);
     let mut status = Status::MaxIterations;
     let mut since_best = 0;
     let mut lambda = 0.0;
@@ -326,7 +347,7 @@ pub fn run(
         if full_max < opts.tolerance {
             // converged: take the (tiny) paper step and stop after recording it
             let mut next: Vec<f64> = current.iter().zip(&full).map(|(p, u)| p * (1.0 + u)).collect();
-            clip(&mut next, &opts.bounds);
+            clip(&mut next, &bounds);
             params.set_values(sys, &next)?;
             last_step = (full_max, full_limited, sol.rank, 0.0);
             converged = true;
@@ -338,7 +359,7 @@ pub fn run(
             let mut u = if lambda == 0.0 { sol.x.clone() } else { sol.damped(lambda) };
             let limited = guard(&mut u);
             let mut next: Vec<f64> = current.iter().zip(&u).map(|(p, u)| p * (1.0 + u)).collect();
-            clip(&mut next, &opts.bounds);
+            clip(&mut next, &bounds);
             let trial = params.set_values(sys, &next).ok().and_then(|()| misfit(sys, &solver, measured, &weights));
             if trial.is_some_and(|r| r < residual) {
                 last_step = (u.iter().map(|x| x.abs()).fold(0.0, f64::max), limited, sol.rank, lambda);
@@ -359,17 +380,23 @@ pub fn run(
     }
     let final_values = values(sys);
     let residual = if status == Status::Converged { history.last().map_or(f64::NAN, |r| r.residual) } else { best.0 };
-    let at_bound = (0..final_values.len())
-        .map(|i| {
-            opts.bounds.get(i).copied().flatten().is_some_and(|(lo, hi)| {
-                let v = final_values[i];
-                (v - lo).abs() <= 1e-9 * lo.abs() || (v - hi).abs() <= 1e-9 * hi.abs()
-            })
-        })
+    let at_bound = final_values
+        .iter()
+        .zip(&bounds)
+        .map(|(&v, &(lo, hi))| (v - lo).abs() <= 1e-9 * lo.abs() || (v - hi).abs() <= 1e-9 * hi.abs())
         .collect();
     let names: Vec<String> = params.params().iter().map(|p| p.name.clone()).collect();
     let unresolved = crate::uncertainty::unresolved_combination(&best_svd.0, &best_svd.1, &names);
-    Ok(RfmResult { history, status, values: final_values, residual, at_bound, singular_values: best_svd.0, unresolved })
+    Ok(RfmResult {
+        history,
+        status,
+        values: final_values,
+        residual,
+        at_bound,
+        bounds,
+        singular_values: best_svd.0,
+        unresolved,
+    })
 }
 
 #[cfg(test)]
@@ -414,5 +441,36 @@ mod tests {
         assert!((w[0][1] - 0.2).abs() < 1e-15);
         // a channel of zeros has no size at all: weight 1, never infinite
         assert_eq!(w[1], vec![1.0, 1.0]);
+    }
+
+    #[test]
+    fn every_status_is_a_name_case_checks_may_use() {
+        let all = [
+            Status::Converged,
+            Status::Stalled,
+            Status::WithinNoise,
+            Status::MaxIterations,
+            Status::Failed("x".into()),
+        ];
+        // a new variant breaks this match: add it to `all` and to RUN_STATUSES
+        for s in &all {
+            match s {
+                Status::Converged
+                | Status::Stalled
+                | Status::WithinNoise
+                | Status::MaxIterations
+                | Status::Failed(_) => {}
+            }
+        }
+        let names: Vec<String> = all
+            .iter()
+            .map(|s| match serde_json::to_value(s).unwrap() {
+                serde_json::Value::String(name) => name,
+                // a status with a payload is an object keyed by its name
+                serde_json::Value::Object(o) => o.keys().next().unwrap().clone(),
+                other => panic!("{other}"),
+            })
+            .collect();
+        assert_eq!(names, fe_model::case::RUN_STATUSES);
     }
 }

@@ -349,10 +349,20 @@ impl Study {
         let mut warnings: Vec<String> = self
             .parameters
             .iter()
-            .zip(&result.at_bound)
-            .zip(&opts.bounds)
-            .filter(|((_, at), _)| **at)
-            .filter_map(|((p, _), b)| b.map(|(lo, hi)| format!("{} ended on its bound [{lo:e}, {hi:e}]", p.name)))
+            .enumerate()
+            .filter(|&(i, _)| result.at_bound[i])
+            .map(|(i, p)| {
+                let (lo, hi) = result.bounds[i];
+                if opts.bounds.get(i).copied().flatten().is_some() {
+                    format!("{} ended on its bound [{lo:e}, {hi:e}]", p.name)
+                } else {
+                    format!(
+                        "{} ended a factor of {:e} from its initial value, the most the RFM allows without bounds of its own: the data do not determine it",
+                        p.name,
+                        rfm::DEFAULT_RANGE
+                    )
+                }
+            })
             .collect();
         warnings.extend(result.unresolved.clone());
         let natural_frequencies_hz = self.frequency_table(&sys);
