@@ -58,6 +58,9 @@ fn every_paper_case_loads_and_has_truth_and_parameters() {
     ] {
         let study = Study::load(&case(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
         assert!(study.truth.is_some(), "{name}");
+        // its acceptance, which `cargo xtask reproduce` holds its runs to
+        let check = study.case.check.as_ref().unwrap_or_else(|| panic!("{name} has no [check]"));
+        assert!(check.rfm.is_some() || check.output_error.is_some(), "{name}: {check:?}");
         assert!(!study.parameters.is_empty(), "{name}");
         assert!(!study.update_frequencies_hz.is_empty(), "{name}");
         // the chosen lines are lines of the data and avoid its resonances
