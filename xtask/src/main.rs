@@ -21,6 +21,8 @@
 //!   Then the whole diagnosis end to end on small frames (`diagnose_point`
 //!   example): candidates, time, and whether it named the hidden effect; it
 //!   exits non-zero when a diagnosis names the wrong one.
+//! - `mutants [ARGS...]`: the mutation check of the numerical modules with
+//!   cargo-mutants (see `mutants.rs`).
 //!
 //! Binaries are found through cargo's target directory (`CARGO_TARGET_DIR`
 //! and cargo's configuration are honoured): `cargo build
@@ -28,6 +30,7 @@
 
 mod bench;
 mod check;
+mod mutants;
 mod reproduce;
 
 use std::path::{Path, PathBuf};
@@ -46,7 +49,10 @@ fn main() -> ExitCode {
     let result = match args.first().map(String::as_str) {
         Some("reproduce") => reproduce::reproduce(&args[1..]),
         Some("bench") => bench::bench(&args[1..]),
-        _ => Err("usage: cargo xtask reproduce [CASE... | tutorial] | cargo xtask bench [--full]".to_string()),
+        Some("mutants") => mutants::mutants(&args[1..]),
+        _ => Err("usage: cargo xtask reproduce [CASE... | tutorial] | cargo xtask bench [--full] | \
+                  cargo xtask mutants [--list | cargo-mutants options]"
+            .to_string()),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
