@@ -152,9 +152,8 @@ pub struct RfmResult {
 
 /// Without bounds of its own, a parameter stays within this factor of its
 /// initial value either way, as in the output-error estimator: one that the
-/// data do not determine cannot run off to 1e16 (where `Z` is singular to
-/// working precision and no FRF of the result can be computed), and it is
-/// reported on that bound.
+/// data do not determine cannot run off by ten orders of magnitude and more
+/// (as the joints of the f-frame twin did), and it is reported on that bound.
 pub const DEFAULT_RANGE: f64 = 1e6;
 
 /// The bounds each parameter is kept within: its own, or a factor of
