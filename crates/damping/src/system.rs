@@ -292,4 +292,27 @@ mod tests {
             assert!(max_rel_diff(&got, &expect) < 1e-13, "{name}");
         }
     }
+
+    /// A derivative is zero exactly when the parameter touches nothing at
+    /// that frequency: the joint group of the frame has no mass terms and
+    /// beta = 0, its alpha acts on the joint spring.
+    #[test]
+    fn a_derivative_that_changes_nothing_is_zero() {
+        let sys = DampedSystem::new(samples::frame_with_joint()).unwrap();
+        let d = |name: &str| sys.derivative(sys.model().quantity(name).unwrap(), 300.0);
+        assert!(d("group.joint.beta").is_zero());
+        assert!(d("group.joint.beta").values(sys.assembly()).iter().all(|v| *v == C64::new(0.0, 0.0)));
+        assert!(!d("group.joint.alpha").is_zero());
+        assert!(!d("mass.tip.m").is_zero());
+    }
+
+    #[test]
+    fn into_model_gives_back_the_model_with_its_current_values() {
+        let mut sys = DampedSystem::new(samples::frame_with_joint()).unwrap();
+        let q = sys.model().quantity("spring.joint.kr").unwrap();
+        sys.set(q, 1234.5).unwrap();
+        let model = sys.into_model();
+        assert_eq!(model.title, "L-frame with a lossy joint");
+        assert_eq!(model.get(q), 1234.5);
+    }
 }
