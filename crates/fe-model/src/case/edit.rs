@@ -28,9 +28,13 @@ pub struct CaseEditor {
 }
 
 impl CaseFile {
-    /// An editor on this case's text.
+    /// An editor on this case's text, for a new case derived from it. The
+    /// `[check]` table is left out: it is the acceptance of this case's own
+    /// results (`cargo xtask reproduce`), which a case with added effects or
+    /// updated values does not share.
     pub fn editor(&self) -> Result<CaseEditor, CaseError> {
-        let doc = self.source.parse::<DocumentMut>().map_err(|e| self.error(e.span(), e.message().to_string()))?;
+        let mut doc = self.source.parse::<DocumentMut>().map_err(|e| self.error(e.span(), e.message().to_string()))?;
+        doc.remove("check");
         let data = self.measurement.as_ref().and_then(|m| m.data.clone());
         Ok(CaseEditor { path: self.path.clone(), data, doc })
     }
@@ -308,6 +312,19 @@ data = \"data/measured.csv\"   # from the lab
         let got = back.measurement.unwrap().data.unwrap();
         assert_eq!(resolved(&got), resolved(&dir.join("study/data/measured.csv")));
         assert!(same.contains("# the user's comment"), "comments stay");
+    }
+
+    /// A derived case does not inherit the shipped case's acceptance.
+    #[test]
+    fn the_check_table_is_not_carried_into_a_derived_case() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../cases/two-material-beam.toml");
+        let c = CaseFile::load(&path).unwrap();
+        assert!(c.check.is_some() && c.source.contains("[check"));
+        let text = c.editor().unwrap().text_at(&path.with_file_name("derived.toml")).unwrap();
+        assert!(!text.contains("[check"), "{text}");
+        let back = CaseFile::parse(&path.with_file_name("derived.toml"), &text).unwrap();
+        assert!(back.check.is_none());
+        assert_eq!(back.model.nodes().len(), c.model.nodes().len());
     }
 
     #[test]
