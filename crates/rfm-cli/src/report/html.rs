@@ -144,7 +144,9 @@ pub(crate) fn escape(s: &str) -> String {
 
 /// Makes a plotters SVG scale with the page: the fixed `width`/`height` of
 /// its root element are replaced by a relative width (the `viewBox` keeps
-/// the aspect ratio), and an accessible name is added.
+/// the aspect ratio) that never exceeds the drawn width, so that its text is
+/// never blown up past the size it was drawn at; and an accessible name is
+/// added.
 fn responsive(svg: &str, label: &str) -> String {
     let Some(start) = svg.find("<svg") else {
         return svg.to_string();
@@ -152,6 +154,7 @@ fn responsive(svg: &str, label: &str) -> String {
     let end = start + svg[start..].find('>').unwrap_or(0);
     let open = &svg[start..end];
     let mut attrs = String::new();
+    let mut width = None;
     let mut rest = open.trim_start_matches("<svg");
     // keep every attribute but width and height
     while let Some(eq) = rest.find("=\"") {
@@ -159,13 +162,16 @@ fn responsive(svg: &str, label: &str) -> String {
         let after = &rest[eq + 2..];
         let Some(close) = after.find('"') else { break };
         let value = &after[..close];
-        if name != "width" && name != "height" {
-            attrs.push_str(&format!(" {name}=\"{value}\""));
+        match name {
+            "width" => width = value.parse::<u32>().ok(),
+            "height" => {}
+            _ => attrs.push_str(&format!(" {name}=\"{value}\"")),
         }
         rest = &after[close + 1..];
     }
+    let style = width.map_or(String::new(), |w| format!(" style=\"max-width: {w}px\""));
     format!(
-        "{}<svg{attrs} role=\"img\" aria-label=\"{}\" class=\"figure\">{}",
+        "{}<svg{attrs}{style} role=\"img\" aria-label=\"{}\" class=\"figure\">{}",
         &svg[..start],
         escape(label),
         &svg[end + 1..]
@@ -200,7 +206,7 @@ td.bad { background: var(--bad); color: var(--bad-ink); font-weight: 600; }
 td.good { background: var(--good); color: var(--good-ink); }
 .scroll { overflow-x: auto; }
 figure { margin: 14px 0 26px; }
-svg.figure { width: 100%; height: auto; display: block; border: 1px solid var(--rule); }
+svg.figure { width: 100%; height: auto; display: block; margin: 0 auto; border: 1px solid var(--rule); }
 figcaption { color: var(--muted); font-size: 14px; margin-top: 6px; }
 details { margin: 4px 0 18px; }
 summary { color: var(--accent); cursor: pointer; font-size: 14px; }
@@ -339,7 +345,7 @@ mod tests {
         assert!(html.contains("<h1>a &lt;b&gt; &amp; c</h1>"));
         assert!(html.contains("<td>&lt;1&gt;</td><td class=\"bad\">2</td>"));
         assert!(html.contains(
-            "<svg viewBox=\"0 0 960 400\" xmlns=\"http://www.w3.org/2000/svg\" role=\"img\" aria-label=\"cap &quot;q&quot;\" class=\"figure\">\n<rect/>"
+            "<svg viewBox=\"0 0 960 400\" xmlns=\"http://www.w3.org/2000/svg\" style=\"max-width: 960px\" role=\"img\" aria-label=\"cap &quot;q&quot;\" class=\"figure\">\n<rect/>"
         ));
         assert!(!html.contains("width=\"960\""));
         assert!(!html.contains("<script"));
