@@ -10,6 +10,9 @@
 //!   the run: status, misfit, largest error against the truth, and for the
 //!   output-error runs the largest distance from the truth in standard
 //!   deviations over the parameters the data determine.
+//! - `figures`: builds the `rfm` binary (release), writes the tutorial's
+//!   compare and fix reports into `target/figures/`, and copies the figures
+//!   the documentation shows into `docs/images/` (see [`FIGURES`]).
 //! - `bench [--full]`: builds the `bench_point` example of rfm-update
 //!   (release) and runs quick versions of the sensitivity benchmarks, each
 //!   configuration in its own process so that its peak memory is its own;
@@ -47,7 +50,11 @@ fn main() -> ExitCode {
     let result = match args.first().map(String::as_str) {
         Some("reproduce") => reproduce(&args[1..]),
         Some("bench") => bench(&args[1..]),
-        _ => Err("usage: cargo xtask reproduce [CASE... | tutorial] | cargo xtask bench [--full]".to_string()),
+        Some("figures") => figures(),
+        _ => {
+            Err("usage: cargo xtask reproduce [CASE... | tutorial] | cargo xtask figures | cargo xtask bench [--full]"
+                .to_string())
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -237,6 +244,44 @@ fn tutorial_loop(rfm: &Path, out: &Path, runs: &mut Vec<Run>) -> Result<String, 
          {fall:.0} times, from {nominal:.3e} (nominal model) to {last:.3e}",
         leader["description"].as_str().unwrap_or("?"),
     ))
+}
+
+/// The figures of `docs/`: (report, figure in it, name under `docs/images/`).
+const FIGURES: [(&str, &str, &str); 8] = [
+    ("compare", "frf-23uy-23uy.svg", "tutorial-before-23uy.svg"),
+    ("compare", "error-vs-frequency.svg", "tutorial-error-before.svg"),
+    ("compare", "frf-channels.svg", "tutorial-channels.svg"),
+    ("compare", "mac-matrix.svg", "tutorial-mac.svg"),
+    ("compare", "stabilisation.svg", "tutorial-stabilisation.svg"),
+    ("compare", "mode-shapes.svg", "tutorial-mode-shapes.svg"),
+    ("fix", "misfit-steps.svg", "tutorial-fix-misfit.svg"),
+    ("fix", "structure.svg", "tutorial-fix-structure.svg"),
+];
+
+/// Writes the tutorial's compare and fix reports and copies [`FIGURES`]
+/// into `docs/images/`, so that every figure the documentation shows is
+/// what the tool draws today.
+fn figures() -> Result<(), String> {
+    let rfm = build_cli()?;
+    let case = root().join("cases/tutorial/l-frame.toml");
+    let base = root().join("target/figures");
+    for command in ["compare", "fix"] {
+        println!("rfm {command} {} --out {}", case.display(), base.join(command).display());
+        let out = Command::new(&rfm)
+            .args([OsStr::new(command), case.as_os_str(), OsStr::new("--out"), base.join(command).as_os_str()])
+            .output()
+            .map_err(|e| format!("cannot run {}: {e}", rfm.display()))?;
+        if !out.status.success() {
+            return Err(format!("rfm {command} failed:\n{}", String::from_utf8_lossy(&out.stderr)));
+        }
+    }
+    let images = root().join("docs/images");
+    for (report, figure, name) in FIGURES {
+        let (from, to) = (base.join(report).join(figure), images.join(name));
+        std::fs::copy(&from, &to).map_err(|e| format!("{} -> {}: {e}", from.display(), to.display()))?;
+        println!("wrote {}", to.display());
+    }
+    Ok(())
 }
 
 /// One `bench_point` run: what the table shows about it.
