@@ -21,7 +21,7 @@ use crate::exit::Exit;
 use crate::output::Outputs;
 use crate::report::html::{Block, Report, Section};
 use crate::report::json::CorrelationJson;
-use crate::report::modes::{ModalComparison, ModesJson, compare_modes, mode_table_rows};
+use crate::report::modes::{ModesJson, compare_modes, mode_table_rows, rows};
 use crate::report::{self, ModelFrfs, ReportOptions, plot, sig, signed};
 use crate::table::Table;
 
@@ -174,7 +174,7 @@ pub(crate) fn compare(
     let frfs = synthesize(&system, measured.channels(), measured.frequencies_hz())?;
     let correlation = correlate(&measured, &frfs, &spec)?;
     let comparison = compare_modes(&system, &measured);
-    let modes = comparison.as_ref().map(ModalComparison::rows).map_err(Clone::clone);
+    let modes = comparison.as_ref().map(rows).map_err(Clone::clone);
     let doc = CompareJson {
         case: case_path.display().to_string(),
         title: case.model.title.clone(),
@@ -223,7 +223,7 @@ fn report_sections(
     measured: &FrfSet,
     source: &str,
     model: &ModelFrfs,
-    modes: std::result::Result<&ModalComparison, &String>,
+    modes: std::result::Result<&frf::ModalComparison, &String>,
     opts: &ReportOptions,
     out: &mut Outputs,
 ) -> Result<Vec<Section>> {

@@ -4,16 +4,15 @@
 //! MAC matrix, the stabilisation diagram and the paired mode shapes drawn
 //! on the structure.
 //!
-//! (The estimation and pairing are library calls; gathering them into one
-//! comparison belongs in a library too, which the architecture issue will
-//! do. Until then it lives here, beside the only code that reads it.)
+//! The comparison itself is [`frf::compare_modes`]; this file turns it
+//! into the table, the JSON and the figures.
 
 use std::collections::HashMap;
 
 use damping::DampedSystem;
-use fe_model::{Dof, DofRef, Model, Slot};
-use frf::modal::{Mode, Pairing};
-use frf::{C64, FrfSet, ModalEstimate};
+use fe_model::Model;
+use frf::comparison::{measured_on_model, real_shape};
+use frf::{FrfSet, ModalComparison};
 use serde::Serialize;
 
 use super::html::{Block, Section, Table, Tone};
@@ -24,46 +23,10 @@ use crate::output::Outputs;
 /// Least MAC of a pair.
 const MIN_MAC: f64 = 0.5;
 
-/// Measured modes and a model's, paired.
-pub(crate) struct ModalComparison {
-    /// The LSCF estimate of the measured modes (every order's poles kept).
-    pub(crate) estimate: ModalEstimate,
-    /// The measured modes, shapes at the measured responses.
-    pub(crate) measured: Vec<Mode>,
-    /// The model's modes in the band, shapes at every free DOF.
-    pub(crate) model: Vec<Mode>,
-    /// The pairing (MAC over the measured responses).
-    pub(crate) pairing: Pairing,
-    /// The band of the estimate (Hz).
-    pub(crate) band_hz: (f64, f64),
-}
-
-/// Every free DOF of a system, node by node.
-fn free_dofs(system: &DampedSystem) -> Vec<DofRef> {
-    let dofs = &system.assembly().dofs;
-    system
-        .model()
-        .nodes()
-        .iter()
-        .flat_map(|n| Dof::ALL.map(|d| DofRef::new(n.id.0, d)))
-        .filter(|&r| matches!(dofs.slot(r), Some(Slot::Free(_))))
-        .collect()
-}
-
-/// Estimates the measured modes (LSCF over the measured band) and pairs
-/// them with the system's complex modes by MAC at the measured responses.
+/// The measured modes paired with `system`'s ([`frf::compare_modes`]), the
+/// error as the text the report and `--json` show.
 pub(crate) fn compare_modes(system: &DampedSystem, measured: &FrfSet) -> std::result::Result<ModalComparison, String> {
-    let rec = measured.to_receptance();
-    let f = rec.frequencies_hz();
-    let band = (f[0], f[f.len() - 1]);
-    let estimate =
-        frf::lscf(&rec, &frf::LscfOptions::new(band.0, band.1)).map_err(|e| format!("modal estimation: {e}"))?;
-    let meas = frf::measured_modes(&estimate);
-    // shapes at every DOF, for drawing; the MAC is taken over the DOFs
-    // both sides have, the measured responses
-    let model = frf::model_modes(system, &free_dofs(system), band.1).map_err(|e| format!("model modes: {e}"))?;
-    let pairing = frf::pair_modes(&model, &meas, MIN_MAC);
-    Ok(ModalComparison { estimate, measured: meas, model, pairing, band_hz: band })
+    frf::compare_modes(system, measured, MIN_MAC).map_err(|e| e.to_string())
 }
 
 /// One measured mode and its model partner.
@@ -87,59 +50,57 @@ pub(crate) struct ModesJson {
     rows: Vec<ModeRow>,
 }
 
-impl ModalComparison {
-    /// The mode table: each measured mode with its partner and what the
-    /// pair suggests, then the model modes nothing was paired with, by frequency.
-    pub(crate) fn rows(&self) -> ModesJson {
-        let mut rows = Vec::new();
-        for (i, m) in self.measured.iter().enumerate() {
-            let row = match self.pairing.pairs.iter().find(|p| p.measured == i) {
-                Some(p) => {
-                    let x = &self.model[p.model];
-                    ModeRow {
-                        measured_hz: Some(m.frequency_hz),
-                        measured_damping_ratio: Some(m.damping_ratio),
-                        model_hz: Some(x.frequency_hz),
-                        model_damping_ratio: Some(x.damping_ratio),
-                        frequency_error_pct: Some(p.frequency_error_pct),
-                        damping_error_pct: Some(p.damping_error_pct),
-                        mac: Some(p.mac),
-                        reading: frf::symptom(x, m, p.mac).reading().to_string(),
-                    }
-                }
-                None => ModeRow {
+/// The mode table: each measured mode with its partner and what the
+/// pair suggests, then the model modes nothing was paired with, by frequency.
+pub(crate) fn rows(c: &ModalComparison) -> ModesJson {
+    let mut rows = Vec::new();
+    for (i, m) in c.measured.iter().enumerate() {
+        let row = match c.pairing.pairs.iter().find(|p| p.measured == i) {
+            Some(p) => {
+                let x = &c.model[p.model];
+                ModeRow {
                     measured_hz: Some(m.frequency_hz),
                     measured_damping_ratio: Some(m.damping_ratio),
-                    model_hz: None,
-                    model_damping_ratio: None,
-                    frequency_error_pct: None,
-                    damping_error_pct: None,
-                    mac: None,
-                    reading: format!("no model mode with a similar shape (MAC < {MIN_MAC})"),
-                },
-            };
-            rows.push(row);
-        }
-        for &j in &self.pairing.unpaired_model {
-            let x = &self.model[j];
-            rows.push(ModeRow {
-                measured_hz: None,
-                measured_damping_ratio: None,
-                model_hz: Some(x.frequency_hz),
-                model_damping_ratio: Some(x.damping_ratio),
+                    model_hz: Some(x.frequency_hz),
+                    model_damping_ratio: Some(x.damping_ratio),
+                    frequency_error_pct: Some(p.frequency_error_pct),
+                    damping_error_pct: Some(p.damping_error_pct),
+                    mac: Some(p.mac),
+                    reading: frf::symptom(x, m, p.mac).reading().to_string(),
+                }
+            }
+            None => ModeRow {
+                measured_hz: Some(m.frequency_hz),
+                measured_damping_ratio: Some(m.damping_ratio),
+                model_hz: None,
+                model_damping_ratio: None,
                 frequency_error_pct: None,
                 damping_error_pct: None,
                 mac: None,
-                reading: "not seen in the measurement (not excited, not observed, or not in the structure)".into(),
-            });
-        }
-        rows.sort_by(|a, b| {
-            let fa = a.measured_hz.or(a.model_hz).unwrap_or(0.0);
-            let fb = b.measured_hz.or(b.model_hz).unwrap_or(0.0);
-            fa.total_cmp(&fb)
-        });
-        ModesJson { band_hz: self.band_hz, rows }
+                reading: format!("no model mode with a similar shape (MAC < {MIN_MAC})"),
+            },
+        };
+        rows.push(row);
     }
+    for &j in &c.pairing.unpaired_model {
+        let x = &c.model[j];
+        rows.push(ModeRow {
+            measured_hz: None,
+            measured_damping_ratio: None,
+            model_hz: Some(x.frequency_hz),
+            model_damping_ratio: Some(x.damping_ratio),
+            frequency_error_pct: None,
+            damping_error_pct: None,
+            mac: None,
+            reading: "not seen in the measurement (not excited, not observed, or not in the structure)".into(),
+        });
+    }
+    rows.sort_by(|a, b| {
+        let fa = a.measured_hz.or(a.model_hz).unwrap_or(0.0);
+        let fb = b.measured_hz.or(b.model_hz).unwrap_or(0.0);
+        fa.total_cmp(&fb)
+    });
+    ModesJson { band_hz: c.band_hz, rows }
 }
 
 fn opt(v: Option<f64>, f: impl Fn(f64) -> String) -> String {
@@ -167,34 +128,6 @@ pub(crate) fn mode_table_rows(m: &ModesJson) -> (Vec<&'static str>, Vec<Vec<Stri
         })
         .collect();
     (header, rows)
-}
-
-/// The real shape to draw of a complex one: turned by the angle that makes
-/// it most nearly real (half the angle of `sum phi_i^2` over its
-/// translations), then its real part. Returns that angle as well, so that a
-/// partner can be turned the same way.
-fn realise(dofs: &[DofRef], shape: &[C64]) -> (f64, Vec<f64>) {
-    let sum: C64 = dofs.iter().zip(shape).filter(|(d, _)| d.dof.is_translation()).map(|(_, v)| v * v).sum();
-    let theta = 0.5 * sum.arg();
-    let turn = C64::from_polar(1.0, -theta);
-    (theta, shape.iter().map(|v| (v * turn).re).collect())
-}
-
-/// The measured shape scaled and turned onto the model's at the DOFs they
-/// share (the modal scale factor, `a = psi^H phi / psi^H psi`), then made
-/// real by the model's angle `theta`.
-fn measured_on_model(measured: &Mode, model: &Mode, theta: f64) -> Vec<(DofRef, f64)> {
-    let index: HashMap<DofRef, usize> = model.dofs.iter().enumerate().map(|(i, d)| (*d, i)).collect();
-    let (mut num, mut den) = (C64::new(0.0, 0.0), 0.0);
-    for (d, psi) in measured.dofs.iter().zip(&measured.shape) {
-        if let Some(&i) = index.get(d) {
-            num += psi.conj() * model.shape[i];
-            den += psi.norm_sqr();
-        }
-    }
-    let a = if den > 0.0 { num / den } else { C64::new(0.0, 0.0) };
-    let turn = C64::from_polar(1.0, -theta);
-    measured.dofs.iter().zip(&measured.shape).map(|(d, psi)| (*d, (a * psi * turn).re)).collect()
 }
 
 /// The figures of a modal comparison: the MAC matrix, the stabilisation
@@ -270,7 +203,7 @@ fn figures(
     let mut panels = Vec::new();
     for (k, p) in c.pairing.pairs.iter().enumerate() {
         let (x, m) = (&c.model[p.model], &c.measured[p.measured]);
-        let (theta, real) = realise(&x.dofs, &x.shape);
+        let (theta, real) = real_shape(&x.dofs, &x.shape);
         let mut per_node: HashMap<u32, [f64; 3]> = HashMap::new();
         for (d, v) in x.dofs.iter().zip(&real) {
             per_node.entry(d.node.0).or_insert([0.0; 3])[d.dof.index()] = *v;
@@ -324,7 +257,7 @@ pub(crate) fn section(
         }
         Ok(c) => c,
     };
-    let m = c.rows();
+    let m = rows(c);
     s.push(Block::Text(format!(
         "Measured modes estimated from the FRFs (least-squares complex frequency method, stable poles over model \
          orders, {} to {} Hz), paired with {against}'s complex modes by MAC at the measured responses. A resonance \
@@ -346,34 +279,4 @@ pub(crate) fn section(
         s.push(b);
     }
     Ok(s)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_shape_turned_by_any_angle_comes_back_real_and_the_measured_one_onto_it() {
-        let dofs: Vec<DofRef> = (1..=4).map(|n| DofRef::new(n, Dof::Uy)).collect();
-        let real = [0.1, 0.4, -0.3, 1.0];
-        let turn = C64::from_polar(2.0, 1.1);
-        let shape: Vec<C64> = real.iter().map(|&v| turn * v).collect();
-        let (theta, back) = realise(&dofs, &shape);
-        // real up to the sign, scaled by |turn|
-        let sign = back[3].signum();
-        for (b, r) in back.iter().zip(real) {
-            assert!((b - sign * 2.0 * r).abs() < 1e-12, "{back:?}");
-        }
-        let model = Mode { frequency_hz: 1.0, damping_ratio: 0.01, dofs: dofs.clone(), shape: shape.clone() };
-        // measured at two of the DOFs, with another scale and phase
-        let other = C64::from_polar(0.3, -2.0);
-        let meas = Mode {
-            frequency_hz: 1.0,
-            damping_ratio: 0.01,
-            dofs: vec![dofs[1], dofs[3]],
-            shape: vec![other * real[1], other * real[3]],
-        };
-        let on = measured_on_model(&meas, &model, theta);
-        assert!((on[0].1 - back[1]).abs() < 1e-12 && (on[1].1 - back[3]).abs() < 1e-12, "{on:?} {back:?}");
-    }
 }
