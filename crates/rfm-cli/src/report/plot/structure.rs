@@ -568,6 +568,40 @@ mod tests {
     }
 
     #[test]
+    fn every_kind_of_effect_is_marked_in_a_colour_of_its_own() {
+        let m = l_frame();
+        let kinds = [
+            ("a joint", HighlightKind::Joint, vec![2], vec![2]),
+            ("a support", HighlightKind::Support, vec![1], vec![]),
+            ("a mass", HighlightKind::Mass, vec![3], vec![]),
+            ("a patch", HighlightKind::Patch, vec![], vec![1]),
+        ];
+        let highlights: Vec<Highlight> = kinds
+            .iter()
+            .map(|(label, kind, nodes, elements)| Highlight {
+                label: (*label).into(),
+                kind: *kind,
+                nodes: nodes.clone(),
+                elements: elements.clone(),
+            })
+            .collect();
+        let svg = structure("frame", &m, &Sensors { responses: &[], references: &[] }, &highlights).unwrap();
+        let hex = |c: RGBColor| format!("#{:02X}{:02X}{:02X}", c.0, c.1, c.2);
+        let distinct: std::collections::HashSet<String> = HIGHLIGHTS.iter().map(|&c| hex(c)).collect();
+        assert_eq!(distinct.len(), HIGHLIGHTS.len());
+        for (i, (label, ..)) in kinds.iter().enumerate() {
+            assert!(super::super::has_text(&svg, &format!("{}: {label}", i + 1)), "legend of {label}");
+            // its mark on the drawing and its dot in the legend
+            assert!(svg.matches(&hex(HIGHLIGHTS[i])).count() >= 2, "{label} is not drawn in {}", hex(HIGHLIGHTS[i]));
+        }
+        // the mass is a filled square in its colour
+        assert!(
+            svg.lines().any(|l| l.starts_with("<rect") && l.contains(&format!("fill=\"{}\"", hex(HIGHLIGHTS[2])))),
+            "no square for the mass"
+        );
+    }
+
+    #[test]
     fn mode_shapes_draw_one_panel_per_mode() {
         let m = l_frame();
         let panels: Vec<ShapePanel> = (1..=3)
