@@ -11,8 +11,10 @@
 //!   output-error runs the largest distance from the truth in standard
 //!   deviations over the parameters the data determine.
 //! - `figures`: builds the `rfm` binary (release), writes the tutorial's
-//!   compare and fix reports into `target/figures/`, and copies the figures
-//!   the documentation shows into `docs/images/` (see [`FIGURES`]).
+//!   compare and fix reports and the walkthrough's update report into
+//!   `target/figures/`, and copies the figures the documentation shows into
+//!   `docs/images/` (see [`FIGURES`]); `RFM_BIN=PATH` uses that `rfm`
+//!   binary instead of building one.
 //! - `bench [--full]`: builds the `bench_point` example of rfm-update
 //!   (release) and runs quick versions of the sensitivity benchmarks, each
 //!   configuration in its own process so that its peak memory is its own;
@@ -247,7 +249,8 @@ fn tutorial_loop(rfm: &Path, out: &Path, runs: &mut Vec<Run>) -> Result<String, 
 }
 
 /// The figures of `docs/`: (report, figure in it, name under `docs/images/`).
-const FIGURES: [(&str, &str, &str); 8] = [
+/// `update` is the walkthrough's update from its hand-written guess.
+const FIGURES: [(&str, &str, &str); 10] = [
     ("compare", "frf-23uy-23uy.svg", "tutorial-before-23uy.svg"),
     ("compare", "error-vs-frequency.svg", "tutorial-error-before.svg"),
     ("compare", "frf-channels.svg", "tutorial-channels.svg"),
@@ -256,16 +259,40 @@ const FIGURES: [(&str, &str, &str); 8] = [
     ("compare", "mode-shapes.svg", "tutorial-mode-shapes.svg"),
     ("fix", "misfit-steps.svg", "tutorial-fix-misfit.svg"),
     ("fix", "structure.svg", "tutorial-fix-structure.svg"),
+    ("update", "convergence.svg", "tutorial-convergence.svg"),
+    ("update", "frf-23uy-23uy.svg", "tutorial-after-23uy.svg"),
 ];
 
-/// Writes the tutorial's compare and fix reports and copies [`FIGURES`]
-/// into `docs/images/`, so that every figure the documentation shows is
-/// what the tool draws today.
+/// The walkthrough's guess (`docs/walkthrough.md`, section 3): the tutorial
+/// case with the lines of the walkthrough's first `toml` block added, its
+/// measured data named by absolute path so that the case can live elsewhere.
+fn walkthrough_guess() -> Result<String, String> {
+    let read = |p: &Path| std::fs::read_to_string(p).map_err(|e| format!("{}: {e}", p.display()));
+    let doc = read(&root().join("docs/walkthrough.md"))?;
+    let start = doc.find("```toml\n").ok_or("docs/walkthrough.md has no toml block")? + "```toml\n".len();
+    let len = doc[start..].find("```").ok_or("docs/walkthrough.md: an unclosed toml block")?;
+    let tutorial = root().join("cases/tutorial");
+    let case = read(&tutorial.join("l-frame.toml"))?;
+    let data = tutorial.join("l-frame-measured.csv");
+    let case = case.replace("data = \"l-frame-measured.csv\"", &format!("data = {:?}", data.display().to_string()));
+    Ok(format!("{case}\n{}", &doc[start..start + len]))
+}
+
+/// Writes the tutorial's compare and fix reports and the walkthrough's
+/// update report, and copies [`FIGURES`] into `docs/images/`, so that every
+/// figure the documentation shows is what the tool draws today.
 fn figures() -> Result<(), String> {
-    let rfm = build_cli()?;
+    // a binary already built (`RFM_BIN=target/debug/rfm`) spares the release build
+    let rfm = match std::env::var_os("RFM_BIN") {
+        Some(bin) => PathBuf::from(bin),
+        None => build_cli()?,
+    };
     let case = root().join("cases/tutorial/l-frame.toml");
     let base = root().join("target/figures");
-    for command in ["compare", "fix"] {
+    std::fs::create_dir_all(&base).map_err(|e| format!("{}: {e}", base.display()))?;
+    let guess = base.join("l-frame-guess.toml");
+    std::fs::write(&guess, walkthrough_guess()?).map_err(|e| format!("{}: {e}", guess.display()))?;
+    for (command, case) in [("compare", &case), ("fix", &case), ("update", &guess)] {
         println!("rfm {command} {} --out {}", case.display(), base.join(command).display());
         let out = Command::new(&rfm)
             .args([OsStr::new(command), case.as_os_str(), OsStr::new("--out"), base.join(command).as_os_str()])
