@@ -485,3 +485,47 @@ fn bench(args: &[String]) -> Result<(), String> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every image the README and `docs/` show is one `cargo xtask figures`
+    /// draws, and is there: a figure nobody can redraw would drift from
+    /// what the tool draws.
+    #[test]
+    fn every_image_the_documentation_shows_is_drawn_by_figures() {
+        let mut pages = vec![root().join("README.md")];
+        for e in std::fs::read_dir(root().join("docs")).unwrap() {
+            let p = e.unwrap().path();
+            if p.extension().is_some_and(|x| x == "md") {
+                pages.push(p);
+            }
+        }
+        let drawn: Vec<&str> = FIGURES.iter().map(|f| f.2).collect();
+        let mut shown = 0;
+        for page in &pages {
+            let text = std::fs::read_to_string(page).unwrap();
+            for (i, _) in text.match_indices("images/") {
+                let rest = &text[i + "images/".len()..];
+                let name = &rest[..rest.find([')', '"', ' ', '\n']).unwrap_or(rest.len())];
+                assert!(
+                    drawn.contains(&name),
+                    "{} shows images/{name}, which cargo xtask figures does not draw",
+                    page.display()
+                );
+                assert!(root().join("docs/images").join(name).is_file(), "docs/images/{name} is missing");
+                shown += 1;
+            }
+        }
+        assert!(shown >= FIGURES.len(), "only {shown} images shown");
+    }
+
+    #[test]
+    fn the_walkthrough_guess_adds_the_joint_and_names_the_data_by_absolute_path() {
+        let guess = walkthrough_guess().unwrap();
+        assert!(guess.contains("[[joints]]") && guess.contains("[update]"), "{guess}");
+        let data = root().join("cases/tutorial/l-frame-measured.csv");
+        assert!(guess.contains(&format!("data = {:?}", data.display().to_string())), "{guess}");
+    }
+}

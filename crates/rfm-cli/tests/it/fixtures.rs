@@ -32,14 +32,18 @@ pub(crate) struct Written {
     pub(crate) output: Output,
 }
 
+/// [`write_case`] with a case file under `cases/`.
+fn write(name: &str, command: &str, case_name: &str, extra: &[&str]) -> Written {
+    write_case(name, command, &case(case_name), extra)
+}
+
 /// Runs `rfm <command> <case> --out DIR [extra...]` into a fresh folder
 /// named `name` and returns it.
-fn write(name: &str, command: &str, case_name: &str, extra: &[&str]) -> Written {
+fn write_case(name: &str, command: &str, case: &Path, extra: &[&str]) -> Written {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("reports").join(name);
     // an earlier run's report, if any, is replaced whole
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(dir.parent().expect("a parent")).expect("the reports folder");
-    let case = case(case_name);
     let mut args = vec![command, case.to_str().expect("a UTF-8 path"), "--out", dir.to_str().expect("a UTF-8 path")];
     args.extend_from_slice(extra);
     let output = rfm(&args);
@@ -56,6 +60,29 @@ pub(crate) fn tutorial_compare() -> &'static Written {
 pub(crate) fn tutorial_fix() -> &'static Written {
     static W: OnceLock<Written> = OnceLock::new();
     W.get_or_init(|| write("tutorial-fix", "fix", "tutorial/l-frame", &[]))
+}
+
+/// `rfm update` of the walkthrough's guess (`docs/walkthrough.md`, section
+/// 3): the tutorial case with the lines of the walkthrough's first `toml`
+/// block added, as `cargo xtask figures` builds it.
+pub(crate) fn tutorial_update() -> &'static Written {
+    static W: OnceLock<Written> = OnceLock::new();
+    W.get_or_init(|| {
+        let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let doc = std::fs::read_to_string(root.join("docs/walkthrough.md")).expect("the walkthrough");
+        let start = doc.find("```toml\n").expect("a toml block") + "```toml\n".len();
+        let block = &doc[start..start + doc[start..].find("```").expect("a closed toml block")];
+        let tutorial = root.join("cases/tutorial");
+        let data = tutorial.join("l-frame-measured.csv").canonicalize().expect("the tutorial data");
+        let case = std::fs::read_to_string(tutorial.join("l-frame.toml"))
+            .expect("the tutorial case")
+            .replace("data = \"l-frame-measured.csv\"", &format!("data = {:?}", data.display().to_string()));
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("reports");
+        std::fs::create_dir_all(&dir).expect("the reports folder");
+        let guess = dir.join("l-frame-guess.toml");
+        std::fs::write(&guess, format!("{case}\n{block}")).expect("the guess");
+        write_case("tutorial-update", "update", &guess, &[])
+    })
 }
 
 /// `rfm update` of the flexible-clamp cantilever (it stalls short of the

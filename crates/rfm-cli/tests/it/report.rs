@@ -10,7 +10,7 @@ use damping::DampedSystem;
 use frf::correlation::{BandSpec, correlate};
 use rfm_update::Study;
 
-use super::fixtures::{case, clamp_update, rfm, svg_files, text, tutorial_compare, tutorial_fix};
+use super::fixtures::{case, clamp_update, rfm, svg_files, text, tutorial_compare, tutorial_fix, tutorial_update};
 
 fn read(path: &Path) -> String {
     std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
@@ -476,6 +476,38 @@ fn the_tutorial_fix_report_marks_the_added_joint_where_it_sits() {
     assert_eq!(html.matches("<svg").count(), svg_files(d).len());
     for heading in ["The fall of the misfit", "Modes", "FRF overlays"] {
         assert!(html.contains(&format!("<h2>{heading}</h2>")), "report.html lacks the section {heading}");
+    }
+}
+
+/// The walkthrough's update: every channel before and after, its 200
+/// updating lines as ticks on the axes (no marks on the curves) and folded
+/// in the summary.
+#[test]
+fn the_tutorial_update_report_shows_every_channel_and_ticks_its_updating_lines() {
+    let w = tutorial_update();
+    assert!(w.output.status.success(), "{}", text(&w.output.stderr));
+    let d = w.dir.as_path();
+    let json: serde_json::Value = serde_json::from_str(&read(&d.join("results.json"))).unwrap();
+    let lines = json["frequencies_hz"].as_array().map_or(0, Vec::len);
+    assert!(lines > 12, "{lines} updating lines");
+    let all = check_svg(
+        &d.join("frf-channels.svg"),
+        &["initial model", "updated model", "updating lines (ticks on the axis)"],
+    );
+    assert_eq!(panel_titles(&all).len(), 8);
+    assert!(!all.contains("<circle"), "updating lines are ticks, not marks on the curves");
+    // a tick per updating line in each magnitude panel: short vertical black paths
+    let ticks = all
+        .lines()
+        .filter(|l| l.starts_with("<polyline") && l.contains("stroke=\"#000000\" stroke-width=\"1\""))
+        .count();
+    assert!(ticks >= 8 * lines, "{ticks} ticks for {lines} lines in 8 panels");
+    let html = read(&d.join("report.html"));
+    check_self_contained(&html);
+    assert!(html.contains(&format!("{lines} lines from")), "the summary names how many lines");
+    assert!(html.contains(&format!("<summary>The {lines} updating lines (Hz)</summary>")), "the lines are folded");
+    for name in ["structure.svg", "mac-matrix.svg", "stabilisation.svg", "mode-shapes.svg", "parameters.svg"] {
+        assert!(d.join(name).is_file(), "no {name}");
     }
 }
 
