@@ -36,6 +36,34 @@ fn highlight(e: &Ranked) -> Highlight {
     Highlight { label: e.description.clone(), kind, nodes: e.nodes.clone(), elements: e.elements.clone() }
 }
 
+/// An effect in a few words for an axis label, numbered elsewhere as on
+/// the structure: what it is and where (`joint at node 13`, `stiffness of
+/// elements 4-7`).
+fn short_effect(e: &Ranked) -> String {
+    let what = match e.kind {
+        EffectKind::FlexibleSupport => "support",
+        EffectKind::FlexibleJoint => "joint",
+        EffectKind::LumpedMass => "mass",
+        EffectKind::StiffnessChange => "stiffness",
+        EffectKind::MassChange => "mass change",
+        EffectKind::ViscousDamping | EffectKind::NonViscousDamping => "damping",
+    };
+    let span = |ids: &[u32], one: &str, many: &str| match (ids.iter().min(), ids.iter().max()) {
+        (Some(a), Some(b)) if a == b => format!("{one} {a}"),
+        (Some(a), Some(b)) => format!("{many} {a}-{b}"),
+        _ => String::new(),
+    };
+    let place = match e.kind {
+        EffectKind::FlexibleSupport | EffectKind::FlexibleJoint | EffectKind::LumpedMass if !e.nodes.is_empty() => {
+            format!("at {}", span(&e.nodes, "node", "nodes"))
+        }
+        _ if !e.elements.is_empty() => format!("of {}", span(&e.elements, "element", "elements")),
+        _ if !e.nodes.is_empty() => format!("at {}", span(&e.nodes, "node", "nodes")),
+        _ => String::new(),
+    };
+    if place.is_empty() { what.to_string() } else { format!("{what} {place}") }
+}
+
 /// Writes the report files of the loop through `out` and returns where
 /// `report.html` will be.
 pub(crate) fn write(study: &Study, outcome: &FixOutcome, opts: &ReportOptions, out: &mut Outputs) -> Result<PathBuf> {
@@ -57,17 +85,22 @@ pub(crate) fn write(study: &Study, outcome: &FixOutcome, opts: &ReportOptions, o
 
     let stages = outcome.stages();
     let mut fall = Section::new("The fall of the misfit");
-    let short: Vec<String> = std::iter::once("nominal".to_string())
-        .chain((1..=outcome.steps.len()).flat_map(|k| [format!("+ effect {k}"), format!("updated {k}")]))
-        .collect();
+    let short: Vec<String> =
+        std::iter::once("nominal".to_string())
+            .chain(
+                outcome.steps.iter().enumerate().flat_map(|(k, s)| {
+                    [format!("+ {}: {}", k + 1, short_effect(&s.effect)), format!("updated {}", k + 1)]
+                }),
+            )
+            .collect();
     let misfits: Vec<f64> = stages.iter().map(|(_, m)| *m).collect();
     fall.push(out.figure(
         "misfit-steps",
         plot::misfit_steps(&short, &misfits, outcome.noise, CONSISTENT)?,
         format!(
             "The misfit (RMS of ln(model / measured) per complex value, over {} lines spread across the band) of \
-             the nominal model, after adding each effect at its diagnosed values, and after updating every added \
-             parameter together. The green band runs from the noise level estimated from the data to {CONSISTENT} \
+             the nominal model, after adding each effect at its diagnosed values (numbered as on the structure \
+             below), and after updating every added parameter together. The green band runs from the noise level estimated from the data to {CONSISTENT} \
              times it: a misfit inside it is consistent with the noise.",
             rfm_update::diagnose::DiagnoseOptions::default().lines
         ),

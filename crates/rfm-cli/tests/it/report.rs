@@ -458,7 +458,8 @@ fn the_tutorial_fix_report_marks_the_added_joint_where_it_sits() {
     assert_eq!(first["kind"], "flexible_joint", "{first}");
     let description = first["description"].as_str().unwrap();
 
-    check_svg(&d.join("misfit-steps.svg"), &["nominal", "updated 1"]);
+    // each step named on the axis, numbered as on the structure
+    check_svg(&d.join("misfit-steps.svg"), &["nominal", "+ 1: joint at node 13", "updated 1"]);
     let structure = check_figure(&d.join("structure.svg"), &["The structure and what was added"]);
     assert!(structure.contains(&format!("1: {description}")), "the legend names the joint: {description}");
     // a ring in the first step's colour, and its badge
