@@ -12,6 +12,11 @@
 //!   standard deviations over the parameters the data determine, and whether
 //!   the run met its case's `[check]`. Every missed check is printed, and the
 //!   task exits non-zero when any was missed.
+//! - `figures`: builds the `rfm` binary (release), writes the tutorial's
+//!   compare and fix reports and the walkthrough's update report into
+//!   `<target>/figures/`, and copies the figures the documentation shows into
+//!   `docs/images/` (see `figures.rs`); `RFM_BIN=PATH` uses that `rfm`
+//!   binary instead of building one.
 //! - `bench [--full]`: builds the `bench_point` example of rfm-update
 //!   (release) and runs quick versions of the sensitivity benchmarks, each
 //!   configuration in its own process so that its peak memory is its own;
@@ -32,6 +37,7 @@
 
 mod bench;
 mod check;
+mod figures;
 mod heldout;
 mod mutants;
 mod reproduce;
@@ -54,8 +60,9 @@ fn main() -> ExitCode {
         Some("bench") => bench::bench(&args[1..]),
         Some("mutants") => mutants::mutants(&args[1..]),
         Some("heldout") => heldout::heldout(&args[1..]),
+        Some("figures") => figures::figures(),
         _ => Err(
-            "usage: cargo xtask reproduce [CASE... | tutorial] | cargo xtask bench [--full] | cargo xtask heldout | \
+            "usage: cargo xtask reproduce [CASE... | tutorial] | cargo xtask bench [--full] | cargo xtask heldout | cargo xtask figures | \
                   cargo xtask mutants [--list | cargo-mutants options]"
                 .to_string(),
         ),

@@ -75,6 +75,7 @@
 //! }
 //! ```
 
+pub mod comparison;
 pub mod correlation;
 pub mod error;
 pub mod io;
@@ -86,6 +87,7 @@ pub mod set;
 pub mod solver;
 pub mod synth;
 
+pub use comparison::{ComparisonError, ModalComparison, compare_modes};
 pub use correlation::{BandSpec, Correlation, correlate};
 pub use error::FrfError;
 pub use lscf::{EstimatedMode, LscfError, LscfOptions, ModalEstimate, PoleStatus, lscf};

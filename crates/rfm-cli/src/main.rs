@@ -69,6 +69,9 @@ enum Command {
         /// Frequency bands: auto, resonances, octave, third-octave, or edges in Hz such as 0,50,120,400.
         #[arg(long, default_value = "auto")]
         bands: String,
+        /// Frequency axis of the report's figures: auto (logarithmic for bands of a decade or more), log or linear.
+        #[arg(long, value_enum, default_value = "auto")]
+        frequency_axis: report::plot::axes::FrequencyScale,
     },
     /// Find which physical effect is missing: fit every candidate effect and rank them.
     Diagnose {
@@ -107,6 +110,9 @@ enum Command {
         /// Print machine-readable JSON instead of tables.
         #[arg(long)]
         json: bool,
+        /// Frequency axis of the report's figures: auto (logarithmic for bands of a decade or more), log or linear.
+        #[arg(long, value_enum, default_value = "auto")]
+        frequency_axis: report::plot::axes::FrequencyScale,
     },
     /// List what a measurement file holds (UFF dataset 58 or CSV): channels,
     /// function types, units, frequency lines, data types; skipped datasets.
@@ -136,6 +142,9 @@ enum Command {
         /// Iteration limit (overrides the case).
         #[arg(long)]
         iterations: Option<usize>,
+        /// Frequency axis of the report's figures: auto (logarithmic for bands of a decade or more), log or linear.
+        #[arg(long, value_enum, default_value = "auto")]
+        frequency_axis: report::plot::axes::FrequencyScale,
     },
 }
 
@@ -233,9 +242,14 @@ fn main() -> ExitCode {
 fn run(cli: Cli) -> commands::Result<Exit> {
     match cli.command {
         Command::Simulate { case, out, truth, noise, seed } => commands::simulate(&case, &out, truth, noise, seed),
-        Command::Compare { case, measured, out, json, bands } => {
-            commands::compare(&case, &measured, out.as_deref(), json, &bands)
-        }
+        Command::Compare { case, measured, out, json, bands, frequency_axis } => commands::compare(
+            &case,
+            &measured,
+            out.as_deref(),
+            json,
+            &bands,
+            &report::ReportOptions { frequency_scale: frequency_axis },
+        ),
         Command::Diagnose { case, measured, json, apply, out, top, verbose } => {
             commands::diagnose(&commands::DiagnoseArgs {
                 case: &case,
@@ -247,15 +261,20 @@ fn run(cli: Cli) -> commands::Result<Exit> {
                 verbose,
             })
         }
-        Command::Fix { case, out, steps, json } => {
-            commands::fix(&commands::FixArgs { case: &case, out: &out, steps: steps as usize, json })
-        }
+        Command::Fix { case, out, steps, json, frequency_axis } => commands::fix(&commands::FixArgs {
+            case: &case,
+            out: &out,
+            steps: steps as usize,
+            json,
+            report: report::ReportOptions { frequency_scale: frequency_axis },
+        }),
         Command::Inspect { file, json } => commands::inspect(&file, json),
-        Command::Update { case, out, json, method, lines, iterations } => commands::update(
+        Command::Update { case, out, json, method, lines, iterations, frequency_axis } => commands::update(
             &case,
             out.as_deref(),
             json,
             &commands::UpdateOverrides { method, lines, max_iterations: iterations },
+            &report::ReportOptions { frequency_scale: frequency_axis },
         ),
     }
 }

@@ -19,13 +19,11 @@ use serde::Serialize;
 use super::{Result, load_case, print_masked, print_notes};
 use crate::exit::Exit;
 use crate::output::Outputs;
-use crate::report::html::{self, Block, Report, Section, Tone};
+use crate::report::html::{Block, Report, Section};
 use crate::report::json::CorrelationJson;
-use crate::report::{self, ModelFrfs, plot, sig, signed};
+use crate::report::modes::{ModesJson, compare_modes, mode_table_rows, rows};
+use crate::report::{self, ModelFrfs, ReportOptions, plot, sig, signed};
 use crate::table::Table;
-
-/// Number of overlay figures.
-const OVERLAYS: usize = 4;
 
 /// What `--json` prints and `compare.json` holds.
 #[derive(Serialize)]
@@ -45,142 +43,6 @@ struct CompareJson {
     masked: Vec<String>,
     /// What reading the measured data changed or passed over.
     notes: Vec<String>,
-}
-
-/// One measured mode and its model partner.
-#[derive(Serialize)]
-struct ModeRow {
-    measured_hz: Option<f64>,
-    measured_damping_ratio: Option<f64>,
-    model_hz: Option<f64>,
-    model_damping_ratio: Option<f64>,
-    frequency_error_pct: Option<f64>,
-    damping_error_pct: Option<f64>,
-    mac: Option<f64>,
-    reading: String,
-}
-
-/// The mode table.
-#[derive(Serialize)]
-struct ModesJson {
-    /// Band of the modal estimation (Hz).
-    band_hz: (f64, f64),
-    rows: Vec<ModeRow>,
-}
-
-/// Estimates the measured modes (LSCF over the measured band) and pairs
-/// them with the model's complex modes by MAC; reads each pair.
-fn compare_modes(system: &DampedSystem, measured: &FrfSet) -> std::result::Result<ModesJson, String> {
-    let rec = measured.to_receptance();
-    let f = rec.frequencies_hz();
-    let band = (f[0], f[f.len() - 1]);
-    let est = frf::lscf(&rec, &frf::LscfOptions::new(band.0, band.1)).map_err(|e| format!("modal estimation: {e}"))?;
-    let meas = frf::measured_modes(&est);
-    let model = frf::model_modes(system, &est.responses, band.1).map_err(|e| format!("model modes: {e}"))?;
-    let pairing = frf::pair_modes(&model, &meas, 0.5);
-    let mut rows = Vec::new();
-    for (i, m) in meas.iter().enumerate() {
-        let row = match pairing.pairs.iter().find(|p| p.measured == i) {
-            Some(p) => {
-                let x = &model[p.model];
-                ModeRow {
-                    measured_hz: Some(m.frequency_hz),
-                    measured_damping_ratio: Some(m.damping_ratio),
-                    model_hz: Some(x.frequency_hz),
-                    model_damping_ratio: Some(x.damping_ratio),
-                    frequency_error_pct: Some(p.frequency_error_pct),
-                    damping_error_pct: Some(p.damping_error_pct),
-                    mac: Some(p.mac),
-                    reading: frf::symptom(x, m, p.mac).reading().to_string(),
-                }
-            }
-            None => ModeRow {
-                measured_hz: Some(m.frequency_hz),
-                measured_damping_ratio: Some(m.damping_ratio),
-                model_hz: None,
-                model_damping_ratio: None,
-                frequency_error_pct: None,
-                damping_error_pct: None,
-                mac: None,
-                reading: "no model mode with a similar shape (MAC < 0.5)".into(),
-            },
-        };
-        rows.push(row);
-    }
-    for &j in &pairing.unpaired_model {
-        let x = &model[j];
-        rows.push(ModeRow {
-            measured_hz: None,
-            measured_damping_ratio: None,
-            model_hz: Some(x.frequency_hz),
-            model_damping_ratio: Some(x.damping_ratio),
-            frequency_error_pct: None,
-            damping_error_pct: None,
-            mac: None,
-            reading: "not seen in the measurement (not excited, not observed, or not in the structure)".into(),
-        });
-    }
-    rows.sort_by(|a, b| {
-        let fa = a.measured_hz.or(a.model_hz).unwrap_or(0.0);
-        let fb = b.measured_hz.or(b.model_hz).unwrap_or(0.0);
-        fa.total_cmp(&fb)
-    });
-    Ok(ModesJson { band_hz: band, rows })
-}
-
-fn opt(v: Option<f64>, f: impl Fn(f64) -> String) -> String {
-    v.map(f).unwrap_or_else(|| "-".into())
-}
-
-fn mode_table_rows(m: &ModesJson) -> (Vec<&'static str>, Vec<Vec<String>>) {
-    let header = vec!["mode", "measured Hz", "model Hz", "error %", "zeta meas. %", "zeta model %", "MAC", "reading"];
-    let rows = m
-        .rows
-        .iter()
-        .enumerate()
-        .map(|(i, r)| {
-            vec![
-                format!("{}", i + 1),
-                opt(r.measured_hz, |f| format!("{f:.2}")),
-                opt(r.model_hz, |f| format!("{f:.2}")),
-                opt(r.frequency_error_pct, |e| format!("{e:+.2}")),
-                opt(r.measured_damping_ratio, |z| format!("{:.3}", 100.0 * z)),
-                opt(r.model_damping_ratio, |z| format!("{:.3}", 100.0 * z)),
-                opt(r.mac, |m| format!("{m:.3}")),
-                r.reading.clone(),
-            ]
-        })
-        .collect();
-    (header, rows)
-}
-
-fn modes_section(m: &std::result::Result<ModesJson, String>) -> Section {
-    let mut s = Section::new("Modes");
-    match m {
-        Err(e) => {
-            s.push(Block::Text(format!("The modes could not be compared: {e}.")));
-        }
-        Ok(m) => {
-            s.push(Block::Text(format!(
-                "Measured modes estimated from the FRFs (least-squares complex frequency method, stable poles over model orders, {} to {} Hz), paired with the model's complex modes by MAC at the measured responses. A resonance moved by more than its peak is wide points at stiffness or mass; a peak of the right frequency but the wrong height and width points at damping.",
-                report::short(m.band_hz.0),
-                report::short(m.band_hz.1)
-            )));
-            let (header, rows) = mode_table_rows(m);
-            let mut t = html::Table::new(&header);
-            for r in rows {
-                let bad = !r[7].starts_with("matches");
-                let cells = r
-                    .into_iter()
-                    .enumerate()
-                    .map(|(i, c)| (c, if bad && i == 7 { Tone::Bad } else { Tone::Plain }))
-                    .collect();
-                t.rows.push(cells);
-            }
-            s.push(Block::Table(t));
-        }
-    }
-    s
 }
 
 /// Parses `--bands`: `auto`, `resonances`, `octave`, `third-octave`, or
@@ -298,6 +160,7 @@ pub(crate) fn compare(
     out: Option<&Path>,
     json: bool,
     bands: &str,
+    opts: &ReportOptions,
 ) -> Result<Exit> {
     let spec = parse_bands(bands)?;
     let case = load_case(case_path)?;
@@ -310,7 +173,8 @@ pub(crate) fn compare(
     print_masked(&masked, json)?;
     let frfs = synthesize(&system, measured.channels(), measured.frequencies_hz())?;
     let correlation = correlate(&measured, &frfs, &spec)?;
-    let modes = compare_modes(&system, &measured);
+    let comparison = compare_modes(&system, &measured);
+    let modes = comparison.as_ref().map(rows).map_err(Clone::clone);
     let doc = CompareJson {
         case: case_path.display().to_string(),
         title: case.model.title.clone(),
@@ -343,7 +207,7 @@ pub(crate) fn compare(
         let model = ModelFrfs { label: "model".into(), colour: plot::UPDATED, frfs, correlation };
         let mut report = Report::new(format!("{}: model against measurement", case.model.title));
         report.subtitle = Some(format!("rfm compare, case file {}", case_path.display()));
-        report.sections = report_sections(&case, &measured, &source, &model, &doc.modes, &mut output)?;
+        report.sections = report_sections(&case, &measured, &source, &model, comparison.as_ref(), opts, &mut output)?;
         let html = output.write("report.html", report.render().as_bytes())?;
         let written = output.commit()?;
         if !json {
@@ -353,24 +217,24 @@ pub(crate) fn compare(
     Ok(Exit::Success)
 }
 
-/// The report's sections, in order. A modal comparison goes in before the
-/// definitions.
+/// The report's sections, in order.
 fn report_sections(
     case: &CaseFile,
     measured: &FrfSet,
     source: &str,
     model: &ModelFrfs,
-    modes: &std::result::Result<ModesJson, String>,
+    modes: std::result::Result<&frf::ModalComparison, &String>,
+    opts: &ReportOptions,
     out: &mut Outputs,
 ) -> Result<Vec<Section>> {
     let c = &model.correlation;
-    let mut sections = vec![summary(case, measured, source, c)];
+    let mut first = summary(case, measured, source, c);
+    first.push(report::structure_figure(&case.model, measured, &[], "The case's model.", out)?);
+    let mut sections = vec![first];
     let notes = vec!["The case's model with its initial parameter values against the measured FRFs.".to_string()];
-    sections.push(report::correlation_section(measured, std::slice::from_ref(model), out, notes)?);
-    let worst = report::notable_channels(c, 2);
-    let picks = report::representative_channels(measured, &worst, OVERLAYS);
-    sections.push(modes_section(modes));
-    sections.push(report::overlay_section(measured, std::slice::from_ref(model), &picks, &worst, &[], out)?);
+    sections.push(report::correlation_section(measured, std::slice::from_ref(model), opts, out, notes)?);
+    sections.push(report::modes::section(modes, "the model", &case.model, measured, opts, out)?);
+    sections.push(report::overlay_section(measured, std::slice::from_ref(model), &[], opts, out)?);
     sections.push(report::definitions_section());
     Ok(sections)
 }

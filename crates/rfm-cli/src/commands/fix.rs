@@ -24,6 +24,7 @@ pub(crate) struct FixArgs<'a> {
     pub(crate) out: &'a Path,
     pub(crate) steps: usize,
     pub(crate) json: bool,
+    pub(crate) report: crate::report::ReportOptions,
 }
 
 /// The name of the case file written after step `k` (1-based).
@@ -103,7 +104,7 @@ pub(crate) fn fix(args: &FixArgs<'_>) -> Result<Exit> {
         output.write(&name, text.as_bytes())?;
     }
     output.write("results.json", serde_json::to_string_pretty(&outcome)?.as_bytes())?;
-    crate::report::fix_report::write(&study, &outcome, &mut output)?;
+    crate::report::fix_report::write(&study, &outcome, &args.report, &mut output)?;
     let written = output.commit()?;
     if !json {
         outln!("\nwrote {} files into {}", written.len(), args.out.display());

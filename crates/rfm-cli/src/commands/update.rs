@@ -26,7 +26,13 @@ pub(crate) struct Overrides {
     pub(crate) max_iterations: Option<usize>,
 }
 
-pub(crate) fn update(case: &Path, out: Option<&Path>, json: bool, over: &Overrides) -> Result<Exit> {
+pub(crate) fn update(
+    case: &Path,
+    out: Option<&Path>,
+    json: bool,
+    over: &Overrides,
+    report: &crate::report::ReportOptions,
+) -> Result<Exit> {
     let mut study = Study::load(case)?;
     let mut output = out
         .map(|dir| Outputs::folder(dir, &study.case.inputs(), &["results.json", "updated.toml", "report.html"]))
@@ -122,7 +128,7 @@ pub(crate) fn update(case: &Path, out: Option<&Path>, json: bool, over: &Overrid
     if let Some(mut output) = output.take() {
         let path = output.write("results.json", serde_json::to_string_pretty(&outcome)?.as_bytes())?;
         let updated = write_updated_model(&study, &outcome, &step, &mut output)?;
-        let report = crate::report::update_report::write(&study, &outcome, &mut output, case)?;
+        let report = crate::report::update_report::write(&study, &outcome, &mut output, case, report)?;
         output.commit()?;
         if !json {
             outln!("\nwrote {} and {}", path.display(), updated.display());

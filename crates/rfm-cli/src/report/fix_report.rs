@@ -1,27 +1,80 @@
 //! The report of the loop (`rfm fix --out DIR`): its headline is the misfit
-//! after each step against the noise; then each step's effect and updated
-//! parameters, what still stands out, and the nominal and final models
-//! against the measured FRFs.
+//! after each step against the noise, beside the structure with each added
+//! effect marked where it sits; then each step's effect and updated
+//! parameters, what still stands out, the nominal and final models against
+//! the measured FRFs, and the final model's modes against the measured ones.
 
 use std::path::PathBuf;
 
 use frf::correlation::{BandSpec, correlate};
 use frf::synthesize;
 use rfm_update::Study;
+use rfm_update::diagnose::{EffectKind, Ranked};
 use rfm_update::fix::FixOutcome;
 
 use super::html::{Block, Report, Section, Table, Tone};
-use super::{ModelFrfs, Result, plot, sig};
+use super::plot::structure::{Highlight, HighlightKind};
+use super::{ModelFrfs, ReportOptions, Result, plot, sig};
 use crate::commands::fix::{CONSISTENT, step_file};
 use crate::output::Outputs;
 use crate::table::{num, percent};
 
-/// Overlay figures of the worst channels.
-const OVERLAYS: usize = 4;
+/// How an effect is marked on the structure: at its nodes for a joint, a
+/// support or a mass, along its elements for a change over a region.
+fn highlight(e: &Ranked) -> Highlight {
+    let kind = match e.kind {
+        EffectKind::FlexibleSupport => HighlightKind::Support,
+        EffectKind::FlexibleJoint => HighlightKind::Joint,
+        EffectKind::LumpedMass => HighlightKind::Mass,
+        EffectKind::StiffnessChange
+        | EffectKind::MassChange
+        | EffectKind::ViscousDamping
+        | EffectKind::NonViscousDamping => HighlightKind::Patch,
+    };
+    // a region change without elements can only be pointed at by its nodes
+    let kind = if kind == HighlightKind::Patch && e.elements.is_empty() { HighlightKind::Joint } else { kind };
+    Highlight { label: e.description.clone(), kind, nodes: e.nodes.clone(), elements: e.elements.clone() }
+}
+
+/// An effect in a few words for an axis label, numbered elsewhere as on
+/// the structure: what it is and where (`joint at node 13`, `stiffness of
+/// elements 4-7`).
+fn short_effect(e: &Ranked) -> String {
+    let what = match e.kind {
+        EffectKind::FlexibleSupport => "support",
+        EffectKind::FlexibleJoint => "joint",
+        EffectKind::LumpedMass => "mass",
+        EffectKind::StiffnessChange => "stiffness",
+        EffectKind::MassChange => "mass change",
+        EffectKind::ViscousDamping | EffectKind::NonViscousDamping => "damping",
+    };
+    let span = |ids: &[u32], one: &str, many: &str| match (ids.iter().min(), ids.iter().max()) {
+        (Some(a), Some(b)) if a == b => format!("{one} {a}"),
+        (Some(a), Some(b)) => format!("{many} {a}-{b}"),
+        _ => String::new(),
+    };
+    let place = match e.kind {
+        EffectKind::FlexibleSupport | EffectKind::FlexibleJoint | EffectKind::LumpedMass if !e.nodes.is_empty() => {
+            format!("at {}", span(&e.nodes, "node", "nodes"))
+        }
+        _ if !e.elements.is_empty() => format!("of {}", span(&e.elements, "element", "elements")),
+        _ if !e.nodes.is_empty() => format!("at {}", span(&e.nodes, "node", "nodes")),
+        _ => String::new(),
+    };
+    if place.is_empty() { what.to_string() } else { format!("{what} {place}") }
+}
 
 /// Writes the report files of the loop through `out` and returns where
 /// `report.html` will be.
-pub(crate) fn write(study: &Study, outcome: &FixOutcome, out: &mut Outputs) -> Result<PathBuf> {
+pub(crate) fn write(study: &Study, outcome: &FixOutcome, opts: &ReportOptions, out: &mut Outputs) -> Result<PathBuf> {
+    // the model after the last step, with every effect added
+    let fixed = match outcome.steps.last() {
+        Some(s) => {
+            let text = s.case.text_at(&study.case.path)?;
+            Some(damping::DampedSystem::new(fe_model::CaseFile::parse(&study.case.path, &text)?.model)?)
+        }
+        None => None,
+    };
     let mut report = Report::new(format!("{}: closing the loop", study.case.model.title));
     report.subtitle = Some(format!(
         "rfm fix, case file {}: {} effect(s) added; {}",
@@ -32,20 +85,39 @@ pub(crate) fn write(study: &Study, outcome: &FixOutcome, out: &mut Outputs) -> R
 
     let stages = outcome.stages();
     let mut fall = Section::new("The fall of the misfit");
-    let short: Vec<String> = std::iter::once("nominal".to_string())
-        .chain((1..=outcome.steps.len()).flat_map(|k| [format!("+ effect {k}"), format!("updated {k}")]))
-        .collect();
+    let short: Vec<String> =
+        std::iter::once("nominal".to_string())
+            .chain(
+                outcome.steps.iter().enumerate().flat_map(|(k, s)| {
+                    [format!("+ {}: {}", k + 1, short_effect(&s.effect)), format!("updated {}", k + 1)]
+                }),
+            )
+            .collect();
     let misfits: Vec<f64> = stages.iter().map(|(_, m)| *m).collect();
     fall.push(out.figure(
         "misfit-steps",
         plot::misfit_steps(&short, &misfits, outcome.noise, CONSISTENT)?,
         format!(
             "The misfit (RMS of ln(model / measured) per complex value, over {} lines spread across the band) of \
-             the nominal model, after adding each effect at its diagnosed values, and after updating every added \
-             parameter together. The green band runs from the noise level estimated from the data to {CONSISTENT} \
+             the nominal model, after adding each effect at its diagnosed values (numbered as on the structure \
+             below), and after updating every added parameter together. The green band runs from the noise level estimated from the data to {CONSISTENT} \
              times it: a misfit inside it is consistent with the noise.",
             rfm_update::diagnose::DiagnoseOptions::default().lines
         ),
+    )?);
+    let highlights: Vec<Highlight> = outcome.steps.iter().map(|s| highlight(&s.effect)).collect();
+    let drawn = fixed.as_ref().map_or(&study.case.model, |f| f.model());
+    fall.push(super::structure_figure(
+        drawn,
+        &study.measured,
+        &highlights,
+        if highlights.is_empty() {
+            "Nothing was added: the nominal model."
+        } else {
+            "The model after the last step, each added effect numbered by its step and marked where it sits (a \
+             ring at a joint, a support or a mass, a broad band along the elements of a changed region)."
+        },
+        out,
     )?);
     let mut t = Table::new(&["step", "misfit", "(dB)", "x noise"]);
     for (label, m) in &stages {
@@ -160,17 +232,23 @@ pub(crate) fn write(study: &Study, outcome: &FixOutcome, out: &mut Outputs) -> R
         Ok(ModelFrfs { label: label.into(), colour, frfs, correlation })
     };
     let mut models = vec![model("nominal model", plot::INITIAL, &study.system)?];
-    if let Some(s) = outcome.steps.last() {
-        let text = s.case.text_at(&study.case.path)?;
-        let fixed = fe_model::CaseFile::parse(&study.case.path, &text)?;
-        models.push(model("fixed model", plot::UPDATED, &damping::DampedSystem::new(fixed.model)?)?);
+    if let Some(f) = &fixed {
+        models.push(model("fixed model", plot::UPDATED, f)?);
     }
     let notes = vec!["The nominal model and the model after the last step against the measured FRFs.".to_string()];
-    report.sections.push(super::correlation_section(measured, &models, out, notes)?);
-    let last_model = models.last().expect("the nominal model at least");
-    let worst = super::notable_channels(&last_model.correlation, 2);
-    let picks = super::representative_channels(measured, &worst, OVERLAYS);
-    report.sections.push(super::overlay_section(measured, &models, &picks, &worst, &[], out)?);
+    report.sections.push(super::correlation_section(measured, &models, opts, out, notes)?);
+    let last_system = fixed.as_ref().unwrap_or(&study.system);
+    let comparison = super::modes::compare_modes(last_system, measured);
+    let against = if fixed.is_some() { "the fixed model" } else { "the nominal model" };
+    report.sections.push(super::modes::section(
+        comparison.as_ref(),
+        against,
+        last_system.model(),
+        measured,
+        opts,
+        out,
+    )?);
+    report.sections.push(super::overlay_section(measured, &models, &[], opts, out)?);
     report.sections.push(super::definitions_section());
     Ok(out.write("report.html", report.render().as_bytes())?)
 }

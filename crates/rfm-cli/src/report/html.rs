@@ -47,6 +47,14 @@ pub(crate) enum Block {
     Table(Table),
     /// An SVG figure with a caption.
     Figure(Figure),
+    /// A paragraph folded away under a one-line summary (HTML `<details>`,
+    /// which opens without scripts).
+    Details {
+        /// What the fold holds, always shown.
+        summary: String,
+        /// The folded text.
+        text: String,
+    },
 }
 
 /// A table cell's emphasis.
@@ -61,6 +69,10 @@ pub(crate) enum Tone {
 }
 
 /// A table with a header; cells other than the first column are right-aligned numbers.
+///
+/// A long table shows its first [`Table::shown`] rows and folds the rest
+/// under a `<details>` element, so that a 100-row iteration history does
+/// not push the figures after it out of sight.
 pub(crate) struct Table {
     /// Caption above the table.
     pub(crate) caption: Option<String>,
@@ -68,12 +80,25 @@ pub(crate) struct Table {
     pub(crate) header: Vec<String>,
     /// Rows of (text, tone).
     pub(crate) rows: Vec<Vec<(String, Tone)>>,
+    /// Rows shown before the fold, when there are more than [`FOLD_ABOVE`].
+    pub(crate) shown: usize,
 }
+
+/// Tables with more rows than this are folded after their first rows.
+pub(crate) const FOLD_ABOVE: usize = 15;
+
+/// Rows a folded table shows by default.
+pub(crate) const SHOWN_ROWS: usize = 10;
 
 impl Table {
     /// A table with the given headings.
     pub(crate) fn new(header: &[&str]) -> Self {
-        Table { caption: None, header: header.iter().map(|s| s.to_string()).collect(), rows: Vec::new() }
+        Table {
+            caption: None,
+            header: header.iter().map(|s| s.to_string()).collect(),
+            rows: Vec::new(),
+            shown: SHOWN_ROWS,
+        }
     }
 
     /// Sets the caption.
@@ -119,7 +144,9 @@ pub(crate) fn escape(s: &str) -> String {
 
 /// Makes a plotters SVG scale with the page: the fixed `width`/`height` of
 /// its root element are replaced by a relative width (the `viewBox` keeps
-/// the aspect ratio), and an accessible name is added.
+/// the aspect ratio) that never exceeds the drawn width, so that its text is
+/// never blown up past the size it was drawn at; and an accessible name is
+/// added.
 fn responsive(svg: &str, label: &str) -> String {
     let Some(start) = svg.find("<svg") else {
         return svg.to_string();
@@ -127,6 +154,7 @@ fn responsive(svg: &str, label: &str) -> String {
     let end = start + svg[start..].find('>').unwrap_or(0);
     let open = &svg[start..end];
     let mut attrs = String::new();
+    let mut width = None;
     let mut rest = open.trim_start_matches("<svg");
     // keep every attribute but width and height
     while let Some(eq) = rest.find("=\"") {
@@ -134,13 +162,16 @@ fn responsive(svg: &str, label: &str) -> String {
         let after = &rest[eq + 2..];
         let Some(close) = after.find('"') else { break };
         let value = &after[..close];
-        if name != "width" && name != "height" {
-            attrs.push_str(&format!(" {name}=\"{value}\""));
+        match name {
+            "width" => width = value.parse::<u32>().ok(),
+            "height" => {}
+            _ => attrs.push_str(&format!(" {name}=\"{value}\"")),
         }
         rest = &after[close + 1..];
     }
+    let style = width.map_or(String::new(), |w| format!(" style=\"max-width: {w}px\""));
     format!(
-        "{}<svg{attrs} role=\"img\" aria-label=\"{}\" class=\"figure\">{}",
+        "{}<svg{attrs}{style} role=\"img\" aria-label=\"{}\" class=\"figure\">{}",
         &svg[..start],
         escape(label),
         &svg[end + 1..]
@@ -175,8 +206,11 @@ td.bad { background: var(--bad); color: var(--bad-ink); font-weight: 600; }
 td.good { background: var(--good); color: var(--good-ink); }
 .scroll { overflow-x: auto; }
 figure { margin: 14px 0 26px; }
-svg.figure { width: 100%; height: auto; display: block; border: 1px solid var(--rule); }
+svg.figure { width: 100%; height: auto; display: block; margin: 0 auto; border: 1px solid var(--rule); }
 figcaption { color: var(--muted); font-size: 14px; margin-top: 6px; }
+details { margin: 4px 0 18px; }
+summary { color: var(--accent); cursor: pointer; font-size: 14px; }
+details > p { font-size: 13.5px; color: var(--muted); }
 footer { margin-top: 48px; color: var(--muted); font-size: 13px; border-top: 1px solid var(--rule); padding-top: 8px; }
 @media print { main { max-width: none; padding: 0; } figure, table { break-inside: avoid; } nav { display: none; } }
 "#;
@@ -219,6 +253,11 @@ impl Report {
                         h.push_str("</dl>\n");
                     }
                     Block::Table(t) => render_table(&mut h, t),
+                    Block::Details { summary, text } => h.push_str(&format!(
+                        "<details><summary>{}</summary><p>{}</p></details>\n",
+                        escape(summary),
+                        escape(text)
+                    )),
                     Block::Figure(f) => {
                         figure_no += 1;
                         h.push_str("<figure>\n");
@@ -249,13 +288,28 @@ fn render_table(h: &mut String, t: &Table) {
     if let Some(c) = &t.caption {
         h.push_str(&format!("<p class=\"table-caption\">{}</p>\n", escape(c)));
     }
+    let fold = t.rows.len() > FOLD_ABOVE;
+    let (first, rest) = t.rows.split_at(if fold { t.shown.min(t.rows.len()) } else { t.rows.len() });
+    render_rows(h, &t.header, first);
+    if fold {
+        h.push_str(&format!(
+            "<details class=\"more-rows\"><summary>The other {} rows (of {})</summary>\n",
+            rest.len(),
+            t.rows.len()
+        ));
+        render_rows(h, &t.header, rest);
+        h.push_str("</details>\n");
+    }
+}
+
+fn render_rows(h: &mut String, header: &[String], rows: &[Vec<(String, Tone)>]) {
     h.push_str("<div class=\"scroll\"><table>\n");
     h.push_str("<thead><tr>");
-    for c in &t.header {
+    for c in header {
         h.push_str(&format!("<th>{}</th>", escape(c)));
     }
     h.push_str("</tr></thead>\n<tbody>\n");
-    for r in &t.rows {
+    for r in rows {
         h.push_str("<tr>");
         for (text, tone) in r {
             let class = match tone {
@@ -291,9 +345,38 @@ mod tests {
         assert!(html.contains("<h1>a &lt;b&gt; &amp; c</h1>"));
         assert!(html.contains("<td>&lt;1&gt;</td><td class=\"bad\">2</td>"));
         assert!(html.contains(
-            "<svg viewBox=\"0 0 960 400\" xmlns=\"http://www.w3.org/2000/svg\" role=\"img\" aria-label=\"cap &quot;q&quot;\" class=\"figure\">\n<rect/>"
+            "<svg viewBox=\"0 0 960 400\" xmlns=\"http://www.w3.org/2000/svg\" style=\"max-width: 960px\" role=\"img\" aria-label=\"cap &quot;q&quot;\" class=\"figure\">\n<rect/>"
         ));
         assert!(!html.contains("width=\"960\""));
         assert!(!html.contains("<script"));
+    }
+
+    #[test]
+    fn long_tables_fold_after_their_first_rows_and_short_ones_do_not() {
+        let mut long = Table::new(&["k"]);
+        for k in 0..=FOLD_ABOVE {
+            long.row(vec![format!("row {k}")]);
+        }
+        let mut short = Table::new(&["k"]);
+        for k in 0..FOLD_ABOVE {
+            short.row(vec![format!("row {k}")]);
+        }
+        let mut r = Report::new("t");
+        let mut s = Section::new("one");
+        s.push(Block::Table(long));
+        r.sections.push(s);
+        let html = r.render();
+        let fold = html.find("<details").expect("the long table folds");
+        assert_eq!(html[..fold].matches("<tr>").count(), 1 + SHOWN_ROWS, "the header and the first rows");
+        assert_eq!(html[fold..].matches("<td>").count(), FOLD_ABOVE + 1 - SHOWN_ROWS);
+        assert!(html.contains(&format!("The other {} rows (of {})", FOLD_ABOVE + 1 - SHOWN_ROWS, FOLD_ABOVE + 1)));
+        let mut r = Report::new("t");
+        let mut s = Section::new("one");
+        s.push(Block::Table(short));
+        s.push(Block::Details { summary: "200 lines".into(), text: "1, 2 & 3".into() });
+        r.sections.push(s);
+        let html = r.render();
+        assert_eq!(html.matches("<details").count(), 1, "only the text is folded");
+        assert!(html.contains("<details><summary>200 lines</summary><p>1, 2 &amp; 3</p></details>"));
     }
 }

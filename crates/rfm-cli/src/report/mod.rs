@@ -1,7 +1,9 @@
 //! Plots and reports: SVG figures ([`plot`]), the self-contained HTML
 //! report ([`html`]), the JSON form of an FRF correlation ([`json`]), the
-//! report sections shared by `rfm compare` and `rfm update` (this module),
-//! the update report ([`update_report`]) and the report of the loop
+//! report sections shared by `rfm compare`, `rfm update` and `rfm fix`
+//! (this module: the correlation, the overlays of every channel, the
+//! structure, the definitions), the modal comparison ([`modes`]), the
+//! update report ([`update_report`]) and the report of the loop
 //! ([`fix_report`]).
 //!
 //! Figures are drawn to strings and written through the run's
@@ -10,12 +12,17 @@
 pub(crate) mod fix_report;
 pub(crate) mod html;
 pub(crate) mod json;
+pub(crate) mod modes;
 pub(crate) mod plot;
 pub(crate) mod update_report;
 
+use fe_model::{DofRef, Model};
 use frf::correlation::Correlation;
 use frf::{Channel, FrfSet};
 use plotters::style::RGBColor;
+
+use plot::axes::FrequencyScale;
+use plot::structure::{Highlight, Sensors};
 
 use html::{Block, Figure, Section, Table, Tone};
 
@@ -29,6 +36,13 @@ impl Outputs {
         self.write(&format!("{name}.svg"), svg.as_bytes())?;
         Ok(Block::Figure(Figure { svg, caption: caption.into() }))
     }
+}
+
+/// How a report draws what the command line lets one choose.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct ReportOptions {
+    /// Scale of every frequency axis.
+    pub(crate) frequency_scale: FrequencyScale,
 }
 
 /// One model's FRFs on the measured lines and their correlation with the
@@ -50,46 +64,34 @@ pub(crate) fn channel_file_stem(c: Channel) -> String {
     format!("frf-{}-{}", clean(c.response.to_string()), clean(c.reference.to_string()))
 }
 
-/// Channels to show as overlays: the driving point(s) first (at most one
-/// per reference, at most `n / 2`), then the `priority` channels (e.g. the
-/// worst ones), then a spread over the rest, `n` at most in all.
-pub(crate) fn representative_channels(set: &FrfSet, priority: &[usize], n: usize) -> Vec<usize> {
-    let channels = set.channels();
-    let mut out: Vec<usize> = Vec::new();
-    let mut refs_done = Vec::new();
-    for (i, c) in channels.iter().enumerate() {
-        if c.response == c.reference && !refs_done.contains(&c.reference) && out.len() < n.div_ceil(2) {
-            refs_done.push(c.reference);
-            out.push(i);
-        }
-    }
-    for &p in priority {
-        if out.len() < n && p < channels.len() && !out.contains(&p) {
-            out.push(p);
-        }
-    }
-    let rest: Vec<usize> = (0..channels.len()).filter(|i| !out.contains(i)).collect();
-    let want = n.saturating_sub(out.len()).min(rest.len());
-    // evenly over the remaining channels, ends included
-    for j in 0..want {
-        let pos = if want == 1 { rest.len() / 2 } else { j * (rest.len() - 1) / (want - 1) };
-        if !out.contains(&rest[pos]) {
-            out.push(rest[pos]);
-        }
-    }
-    out
+/// The channels from the worst to the best by the complex-log misfit of
+/// `c` (channels without a misfit last, in measurement order).
+pub(crate) fn worst_first(c: &Correlation) -> Vec<usize> {
+    let key = |i: usize| {
+        let m = c.channels[i].log_misfit;
+        if m.is_finite() { m } else { f64::NEG_INFINITY }
+    };
+    let mut order: Vec<usize> = (0..c.channels.len()).collect();
+    order.sort_by(|&a, &b| key(b).total_cmp(&key(a)).then(a.cmp(&b)));
+    order
 }
 
-/// Why a channel was picked for an overlay, for its caption.
-fn role(set: &FrfSet, c: usize, priority: &[usize]) -> &'static str {
-    let ch = set.channels()[c];
-    if ch.response == ch.reference {
-        "driving point"
-    } else if priority.contains(&c) {
-        "among the largest errors"
-    } else {
-        "transfer FRF"
-    }
+/// The distinct driving points of a set (response equal to reference), at
+/// most `n`, in measurement order.
+fn driving_points(set: &FrfSet, n: usize) -> Vec<usize> {
+    let mut seen = Vec::new();
+    set.channels()
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| c.response == c.reference)
+        .filter(|(_, c)| {
+            let new = !seen.contains(&c.reference);
+            seen.push(c.reference);
+            new
+        })
+        .map(|(i, _)| i)
+        .take(n)
+        .collect()
 }
 
 /// A number with about `sig` significant digits in a short form: fixed
@@ -164,6 +166,7 @@ fn short_label(label: &str) -> &str {
 pub(crate) fn correlation_section(
     measured: &FrfSet,
     models: &[ModelFrfs],
+    opts: &ReportOptions,
     out: &mut Outputs,
     notes: Vec<String>,
 ) -> Result<Section> {
@@ -213,7 +216,8 @@ pub(crate) fn correlation_section(
         .iter()
         .map(|m| plot::ErrorCurve { label: m.label.clone(), colour: m.colour, lines: &m.correlation.lines })
         .collect();
-    let svg = plot::error_vs_frequency("Error against frequency (RMS over channels)", &curves, &bands)?;
+    let svg =
+        plot::error_vs_frequency("Error against frequency (RMS over channels)", &curves, &bands, opts.frequency_scale)?;
     s.push(out.figure(
         "error-vs-frequency",
         svg,
@@ -237,9 +241,9 @@ pub(crate) fn correlation_section(
     s.push(out.figure(
         "channel-errors",
         svg,
-        "RMS magnitude error and FRAC per measured channel (labelled by response DOF). A single bad channel \
-         suggests a sensor problem (position, direction, calibration) or a local model error near it; FRAC near \
-         1 with a large dB error means the right shape at the wrong level.",
+        "RMS magnitude error (bars) and FRAC (dots) per measured channel, labelled by response DOF, one colour \
+         per model. A single bad channel suggests a sensor problem (position, direction, calibration) or a local \
+         model error near it; FRAC near 1 with a large dB error means the right shape at the wrong level.",
     )?);
 
     // bands
@@ -318,42 +322,58 @@ pub(crate) fn correlation_section(
     Ok(s)
 }
 
-/// The overlay section: one figure per chosen channel with the measured FRF
-/// and every model's, updating lines marked when given.
+/// Driving points drawn large, besides the small multiples of every channel.
+const LARGE_OVERLAYS: usize = 2;
+
+/// The overlay section: the driving points large, then every channel as
+/// small multiples from the worst to the best (by the last model's
+/// misfit), the updating lines as ticks on the frequency axis when given.
 pub(crate) fn overlay_section(
     measured: &FrfSet,
     models: &[ModelFrfs],
-    channels: &[usize],
-    priority: &[usize],
-    marks_hz: &[f64],
+    ticks_hz: &[f64],
+    opts: &ReportOptions,
     out: &mut Outputs,
 ) -> Result<Section> {
     let mut s = Section::new("FRF overlays");
+    let n = measured.channels().len();
     s.push(Block::Text(format!(
-        "Measured and model FRFs ({}) of {} representative channels: the driving point first, then the \
-         channels with the largest errors and a spread over the others. Magnitude in dB (20 log10 |H|), phase \
-         in degrees wrapped to one turn.{}",
+        "Measured and model FRFs ({}) of all {n} channels, the driving point{} large first. Magnitude in dB \
+         (20 log10 |H|, re 1 {}), phase in degrees drawn continuous: each model's phase at the turn nearest the \
+         measured one, so that the gap between the curves is the phase error.{}",
         measured.kind(),
-        channels.len(),
-        if marks_hz.is_empty() { "" } else { " Circles mark the lines used for updating." }
+        if driving_points(measured, LARGE_OVERLAYS).len() > 1 { "s" } else { "" },
+        plot::unit(measured.kind()),
+        if ticks_hz.is_empty() { "" } else { " Ticks on the frequency axis mark the lines used for updating." }
     )));
-    for &c in channels {
-        let ch = measured.channels()[c];
-        let mut curves =
-            vec![plot::FrfCurve { label: "measured".into(), colour: plot::MEASURED, values: measured.channel(c) }];
-        for m in models {
-            let mc = m.frfs.find(ch).ok_or_else(|| format!("the model FRFs lack channel {ch}"))?;
-            curves.push(plot::FrfCurve { label: m.label.clone(), colour: m.colour, values: m.frfs.channel(mc) });
-        }
-        let title = format!("{ch}: response {} over excitation {}", ch.response, ch.reference);
-        let svg = plot::frf_overlay(&plot::Overlay {
-            title,
-            frequencies_hz: measured.frequencies_hz(),
-            kind: measured.kind(),
-            curves,
-            marks_hz,
-        })?;
-        let stats: Vec<String> = models
+    // every model's FRFs in the measured channels' order
+    let mut columns: Vec<Vec<usize>> = Vec::new();
+    for m in models {
+        let idx = m.frfs.channel_indices();
+        let col = measured
+            .channels()
+            .iter()
+            .map(|ch| idx.get(ch).copied().ok_or_else(|| format!("the model FRFs lack channel {ch}")))
+            .collect::<std::result::Result<Vec<usize>, String>>()?;
+        columns.push(col);
+    }
+    let panel = |c: usize, title: String| plot::frf::FrfPanel {
+        title,
+        curves: std::iter::once(plot::frf::FrfCurve {
+            label: "measured".into(),
+            colour: plot::MEASURED,
+            values: measured.channel(c),
+        })
+        .chain(models.iter().zip(&columns).map(|(m, col)| plot::frf::FrfCurve {
+            label: m.label.clone(),
+            colour: m.colour,
+            values: m.frfs.channel(col[c]),
+        }))
+        .collect(),
+        coherence: measured.coherence(c),
+    };
+    let stats = |c: usize| -> String {
+        models
             .iter()
             .map(|m| {
                 let cc = &m.correlation.channels[c];
@@ -365,11 +385,117 @@ pub(crate) fn overlay_section(
                     cc.frac
                 )
             })
-            .collect();
-        let caption = format!("{ch} ({}). {}.", role(measured, c, priority), stats.join("; "));
+            .collect::<Vec<_>>()
+            .join("; ")
+    };
+    let figure = |panels, title: String| plot::frf::FrfFigure {
+        title,
+        frequencies_hz: measured.frequencies_hz(),
+        kind: measured.kind(),
+        panels,
+        ticks_hz,
+        scale: opts.frequency_scale,
+    };
+
+    for c in driving_points(measured, LARGE_OVERLAYS) {
+        let ch = measured.channels()[c];
+        let title = format!("{ch}: response {} over excitation {}", ch.response, ch.reference);
+        let svg = plot::frf::frf_overlay(&figure(vec![panel(c, String::new())], title))?;
+        let caption = format!("{ch} (driving point). {}.", stats(c));
         s.push(out.figure(&channel_file_stem(ch), svg, caption)?);
     }
+
+    let order = models.last().map_or_else(|| (0..n).collect(), |m| worst_first(&m.correlation));
+    let chunks: Vec<&[usize]> = order.chunks(plot::frf::PANELS_PER_FIGURE).collect();
+    for (k, chunk) in chunks.iter().enumerate() {
+        let panels = chunk
+            .iter()
+            .enumerate()
+            .map(|(j, &c)| {
+                let rank = k * plot::frf::PANELS_PER_FIGURE + j + 1;
+                let ch = measured.channels()[c];
+                let worst = models.last().map_or(String::new(), |m| {
+                    let cc = &m.correlation.channels[c];
+                    format!(": {} dB, FRAC {:.3}", sig(cc.rms_db, 2), cc.frac)
+                });
+                panel(c, format!("{rank}. {ch}{worst}"))
+            })
+            .collect();
+        let (name, title) = if chunks.len() == 1 {
+            ("frf-channels".to_string(), format!("Every channel ({n}), worst first"))
+        } else {
+            (
+                format!("frf-channels-{}", k + 1),
+                format!(
+                    "Channels {} to {} of {n}, worst first",
+                    k * plot::frf::PANELS_PER_FIGURE + 1,
+                    k * plot::frf::PANELS_PER_FIGURE + chunk.len()
+                ),
+            )
+        };
+        let svg = plot::frf::frf_multiples(&figure(panels, title))?;
+        let last = models.last().map_or("model".into(), |m| m.label.clone());
+        let caption = format!(
+            "Measured (black) and model FRFs of {} channels, ordered by the complex-log misfit of the {last}, the \
+             worst first; each panel's title gives its RMS magnitude error and FRAC. Every panel has its own \
+             magnitude scale.{}",
+            chunk.len(),
+            if chunk.iter().any(|&c| measured.coherence(c).is_some()) {
+                " Shading marks lines where the measured coherence is poor: the data are less certain there."
+            } else {
+                ""
+            }
+        );
+        s.push(out.figure(&name, svg, caption)?);
+    }
     Ok(s)
+}
+
+/// The distinct responses and references of a set's channels.
+fn sensor_dofs(set: &FrfSet) -> (Vec<DofRef>, Vec<DofRef>) {
+    let mut responses: Vec<DofRef> = Vec::new();
+    let mut references: Vec<DofRef> = Vec::new();
+    let mut seen = std::collections::HashSet::new();
+    for c in set.channels() {
+        if seen.insert((0, c.response)) {
+            responses.push(c.response);
+        }
+        if seen.insert((1, c.reference)) {
+            references.push(c.reference);
+        }
+    }
+    (responses, references)
+}
+
+/// A drawing of the structure with the measured DOFs of `measured` and the
+/// `highlights`, as a report block.
+pub(crate) fn structure_figure(
+    model: &Model,
+    measured: &FrfSet,
+    highlights: &[Highlight],
+    caption: &str,
+    out: &mut Outputs,
+) -> Result<Block> {
+    let (responses, references) = sensor_dofs(measured);
+    let title =
+        if highlights.is_empty() { "The structure and its measured DOFs" } else { "The structure and what was added" };
+    let svg = plot::structure::structure(
+        title,
+        model,
+        &Sensors { responses: &responses, references: &references },
+        highlights,
+    )?;
+    let text = format!(
+        "{caption} The structure to scale ({} nodes, {} beams): supports hatched, joints as hinges, springs as \
+         zigzags, masses as squares; green arrows at the {} measured responses in their direction, orange arrows at \
+         the {} excitation point{}; node numbers where something is measured, supported or added.",
+        model.nodes().len(),
+        model.beams().len(),
+        responses.len(),
+        references.len(),
+        if references.len() == 1 { "" } else { "s" }
+    );
+    out.figure("structure", svg, text)
 }
 
 /// A short section that says how to read the numbers.
@@ -421,17 +547,17 @@ mod tests {
     use frf::FrfKind;
 
     #[test]
-    fn representative_channels_start_at_the_driving_point_and_spread() {
+    fn driving_points_come_once_per_reference() {
         let tip = DofRef::new(31, Dof::Uy);
-        let channels: Vec<Channel> = (2..=31).map(|n| Channel::new(DofRef::new(n, Dof::Uy), tip)).collect();
+        let mid = DofRef::new(15, Dof::Uy);
+        let mut channels: Vec<Channel> = (2..=31).map(|n| Channel::new(DofRef::new(n, Dof::Uy), tip)).collect();
+        channels.push(Channel::new(mid, mid));
         let set = FrfSet::zeros(vec![1.0, 2.0], channels, FrfKind::Receptance).unwrap();
-        let pick = representative_channels(&set, &[], 4);
-        assert_eq!(pick[0], 29, "the driving point 31:uy comes first");
-        assert_eq!(pick.len(), 4);
-        assert_eq!(&pick[1..], &[0, 14, 28]);
-        let pick = representative_channels(&set, &[5, 7], 4);
-        assert_eq!(pick[..3], [29, 5, 7]);
+        assert_eq!(driving_points(&set, 2), vec![29, 30]);
+        assert_eq!(driving_points(&set, 1), vec![29]);
         assert_eq!(channel_file_stem(set.channels()[0]), "frf-2uy-31uy");
+        let (responses, references) = sensor_dofs(&set);
+        assert_eq!((responses.len(), references), (30, vec![tip, mid]));
     }
 
     #[test]

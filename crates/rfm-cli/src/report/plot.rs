@@ -1,6 +1,10 @@
-//! SVG figures drawn with plotters into strings: FRF overlays (magnitude and
-//! phase), error versus frequency, error per channel, misfit per iteration
-//! and parameter values per iteration.
+//! SVG figures drawn with plotters into strings. This file holds what every
+//! figure shares (the frame, the legend, axes and colours) and the figures
+//! of the correlation and the iteration: error versus frequency, error per
+//! channel, misfit and parameter values per iteration. The FRF overlays are
+//! in [`frf`], the frequency and phase axes in [`axes`], the structure and
+//! its mode shapes in [`structure`], the MAC matrix and the stabilisation
+//! diagram in [`modes`], the misfit of each step of the loop in [`steps`].
 //!
 //! Text is emitted as SVG `<text>` elements in a generic `sans-serif` family
 //! (plotters is built without its font features), so the figures need no
@@ -10,14 +14,21 @@
 
 use std::fmt;
 
-use frf::C64;
-use frf::FrfKind;
-use frf::correlation::{Band, LineError};
+// `::frf` is the crate; `frf` alone is the overlay module below
+use ::frf::C64;
+use ::frf::FrfKind;
+use ::frf::correlation::{Band, LineError};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+pub(crate) mod axes;
+pub(crate) mod frf;
+pub(crate) mod modes;
 mod steps;
+pub(crate) mod structure;
 pub(crate) use steps::misfit_steps;
+
+use axes::FreqAxis;
 
 /// Colour of measured data.
 pub(crate) const MEASURED: RGBColor = RGBColor(0, 0, 0);
@@ -25,9 +36,11 @@ pub(crate) const MEASURED: RGBColor = RGBColor(0, 0, 0);
 pub(crate) const INITIAL: RGBColor = RGBColor(213, 94, 0);
 /// Colour of the updated model.
 pub(crate) const UPDATED: RGBColor = RGBColor(0, 114, 178);
-/// Colours for several series (Okabe-Ito, without yellow, which is too
-/// pale on white): distinguishable with the common colour-vision deficiencies.
-pub(crate) const PALETTE: [RGBColor; 7] = [
+/// Colours for several series: Okabe-Ito without yellow (too pale on
+/// white), then three of Paul Tol's muted scheme, all distinguishable with
+/// the common colour-vision deficiencies. With the three [`Dash`] styles
+/// they give 30 different looks before one repeats ([`look`]).
+pub(crate) const PALETTE: [RGBColor; 10] = [
     RGBColor(0, 114, 178),
     RGBColor(213, 94, 0),
     RGBColor(0, 158, 115),
@@ -35,7 +48,69 @@ pub(crate) const PALETTE: [RGBColor; 7] = [
     RGBColor(230, 159, 0),
     RGBColor(86, 180, 233),
     RGBColor(90, 90, 90),
+    RGBColor(136, 34, 85),
+    RGBColor(51, 34, 136),
+    RGBColor(153, 153, 51),
 ];
+
+/// How a series' line is drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) enum Dash {
+    /// Continuous.
+    Solid,
+    /// Long dashes.
+    Dashed,
+    /// Dots.
+    Dotted,
+}
+
+/// Colour and line style of one series of many (a parameter, a step).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) struct Look {
+    /// Colour.
+    pub(crate) colour: RGBColor,
+    /// Line style.
+    pub(crate) dash: Dash,
+}
+
+/// The look of series `i`: every colour solid first, then dashed, then dotted.
+pub(crate) fn look(i: usize) -> Look {
+    let dash = [Dash::Solid, Dash::Dashed, Dash::Dotted][(i / PALETTE.len()) % 3];
+    Look { colour: PALETTE[i % PALETTE.len()], dash }
+}
+
+/// Dash and gap lengths (px) of a line style, `None` for a solid line.
+fn dash_pattern(dash: Dash) -> Option<(i32, i32)> {
+    match dash {
+        Dash::Solid => None,
+        Dash::Dashed => Some((9, 5)),
+        Dash::Dotted => Some((2, 4)),
+    }
+}
+
+/// Draws `points` as a line of the given look and width on a chart.
+fn draw_line<DB, CT>(
+    chart: &mut ChartContext<'_, DB, CT>,
+    points: Vec<(f64, f64)>,
+    look: Look,
+    width: u32,
+) -> DrawResult
+where
+    DB: DrawingBackend,
+    DB::ErrorType: 'static,
+    CT: CoordTranslate<From = (f64, f64)>,
+{
+    let style = look.colour.stroke_width(width);
+    match dash_pattern(look.dash) {
+        None => {
+            chart.draw_series(LineSeries::new(points, style))?;
+        }
+        Some((on, off)) => {
+            chart.draw_series(DashedLineSeries::new(points, on, off, style))?;
+        }
+    }
+    Ok(())
+}
 
 const FONT: &str = "sans-serif";
 const WIDTH: u32 = 960;
@@ -79,10 +154,16 @@ fn svg(figure: &str, height: u32, draw: impl FnOnce(&Area<'_>) -> DrawResult) ->
 /// How a legend entry is drawn.
 #[derive(Clone, Copy)]
 pub(crate) enum Mark {
-    /// A line segment.
+    /// A line segment of the given width.
     Line(u32),
-    /// A hollow circle.
-    Circle,
+    /// A line segment of the given width and style.
+    Styled(u32, Dash),
+    /// A filled circle.
+    Dot,
+    /// A filled bar.
+    Bar,
+    /// A short vertical tick, as on an axis.
+    Tick,
     /// A pale band.
     Shade,
 }
@@ -92,6 +173,13 @@ pub(crate) struct LegendEntry {
     label: String,
     colour: RGBColor,
     mark: Mark,
+}
+
+impl LegendEntry {
+    /// An entry.
+    pub(crate) fn new(label: impl Into<String>, colour: RGBColor, mark: Mark) -> Self {
+        LegendEntry { label: label.into(), colour, mark }
+    }
 }
 
 const LEGEND_ROW: u32 = 22;
@@ -131,7 +219,24 @@ fn draw_legend(area: &Area<'_>, entries: &[LegendEntry]) -> DrawResult {
                 Mark::Line(w) => {
                     area.draw(&PathElement::new(vec![(x, y), (x + 26, y)], e.colour.stroke_width(w + 1)))?;
                 }
-                Mark::Circle => area.draw(&Circle::new((x + 13, y), 5, e.colour.stroke_width(2)))?,
+                Mark::Styled(w, dash) => match dash_pattern(dash) {
+                    None => area.draw(&PathElement::new(vec![(x, y), (x + 26, y)], e.colour.stroke_width(w + 1)))?,
+                    Some((on, off)) => {
+                        let mut a = x;
+                        while a < x + 26 {
+                            let b = (a + on).min(x + 26);
+                            area.draw(&PathElement::new(vec![(a, y), (b, y)], e.colour.stroke_width(w + 1)))?;
+                            a = b + off;
+                        }
+                    }
+                },
+                Mark::Dot => area.draw(&Circle::new((x + 13, y), 5, e.colour.filled()))?,
+                Mark::Bar => area.draw(&Rectangle::new([(x + 6, y - 7), (x + 20, y + 7)], e.colour.filled()))?,
+                Mark::Tick => {
+                    area.draw(&PathElement::new(vec![(x + 8, y + 6), (x + 8, y - 6)], e.colour.stroke_width(1)))?;
+                    area.draw(&PathElement::new(vec![(x + 13, y + 6), (x + 13, y - 6)], e.colour.stroke_width(1)))?;
+                    area.draw(&PathElement::new(vec![(x + 18, y + 6), (x + 18, y - 6)], e.colour.stroke_width(1)))?;
+                }
                 Mark::Shade => {
                     area.draw(&Rectangle::new([(x, y - 7), (x + 26, y + 7)], e.colour.filled()))?;
                     area.draw(&Rectangle::new([(x, y - 7), (x + 26, y + 7)], GRID_BOLD.stroke_width(1)))?;
@@ -153,6 +258,14 @@ fn frame<'a>(root: &Area<'a>, title: &str, legend: &[LegendEntry]) -> Result<Are
     let (strip, rest) = body.split_vertically(h);
     draw_legend(&strip, legend)?;
     Ok(rest)
+}
+
+/// Whether an SVG written by plotters has a text element reading `t`
+/// (plotters puts the text on a line of its own; the compact layout is
+/// accepted too, should a version of plotters write it).
+#[cfg(test)]
+pub(crate) fn has_text(svg: &str, t: &str) -> bool {
+    svg.contains(&format!(">\n{t}\n</text>")) || svg.contains(&format!(">{t}</text>"))
 }
 
 /// Padded range of finite values, or `fallback` when there are none.
@@ -231,151 +344,11 @@ fn segments(x: &[f64], y: &[f64], wrap: Option<f64>) -> Vec<Vec<(f64, f64)>> {
     out
 }
 
-fn unit(kind: FrfKind) -> &'static str {
+pub(crate) fn unit(kind: FrfKind) -> &'static str {
     match kind {
         FrfKind::Receptance => "m/N",
         FrfKind::Mobility => "m/s/N",
         FrfKind::Accelerance => "m/s\u{b2}/N",
-    }
-}
-
-/// One FRF curve of an overlay.
-pub(crate) struct FrfCurve<'a> {
-    /// Legend label.
-    pub(crate) label: String,
-    /// Colour.
-    pub(crate) colour: RGBColor,
-    /// Values on the overlay's lines.
-    pub(crate) values: &'a [C64],
-}
-
-/// An overlay of FRFs of one channel: magnitude (dB) above, phase below.
-pub(crate) struct Overlay<'a> {
-    /// Figure title.
-    pub(crate) title: String,
-    /// Lines (Hz).
-    pub(crate) frequencies_hz: &'a [f64],
-    /// What the values relate (sets the unit).
-    pub(crate) kind: FrfKind,
-    /// Curves; the first is drawn thickest (the measurement).
-    pub(crate) curves: Vec<FrfCurve<'a>>,
-    /// Lines to mark on the first curve (the updating points), Hz.
-    pub(crate) marks_hz: &'a [f64],
-}
-
-/// Draws an [`Overlay`].
-pub(crate) fn frf_overlay(o: &Overlay<'_>) -> Result<String, PlotError> {
-    let db: Vec<Vec<f64>> =
-        o.curves.iter().map(|c| c.values.iter().map(|v| 20.0 * v.norm().log10()).collect()).collect();
-    let phase: Vec<Vec<f64>> =
-        o.curves.iter().map(|c| c.values.iter().map(|v| v.arg().to_degrees()).collect()).collect();
-    let f = o.frequencies_hz;
-    let (f0, f1) = (f.first().copied().unwrap_or(0.0), f.last().copied().unwrap_or(1.0));
-    let (y0, y1) = range(db.iter().flatten().copied(), (-100.0, 0.0));
-    let (y0, y1) = ((y0 / 10.0).floor() * 10.0, (y1 / 10.0).ceil() * 10.0);
-    let mut legend: Vec<LegendEntry> = o
-        .curves
-        .iter()
-        .enumerate()
-        .map(|(i, c)| LegendEntry { label: c.label.clone(), colour: c.colour, mark: Mark::Line(width_of(i)) })
-        .collect();
-    let marks: Vec<(f64, f64)> = match db.first() {
-        Some(first) => o
-            .marks_hz
-            .iter()
-            .filter_map(|&m| f.iter().position(|&x| (x - m).abs() <= 1e-6 * m.abs()).map(|k| (f[k], first[k])))
-            .filter(|p| p.1.is_finite())
-            .collect(),
-        None => Vec::new(),
-    };
-    if !marks.is_empty() {
-        legend.push(LegendEntry { label: "updating lines".into(), colour: MEASURED, mark: Mark::Circle });
-    }
-    svg(&o.title, 660, |root| {
-        let body = frame(root, &o.title, &legend)?;
-        let h = body.dim_in_pixel().1;
-        let (top, bottom) = body.split_vertically(h * 62 / 100);
-        let mut chart = ChartBuilder::on(&top)
-            .margin_left(12)
-            .margin_right(24)
-            .margin_top(6)
-            .x_label_area_size(26)
-            .y_label_area_size(72)
-            .build_cartesian_2d(f0..f1, y0..y1)?;
-        chart
-            .configure_mesh()
-            .y_desc(format!("Magnitude (dB re 1 {})", unit(o.kind)))
-            .x_label_formatter(&tick)
-            .y_label_formatter(&tick)
-            .light_line_style(GRID_LIGHT)
-            .bold_line_style(GRID_BOLD)
-            .axis_style(AXIS)
-            .label_style((FONT, 13))
-            .axis_desc_style((FONT, 15))
-            .x_labels(12)
-            .y_labels(8)
-            .draw()?;
-        // the measurement first and thick, the models thin on top of it, so
-        // that a model that matches shows as a coloured line inside the black
-        for i in 0..o.curves.len() {
-            let style = o.curves[i].colour.stroke_width(width_of(i));
-            for seg in segments(f, &db[i], None) {
-                chart.draw_series(LineSeries::new(seg, style))?;
-            }
-        }
-        chart.draw_series(marks.iter().map(|&p| Circle::new(p, 5, MEASURED.stroke_width(2))))?;
-
-        let mut chart = ChartBuilder::on(&bottom)
-            .margin_left(12)
-            .margin_right(24)
-            .margin_top(8)
-            .x_label_area_size(44)
-            .y_label_area_size(72)
-            .build_cartesian_2d(f0..f1, PhaseAxis)?;
-        chart
-            .configure_mesh()
-            .x_desc("Frequency (Hz)")
-            .y_desc("Phase (deg)")
-            .x_label_formatter(&tick)
-            .y_label_formatter(&tick)
-            .light_line_style(GRID_LIGHT)
-            .bold_line_style(GRID_BOLD)
-            .axis_style(AXIS)
-            .label_style((FONT, 13))
-            .axis_desc_style((FONT, 15))
-            .x_labels(12)
-            .draw()?;
-        for i in 0..o.curves.len() {
-            let style = o.curves[i].colour.stroke_width(width_of(i));
-            for seg in segments(f, &phase[i], Some(360.0)) {
-                chart.draw_series(LineSeries::new(seg, style))?;
-            }
-        }
-        Ok(())
-    })
-}
-
-/// A phase axis from -180 to 180 degrees with ticks every quarter turn
-/// (plotters' automatic ticks would fall on multiples of 50).
-struct PhaseAxis;
-
-impl Ranged for PhaseAxis {
-    type FormatOption = plotters::coord::ranged1d::DefaultFormatting;
-    type ValueType = f64;
-
-    fn map(&self, v: &f64, limit: (i32, i32)) -> i32 {
-        let t = (v + 180.0) / 360.0;
-        limit.0 + (f64::from(limit.1 - limit.0) * t).round() as i32
-    }
-
-    fn key_points<H: plotters::coord::ranged1d::KeyPointHint>(&self, hint: H) -> Vec<f64> {
-        let step = if hint.weight().allow_light_points() && hint.max_num_points() >= 9 { 45.0 } else { 90.0 };
-        let n = (360.0 / step) as i32;
-        (0..=n).map(|i| -180.0 + step * f64::from(i)).collect()
-    }
-
-    fn range(&self) -> std::ops::Range<f64> {
-        -180.0..180.0
     }
 }
 
@@ -425,11 +398,6 @@ impl Ranged for LogAxis {
     }
 }
 
-/// The first curve (the measurement) is drawn thicker, under the others.
-fn width_of(i: usize) -> u32 {
-    if i == 0 { 3 } else { 1 }
-}
-
 /// One model's error per line, for [`error_vs_frequency`].
 pub(crate) struct ErrorCurve<'a> {
     /// Legend label.
@@ -442,20 +410,25 @@ pub(crate) struct ErrorCurve<'a> {
 
 /// RMS (over channels) dB and phase errors against frequency, one curve
 /// per model, bands shaded alternately and numbered as in the band table.
-pub(crate) fn error_vs_frequency(title: &str, curves: &[ErrorCurve<'_>], bands: &[Band]) -> Result<String, PlotError> {
+pub(crate) fn error_vs_frequency(
+    title: &str,
+    curves: &[ErrorCurve<'_>],
+    bands: &[Band],
+    scale: axes::FrequencyScale,
+) -> Result<String, PlotError> {
     let f: Vec<f64> = curves.first().map(|c| c.lines.iter().map(|l| l.frequency_hz).collect()).unwrap_or_default();
-    let (f0, f1) = (f.first().copied().unwrap_or(0.0), f.last().copied().unwrap_or(1.0));
+    let axis = FreqAxis::new(&f, scale);
+    let (f0, f1) = axis.ends();
+    // lines a logarithmic axis cannot show (0 Hz) are left out of the curves
+    let f: Vec<f64> = f.iter().map(|&x| if axis.shows(x) { x } else { f64::NAN }).collect();
     let db_max = range(curves.iter().flat_map(|c| c.lines.iter().map(|l| l.rms_db)), (0.0, 1.0)).1.max(1e-3);
     let ph_max = range(curves.iter().flat_map(|c| c.lines.iter().map(|l| l.rms_phase_deg)), (0.0, 1.0)).1.max(1e-3);
     let mut legend: Vec<LegendEntry> =
-        curves.iter().map(|c| LegendEntry { label: c.label.clone(), colour: c.colour, mark: Mark::Line(2) }).collect();
+        curves.iter().map(|c| LegendEntry::new(c.label.clone(), c.colour, Mark::Line(2))).collect();
     if bands.len() > 1 {
-        legend.push(LegendEntry {
-            label: "bands (numbered as in the table)".into(),
-            colour: BAND_SHADE,
-            mark: Mark::Shade,
-        });
+        legend.push(LegendEntry::new("bands (numbered as in the table)", BAND_SHADE, Mark::Shade));
     }
+    let x_label = |v: &f64| axis.label(v);
     svg(title, 600, |root| {
         let body = frame(root, title, &legend)?;
         let h = body.dim_in_pixel().1;
@@ -468,7 +441,7 @@ pub(crate) fn error_vs_frequency(title: &str, curves: &[ErrorCurve<'_>], bands: 
                 .margin_top(8)
                 .x_label_area_size(if panel == 0 { 30 } else { 44 })
                 .y_label_area_size(72)
-                .build_cartesian_2d(f0..f1, 0.0..ymax)?;
+                .build_cartesian_2d(axis, 0.0..ymax)?;
             // shading first, so that the grid and the curves stay on top
             if bands.len() > 1 {
                 for (i, b) in bands.iter().enumerate() {
@@ -489,11 +462,11 @@ pub(crate) fn error_vs_frequency(title: &str, curves: &[ErrorCurve<'_>], bands: 
                 .label_style((FONT, 13))
                 .axis_desc_style((FONT, 15))
                 .x_labels(12)
-                .x_label_formatter(&tick)
+                .x_label_formatter(&x_label)
                 .y_labels(6)
                 .y_label_formatter(&tick);
             if panel == 1 {
-                mesh.x_desc("Frequency (Hz)");
+                mesh.x_desc(axis.describe());
             }
             mesh.draw()?;
             if panel == 0 && bands.len() > 1 {
@@ -503,7 +476,7 @@ pub(crate) fn error_vs_frequency(title: &str, curves: &[ErrorCurve<'_>], bands: 
                     let (px0, _) = chart.backend_coord(&(lo, ymax));
                     let (px1, _) = chart.backend_coord(&(hi, ymax));
                     if px1 - px0 >= 18 {
-                        let mid = 0.5 * (lo + hi);
+                        let mid = if axis.is_log() { (lo * hi).sqrt() } else { 0.5 * (lo + hi) };
                         chart.draw_series(std::iter::once(Text::new(
                             format!("{}", i + 1),
                             (mid, ymax * 0.97),
@@ -538,12 +511,14 @@ pub(crate) struct ChannelSeries {
     pub(crate) frac: Vec<f64>,
 }
 
-/// RMS dB error and FRAC per channel (measurement point), one series per model.
+/// RMS dB error (bars) and FRAC (dots) per channel (measurement point),
+/// one series per model side by side. Channels are categories: nothing
+/// joins one to the next.
 pub(crate) fn channel_errors(title: &str, names: &[String], series: &[ChannelSeries]) -> Result<String, PlotError> {
     let n = names.len().max(1);
     let db_max = range(series.iter().flat_map(|s| s.rms_db.iter().copied()), (0.0, 1.0)).1.max(1e-3);
     let legend: Vec<LegendEntry> =
-        series.iter().map(|s| LegendEntry { label: s.label.clone(), colour: s.colour, mark: Mark::Line(2) }).collect();
+        series.iter().map(|s| LegendEntry::new(s.label.clone(), s.colour, Mark::Bar)).collect();
     let label = |v: &f64| {
         let i = v.round();
         if (v - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < names.len() {
@@ -559,6 +534,9 @@ pub(crate) fn channel_errors(title: &str, names: &[String], series: &[ChannelSer
         .fold(1.0f64, f64::min)
         .clamp(0.0, 0.9);
     let frac_lo = (frac_min * 10.0).floor() / 10.0;
+    // each channel's slot holds one bar per model, side by side
+    let slot = 0.8 / series.len().max(1) as f64;
+    let offset = |k: usize| -0.4 + slot * (k as f64 + 0.5);
     svg(title, 560, |root| {
         let body = frame(root, title, &legend)?;
         let h = body.dim_in_pixel().1;
@@ -579,6 +557,7 @@ pub(crate) fn channel_errors(title: &str, names: &[String], series: &[ChannelSer
                 .axis_style(AXIS)
                 .label_style((FONT, 13))
                 .axis_desc_style((FONT, 15))
+                .disable_x_mesh()
                 .x_labels(n.min(16))
                 .x_label_formatter(&label)
                 .y_labels(6)
@@ -587,12 +566,16 @@ pub(crate) fn channel_errors(title: &str, names: &[String], series: &[ChannelSer
                 mesh.x_desc("Channel (response DOF)");
             }
             mesh.draw()?;
-            for s in series.iter().rev() {
+            for (k, s) in series.iter().enumerate() {
                 let y = if panel == 0 { &s.rms_db } else { &s.frac };
-                let x: Vec<f64> = (0..y.len()).map(|i| i as f64).collect();
-                for seg in segments(&x, y, None) {
-                    chart.draw_series(LineSeries::new(seg.clone(), s.colour.stroke_width(1)))?;
-                    chart.draw_series(seg.into_iter().map(|p| Circle::new(p, 3, s.colour.filled())))?;
+                let points =
+                    y.iter().enumerate().filter(|(_, v)| v.is_finite()).map(|(i, &v)| (i as f64 + offset(k), v));
+                if panel == 0 {
+                    chart.draw_series(points.map(|(x, v)| {
+                        Rectangle::new([(x - 0.45 * slot, 0.0), (x + 0.45 * slot, v)], s.colour.filled())
+                    }))?;
+                } else {
+                    chart.draw_series(points.map(|p| Circle::new(p, 4, s.colour.filled())))?;
                 }
             }
         }
@@ -608,17 +591,9 @@ pub(crate) fn convergence(
     all_lines_db: Option<&[f64]>,
 ) -> Result<String, PlotError> {
     let title = "Misfit per iteration";
-    let mut legend = vec![LegendEntry {
-        label: format!("{residual_label} at the updating lines"),
-        colour: UPDATED,
-        mark: Mark::Line(2),
-    }];
+    let mut legend = vec![LegendEntry::new(format!("{residual_label} at the updating lines"), UPDATED, Mark::Line(2))];
     if all_lines_db.is_some() {
-        legend.push(LegendEntry {
-            label: "RMS magnitude error over the measured band".into(),
-            colour: INITIAL,
-            mark: Mark::Line(2),
-        });
+        legend.push(LegendEntry::new("RMS magnitude error over the measured band", INITIAL, Mark::Line(2)));
     }
     let n = residual.len().max(all_lines_db.map_or(0, <[f64]>::len)).max(2);
     let panels: Vec<(&str, RGBColor, &[f64])> = std::iter::once((residual_label, UPDATED, residual))
@@ -682,21 +657,30 @@ pub(crate) struct ParameterTrace {
 }
 
 /// Parameter values relative to their initial values, per iteration
-/// (logarithmic axis); the truth, when known, as a pale horizontal line.
+/// (logarithmic axis), each parameter in its own [`look`]; its truth, when
+/// known, as a thin dotted line in the same colour, labelled at the right.
 pub(crate) fn parameter_history(traces: &[ParameterTrace]) -> Result<String, PlotError> {
     let title = "Parameter values relative to initial";
     let mut legend: Vec<LegendEntry> = traces
         .iter()
         .enumerate()
-        .map(|(i, t)| LegendEntry { label: t.name.clone(), colour: PALETTE[i % PALETTE.len()], mark: Mark::Line(2) })
+        .map(|(i, t)| {
+            let l = look(i);
+            LegendEntry::new(t.name.clone(), l.colour, Mark::Styled(2, l.dash))
+        })
         .collect();
     if traces.iter().any(|t| t.truth_ratio.is_some()) {
-        legend.push(LegendEntry { label: "truth (pale line)".into(), colour: GRID_BOLD, mark: Mark::Line(3) });
+        legend.push(LegendEntry::new(
+            "truth (thin dotted line in the parameter's colour)",
+            AXIS,
+            Mark::Styled(1, Dash::Dotted),
+        ));
     }
     let n = traces.iter().map(|t| t.ratios.len()).max().unwrap_or(0).max(2);
     let (y0, y1) =
         log_range(traces.iter().flat_map(|t| t.ratios.iter().copied().chain(t.truth_ratio)).chain([0.9, 1.1]));
-    svg(title, 460, |root| {
+    let x1 = n as f64 - 0.7;
+    svg(title, 500, |root| {
         let body = frame(root, title, &legend)?;
         let mut chart = ChartBuilder::on(&body)
             .margin_left(12)
@@ -704,7 +688,7 @@ pub(crate) fn parameter_history(traces: &[ParameterTrace]) -> Result<String, Plo
             .margin_top(8)
             .x_label_area_size(44)
             .y_label_area_size(72)
-            .build_cartesian_2d(-0.3..(n as f64 - 0.7), LogAxis { lo: y0, hi: y1 })?;
+            .build_cartesian_2d(-0.3..x1, LogAxis { lo: y0, hi: y1 })?;
         chart
             .configure_mesh()
             .x_desc("Iteration")
@@ -720,17 +704,11 @@ pub(crate) fn parameter_history(traces: &[ParameterTrace]) -> Result<String, Plo
             })
             .y_label_formatter(&log_tick)
             .draw()?;
-        chart.draw_series(std::iter::once(PathElement::new(
-            vec![(-0.3, 1.0), (n as f64 - 0.7, 1.0)],
-            AXIS.stroke_width(1),
-        )))?;
+        chart.draw_series(std::iter::once(PathElement::new(vec![(-0.3, 1.0), (x1, 1.0)], AXIS.stroke_width(1))))?;
         for (i, t) in traces.iter().enumerate() {
-            let colour = PALETTE[i % PALETTE.len()];
+            let l = look(i);
             if let Some(r) = t.truth_ratio.filter(|r| r.is_finite() && *r > 0.0) {
-                chart.draw_series(std::iter::once(PathElement::new(
-                    vec![(-0.3, r), (n as f64 - 0.7, r)],
-                    colour.mix(0.35).stroke_width(3),
-                )))?;
+                draw_line(&mut chart, vec![(-0.3, r), (x1, r)], Look { colour: l.colour, dash: Dash::Dotted }, 1)?;
             }
             let pts: Vec<(f64, f64)> = t
                 .ratios
@@ -739,8 +717,8 @@ pub(crate) fn parameter_history(traces: &[ParameterTrace]) -> Result<String, Plo
                 .filter(|(_, v)| v.is_finite() && **v > 0.0)
                 .map(|(k, &v)| (k as f64, v))
                 .collect();
-            chart.draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))?;
-            chart.draw_series(pts.into_iter().map(|p| Circle::new(p, 3, colour.filled())))?;
+            draw_line(&mut chart, pts.clone(), l, 2)?;
+            chart.draw_series(pts.into_iter().map(|p| Circle::new(p, 3, l.colour.filled())))?;
         }
         Ok(())
     })
@@ -761,6 +739,51 @@ mod tests {
     }
 
     #[test]
+    fn thirty_series_look_different_and_each_truth_takes_its_parameter_colour() {
+        let looks: std::collections::HashSet<Look> = (0..3 * PALETTE.len()).map(look).collect();
+        assert_eq!(looks.len(), 30);
+        let colours: std::collections::HashSet<RGBColor> = PALETTE.iter().copied().collect();
+        assert_eq!(colours.len(), PALETTE.len());
+        // nine parameters, as the F-frame updates: nine colours, each with its truth
+        let traces: Vec<ParameterTrace> = (0..9)
+            .map(|i| ParameterTrace {
+                name: format!("p{i}"),
+                ratios: vec![1.0, 1.5, 2.0 + f64::from(i)],
+                truth_ratio: Some(2.0 + f64::from(i)),
+            })
+            .collect();
+        let svg = parameter_history(&traces).unwrap();
+        for i in 0..9 {
+            let c = look(i).colour;
+            let stroke = format!("stroke=\"#{:02X}{:02X}{:02X}\"", c.0, c.1, c.2);
+            // the trace (one polyline) and its dotted truth (many short ones)
+            assert!(svg.matches(&stroke).count() >= 3, "parameter {i}");
+        }
+        assert!(svg.contains("truth (thin dotted line in the parameter"));
+    }
+
+    #[test]
+    fn channel_errors_are_bars_and_dots_not_lines() {
+        let names: Vec<String> = (1..=4).map(|k| format!("{k}:uy")).collect();
+        let series = vec![
+            ChannelSeries { label: "a".into(), colour: INITIAL, rms_db: vec![1.0, 2.0, 0.5, 3.0], frac: vec![0.9; 4] },
+            ChannelSeries {
+                label: "b".into(),
+                colour: UPDATED,
+                rms_db: vec![0.1, 0.2, 0.05, 0.3],
+                frac: vec![0.99; 4],
+            },
+        ];
+        let svg = channel_errors("per channel", &names, &series).unwrap();
+        let fill = |c: RGBColor| format!("fill=\"#{:02X}{:02X}{:02X}\"", c.0, c.1, c.2);
+        // four bars, four dots and the legend's bar, per model
+        for c in [INITIAL, UPDATED] {
+            assert_eq!(svg.matches(&fill(c)).count(), 4 + 4 + 1);
+        }
+        assert_eq!(svg.matches("<circle").count(), 8);
+    }
+
+    #[test]
     fn log_axes_span_1_2_5_steps_and_label_them() {
         assert_eq!(log_range([3e-9, 0.0015, 0.0, f64::NAN].into_iter()), (2e-9, 0.002));
         assert_eq!(log_range([0.4, 3.3].into_iter()), (0.2, 5.0));
@@ -773,29 +796,5 @@ mod tests {
         assert_eq!(tick(&50.0), "50");
         assert_eq!(tick(&-0.0), "0");
         assert_eq!(tick(&0.25), "0.25");
-    }
-
-    #[test]
-    fn an_overlay_has_both_panels_labels_and_marks() {
-        let f = [1.0, 2.0, 3.0, 4.0];
-        let x: Vec<C64> = f.iter().map(|&v| C64::new(1.0 / v, 0.1)).collect();
-        let a: Vec<C64> = f.iter().map(|&v| C64::new(-1.0 / v, 0.2)).collect();
-        let svg = frf_overlay(&Overlay {
-            title: "H(3:uy,3:uy) <driving point>".into(),
-            frequencies_hz: &f,
-            kind: FrfKind::Accelerance,
-            curves: vec![
-                FrfCurve { label: "measured".into(), colour: MEASURED, values: &x },
-                FrfCurve { label: "model".into(), colour: UPDATED, values: &a },
-            ],
-            marks_hz: &[2.0],
-        })
-        .unwrap();
-        assert!(svg.starts_with("<svg"));
-        for text in ["Frequency (Hz)", "Phase (deg)", "dB re 1 m/s\u{b2}/N", "updating lines", "&lt;driving point&gt;"]
-        {
-            assert!(svg.contains(text), "missing {text}");
-        }
-        assert!(svg.matches("<polyline").count() >= 4);
     }
 }

@@ -1,7 +1,8 @@
-//! The report of an updating run (`rfm update --out DIR`): before/after FRF
-//! overlays of representative channels, error against frequency and per
-//! channel, misfit and parameter values per iteration, the parameter table
-//! (also as `parameters.csv`) and `report.html` with all of it.
+//! The report of an updating run (`rfm update --out DIR`): the structure,
+//! misfit and parameter values per iteration, the parameter table (also as
+//! `parameters.csv`), error against frequency and per channel, the modes of
+//! the updated model against the measured ones, before/after FRF overlays
+//! of every channel, and `report.html` with all of it.
 
 use std::path::{Path, PathBuf};
 
@@ -14,7 +15,7 @@ use rfm_update::study::FrequencyTable;
 use rfm_update::{Study, UpdateOutcome};
 
 use super::html::{Block, Report, Section, Table, Tone};
-use super::{ModelFrfs, Result, plot, sig};
+use super::{ModelFrfs, ReportOptions, Result, plot, sig};
 use crate::output::Outputs;
 use crate::table::num;
 
@@ -22,12 +23,15 @@ use crate::table::num;
 /// convergence plot (evenly spread, first and last included).
 const MAX_ITERATIONS_EVALUATED: usize = 30;
 
-/// Number of overlay figures.
-const OVERLAYS: usize = 4;
-
 /// Writes the report files of an updating run into the run's outputs and
 /// returns where `report.html` will be.
-pub(crate) fn write(study: &Study, outcome: &UpdateOutcome, out: &mut Outputs, case_path: &Path) -> Result<PathBuf> {
+pub(crate) fn write(
+    study: &Study,
+    outcome: &UpdateOutcome,
+    out: &mut Outputs,
+    case_path: &Path,
+    opts: &ReportOptions,
+) -> Result<PathBuf> {
     let measured = &study.measured;
     let channels = measured.channels();
     let freqs = measured.frequencies_hz();
@@ -70,6 +74,13 @@ pub(crate) fn write(study: &Study, outcome: &UpdateOutcome, out: &mut Outputs, c
     for text in singular {
         first.push(Block::Text(text));
     }
+    first.push(super::structure_figure(
+        outcome.system.model(),
+        measured,
+        &[],
+        "The updated model (its geometry is the initial model's).",
+        out,
+    )?);
     report.sections.push(first);
 
     let mut conv = Section::new("Convergence");
@@ -132,11 +143,17 @@ pub(crate) fn write(study: &Study, outcome: &UpdateOutcome, out: &mut Outputs, c
         freqs.len(),
         outcome.frequencies_hz.len()
     )];
-    report.sections.push(super::correlation_section(measured, &models, out, notes)?);
-
-    let worst = super::notable_channels(&models[1].correlation, 2);
-    let picks = super::representative_channels(measured, &worst, OVERLAYS);
-    report.sections.push(super::overlay_section(measured, &models, &picks, &worst, &outcome.frequencies_hz, out)?);
+    report.sections.push(super::correlation_section(measured, &models, opts, out, notes)?);
+    let comparison = super::modes::compare_modes(&outcome.system, measured);
+    report.sections.push(super::modes::section(
+        comparison.as_ref(),
+        "the updated model",
+        outcome.system.model(),
+        measured,
+        opts,
+        out,
+    )?);
+    report.sections.push(super::overlay_section(measured, &models, &outcome.frequencies_hz, opts, out)?);
     report.sections.push(super::definitions_section());
     Ok(out.write("report.html", report.render().as_bytes())?)
 }
@@ -267,10 +284,7 @@ fn summary(study: &Study, outcome: &UpdateOutcome, models: &[ModelFrfs; 2]) -> S
         ),
         ("method".into(), method_name(&outcome.method)),
         ("parameters".into(), outcome.parameters.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join(", ")),
-        (
-            "updating lines (Hz)".into(),
-            outcome.frequencies_hz.iter().map(|&v| super::short(v)).collect::<Vec<_>>().join(", "),
-        ),
+        ("updating lines".into(), lines_summary(&outcome.frequencies_hz)),
         ("status".into(), format!("{} after {iterations} iterations", status_text(&outcome.status))),
         ("residual at updating lines".into(), format!("{} -> {}", sig(first, 3), sig(outcome.residual, 3))),
         (
@@ -283,6 +297,12 @@ fn summary(study: &Study, outcome: &UpdateOutcome, models: &[ModelFrfs; 2]) -> S
         ),
         ("mean FRAC".into(), format!("{:.4} -> {:.4}", a.total.mean_frac, b.total.mean_frac)),
     ]));
+    if outcome.frequencies_hz.len() > 12 {
+        s.push(Block::Details {
+            summary: format!("The {} updating lines (Hz)", outcome.frequencies_hz.len()),
+            text: outcome.frequencies_hz.iter().map(|&v| super::short(v)).collect::<Vec<_>>().join(", "),
+        });
+    }
     let band = super::notable_bands(b, 1).first().map(|&i| &b.bands[i]);
     let channel = super::notable_channels(b, 1).first().map(|&i| &b.channels[i]);
     if b.total.log_misfit < super::NOTABLE_MISFIT {
@@ -304,6 +324,21 @@ fn summary(study: &Study, outcome: &UpdateOutcome, models: &[ModelFrfs; 2]) -> S
         )));
     }
     s
+}
+
+/// The updating lines in a few words: all of them when few, else how many
+/// and over what range (the list is folded under the summary).
+fn lines_summary(f: &[f64]) -> String {
+    match (f.first(), f.last()) {
+        _ if f.len() <= 12 => format!("{} Hz", f.iter().map(|&v| super::short(v)).collect::<Vec<_>>().join(", ")),
+        (Some(a), Some(b)) => format!(
+            "{} lines from {} to {} Hz (ticks on the overlays' frequency axes; listed below)",
+            f.len(),
+            super::short(*a),
+            super::short(*b)
+        ),
+        _ => "none".into(),
+    }
 }
 
 fn iteration_table(outcome: &UpdateOutcome, all_lines_db: &[f64]) -> Table {
@@ -464,6 +499,15 @@ fn frequency_table(outcome: &UpdateOutcome) -> Table {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn many_updating_lines_are_summarised_and_few_listed() {
+        assert_eq!(lines_summary(&[10.0, 20.5]), "10, 20.5 Hz");
+        let many: Vec<f64> = (1..=200).map(|k| 3.0 * f64::from(k)).collect();
+        let s = lines_summary(&many);
+        assert!(s.starts_with("200 lines from 3 to 600 Hz"), "{s}");
+        assert!(!s.contains("9,"), "{s}");
+    }
 
     #[test]
     fn small_models_use_every_line_and_large_ones_a_thinned_grid() {

@@ -1,25 +1,16 @@
-//! Reports of `rfm update --out` and `rfm compare`: the files exist, the
-//! SVG figures are well-formed XML with the expected content, the HTML is
-//! self-contained, and the numbers agree with the library's.
+//! Reports of `rfm update --out`, `rfm compare --out` and `rfm fix`: the
+//! files exist, the SVG figures are well-formed XML with the expected
+//! content (every channel, the MAC matrix, the stabilisation diagram, the
+//! structure with what was added), the HTML is self-contained, and the
+//! numbers agree with the library's.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
 
 use damping::DampedSystem;
 use frf::correlation::{BandSpec, correlate};
 use rfm_update::Study;
 
-fn rfm(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_rfm")).args(args).output().expect("rfm runs")
-}
-
-fn case(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases").join(format!("{name}.toml"))
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
-}
+use super::fixtures::{case, clamp_update, rfm, svg_files, text, tutorial_compare, tutorial_fix, tutorial_update};
 
 fn read(path: &Path) -> String {
     std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
@@ -102,16 +93,38 @@ fn check_text(t: &str) -> Result<(), String> {
     Ok(())
 }
 
-/// Checks an SVG figure and returns its text.
-fn check_svg(path: &Path, must_contain: &[&str]) -> String {
+/// Checks an SVG figure (well-formed, labelled, with the given texts) and
+/// returns its text.
+fn check_figure(path: &Path, must_contain: &[&str]) -> String {
     let svg = read(path);
-    let names = check_xml(&svg, "svg").unwrap_or_else(|e| panic!("{} is not well-formed: {e}", path.display()));
-    assert!(names.iter().any(|n| n == "polyline"), "{} draws no curve", path.display());
-    assert!(names.iter().filter(|n| *n == "text").count() >= 5, "{} has too few labels", path.display());
+    check_xml(&svg, "svg").unwrap_or_else(|e| panic!("{} is not well-formed: {e}", path.display()));
+    assert!(svg.matches("<text").count() >= 5, "{} has too few labels", path.display());
     for s in must_contain {
         assert!(svg.contains(s), "{} lacks {s:?}", path.display());
     }
     svg
+}
+
+/// Checks an SVG figure of curves and returns its text.
+fn check_svg(path: &Path, must_contain: &[&str]) -> String {
+    let svg = check_figure(path, must_contain);
+    assert!(svg.contains("<polyline"), "{} draws no curve", path.display());
+    svg
+}
+
+/// `#RRGGBB` as plotters writes a colour.
+fn hex(r: u8, g: u8, b: u8) -> String {
+    format!("#{r:02X}{g:02X}{b:02X}")
+}
+
+/// The panel titles of a small-multiples figure (`1. H(...)...`), in order.
+fn panel_titles(svg: &str) -> Vec<String> {
+    svg.split('>')
+        .filter_map(|t| t.split('<').next())
+        .map(str::trim)
+        .filter(|t| t.split_once(". H(").is_some_and(|(k, _)| k.parse::<usize>().is_ok()))
+        .map(str::to_string)
+        .collect()
 }
 
 /// Fails if the HTML loads anything from elsewhere or runs scripts.
@@ -131,9 +144,8 @@ fn check_self_contained(html: &str) {
 
 #[test]
 fn update_out_writes_figures_parameters_and_a_self_contained_report() {
-    let dir = tempfile::tempdir().unwrap();
-    let case_file = case("cantilever-flexible-clamp");
-    let out = rfm(&["update", case_file.to_str().unwrap(), "--out", dir.path().to_str().unwrap()]);
+    let w = clamp_update();
+    let out = &w.output;
     // this twin stalls short of the tolerance: its outputs are written, and
     // the exit code says it did not converge
     assert_eq!(out.status.code(), Some(5), "{}", text(&out.stderr));
@@ -141,29 +153,32 @@ fn update_out_writes_figures_parameters_and_a_self_contained_report() {
     assert!(text(&out.stderr).contains("exit code 5: not converged"), "{}", text(&out.stderr));
     assert!(text(&out.stdout).contains("report.html"), "{}", text(&out.stdout));
 
-    let d = dir.path();
+    let d = w.dir.as_path();
     check_svg(&d.join("convergence.svg"), &["Iteration", "Relative residual", "RMS error over the band (dB)"]);
-    check_svg(&d.join("parameters.svg"), &["Value / initial value", "spring.clamp_r.kr", "group.clamp_x.alpha"]);
-    check_svg(&d.join("error-vs-frequency.svg"), &["Frequency (Hz)", "RMS phase error (deg)", "initial model"]);
-    check_svg(&d.join("channel-errors.svg"), &["FRAC", "3:uy", "7:uy"]);
-    // the driving point (tip over tip) is always among the overlays
-    let overlays: Vec<PathBuf> = std::fs::read_dir(d)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.file_name().unwrap().to_str().unwrap().starts_with("frf-"))
-        .collect();
-    assert!(overlays.len() >= 3 && overlays.len() <= 4, "{overlays:?}");
+    let params =
+        check_svg(&d.join("parameters.svg"), &["Value / initial value", "spring.clamp_r.kr", "group.clamp_x.alpha"]);
+    check_svg(&d.join("error-vs-frequency.svg"), &["Frequency (Hz", "RMS phase error (deg)", "initial model"]);
+    // categories as bars, one colour per model, nothing joining the channels
+    let bars = check_figure(&d.join("channel-errors.svg"), &["FRAC", "3:uy", "7:uy"]);
+    for colour in [hex(213, 94, 0), hex(0, 114, 178)] {
+        assert!(bars.matches(&format!("fill=\"{colour}\"")).count() >= 2 * 5, "bars and dots of {colour}");
+    }
+    // the driving point large, and every channel in the small multiples, ticks for the updating lines
     assert!(d.join("frf-7uy-7uy.svg").exists());
-    for p in &overlays {
-        check_svg(p, &["Frequency (Hz)", "Phase (deg)", "dB re 1 m/N", "measured", "initial model", "updated model"]);
+    let all = check_svg(
+        &d.join("frf-channels.svg"),
+        &["Frequency (Hz", "measured", "initial model", "updated model", "updating lines (ticks on the axis)"],
+    );
+    assert_eq!(panel_titles(&all).len(), 5, "{:?}", panel_titles(&all));
+    for p in svg_files(d).iter().filter(|p| p.file_name().unwrap().to_str().unwrap().starts_with("frf-")) {
+        let svg = check_svg(p, &["deg", "dB", "Frequency (Hz"]);
+        assert!(!svg.contains("<circle"), "{}: updating lines are ticks, not circles on the curve", p.display());
     }
 
     let html = read(&d.join("report.html"));
     check_self_contained(&html);
-    let svg_files =
-        std::fs::read_dir(d).unwrap().filter(|e| e.as_ref().unwrap().path().extension().is_some_and(|x| x == "svg"));
-    assert_eq!(html.matches("<svg").count(), svg_files.count(), "every figure is inline in the report");
-    for heading in ["Summary", "Convergence", "Parameters", "FRF correlation", "FRF overlays"] {
+    assert_eq!(html.matches("<svg").count(), svg_files(d).len(), "every figure is inline in the report");
+    for heading in ["Summary", "Convergence", "Parameters", "FRF correlation", "Modes", "FRF overlays"] {
         assert!(html.contains(&format!("<h2>{heading}</h2>")), "report.html lacks the section {heading}");
     }
     // the HTML is well-formed apart from the void elements of its head
@@ -172,18 +187,29 @@ fn update_out_writes_figures_parameters_and_a_self_contained_report() {
 
     // parameters.csv holds the values of results.json
     let json: serde_json::Value = serde_json::from_str(&read(&d.join("results.json"))).unwrap();
-    let params = json["parameters"].as_array().unwrap();
+    let params_json = json["parameters"].as_array().unwrap();
     let csv = read(&d.join("parameters.csv"));
     let lines: Vec<&str> = csv.lines().collect();
-    assert_eq!(lines.len(), params.len() + 1);
+    assert_eq!(lines.len(), params_json.len() + 1);
     assert!(lines[0].starts_with("parameter,initial,updated"));
-    for (line, p) in lines[1..].iter().zip(params) {
+    for (line, p) in lines[1..].iter().zip(params_json) {
         let cells: Vec<&str> = line.split(',').collect();
         assert_eq!(cells[0], p["name"].as_str().unwrap());
         let updated: f64 = cells[2].parse().unwrap();
         let expect = p["updated"].as_f64().unwrap();
         assert!(((updated - expect) / expect).abs() < 1e-12, "{line}");
         assert!(html.contains(&format!("<td>{}</td>", cells[0])));
+    }
+    // each parameter in its own colour (the first ten are the palette's, solid)
+    let palette = [(0, 114, 178), (213, 94, 0), (0, 158, 115), (204, 121, 167), (230, 159, 0), (86, 180, 233)];
+    for (i, _) in params_json.iter().enumerate().take(palette.len()) {
+        let (r, g, b) = palette[i];
+        assert!(params.contains(&format!("stroke=\"{}\"", hex(r, g, b))), "parameter {i} has no line of its own");
+    }
+    // many updating lines are summarised, and listed folded away
+    let n_lines = json["frequencies_hz"].as_array().unwrap().len();
+    if n_lines > 12 {
+        assert!(html.contains(&format!("<summary>The {n_lines} updating lines (Hz)</summary>")), "{n_lines} lines");
     }
 }
 
@@ -303,7 +329,7 @@ fn compare_reads_a_measured_file_and_writes_a_report_with_given_bands() {
     assert_eq!(json["correlation"]["channels"].as_array().unwrap().len(), 5);
 
     check_svg(&report_dir.join("error-vs-frequency.svg"), &["RMS magnitude error (dB)"]);
-    check_svg(&report_dir.join("channel-errors.svg"), &["Channel (response DOF)"]);
+    check_figure(&report_dir.join("channel-errors.svg"), &["Channel (response DOF)"]);
     check_svg(&report_dir.join("frf-7uy-7uy.svg"), &["measured", "model", "Phase (deg)"]);
     let html = read(&report_dir.join("report.html"));
     check_self_contained(&html);
@@ -370,4 +396,159 @@ fn a_diverged_rfm_run_still_writes_its_report() {
     let json: serde_json::Value = serde_json::from_str(&read(&dir.path().join("results.json"))).unwrap();
     assert_eq!(json["status"], "stalled");
     check_self_contained(&read(&dir.path().join("report.html")));
+}
+
+/// The tutorial's compare report: every one of its 8 channels, worst first
+/// by the misfit of compare.json; the MAC matrix with the pairing of the
+/// mode table; the stabilisation diagram; the paired shapes; the structure
+/// with every measured DOF.
+#[test]
+fn the_tutorial_compare_report_shows_every_channel_the_modes_and_the_structure() {
+    let w = tutorial_compare();
+    assert!(w.output.status.success(), "{}", text(&w.output.stderr));
+    let d = w.dir.as_path();
+    let json: serde_json::Value = serde_json::from_str(&read(&d.join("compare.json"))).unwrap();
+    let channels = json["correlation"]["channels"].as_array().unwrap();
+    assert_eq!(channels.len(), 8);
+    let mut by_misfit: Vec<(f64, String)> = channels
+        .iter()
+        .map(|c| (c["log_misfit"].as_f64().unwrap(), c["channel"].as_str().unwrap().to_string()))
+        .collect();
+    by_misfit.sort_by(|a, b| b.0.total_cmp(&a.0));
+
+    let all =
+        check_svg(&d.join("frf-channels.svg"), &["Every channel (8), worst first", "Frequency (Hz, logarithmic)"]);
+    let titles = panel_titles(&all);
+    assert_eq!(titles.len(), 8, "{titles:?}");
+    for (k, (t, (_, ch))) in titles.iter().zip(&by_misfit).enumerate() {
+        assert!(t.starts_with(&format!("{}. {ch}", k + 1)), "panel {} is {t}, not {ch}", k + 1);
+    }
+    assert_eq!(all.matches(">\nmeasured\n<").count(), 1, "one legend for all panels");
+    check_svg(&d.join("error-vs-frequency.svg"), &["Frequency (Hz, logarithmic)"]);
+
+    let rows = json["modes"]["Ok"]["rows"].as_array().unwrap_or_else(|| panic!("no modes: {}", json["modes"]));
+    let pairs = rows.iter().filter(|r| !r["mac"].is_null()).count();
+    let measured = rows.iter().filter(|r| !r["measured_hz"].is_null()).count();
+    assert!(pairs >= 4, "{rows:?}");
+    let mac = check_figure(&d.join("mac-matrix.svg"), &["measured modes", "model modes", "paired"]);
+    assert_eq!(
+        mac.matches("stroke=\"#000000\" stroke-width=\"3\"").count(),
+        pairs + 1,
+        "an outline per pair, and the legend's"
+    );
+    for r in rows.iter().filter(|r| !r["measured_hz"].is_null()) {
+        let f = r["measured_hz"].as_f64().unwrap();
+        assert!(mac.contains(&format!(": {f:.1} Hz\n<")), "no row for the mode at {f:.1} Hz");
+    }
+    let stab =
+        check_figure(&d.join("stabilisation.svg"), &["Model order", "identified mode", "stable (and participation)"]);
+    assert!(stab.matches(&format!("fill=\"{}\"", hex(0, 114, 178))).count() >= 5 * measured, "columns of stable poles");
+    let shapes = check_figure(&d.join("mode-shapes.svg"), &["undeformed", "model", "measured"]);
+    assert_eq!(shapes.matches("\nMode ").count(), pairs, "one panel per pair");
+
+    let structure = check_figure(&d.join("structure.svg"), &["measured response", "excitation"]);
+    // an arrowhead per measured response (8 translations) and one for the excitation
+    assert_eq!(structure.matches("<polygon").count(), 9);
+    for node in ["15", "23", "5", "13"] {
+        assert!(structure.contains(&format!(">\n{node}\n<")), "node {node} is not labelled");
+    }
+
+    let html = read(&d.join("report.html"));
+    check_self_contained(&html);
+    assert_eq!(html.matches("<svg").count(), svg_files(d).len(), "every figure is inline in the report");
+    for heading in ["Summary", "FRF correlation", "Modes", "FRF overlays"] {
+        assert!(html.contains(&format!("<h2>{heading}</h2>")), "report.html lacks the section {heading}");
+    }
+}
+
+/// The loop's report on the tutorial: the misfit per step, the structure
+/// with the joint it added marked at the corner, the modes of the fixed
+/// model and all 8 channels before and after.
+#[test]
+fn the_tutorial_fix_report_marks_the_added_joint_where_it_sits() {
+    let w = tutorial_fix();
+    let d = w.dir.as_path();
+    assert!(d.join("report.html").exists(), "{}", text(&w.output.stderr));
+    let json: serde_json::Value = serde_json::from_str(&read(&d.join("results.json"))).unwrap();
+    let first = &json["steps"][0]["effect"];
+    assert_eq!(first["kind"], "flexible_joint", "{first}");
+    let description = first["description"].as_str().unwrap();
+
+    // each step named on the axis, numbered as on the structure
+    check_svg(&d.join("misfit-steps.svg"), &["nominal", "+ 1: joint at node 13", "updated 1"]);
+    let structure = check_figure(&d.join("structure.svg"), &["The structure and what was added"]);
+    assert!(structure.contains(&format!("1: {description}")), "the legend names the joint: {description}");
+    // a ring in the first step's colour, and its badge
+    assert!(structure.contains(&format!("stroke=\"{}\"", hex(204, 37, 41))), "no ring for the joint");
+    assert!(structure.contains(&format!("fill=\"{}\"", hex(204, 37, 41))), "no badge for the joint");
+    assert!(structure.contains(">\n13\n<"), "the corner node is labelled");
+
+    let all = check_svg(&d.join("frf-channels.svg"), &["nominal model", "fixed model"]);
+    assert_eq!(panel_titles(&all).len(), 8);
+    check_figure(&d.join("mac-matrix.svg"), &["measured modes"]);
+    check_figure(&d.join("stabilisation.svg"), &["Model order"]);
+    check_figure(&d.join("mode-shapes.svg"), &["MAC"]);
+    let html = read(&d.join("report.html"));
+    check_self_contained(&html);
+    assert_eq!(html.matches("<svg").count(), svg_files(d).len());
+    for heading in ["The fall of the misfit", "Modes", "FRF overlays"] {
+        assert!(html.contains(&format!("<h2>{heading}</h2>")), "report.html lacks the section {heading}");
+    }
+}
+
+/// The walkthrough's update: every channel before and after, its 200
+/// updating lines as ticks on the axes (no marks on the curves) and folded
+/// in the summary.
+#[test]
+fn the_tutorial_update_report_shows_every_channel_and_ticks_its_updating_lines() {
+    let w = tutorial_update();
+    assert!(w.output.status.success(), "{}", text(&w.output.stderr));
+    let d = w.dir.as_path();
+    let json: serde_json::Value = serde_json::from_str(&read(&d.join("results.json"))).unwrap();
+    let lines = json["frequencies_hz"].as_array().map_or(0, Vec::len);
+    assert!(lines > 12, "{lines} updating lines");
+    let all = check_svg(
+        &d.join("frf-channels.svg"),
+        &["initial model", "updated model", "updating lines (ticks on the axis)"],
+    );
+    assert_eq!(panel_titles(&all).len(), 8);
+    assert!(!all.contains("<circle"), "updating lines are ticks, not marks on the curves");
+    // a tick per updating line in each magnitude panel: short vertical black paths
+    let ticks = all
+        .lines()
+        .filter(|l| l.starts_with("<polyline") && l.contains("stroke=\"#000000\" stroke-width=\"1\""))
+        .count();
+    assert!(ticks >= 8 * lines, "{ticks} ticks for {lines} lines in 8 panels");
+    let html = read(&d.join("report.html"));
+    check_self_contained(&html);
+    assert!(html.contains(&format!("{lines} lines from")), "the summary names how many lines");
+    assert!(html.contains(&format!("<summary>The {lines} updating lines (Hz)</summary>")), "the lines are folded");
+    for name in ["structure.svg", "mac-matrix.svg", "stabilisation.svg", "mode-shapes.svg", "parameters.svg"] {
+        assert!(d.join(name).is_file(), "no {name}");
+    }
+}
+
+/// `--frequency-axis linear` draws linear axes where the default would be
+/// logarithmic, and an unknown scale is refused with the choices.
+#[test]
+fn the_frequency_axis_can_be_linear_and_a_bad_choice_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let case_file = case("cantilever-flexible-clamp");
+    let out = rfm(&[
+        "compare",
+        case_file.to_str().unwrap(),
+        "--frequency-axis",
+        "linear",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    for name in ["frf-channels.svg", "error-vs-frequency.svg", "stabilisation.svg"] {
+        let svg = check_figure(&dir.path().join(name), &["Frequency (Hz)"]);
+        assert!(!svg.contains("logarithmic"), "{name}");
+    }
+    let out = rfm(&["compare", case_file.to_str().unwrap(), "--frequency-axis", "octave"]);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out.stderr));
+    let e = text(&out.stderr);
+    assert!(e.contains("auto") && e.contains("log") && e.contains("linear"), "{e}");
 }

@@ -1,0 +1,381 @@
+//! FRF overlays: measured and model FRFs of a channel, magnitude (dB) above
+//! and phase below. [`frf_overlay`] draws one channel large;
+//! [`frf_multiples`] draws many channels as small multiples with one legend
+//! for all, so that every channel can be seen at once.
+//!
+//! The measurement is drawn first and thick, the models thin on top of it,
+//! so that a model that matches shows as a coloured line inside the black
+//! one. The lines used for updating are ticks on the frequency axis (marks
+//! on the curve would bury it), lines of poor coherence are shaded, and the
+//! phase is drawn continuous ([`super::axes::phases`]).
+
+use frf::{C64, FrfKind};
+use plotters::prelude::*;
+
+use super::axes::{FreqAxis, FrequencyScale, PhaseAxis, phases};
+use super::{
+    AXIS, Area, DrawResult, FONT, GRID_BOLD, GRID_LIGHT, LegendEntry, MEASURED, Mark, PlotError, frame, range,
+    segments, svg, tick, unit,
+};
+
+/// Shade of lines whose coherence is below [`COHERENCE_FAIR`].
+const COHERENCE_SHADE: RGBColor = RGBColor(253, 228, 214);
+/// Shade of lines whose coherence is below [`COHERENCE_POOR`].
+const COHERENCE_DARK: RGBColor = RGBColor(246, 190, 160);
+/// Below this coherence a line is shaded.
+pub(crate) const COHERENCE_FAIR: f64 = 0.9;
+/// Below this coherence a line is shaded darker.
+pub(crate) const COHERENCE_POOR: f64 = 0.5;
+
+/// Panels of [`frf_multiples`] per row.
+pub(crate) const COLUMNS: usize = 2;
+/// Height of one panel of [`frf_multiples`] (px).
+const PANEL_HEIGHT: u32 = 290;
+
+/// One FRF curve of an overlay.
+pub(crate) struct FrfCurve<'a> {
+    /// Legend label.
+    pub(crate) label: String,
+    /// Colour.
+    pub(crate) colour: RGBColor,
+    /// Values on the figure's lines.
+    pub(crate) values: &'a [C64],
+}
+
+/// One channel: its curves (the first is the measurement) and coherence.
+pub(crate) struct FrfPanel<'a> {
+    /// Panel title (small multiples only; a single overlay uses the figure's).
+    pub(crate) title: String,
+    /// Curves; the first is drawn thickest (the measurement).
+    pub(crate) curves: Vec<FrfCurve<'a>>,
+    /// Coherence of the measurement per line, when the data carry it.
+    pub(crate) coherence: Option<&'a [f64]>,
+}
+
+/// FRFs of one or more channels on common lines.
+pub(crate) struct FrfFigure<'a> {
+    /// Figure title.
+    pub(crate) title: String,
+    /// Lines (Hz).
+    pub(crate) frequencies_hz: &'a [f64],
+    /// What the values relate (sets the unit).
+    pub(crate) kind: FrfKind,
+    /// One panel per channel; every panel has the same curve labels.
+    pub(crate) panels: Vec<FrfPanel<'a>>,
+    /// Lines to tick on the frequency axis (the updating lines), Hz.
+    pub(crate) ticks_hz: &'a [f64],
+    /// Frequency axis scale.
+    pub(crate) scale: FrequencyScale,
+}
+
+/// The first curve (the measurement) is drawn thicker, under the others.
+fn width_of(i: usize, compact: bool) -> u32 {
+    match (i, compact) {
+        (0, false) => 3,
+        (0, true) => 2,
+        _ => 1,
+    }
+}
+
+/// Coherence level of a line: 0 fair, 1 below [`COHERENCE_FAIR`], 2 below [`COHERENCE_POOR`].
+fn coherence_level(c: f64) -> u8 {
+    if !c.is_finite() {
+        0
+    } else if c < COHERENCE_POOR {
+        2
+    } else if c < COHERENCE_FAIR {
+        1
+    } else {
+        0
+    }
+}
+
+/// Runs of lines with poor coherence as `(from Hz, to Hz, level)`, each
+/// line covering the span to halfway (geometrically on a log axis) to its
+/// neighbours.
+fn coherence_spans(f: &[f64], coherence: &[f64], axis: &FreqAxis) -> Vec<(f64, f64, u8)> {
+    let mid = |a: f64, b: f64| if axis.is_log() && a > 0.0 { (a * b).sqrt() } else { 0.5 * (a + b) };
+    let (lo, hi) = axis.ends();
+    let mut out: Vec<(f64, f64, u8)> = Vec::new();
+    for (k, (&fk, &c)) in f.iter().zip(coherence).enumerate() {
+        let level = coherence_level(c);
+        if level == 0 || !axis.shows(fk) {
+            continue;
+        }
+        let left = if k == 0 { fk } else { mid(f[k - 1], fk) }.max(lo);
+        let right = if k + 1 == f.len() { fk } else { mid(fk, f[k + 1]) }.min(hi);
+        match out.last_mut() {
+            Some(last) if last.2 == level && (last.1 - left).abs() <= 1e-9 * left.abs().max(1.0) => last.1 = right,
+            _ => out.push((left, right, level)),
+        }
+    }
+    out
+}
+
+/// The legend shared by every panel: the curves of the first panel, then
+/// the ticks and the coherence shades when they appear.
+fn legend(fig: &FrfFigure<'_>, axis: &FreqAxis, compact: bool) -> Vec<LegendEntry> {
+    let mut legend: Vec<LegendEntry> = fig.panels.first().map_or_else(Vec::new, |p| {
+        p.curves
+            .iter()
+            .enumerate()
+            .map(|(i, c)| LegendEntry::new(c.label.clone(), c.colour, Mark::Line(width_of(i, compact))))
+            .collect()
+    });
+    if fig.ticks_hz.iter().any(|&t| axis.shows(t)) {
+        legend.push(LegendEntry::new("updating lines (ticks on the axis)", MEASURED, Mark::Tick));
+    }
+    let levels: Vec<u8> =
+        fig.panels.iter().filter_map(|p| p.coherence).flat_map(|c| c.iter().map(|&v| coherence_level(v))).collect();
+    if levels.contains(&1) {
+        legend.push(LegendEntry::new(format!("coherence below {COHERENCE_FAIR}"), COHERENCE_SHADE, Mark::Shade));
+    }
+    if levels.contains(&2) {
+        legend.push(LegendEntry::new(format!("coherence below {COHERENCE_POOR}"), COHERENCE_DARK, Mark::Shade));
+    }
+    legend
+}
+
+/// Sizes of one panel's text and axes.
+struct Style {
+    compact: bool,
+    label: u32,
+    desc: u32,
+    y_area: u32,
+    x_labels: usize,
+}
+
+const LARGE: Style = Style { compact: false, label: 13, desc: 15, y_area: 72, x_labels: 12 };
+const SMALL: Style = Style { compact: true, label: 11, desc: 12, y_area: 54, x_labels: 7 };
+
+/// Draws one channel's magnitude into `top` and phase into `bottom`.
+fn draw_channel(
+    top: &Area<'_>,
+    bottom: &Area<'_>,
+    fig: &FrfFigure<'_>,
+    panel: &FrfPanel<'_>,
+    axis: FreqAxis,
+    style: &Style,
+) -> DrawResult {
+    let f = fig.frequencies_hz;
+    let shown: Vec<f64> = f.iter().map(|&x| if axis.shows(x) { x } else { f64::NAN }).collect();
+    let db: Vec<Vec<f64>> =
+        panel.curves.iter().map(|c| c.values.iter().map(|v| 20.0 * v.norm().log10()).collect()).collect();
+    let (reference, others) = match panel.curves.split_first() {
+        Some((first, rest)) => {
+            let rest: Vec<&[C64]> = rest.iter().map(|c| c.values).collect();
+            let (r, o) = phases(first.values, &rest);
+            (vec![r], o)
+        }
+        None => (Vec::new(), Vec::new()),
+    };
+    let phase: Vec<Vec<f64>> = reference.into_iter().chain(others).collect();
+    let visible =
+        |v: &[f64]| -> Vec<f64> { v.iter().zip(&shown).filter(|(_, x)| x.is_finite()).map(|(y, _)| *y).collect() };
+    let (y0, y1) = range(db.iter().flat_map(|c| visible(c)), (-100.0, 0.0));
+    let (y0, y1) = ((y0 / 10.0).floor() * 10.0, (y1 / 10.0).ceil() * 10.0);
+    let phase_axis = PhaseAxis::over(phase.iter().flat_map(|c| visible(c)));
+    let spans = panel.coherence.map(|c| coherence_spans(f, c, &axis)).unwrap_or_default();
+    let shade = |level: u8| if level == 2 { COHERENCE_DARK } else { COHERENCE_SHADE };
+    let x_label = |v: &f64| axis.label(v);
+    let y_desc = if style.compact { "dB".to_string() } else { format!("Magnitude (dB re 1 {})", unit(fig.kind)) };
+
+    let mut chart = ChartBuilder::on(top)
+        .margin_left(if style.compact { 6 } else { 12 })
+        .margin_right(if style.compact { 12 } else { 24 })
+        .margin_top(6)
+        .x_label_area_size(if style.compact { 4 } else { 26 })
+        .y_label_area_size(style.y_area)
+        .build_cartesian_2d(axis, y0..y1)?;
+    // the shading first, so that the grid and the curves stay on top
+    chart.draw_series(spans.iter().map(|&(a, b, l)| Rectangle::new([(a, y0), (b, y1)], shade(l).filled())))?;
+    let mut mesh = chart.configure_mesh();
+    mesh.y_desc(y_desc)
+        .x_label_formatter(&x_label)
+        .y_label_formatter(&tick)
+        .light_line_style(GRID_LIGHT)
+        .bold_line_style(GRID_BOLD)
+        .axis_style(AXIS)
+        .label_style((FONT, style.label))
+        .axis_desc_style((FONT, style.desc))
+        .x_labels(style.x_labels)
+        .y_labels(if style.compact { 5 } else { 8 });
+    let blank = |_: &f64| String::new();
+    if style.compact {
+        // the phase panel below carries the frequency labels
+        mesh.x_label_formatter(&blank);
+    }
+    mesh.draw()?;
+    for (i, c) in panel.curves.iter().enumerate() {
+        let line = c.colour.stroke_width(width_of(i, style.compact));
+        for seg in segments(&shown, &db[i], None) {
+            chart.draw_series(LineSeries::new(seg, line))?;
+        }
+    }
+    let tick_height = 0.06 * (y1 - y0);
+    chart.draw_series(
+        fig.ticks_hz
+            .iter()
+            .filter(|&&t| axis.shows(t))
+            .map(|&t| PathElement::new(vec![(t, y0), (t, y0 + tick_height)], MEASURED.stroke_width(1))),
+    )?;
+
+    let mut chart = ChartBuilder::on(bottom)
+        .margin_left(if style.compact { 6 } else { 12 })
+        .margin_right(if style.compact { 12 } else { 24 })
+        .margin_top(if style.compact { 4 } else { 8 })
+        .x_label_area_size(if style.compact { 34 } else { 44 })
+        .y_label_area_size(style.y_area)
+        .build_cartesian_2d(axis, phase_axis)?;
+    chart.draw_series(
+        spans.iter().map(|&(a, b, l)| Rectangle::new([(a, phase_axis.lo), (b, phase_axis.hi)], shade(l).filled())),
+    )?;
+    chart
+        .configure_mesh()
+        .x_desc(axis.describe())
+        .y_desc(if style.compact { "deg" } else { "Phase (deg)" })
+        .x_label_formatter(&x_label)
+        .y_label_formatter(&tick)
+        .light_line_style(GRID_LIGHT)
+        .bold_line_style(GRID_BOLD)
+        .axis_style(AXIS)
+        .label_style((FONT, style.label))
+        .axis_desc_style((FONT, style.desc))
+        .x_labels(style.x_labels)
+        .y_labels(if style.compact { 4 } else { 9 })
+        .draw()?;
+    for (i, c) in panel.curves.iter().enumerate() {
+        let line = c.colour.stroke_width(width_of(i, style.compact));
+        // a jump of more than half a turn is a model crossing the measured
+        // phase's opposite: split there rather than draw a vertical line
+        for seg in segments(&shown, &phase[i], Some(360.0)) {
+            chart.draw_series(LineSeries::new(seg, line))?;
+        }
+    }
+    Ok(())
+}
+
+/// Draws the first panel of `fig` large: magnitude above, phase below.
+pub(crate) fn frf_overlay(fig: &FrfFigure<'_>) -> Result<String, PlotError> {
+    let axis = FreqAxis::new(fig.frequencies_hz, fig.scale);
+    let legend = legend(fig, &axis, false);
+    svg(&fig.title, 660, |root| {
+        let body = frame(root, &fig.title, &legend)?;
+        let Some(panel) = fig.panels.first() else {
+            return Ok(());
+        };
+        let h = body.dim_in_pixel().1;
+        let (top, bottom) = body.split_vertically(h * 62 / 100);
+        draw_channel(&top, &bottom, fig, panel, axis, &LARGE)
+    })
+}
+
+/// Draws every panel of `fig` as small multiples, [`COLUMNS`] to a row,
+/// under one legend.
+pub(crate) fn frf_multiples(fig: &FrfFigure<'_>) -> Result<String, PlotError> {
+    let axis = FreqAxis::new(fig.frequencies_hz, fig.scale);
+    let legend = legend(fig, &axis, true);
+    let rows = fig.panels.len().div_ceil(COLUMNS).max(1);
+    let height = 44 + super::legend_height(&legend) + rows as u32 * PANEL_HEIGHT;
+    svg(&fig.title, height, |root| {
+        let body = frame(root, &fig.title, &legend)?;
+        let cells = body.split_evenly((rows, COLUMNS));
+        for (panel, cell) in fig.panels.iter().zip(&cells) {
+            let (w, _) = cell.dim_in_pixel();
+            // the title left-aligned over the panel, cut to what fits
+            let max_chars = ((w as f64 - 16.0) / 7.0) as usize;
+            let title: String = if panel.title.chars().count() > max_chars {
+                panel.title.chars().take(max_chars.saturating_sub(1)).chain(['\u{2026}']).collect()
+            } else {
+                panel.title.clone()
+            };
+            cell.draw(&Text::new(title, (12, 6), (FONT, 13).into_font().style(FontStyle::Bold).color(&BLACK)))?;
+            let (_, rest) = cell.split_vertically(24);
+            let h = rest.dim_in_pixel().1;
+            let (top, bottom) = rest.split_vertically(h * 58 / 100);
+            draw_channel(&top, &bottom, fig, panel, axis, &SMALL)?;
+        }
+        Ok(())
+    })
+}
+
+/// Panels of [`frf_multiples`] that fit the page width in one figure of
+/// reasonable height; more channels make more figures.
+pub(crate) const PANELS_PER_FIGURE: usize = 12;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn curves<'a>(x: &'a [C64], a: &'a [C64]) -> Vec<FrfCurve<'a>> {
+        vec![
+            FrfCurve { label: "measured".into(), colour: MEASURED, values: x },
+            FrfCurve { label: "model".into(), colour: super::super::UPDATED, values: a },
+        ]
+    }
+
+    #[test]
+    fn an_overlay_has_both_panels_labels_and_ticks_not_circles() {
+        let f = [1.0, 2.0, 3.0, 4.0];
+        let x: Vec<C64> = f.iter().map(|&v| C64::new(1.0 / v, 0.1)).collect();
+        let a: Vec<C64> = f.iter().map(|&v| C64::new(-1.0 / v, 0.2)).collect();
+        let svg = frf_overlay(&FrfFigure {
+            title: "H(3:uy,3:uy) <driving point>".into(),
+            frequencies_hz: &f,
+            kind: FrfKind::Accelerance,
+            panels: vec![FrfPanel { title: String::new(), curves: curves(&x, &a), coherence: None }],
+            ticks_hz: &[2.0],
+            scale: FrequencyScale::Linear,
+        })
+        .unwrap();
+        assert!(svg.starts_with("<svg"));
+        for text in ["Frequency (Hz)", "Phase (deg)", "dB re 1 m/s\u{b2}/N", "updating lines", "&lt;driving point&gt;"]
+        {
+            assert!(svg.contains(text), "missing {text}");
+        }
+        assert!(svg.matches("<polyline").count() >= 4);
+        assert!(!svg.contains("<circle"), "updating lines are ticks, not circles on the curve");
+    }
+
+    #[test]
+    fn small_multiples_draw_every_panel_under_one_legend_and_shade_poor_coherence() {
+        let f: Vec<f64> = (1..=100).map(f64::from).collect();
+        let x: Vec<C64> = f.iter().map(|&v| C64::new(1.0 / v, 0.1)).collect();
+        let a: Vec<C64> = f.iter().map(|&v| C64::new(1.1 / v, 0.1)).collect();
+        let coherence: Vec<f64> = f.iter().map(|&v| if (40.0..50.0).contains(&v) { 0.3 } else { 0.99 }).collect();
+        let panels: Vec<FrfPanel<'_>> = (0..5)
+            .map(|k| FrfPanel {
+                title: format!("panel {k}"),
+                curves: curves(&x, &a),
+                coherence: (k == 0).then_some(coherence.as_slice()),
+            })
+            .collect();
+        let svg = frf_multiples(&FrfFigure {
+            title: "every channel".into(),
+            frequencies_hz: &f,
+            kind: FrfKind::Receptance,
+            panels,
+            ticks_hz: &[],
+            scale: FrequencyScale::Auto,
+        })
+        .unwrap();
+        for k in 0..5 {
+            assert!(super::super::has_text(&svg, &format!("panel {k}")), "panel {k} missing");
+        }
+        // one legend: each label once
+        assert_eq!(svg.matches(">\nmeasured\n<").count(), 1);
+        assert_eq!(svg.matches(">\nmodel\n<").count(), 1);
+        assert!(svg.contains("coherence below 0.5") && !svg.contains("coherence below 0.9"));
+        assert!(svg.contains("Frequency (Hz, logarithmic)"));
+        // two curves in two panels each, in five channels
+        assert!(svg.matches("<polyline").count() >= 20);
+    }
+
+    #[test]
+    fn poor_coherence_runs_merge_into_spans() {
+        let f = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
+        let c = [0.95, 0.7, 0.6, 0.2, 0.95, 0.1];
+        let axis = FreqAxis::new(&f, FrequencyScale::Linear);
+        assert_eq!(coherence_spans(&f, &c, &axis), vec![(1.5, 3.5, 1), (3.5, 4.5, 2), (5.5, 6.0, 2)]);
+    }
+}

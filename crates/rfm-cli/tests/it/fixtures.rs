@@ -1,0 +1,104 @@
+//! Reports written once per test run and shared by the tests that read
+//! them (the report checks and the browser check), so that the slow ones
+//! (`rfm fix` diagnoses the tutorial up to three times) run once.
+//!
+//! They are written under cargo's target temporary folder, replacing what
+//! an earlier run left there.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::OnceLock;
+
+/// Runs `rfm` with `args`.
+pub(crate) fn rfm(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_rfm")).args(args).output().expect("rfm runs")
+}
+
+/// A case file under `cases/`.
+pub(crate) fn case(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases").join(format!("{name}.toml"))
+}
+
+/// A command's output as text.
+pub(crate) fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+/// A written report: its folder and the command's output.
+pub(crate) struct Written {
+    /// The `--out` folder.
+    pub(crate) dir: PathBuf,
+    /// What the command printed and its exit code.
+    pub(crate) output: Output,
+}
+
+/// [`write_case`] with a case file under `cases/`.
+fn write(name: &str, command: &str, case_name: &str, extra: &[&str]) -> Written {
+    write_case(name, command, &case(case_name), extra)
+}
+
+/// Runs `rfm <command> <case> --out DIR [extra...]` into a fresh folder
+/// named `name` and returns it.
+fn write_case(name: &str, command: &str, case: &Path, extra: &[&str]) -> Written {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("reports").join(name);
+    // an earlier run's report, if any, is replaced whole
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(dir.parent().expect("a parent")).expect("the reports folder");
+    let mut args = vec![command, case.to_str().expect("a UTF-8 path"), "--out", dir.to_str().expect("a UTF-8 path")];
+    args.extend_from_slice(extra);
+    let output = rfm(&args);
+    Written { dir, output }
+}
+
+/// `rfm compare` of the tutorial (8 channels, a bolted corner the model lacks).
+pub(crate) fn tutorial_compare() -> &'static Written {
+    static W: OnceLock<Written> = OnceLock::new();
+    W.get_or_init(|| write("tutorial-compare", "compare", "tutorial/l-frame", &[]))
+}
+
+/// `rfm fix` of the tutorial: the loop that adds the joint.
+pub(crate) fn tutorial_fix() -> &'static Written {
+    static W: OnceLock<Written> = OnceLock::new();
+    W.get_or_init(|| write("tutorial-fix", "fix", "tutorial/l-frame", &[]))
+}
+
+/// `rfm update` of the walkthrough's guess (`docs/walkthrough.md`, section
+/// 3): the tutorial case with the lines of the walkthrough's first `toml`
+/// block added, as `cargo xtask figures` builds it.
+pub(crate) fn tutorial_update() -> &'static Written {
+    static W: OnceLock<Written> = OnceLock::new();
+    W.get_or_init(|| {
+        let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let doc = std::fs::read_to_string(root.join("docs/walkthrough.md")).expect("the walkthrough");
+        let start = doc.find("```toml\n").expect("a toml block") + "```toml\n".len();
+        let block = &doc[start..start + doc[start..].find("```").expect("a closed toml block")];
+        let tutorial = root.join("cases/tutorial");
+        let data = tutorial.join("l-frame-measured.csv").canonicalize().expect("the tutorial data");
+        let case = std::fs::read_to_string(tutorial.join("l-frame.toml"))
+            .expect("the tutorial case")
+            .replace("data = \"l-frame-measured.csv\"", &format!("data = {:?}", data.display().to_string()));
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("reports");
+        std::fs::create_dir_all(&dir).expect("the reports folder");
+        let guess = dir.join("l-frame-guess.toml");
+        std::fs::write(&guess, format!("{case}\n{block}")).expect("the guess");
+        write_case("tutorial-update", "update", &guess, &[])
+    })
+}
+
+/// `rfm update` of the flexible-clamp cantilever (it stalls short of the
+/// tolerance, exit code 5, and writes its report all the same).
+pub(crate) fn clamp_update() -> &'static Written {
+    static W: OnceLock<Written> = OnceLock::new();
+    W.get_or_init(|| write("clamp-update", "update", "cantilever-flexible-clamp", &[]))
+}
+
+/// The SVG files of a report folder, sorted.
+pub(crate) fn svg_files(dir: &Path) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .expect("the report folder")
+        .map(|e| e.expect("an entry").path())
+        .filter(|p| p.extension().is_some_and(|x| x == "svg"))
+        .collect();
+    v.sort();
+    v
+}
