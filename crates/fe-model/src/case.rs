@@ -59,6 +59,7 @@ struct RawCase {
     paper: Option<Spanned<RawPaper>>,
     #[serde(default)]
     history: Vec<Spanned<RawHistory>>,
+    check: Option<Spanned<RawCheck>>,
 }
 
 #[derive(Deserialize)]
@@ -276,6 +277,33 @@ struct RawPaper {
     #[serde(default)]
     frequencies_hz: Vec<f64>,
     note: Option<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawCheck {
+    rfm: Option<Spanned<RawRunCheck>>,
+    #[serde(rename = "output-error")]
+    output_error: Option<Spanned<RawRunCheck>>,
+    diagnosis: Option<Spanned<RawDiagnosisCheck>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawRunCheck {
+    status: Vec<Spanned<String>>,
+    max_error: Option<Spanned<f64>>,
+    within_sd: Option<Spanned<f64>>,
+    #[serde(default)]
+    weak: Vec<Spanned<String>>,
+    noise: Option<Spanned<f64>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawDiagnosisCheck {
+    leader: Spanned<String>,
+    misfit_fall: Option<Spanned<f64>>,
 }
 
 // ------------------------------------------------------------- public specs
@@ -499,6 +527,52 @@ pub struct HistoryEntry {
     pub noise: Option<f64>,
 }
 
+/// How an updating run may end, as its results name it (the statuses of
+/// `rfm_update::rfm::Status`, whose tests keep the two lists equal).
+pub const RUN_STATUSES: [&str; 5] = ["converged", "stalled", "within_noise", "max_iterations", "failed"];
+
+/// What `cargo xtask reproduce` requires of a case's results (`[check]`):
+/// the case's acceptance, as data. See `docs/case-files.md`.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct CheckSpec {
+    /// Of the run with the response function method (`[check.rfm]`).
+    pub rfm: Option<RunCheck>,
+    /// Of the run with the output-error estimator (`[check.output-error]`);
+    /// its presence also asks `reproduce` to make that run.
+    pub output_error: Option<RunCheck>,
+    /// Of the diagnosis loop (`[check.diagnosis]`).
+    pub diagnosis: Option<DiagnosisCheck>,
+}
+
+/// What one updating run must achieve.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunCheck {
+    /// The statuses it may end with (names of [`RUN_STATUSES`]).
+    pub status: Vec<String>,
+    /// Largest `|updated - truth| / |truth|` allowed over the parameters.
+    pub max_error: Option<f64>,
+    /// Largest `|ln(updated / truth)|` allowed, in the run's own standard
+    /// deviations of `ln p`, over the parameters it reports as well
+    /// determined.
+    pub within_sd: Option<f64>,
+    /// Parameters the run must report as weakly determined.
+    pub weak: Vec<String>,
+    /// Largest relative distance allowed between the residual RMS the fit
+    /// leaves and the truth's noise level: the check that its standard
+    /// deviations are scaled honestly.
+    pub noise: Option<f64>,
+}
+
+/// What the diagnosis of the case must find.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DiagnosisCheck {
+    /// Text the leading candidate's description must contain.
+    pub leader: String,
+    /// How many times at least the misfit must fall once the leading
+    /// candidate is added and updated.
+    pub misfit_fall: Option<f64>,
+}
+
 /// A loaded, validated case file.
 #[derive(Clone, Debug)]
 pub struct CaseFile {
@@ -520,6 +594,8 @@ pub struct CaseFile {
     pub paper: Option<PaperSpec>,
     /// The misfit after each step that led to this case (`[[history]]`).
     pub history: Vec<HistoryEntry>,
+    /// Acceptance of the case's results (`[check]`).
+    pub check: Option<CheckSpec>,
 }
 
 // ------------------------------------------------------------------ loading
@@ -614,6 +690,7 @@ impl CaseFile {
                 Ok(HistoryEntry { step: r.step.clone(), misfit: r.misfit, noise: r.noise })
             })
             .collect::<Result<Vec<_>, CaseError>>()?;
+        let check = raw.check.as_ref().map(|c| parse_check(&ctx, c, truth.as_ref(), update.as_ref())).transpose()?;
         if let (Some(m), None) = (&measurement, &truth)
             && m.data.is_none()
         {
@@ -632,6 +709,7 @@ impl CaseFile {
             update,
             paper,
             history,
+            check,
         })
     }
 
@@ -1286,6 +1364,86 @@ fn parse_update(ctx: &Ctx<'_>, u: &Spanned<RawUpdate>, model: &Model) -> Result<
     })
 }
 
+fn parse_check(
+    ctx: &Ctx<'_>,
+    c: &Spanned<RawCheck>,
+    truth: Option<&TruthSpec>,
+    update: Option<&UpdateSpec>,
+) -> Result<CheckSpec, CaseError> {
+    let r = c.get_ref();
+    let run = |table: &Option<Spanned<RawRunCheck>>, name: &str| -> Result<Option<RunCheck>, CaseError> {
+        let Some(t) = table else { return Ok(None) };
+        let Some(update) = update else {
+            return Err(ctx.err(t.span(), format!("[check.{name}] checks an update, and the case has no [update]")));
+        };
+        let r = t.get_ref();
+        if r.status.is_empty() {
+            return Err(ctx.err(t.span(), format!("[check.{name}] needs at least one `status`")));
+        }
+        for s in &r.status {
+            if !RUN_STATUSES.contains(&s.get_ref().as_str()) {
+                let hint = crate::suggest::closest(s.get_ref(), RUN_STATUSES)
+                    .map(|b| format!("; did you mean `{b}`?"))
+                    .unwrap_or_else(|| format!(" (available: {})", RUN_STATUSES.join(", ")));
+                return Err(ctx.err(s.span(), format!("unknown status `{}`{hint}", s.get_ref())));
+            }
+        }
+        let bound = |v: &Option<Spanned<f64>>, key: &str, needs: &str| -> Result<Option<f64>, CaseError> {
+            let Some(v) = v else { return Ok(None) };
+            if !(*v.get_ref() > 0.0 && v.get_ref().is_finite()) {
+                return Err(ctx.err(v.span(), format!("`{key}` must be positive and finite")));
+            }
+            if truth.is_none() {
+                return Err(ctx.err(v.span(), format!("`{key}` compares with {needs}, and the case has no [truth]")));
+            }
+            Ok(Some(*v.get_ref()))
+        };
+        let max_error = bound(&r.max_error, "max_error", "the truth")?;
+        let within_sd = bound(&r.within_sd, "within_sd", "the truth")?;
+        let noise = bound(&r.noise, "noise", "the truth's noise level")?;
+        if let (Some(v), Some(t)) = (&r.noise, truth)
+            && !(t.noise > 0.0)
+        {
+            return Err(ctx.err(v.span(), "`noise` compares with the truth's noise level, and the truth has no noise"));
+        }
+        let names: Vec<&str> = update.parameters.iter().map(|p| p.name.as_str()).collect();
+        for w in &r.weak {
+            if !names.contains(&w.get_ref().as_str()) {
+                let hint = crate::suggest::closest(w.get_ref(), names.iter().copied())
+                    .map(|b| format!("; did you mean `{b}`?"))
+                    .unwrap_or_else(|| format!(" (updated: {})", names.join(", ")));
+                return Err(ctx.err(w.span(), format!("`{}` is not an [update] parameter{hint}", w.get_ref())));
+            }
+        }
+        Ok(Some(RunCheck {
+            status: r.status.iter().map(|s| s.get_ref().clone()).collect(),
+            max_error,
+            within_sd,
+            weak: r.weak.iter().map(|w| w.get_ref().clone()).collect(),
+            noise,
+        }))
+    };
+    let diagnosis = match &r.diagnosis {
+        None => None,
+        Some(d) => {
+            let r = d.get_ref();
+            if r.leader.get_ref().trim().is_empty() {
+                return Err(ctx.err(r.leader.span(), "`leader` must name the effect the diagnosis ranks first"));
+            }
+            if let Some(f) = &r.misfit_fall
+                && !(*f.get_ref() >= 1.0 && f.get_ref().is_finite())
+            {
+                return Err(ctx.err(f.span(), "`misfit_fall` is a factor of at least 1"));
+            }
+            Some(DiagnosisCheck {
+                leader: r.leader.get_ref().clone(),
+                misfit_fall: r.misfit_fall.as_ref().map(|f| *f.get_ref()),
+            })
+        }
+    };
+    Ok(CheckSpec { rfm: run(&r.rfm, "rfm")?, output_error: run(&r.output_error, "output-error")?, diagnosis })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1456,11 +1614,118 @@ node = 1
         assert_eq!(e.location.unwrap().line, base.lines().count() + 1);
     }
 
+    /// The beam with a truth and an update, for the `[check]` tests.
+    fn checked(check: &str) -> String {
+        format!(
+            "{BEAM}[measurement]\nfrequencies = [10.0, 20.0]\nreferences = [\"5:uy\"]\nresponses = [\"2..5:uy\"]\n\
+             [truth]\nnoise = 0.01\n[update]\nparameters = [\"group.beam.alpha\", \"group.beam.stiffness\"]\n{check}"
+        )
+    }
+
+    /// The line of `text` an error points at.
+    fn line_of<'a>(text: &'a str, e: &CaseError) -> &'a str {
+        text.lines().nth(e.location.as_ref().expect("a located error").line - 1).unwrap().trim()
+    }
+
+    #[test]
+    fn check_tables_are_read_per_run() {
+        let text = checked(
+            "[check.rfm]\nstatus = [\"converged\"]\nmax_error = 1e-8\n\
+             [check.output-error]\nstatus = [\"converged\", \"within_noise\"]\nwithin_sd = 3\nweak = [\"group.beam.stiffness\"]\nnoise = 0.1\n\
+             [check.diagnosis]\nleader = \"joint at node 3\"\nmisfit_fall = 10\n",
+        );
+        let c = parse(&text).unwrap().check.unwrap();
+        let rfm = c.rfm.unwrap();
+        assert_eq!(
+            (rfm.status, rfm.max_error, rfm.within_sd, rfm.noise),
+            (vec!["converged".into()], Some(1e-8), None, None)
+        );
+        let oe = c.output_error.unwrap();
+        assert_eq!(oe.status, vec!["converged".to_string(), "within_noise".into()]);
+        assert_eq!((oe.within_sd, oe.noise, oe.weak), (Some(3.0), Some(0.1), vec!["group.beam.stiffness".to_string()]));
+        let d = c.diagnosis.unwrap();
+        assert_eq!((d.leader.as_str(), d.misfit_fall), ("joint at node 3", Some(10.0)));
+        assert!(parse(&checked("")).unwrap().check.is_none());
+    }
+
+    #[test]
+    fn check_errors_name_the_key_and_its_line() {
+        let cases = [
+            // a misspelt key of a run check
+            (
+                "[check.rfm]\nstatus = [\"converged\"]\nmax_eror = 1e-8\n",
+                "max_eror = 1e-8",
+                "did you mean `max_error`?",
+            ),
+            // a misspelt run
+            ("[check.rfn]\nstatus = [\"converged\"]\n", "[check.rfn]", "unknown field `rfn`"),
+            (
+                "[check.rfm]\nstatus = [\"convergd\"]\n",
+                "status = [\"convergd\"]",
+                "unknown status `convergd`; did you mean `converged`?",
+            ),
+            (
+                "[check.rfm]\nstatus = [\"ok\"]\n",
+                "status = [\"ok\"]",
+                "(available: converged, stalled, within_noise, max_iterations, failed)",
+            ),
+            ("[check.rfm]\nstatus = []\n", "[check.rfm]", "needs at least one `status`"),
+            ("[check.rfm]\nmax_error = 1e-8\n", "[check.rfm]", "missing field `status`"),
+            (
+                "[check.rfm]\nstatus = [\"converged\"]\nmax_error = -1\n",
+                "max_error = -1",
+                "`max_error` must be positive and finite",
+            ),
+            (
+                "[check.rfm]\nstatus = [\"converged\"]\nwithin_sd = 0\n",
+                "within_sd = 0",
+                "`within_sd` must be positive and finite",
+            ),
+            (
+                "[check.output-error]\nstatus = [\"converged\"]\nweak = [\"group.beam.stifness\"]\n",
+                "weak = [\"group.beam.stifness\"]",
+                "`group.beam.stifness` is not an [update] parameter; did you mean `group.beam.stiffness`?",
+            ),
+            ("[check.diagnosis]\nleader = \" \"\n", "leader = \" \"", "`leader` must name the effect"),
+            (
+                "[check.diagnosis]\nleader = \"joint\"\nmisfit_fall = 0.5\n",
+                "misfit_fall = 0.5",
+                "a factor of at least 1",
+            ),
+        ];
+        for (check, line, words) in cases {
+            let text = checked(check);
+            let e = parse(&text).unwrap_err();
+            assert!(e.message.contains(words), "{check}: {e}");
+            assert_eq!(line_of(&text, &e), line, "{check}: {e}");
+        }
+        // checks against the truth need one, and checks of an update need an update
+        let no_truth =
+            checked("[check.rfm]\nstatus = [\"converged\"]\nnoise = 0.1\n").replace("[truth]\nnoise = 0.01\n", "");
+        let no_truth = no_truth.replace("frequencies = [10.0, 20.0]", "frequencies = [10.0, 20.0]\ndata = \"m.csv\"");
+        let e = parse(&no_truth).unwrap_err();
+        assert!(
+            e.message.contains("`noise` compares with the truth's noise level, and the case has no [truth]"),
+            "{e}"
+        );
+        assert_eq!(line_of(&no_truth, &e), "noise = 0.1");
+        let silent = checked("[check.output-error]\nstatus = [\"converged\"]\nnoise = 0.1\n")
+            .replace("noise = 0.01", "noise = 0.0");
+        let e = parse(&silent).unwrap_err();
+        assert!(e.message.contains("the truth has no noise"), "{e}");
+        let no_update = format!("{BEAM}[check.rfm]\nstatus = [\"converged\"]\n");
+        let e = parse(&no_update).unwrap_err();
+        assert!(e.message.contains("[check.rfm] checks an update, and the case has no [update]"), "{e}");
+        assert_eq!(line_of(&no_update, &e), "[check.rfm]");
+    }
+
     #[test]
     fn dof_lists_expand_ranges() {
         let v = parse_dof_list("2..4:uy").unwrap();
         assert_eq!(v, vec![DofRef::new(2, Dof::Uy), DofRef::new(3, Dof::Uy), DofRef::new(4, Dof::Uy)]);
-        assert!(parse_dof_list("4..2:uy").is_err());
-        assert!(parse_dof_list("4").is_err());
+        let e = parse_dof_list("4..2:uy").unwrap_err();
+        assert!(e.contains("range `4..2:uy` is empty (last node before first)"), "{e}");
+        let e = parse_dof_list("4").unwrap_err();
+        assert!(e.contains("`4` is not of the form node:dof"), "{e}");
     }
 }

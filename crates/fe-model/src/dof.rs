@@ -181,8 +181,8 @@ mod tests {
         let r: DofRef = "31:uy".parse().unwrap();
         assert_eq!(r, DofRef::new(31, Dof::Uy));
         assert_eq!(r.to_string(), "31:uy");
-        assert!("31".parse::<DofRef>().is_err());
-        assert!("a:uy".parse::<DofRef>().is_err());
+        assert!("31".parse::<DofRef>().unwrap_err().contains("`31` is not of the form node:dof"));
+        assert!("a:uy".parse::<DofRef>().unwrap_err().contains("`a` in `a:uy` is not a node id"));
         assert!("3:uz".parse::<DofRef>().unwrap_err().contains("uz"));
     }
 }

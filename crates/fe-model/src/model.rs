@@ -724,7 +724,10 @@ mod tests {
         assert!(part.supports().is_empty());
         assert_eq!(part.groups(), whole.groups());
         // the arm alone is a mechanism: only a part assembly accepts it
-        assert!(Assembly::new(&part).is_err());
+        assert_eq!(
+            Assembly::new(&part).unwrap_err(),
+            ModelError::Mechanism { hint: "3:ux".into(), modes: 3, nodes: vec![2, 3, 4] }
+        );
         let (a, w) = (Assembly::of_part(&part).unwrap(), Assembly::new(&whole).unwrap());
         assert_eq!(a.n(), 7, "ux, uy shared by nodes 2 and 3, three rotations, node 4's ux, uy");
         let beam = |asm: &Assembly, m: &Model| {

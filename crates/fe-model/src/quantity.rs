@@ -291,6 +291,7 @@ fn names<'a>(it: impl Iterator<Item = &'a String>) -> String {
 
 #[cfg(test)]
 mod tests {
+    use crate::ModelError;
     use crate::samples;
 
     #[test]
@@ -300,9 +301,13 @@ mod tests {
             let q = model.quantity(name).unwrap();
             assert_eq!(model.quantity_name(q).to_string(), name);
         }
-        let e = model.quantity("group.nope.mu").unwrap_err().to_string();
+        let reason = |r: Result<_, ModelError>, name: &str| match r {
+            Err(ModelError::UnknownQuantity { name: n, reason }) if n == name => reason,
+            other => panic!("{name}: expected an unknown quantity, got {other:?}"),
+        };
+        let e = reason(model.quantity("group.nope.mu"), "group.nope.mu");
         assert!(e.contains("no group `nope`"), "{e}");
-        let e = model.quantity("spring.joint.kz").unwrap_err().to_string();
+        let e = reason(model.quantity("spring.joint.kz"), "spring.joint.kz");
         assert!(e.contains("kx, ky, kr"), "{e}");
     }
 
@@ -312,8 +317,17 @@ mod tests {
         let p = model.parameter("element.2..4.stiffness").unwrap();
         assert_eq!(p.quantities.len(), 3);
         assert_eq!(model.quantity_name(p.quantities[2]).to_string(), "element.4.stiffness");
-        assert!(model.parameter("element.5..9.mass").unwrap_err().to_string().contains("no element 7"));
-        assert!(model.parameter("element.4..2.mass").is_err());
+        match model.parameter("element.5..9.mass") {
+            Err(ModelError::UnknownQuantity { name, reason }) => {
+                assert_eq!(name, "element.5..9.mass");
+                assert!(reason.contains("no element 7"), "{reason}");
+            }
+            other => panic!("expected an unknown quantity, got {other:?}"),
+        }
+        assert_eq!(
+            model.parameter("element.4..2.mass").unwrap_err(),
+            ModelError::UnknownQuantity { name: "element.4..2.mass".into(), reason: "the range 4..2 is empty".into() }
+        );
         assert_eq!(model.parameter("group.beam.alpha").unwrap().quantities.len(), 1);
     }
 
@@ -321,8 +335,9 @@ mod tests {
     fn set_rejects_non_physical_values() {
         let mut model = samples::frame_with_joint();
         let q = model.quantity("material.steel.E").unwrap();
-        assert!(model.set(q, -1.0).is_err());
-        assert!(model.set(q, f64::NAN).is_err());
+        let invalid = |reason: &str| ModelError::Invalid { what: "material.steel.E".into(), reason: reason.into() };
+        assert_eq!(model.set(q, -1.0).unwrap_err(), invalid("cannot be set to -1"));
+        assert_eq!(model.set(q, f64::NAN).unwrap_err(), invalid("cannot be set to NaN"));
         model.set(q, 1e11).unwrap();
         assert_eq!(model.get(q), 1e11);
         let mu = model.quantity("group.joint.mu").unwrap();

@@ -727,10 +727,16 @@ mod tests {
         let r = correlate(&x, &reversed, &BandSpec::Auto).unwrap();
         assert!(r.total.log_misfit < 1e-12, "{}", r.total.log_misfit);
         assert_eq!(r.kind(), FrfKind::Receptance);
+        let mismatch = |r: Result<Correlation, FrfError>| match r {
+            Err(FrfError::Mismatch(m)) => m,
+            other => panic!("expected a mismatch, got {other:?}"),
+        };
         let fewer = x.select_channels(&[0, 1]);
-        assert!(correlate(&x, &fewer, &BandSpec::Auto).unwrap_err().to_string().contains("no channel"));
+        let m = mismatch(correlate(&x, &fewer, &BandSpec::Auto));
+        assert!(m.contains(&format!("the model FRFs have no channel {}", x.channels()[2])), "{m}");
         let other = x.select_lines(&[0, 1, 2]).unwrap();
-        assert!(correlate(&x, &other, &BandSpec::Auto).is_err());
+        let m = mismatch(correlate(&x, &other, &BandSpec::Auto));
+        assert!(m.contains(&format!("have 3 lines, the measured {}", x.n_freq())), "{m}");
     }
 
     #[test]
@@ -763,10 +769,18 @@ mod tests {
         assert!(third.iter().all(|b| x.frequencies_hz().iter().any(|&f| inside(b, f))));
         assert!(x.frequencies_hz().iter().all(|&f| third.iter().filter(|b| inside(b, f)).count() == 1));
         assert!((third[1].lo_hz / third[0].lo_hz).log2() * 3.0 >= 1.0 - 1e-9);
-        assert!(bands(&BandSpec::Edges(vec![10.0]), &x).is_err());
-        assert!(bands(&BandSpec::Edges(vec![10.0, 5.0]), &x).is_err());
-        let e = bands(&BandSpec::Edges(vec![200.0, 300.0]), &x).unwrap_err();
-        assert!(e.to_string().contains("no measured line"), "{e}");
+        let mismatch = |spec: BandSpec| match bands(&spec, &x) {
+            Err(FrfError::Mismatch(m)) => m,
+            other => panic!("{spec:?}: expected a mismatch, got {other:?}"),
+        };
+        assert!(mismatch(BandSpec::Edges(vec![10.0])).contains("give at least two frequencies"));
+        assert!(
+            mismatch(BandSpec::Edges(vec![10.0, 5.0]))
+                .contains("must increase strictly, but 10 Hz is followed by 5 Hz")
+        );
+        assert!(mismatch(BandSpec::Edges(vec![-1.0, 5.0])).contains("band edge -1 Hz is not a finite, non-negative"));
+        assert!(mismatch(BandSpec::Octave { fraction: 0 }).contains("at least one band per octave"));
+        assert!(mismatch(BandSpec::Edges(vec![200.0, 300.0])).contains("no measured line"));
     }
 
     #[test]

@@ -725,7 +725,8 @@ mod tests {
             }
         }
         assert_eq!(got, expected.into_iter().collect::<Vec<_>>(), "sorted by column, then row, without repeats");
-        assert!(with_clique_pairs(&pat, &[vec![2, 9]]).is_err());
+        let e = with_clique_pairs(&pat, &[vec![2, 9]]).unwrap_err();
+        assert!(e.contains(&format!("clique equation 9 is not below {}", pat.n)), "{e}");
     }
 
     #[test]

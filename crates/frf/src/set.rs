@@ -304,8 +304,21 @@ mod tests {
     #[test]
     fn frequencies_must_increase_and_channels_be_distinct() {
         let c = Channel::new(DofRef::new(2, Dof::Uy), DofRef::new(2, Dof::Uy));
-        assert!(FrfSet::zeros(vec![1.0, 1.0], vec![c], FrfKind::Receptance).is_err());
-        assert!(FrfSet::zeros(vec![0.0, 1.0], vec![c], FrfKind::Receptance).is_err());
-        assert!(FrfSet::zeros(vec![1.0, 2.0], vec![c, c], FrfKind::Receptance).is_err());
+        let mismatch = |r: Result<FrfSet, FrfError>| match r {
+            Err(FrfError::Mismatch(m)) => m,
+            other => panic!("expected a mismatch, got {other:?}"),
+        };
+        let m = mismatch(FrfSet::zeros(vec![1.0, 1.0], vec![c], FrfKind::Receptance));
+        assert!(m.contains("must increase strictly, but 1 Hz is followed by 1 Hz"), "{m}");
+        assert_eq!(
+            FrfSet::zeros(vec![0.0, 1.0], vec![c], FrfKind::Receptance).unwrap_err(),
+            FrfError::BadFrequency { freq_hz: 0.0 }
+        );
+        assert_eq!(
+            FrfSet::zeros(vec![1.0, f64::INFINITY], vec![c], FrfKind::Receptance).unwrap_err(),
+            FrfError::BadFrequency { freq_hz: f64::INFINITY }
+        );
+        let m = mismatch(FrfSet::zeros(vec![1.0, 2.0], vec![c, c], FrfKind::Receptance));
+        assert!(m.contains(&format!("channel {c} appears twice")), "{m}");
     }
 }

@@ -56,6 +56,32 @@ pub fn synthesize_with(
     channels: &[Channel],
     freqs_hz: &[f64],
 ) -> Result<FrfSet, FrfError> {
+    Ok(synthesize_lines(sys, solver, channels, freqs_hz, false)?.0)
+}
+
+/// As [`synthesize`], except that a line where `Z` is singular
+/// ([`FrfError::Singular`]) gets NaN values instead of failing the whole
+/// set; those lines (Hz) are returned beside it. For figures of a model that
+/// may be singular at a few lines, such as the result of an updating run
+/// that wandered off (correlations and plots leave non-finite values out).
+pub fn synthesize_regular(
+    sys: &DampedSystem,
+    channels: &[Channel],
+    freqs_hz: &[f64],
+) -> Result<(FrfSet, Vec<f64>), FrfError> {
+    let solver = ZSolver::new(&sys.assembly().pattern)?;
+    synthesize_lines(sys, &solver, channels, freqs_hz, true)
+}
+
+/// The FRFs at every line, and with `lenient` NaN at the singular lines
+/// (listed) instead of an error.
+fn synthesize_lines(
+    sys: &DampedSystem,
+    solver: &ZSolver,
+    channels: &[Channel],
+    freqs_hz: &[f64],
+    lenient: bool,
+) -> Result<(FrfSet, Vec<f64>), FrfError> {
     let mut set = FrfSet::zeros(freqs_hz.to_vec(), channels.to_vec(), FrfKind::Receptance)?;
     let refs = set.references();
     let ref_eqs: Vec<usize> = refs.iter().map(|&r| equation_of(sys, r)).collect::<Result<_, _>>()?;
@@ -64,22 +90,28 @@ pub fn synthesize_with(
         .iter()
         .map(|c| Ok((equation_of(sys, c.response)?, refs.iter().position(|&r| r == c.reference).unwrap())))
         .collect::<Result<_, FrfError>>()?;
-    let lines: Vec<Vec<C64>> = freqs_hz
+    let lines: Vec<Option<Vec<C64>>> = freqs_hz
         .par_iter()
         .map_init(
             || (solver.workspace(), Vec::new()),
-            |(ws, z), &f| {
-                let cols = receptance_columns(sys, solver, ws, z, f, &ref_eqs)?;
-                Ok(picks.iter().map(|&(r, j)| cols[(r, j)]).collect())
+            |(ws, z), &f| match receptance_columns(sys, solver, ws, z, f, &ref_eqs) {
+                Ok(cols) => Ok(Some(picks.iter().map(|&(r, j)| cols[(r, j)]).collect())),
+                Err(FrfError::Singular { .. }) if lenient => Ok(None),
+                Err(e) => Err(e),
             },
         )
         .collect::<Result<_, FrfError>>()?;
+    let mut singular = Vec::new();
     for (k, line) in lines.iter().enumerate() {
-        for (c, &v) in line.iter().enumerate() {
-            set.set(c, k, v);
+        match line {
+            Some(line) => line.iter().enumerate().for_each(|(c, &v)| set.set(c, k, v)),
+            None => {
+                singular.push(freqs_hz[k]);
+                (0..channels.len()).for_each(|c| set.set(c, k, C64::new(f64::NAN, f64::NAN)));
+            }
         }
     }
-    Ok(set)
+    Ok((set, singular))
 }
 
 #[cfg(test)]
@@ -97,5 +129,31 @@ mod tests {
             synthesize(&sys, &[bad], &[10.0]).unwrap_err(),
             FrfError::UnknownDof { dof: DofRef::new(9, Dof::Uy) }
         );
+    }
+
+    /// An undamped spring-mass evaluated exactly on its resonance: the
+    /// strict synthesis refuses the set, the lenient one leaves that line
+    /// out (NaN) and agrees with the strict one everywhere else.
+    #[test]
+    fn only_the_singular_line_is_left_out_of_a_lenient_synthesis() {
+        let mut m = fe_model::Model::new("spring-mass");
+        let g = m.add_group(fe_model::Group::new("g")).unwrap();
+        m.add_node(1, 0.0, 0.0).unwrap();
+        let (k, mass) = (4.0e4, 1.0);
+        m.add_spring("s", 1, None, [k, k, k], g).unwrap();
+        m.add_mass("m", 1, mass, mass, g).unwrap();
+        let sys = DampedSystem::new(m).unwrap();
+        let resonance = (k / mass).sqrt() / (2.0 * std::f64::consts::PI);
+        let lines = [0.5 * resonance, resonance, 1.5 * resonance];
+        let ch = [Channel::new(DofRef::new(1, Dof::Uy), DofRef::new(1, Dof::Uy))];
+        assert_eq!(synthesize(&sys, &ch, &lines).unwrap_err(), FrfError::Singular { freq_hz: resonance });
+        let (set, singular) = synthesize_regular(&sys, &ch, &lines).unwrap();
+        assert_eq!(singular, vec![resonance]);
+        assert!(set.get(0, 1).re.is_nan() && set.get(0, 1).im.is_nan());
+        let regular = synthesize(&sys, &ch, &[lines[0], lines[2]]).unwrap();
+        assert_eq!((set.get(0, 0), set.get(0, 2)), (regular.get(0, 0), regular.get(0, 1)));
+        // receptance of a spring-mass: 1 / (k - w^2 m)
+        let w = 2.0 * std::f64::consts::PI * lines[0];
+        assert!((set.get(0, 0).re - 1.0 / (k - w * w * mass)).abs() < 1e-12 / k);
     }
 }

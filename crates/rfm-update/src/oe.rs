@@ -582,19 +582,7 @@ pub(crate) fn run_with(
     let free = (0..n).filter(|&i| !at_bound[i]).count() + ng;
     let dof = (n_data as f64 - free as f64).max(1.0);
     let sigma2 = final_point.cost_data / dof;
-    let m = n + ng;
-    // directions the data cannot resolve have unbounded variance (the
-    // pseudo-inverse would report zero)
-    let undetermined = sol.undetermined();
-    let covariance = Mat::from_fn(m, m, |i, j| {
-        if i == j && undetermined[i] {
-            f64::INFINITY
-        } else if undetermined[i] || undetermined[j] {
-            0.0
-        } else {
-            sigma2 * sol.scaled_inverse_normal[(i, j)] / (sol.column_norms[i] * sol.column_norms[j])
-        }
-    });
+    let covariance = covariance(&sol, sigma2);
     let gains = (0..ev.refs.len())
         .filter(|_| opts.gains)
         .map(|v| {
@@ -614,6 +602,23 @@ pub(crate) fn run_with(
         singular_values: sol.singular_values.clone(),
         v: sol.v.clone(),
         at_bound,
+    })
+}
+
+/// `sigma2 (J^T J)^+` from the column-scaled SVD of the Jacobian `J`, with
+/// unbounded variance in the directions the data cannot resolve (the
+/// pseudo-inverse would report zero there).
+fn covariance(sol: &lstsq::LstsqSolution, sigma2: f64) -> Mat<f64> {
+    let m = sol.column_norms.len();
+    let undetermined = sol.undetermined();
+    Mat::from_fn(m, m, |i, j| {
+        if i == j && undetermined[i] {
+            f64::INFINITY
+        } else if undetermined[i] || undetermined[j] {
+            0.0
+        } else {
+            sigma2 * sol.scaled_inverse_normal[(i, j)] / (sol.column_norms[i] * sol.column_norms[j])
+        }
     })
 }
 

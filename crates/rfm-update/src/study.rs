@@ -393,10 +393,20 @@ impl Study {
         let mut warnings: Vec<String> = self
             .parameters
             .iter()
-            .zip(&result.at_bound)
-            .zip(&opts.bounds)
-            .filter(|((_, at), _)| **at)
-            .filter_map(|((p, _), b)| b.map(|(lo, hi)| format!("{} ended on its bound [{lo:e}, {hi:e}]", p.name)))
+            .enumerate()
+            .filter(|&(i, _)| result.at_bound[i])
+            .map(|(i, p)| {
+                let (lo, hi) = result.bounds[i];
+                if opts.bounds.get(i).copied().flatten().is_some() {
+                    format!("{} ended on its bound [{lo:e}, {hi:e}]", p.name)
+                } else {
+                    format!(
+                        "{} ended a factor of {:e} from its initial value, the most the RFM allows without bounds of its own: the data do not determine it",
+                        p.name,
+                        rfm::DEFAULT_RANGE
+                    )
+                }
+            })
             .collect();
         warnings.extend(result.unresolved.clone());
         let natural_frequencies_hz = self.frequency_table(&sys);
@@ -528,6 +538,21 @@ impl Study {
             warnings: Vec::new(),
             system: sys,
         })
+    }
+
+    /// RFM options from the case's `[update]` section (iteration limit,
+    /// tolerance; [`Self::run_rfm`] adds the bounds).
+    pub fn rfm_options(&self) -> RfmOptions {
+        let mut opts = RfmOptions::default();
+        if let Some(spec) = self.case.update.as_ref() {
+            if let Some(n) = spec.max_iterations {
+                opts.max_iterations = n as usize;
+            }
+            if let Some(t) = spec.tolerance {
+                opts.tolerance = t;
+            }
+        }
+        opts
     }
 
     /// Output-error options from the case's `[update]` section.

@@ -1,3 +1,4 @@
 //! Integration tests of fe-model.
 
+mod elements;
 mod properties;

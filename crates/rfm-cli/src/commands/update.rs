@@ -40,14 +40,16 @@ pub(crate) fn update(case: &Path, out: Option<&Path>, json: bool, over: &Overrid
         u.frequencies = Some(fe_model::case::FrequencyChoice::Lines(n));
     }
     let method = over.method.as_deref();
-    let spec = study.case.update.as_ref().ok_or("the case has no [update] section")?;
+    if study.case.update.is_none() {
+        return Err("the case has no [update] section".into());
+    }
     let method = match method {
         Some(m) => Method::parse(m).ok_or_else(|| format!("unknown method `{m}` (available: rfm, output-error)"))?,
         None => study.checked_method().map_err(|e| e.to_string())?,
     };
     let lines = study.lines_for(method)?;
     let max_iterations = over.max_iterations.unwrap_or(match method {
-        Method::Rfm => spec.max_iterations.map_or(RfmOptions::default().max_iterations, |n| n as usize),
+        Method::Rfm => study.rfm_options().max_iterations,
         Method::OutputError => study.output_error_options()?.max_iterations,
     });
     print_notes(&study.notes, json)?;
@@ -94,10 +96,7 @@ pub(crate) fn update(case: &Path, out: Option<&Path>, json: bool, over: &Overrid
     };
     let outcome = match method {
         Method::Rfm => {
-            let mut opts = RfmOptions { max_iterations, ..Default::default() };
-            if let Some(t) = spec.tolerance {
-                opts.tolerance = t;
-            }
+            let opts = RfmOptions { max_iterations, ..study.rfm_options() };
             study.run_rfm(&opts, on_iteration)?
         }
         Method::OutputError => {

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use frf::C64;
 use frf::correlation::{BandSpec, correlate};
-use frf::{FrfSet, synthesize};
+use frf::{FrfSet, synthesize, synthesize_regular};
 use rfm_update::oe::Gain;
 use rfm_update::rfm::Status;
 use rfm_update::study::FrequencyTable;
@@ -31,8 +31,18 @@ pub(crate) fn write(study: &Study, outcome: &UpdateOutcome, out: &mut Outputs, c
     let measured = &study.measured;
     let channels = measured.channels();
     let freqs = measured.frequencies_hz();
-    let model = |label: &str, colour, sys: &damping::DampedSystem, gains: &[Gain]| -> Result<ModelFrfs> {
-        let mut frfs = synthesize(sys, channels, freqs)?;
+    // a model singular at a line (an RFM run that wandered off, an undamped
+    // model on a resonance) is shown everywhere else, and the report says where
+    let mut singular = Vec::new();
+    let mut model = |label: &str, colour, sys: &damping::DampedSystem, gains: &[Gain]| -> Result<ModelFrfs> {
+        let (mut frfs, lines) = synthesize_regular(sys, channels, freqs)?;
+        if !lines.is_empty() {
+            singular.push(format!(
+                "The {label}'s dynamic stiffness is singular to working precision at {} Hz: its FRFs there are left \
+                 out of the figures and errors.",
+                lines.iter().map(|&f| super::short(f)).collect::<Vec<_>>().join(", ")
+            ));
+        }
         apply_gains(&mut frfs, gains);
         let correlation = correlate(measured, &frfs, &BandSpec::Auto)?;
         Ok(ModelFrfs { label: label.into(), colour, frfs, correlation })
@@ -56,7 +66,11 @@ pub(crate) fn write(study: &Study, outcome: &UpdateOutcome, out: &mut Outputs, c
     let mut report = Report::new(format!("{}: model updating", study.case.model.title));
     report.subtitle =
         Some(format!("rfm update, {} method, case file {}", method_name(&outcome.method), case_path.display()));
-    report.sections.push(summary(study, outcome, &models));
+    let mut first = summary(study, outcome, &models);
+    for text in singular {
+        first.push(Block::Text(text));
+    }
+    report.sections.push(first);
 
     let mut conv = Section::new("Convergence");
     let residuals: Vec<f64> = outcome.history.iter().map(|r| r.residual).collect();
@@ -137,7 +151,7 @@ fn method_name(m: &str) -> String {
 /// Axis label and caption wording of a method's own misfit.
 fn residual_names(method: &str) -> (&'static str, &'static str) {
     match method {
-        "rfm" => ("Relative residual", "the relative residual |R_FE - R_EX| / |R_EX| at the updating lines"),
+        "rfm" => ("Relative residual", "the RMS of the relative residual |R_FE - R_EX| / |R_EX| at the updating lines"),
         _ => ("RMS weighted residual", "the RMS of the weighted residual at the fitted lines"),
     }
 }

@@ -119,3 +119,35 @@ fn a_wrong_command_line_exits_with_the_usage_code() {
     assert_eq!(out.status.code(), Some(2), "{}", text(&out.stderr));
     assert!(text(&out.stderr).contains("--no-such-flag"));
 }
+
+/// The text block that follows the first `rfm ...` command containing
+/// `command` in a markdown document.
+fn printed_after(doc: &str, command: &str) -> Vec<String> {
+    let start = doc.find(command).unwrap_or_else(|| panic!("the document shows no `{command}`"));
+    let rest = &doc[start..];
+    let block = &rest[rest.find("```text\n").expect("a text block follows") + 8..];
+    block[..block.find("```").unwrap()].lines().map(str::to_string).collect()
+}
+
+/// The update output the walkthrough shows (step 4) is what the command
+/// prints: every line of it appears, in order, in `rfm update`'s output for
+/// the case it names. A figure in the docs that no command prints fails
+/// here.
+#[test]
+fn the_walkthrough_shows_what_rfm_update_prints() {
+    let doc =
+        std::fs::read_to_string(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../docs/walkthrough.md")).unwrap();
+    let shown = printed_after(&doc, "rfm update cases/tutorial/l-frame-guess.toml");
+    assert!(shown.len() > 10, "{shown:?}");
+    let dir = tempfile::tempdir().unwrap();
+    let out = rfm(&["update", case("tutorial/l-frame-guess").to_str().unwrap(), "--out", dir.path().to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let printed = text(&out.stdout);
+    let mut lines = printed.lines();
+    for line in shown.iter().filter(|l| !l.is_empty()) {
+        assert!(
+            lines.any(|p| p == line),
+            "the walkthrough shows\n{line}\nwhich rfm update does not print (in this order):\n{printed}"
+        );
+    }
+}

@@ -355,3 +355,18 @@ fn compare_reads_each_mode_of_a_damping_only_error_as_damping() {
     let html = read(&dir.path().join("report.html"));
     assert!(html.contains("Modes") && html.contains("a damping error"));
 }
+
+/// The RFM diverges on the f-frame twin and leaves a model whose dynamic
+/// stiffness is singular to working precision near one of its resonances.
+/// The run still ends with its results and a report (the figures leave that
+/// line out and say so), instead of failing after the results were written.
+#[test]
+fn a_diverged_rfm_run_still_writes_its_report() {
+    let dir = tempfile::tempdir().unwrap();
+    let out =
+        rfm(&["update", case("f-frame").to_str().unwrap(), "--method", "rfm", "--out", dir.path().to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let json: serde_json::Value = serde_json::from_str(&read(&dir.path().join("results.json"))).unwrap();
+    assert_eq!(json["status"], "stalled");
+    check_self_contained(&read(&dir.path().join("report.html")));
+}

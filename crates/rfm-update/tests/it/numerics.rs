@@ -61,3 +61,26 @@ fn rfm_keeps_a_parameter_within_its_bounds_and_says_it_ended_on_one() {
     assert!(outcome.warnings.is_empty(), "{:?}", outcome.warnings);
     assert!((outcome.parameters[0].updated / 1e-5 - 1.0).abs() < 1e-6);
 }
+
+/// From the paper's start the RFM diverges on the f-frame twin (three joints
+/// whose stiffness, damping and relaxation the equation error cannot
+/// separate). Without bounds of their own its parameters ran off to 1e16
+/// and more. Each now stays within a factor of 1e6 of its start, and is
+/// flagged when it ends there.
+#[test]
+fn rfm_keeps_parameters_the_data_do_not_determine_within_a_factor_of_a_million() {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases/f-frame.toml");
+    let study = Study::load(&path).unwrap();
+    let outcome = study.run_rfm(&study.rfm_options(), |_| {}).unwrap();
+    let mut flagged = 0;
+    for p in &outcome.parameters {
+        let factor = p.updated / p.initial;
+        assert!((1e-6 * (1.0 - 1e-12)..=1e6 * (1.0 + 1e-12)).contains(&factor), "{}: {factor:e}", p.name);
+        if (factor.ln().abs() - 1e6f64.ln()).abs() < 1e-9 {
+            flagged += 1;
+            let named = outcome.warnings.iter().any(|w| w.starts_with(&format!("{} ended a factor of 1e6", p.name)));
+            assert!(named, "{} ends on its default bound unflagged: {:?}", p.name, outcome.warnings);
+        }
+    }
+    assert!(flagged > 0, "the RFM no longer diverges here: {:?}", outcome.parameters);
+}

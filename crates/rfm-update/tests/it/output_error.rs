@@ -98,3 +98,82 @@ fn band_weights_of_zero_mask_corrupted_lines() {
     }
     assert_eq!(r.n_data, 2 * data.channels().len() * (nf - bad.len()));
 }
+
+/// Inverse of a small symmetric positive definite matrix by Gauss-Jordan
+/// elimination (the test's own, independent of the solver's SVD).
+fn inverse(a: &[Vec<f64>]) -> Vec<Vec<f64>> {
+    let n = a.len();
+    let mut m: Vec<Vec<f64>> = a
+        .iter()
+        .enumerate()
+        .map(|(i, row)| row.iter().copied().chain((0..n).map(|j| f64::from(i == j))).collect())
+        .collect();
+    for c in 0..n {
+        let p = m[c][c];
+        m[c].iter_mut().for_each(|v| *v /= p);
+        for r in (0..n).filter(|&r| r != c) {
+            let f = m[r][c];
+            let pivot_row = m[c].clone();
+            m[r].iter_mut().zip(&pivot_row).for_each(|(v, pv)| *v -= f * pv);
+        }
+    }
+    m.into_iter().map(|row| row[n..].to_vec()).collect()
+}
+
+/// The covariance of the log-parameters the fit reports is the Gauss-Newton
+/// one, `s^2 (J^T J)^-1` with `s^2 = cost / (n - m)`, built here from
+/// scratch: the residuals `ln(H / M)` (real and imaginary parts) of
+/// synthesised FRFs and their Jacobian by central differences in `ln p`. A
+/// covariance scaled wrongly (doubled, or with the wrong number of degrees
+/// of freedom) fails; so does one from a wrong Jacobian.
+#[test]
+fn covariance_is_the_gauss_newton_one_with_a_finite_difference_jacobian() {
+    let truth = DampedSystem::new(samples::two_material_cantilever()).unwrap();
+    let data = beam_data(&truth, 0.01);
+    let (mut model, params) = perturbed(&truth);
+    let opts = OeOptions { misfit: Misfit::Log, ..OeOptions::default() };
+    let fit = oe::run(&mut model, &params, &OeData { measured: &data, weights: None }, &opts, |_| {}).unwrap();
+    assert_eq!(fit.status, Status::Converged);
+    assert!(fit.at_bound.iter().all(|b| !b));
+    let residuals = |values: &[f64]| -> Vec<f64> {
+        let mut sys = model.clone();
+        params.set_values(&mut sys, values).unwrap();
+        let h = synthesize(&sys, data.channels(), data.frequencies_hz()).unwrap();
+        h.values().iter().zip(data.values()).flat_map(|(h, m)| [(h / m).ln().re, (h / m).ln().im]).collect()
+    };
+    let r0 = residuals(&fit.values);
+    let (n, m) = (r0.len(), fit.values.len());
+    assert_eq!(n, fit.n_data);
+    let cost: f64 = r0.iter().map(|r| r * r).sum();
+    assert!((cost / fit.cost - 1.0).abs() < 1e-9, "cost {cost} vs the fit's {}", fit.cost);
+    let s2 = cost / (n - m) as f64;
+    // about the injected noise: 1 % relative per complex value, so 0.01^2 / 2 per real residual
+    assert!((s2 / (0.01f64.powi(2) / 2.0) - 1.0).abs() < 0.1, "s^2 {s2}");
+    let step = 1e-5;
+    let jacobian: Vec<Vec<f64>> = (0..m)
+        .map(|i| {
+            let at = |sign: f64| {
+                let mut v = fit.values.clone();
+                v[i] *= (sign * step).exp();
+                residuals(&v)
+            };
+            let (plus, minus) = (at(1.0), at(-1.0));
+            plus.iter().zip(&minus).map(|(p, q)| (p - q) / (2.0 * step)).collect()
+        })
+        .collect();
+    let normal: Vec<Vec<f64>> = (0..m)
+        .map(|i| (0..m).map(|j| jacobian[i].iter().zip(&jacobian[j]).map(|(a, b)| a * b).sum()).collect())
+        .collect();
+    let inv = inverse(&normal);
+    for i in 0..m {
+        for j in 0..m {
+            let expect = s2 * inv[i][j];
+            let scale = s2 * (inv[i][i] * inv[j][j]).sqrt();
+            assert!(
+                (fit.covariance[(i, j)] - expect).abs() <= 1e-4 * scale,
+                "C[{i}][{j}] = {} vs {expect} from finite differences",
+                fit.covariance[(i, j)]
+            );
+        }
+    }
+}

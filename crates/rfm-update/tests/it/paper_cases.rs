@@ -3,18 +3,22 @@
 use std::path::PathBuf;
 
 use rfm_update::Study;
-use rfm_update::rfm::{RfmOptions, Status};
+use rfm_update::rfm::Status;
 
 fn case(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases").join(format!("{name}.toml"))
 }
 
 /// Table 1 of Arora, Adhikari and Vijayan (2023): the RFM recovers the true
-/// damping of the two-material beam from the paper's initial values.
+/// damping of the two-material beam from the paper's initial values, with
+/// the case's own options (as `rfm update` runs it). It reaches about 1e-10,
+/// where the round-off of the computed FRFs stops it; 1e-8 leaves room for
+/// that round-off to move, and none for a real loss of accuracy (unweighted
+/// equations stopped at 2e-7).
 #[test]
 fn two_material_beam_recovers_table_1_exactly() {
     let study = Study::load(&case("two-material-beam")).unwrap();
-    let outcome = study.run_rfm(&RfmOptions::default(), |_| {}).unwrap();
+    let outcome = study.run_rfm(&study.rfm_options(), |_| {}).unwrap();
     assert_eq!(outcome.status, Status::Converged);
     let table1 = [
         ("group.steel.mu", 631.12),
@@ -27,7 +31,7 @@ fn two_material_beam_recovers_table_1_exactly() {
     for (name, value) in table1 {
         let p = outcome.parameters.iter().find(|p| p.name == name).unwrap();
         let err = ((p.updated - value) / value).abs();
-        assert!(err < 1e-6, "{name}: updated {} vs Table 1 {value} (relative error {err:.1e})", p.updated);
+        assert!(err < 1e-8, "{name}: updated {} vs Table 1 {value} (relative error {err:.1e})", p.updated);
         assert_eq!(p.paper, Some(value));
     }
     assert!(outcome.history.len() <= 12, "took {} iterations", outcome.history.len() - 1);
@@ -36,7 +40,7 @@ fn two_material_beam_recovers_table_1_exactly() {
 #[test]
 fn monopile_recovers_the_submerged_relaxation_parameter_from_a_viscous_start() {
     let study = Study::load(&case("monopile")).unwrap();
-    let outcome = study.run_rfm(&RfmOptions::default(), |_| {}).unwrap();
+    let outcome = study.run_rfm(&study.rfm_options(), |_| {}).unwrap();
     assert_eq!(outcome.status, Status::Converged);
     let p = &outcome.parameters[0];
     assert!(p.relative_error().unwrap() < 1e-5, "{p:?}");
@@ -54,6 +58,9 @@ fn every_paper_case_loads_and_has_truth_and_parameters() {
     ] {
         let study = Study::load(&case(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
         assert!(study.truth.is_some(), "{name}");
+        // its acceptance, which `cargo xtask reproduce` holds its runs to
+        let check = study.case.check.as_ref().unwrap_or_else(|| panic!("{name} has no [check]"));
+        assert!(check.rfm.is_some() || check.output_error.is_some(), "{name}: {check:?}");
         assert!(!study.parameters.is_empty(), "{name}");
         assert!(!study.update_frequencies_hz.is_empty(), "{name}");
         // the chosen lines are lines of the data and avoid its resonances

@@ -389,4 +389,175 @@ mod tests {
         let deep = format!("{}m{}", "(".repeat(16), "^99)".repeat(16));
         assert_eq!(dims(&deep).map(|d| d.0), Some(i32::MAX));
     }
+
+    use super::super::{DataAxis, OrdinateType, TestDof};
+
+    /// An FRF header: response over reference, abscissa, numerator and
+    /// denominator axes as given.
+    fn header(response: Direction, reference: Direction, abscissa: DataAxis, num: DataAxis, den: DataAxis) -> Header58 {
+        Header58 {
+            ids: Default::default(),
+            function_type: 4,
+            function_id: 1,
+            version: 0,
+            load_case: 0,
+            response_entity: "NONE".into(),
+            response: TestDof::new(5, response),
+            reference_entity: "NONE".into(),
+            reference: TestDof::new(9, reference),
+            ordinate_type: OrdinateType::ComplexDouble,
+            z_value: 0.0,
+            abscissa_axis: abscissa,
+            numerator: num,
+            denominator: den,
+            z_axis: DataAxis::none(),
+        }
+    }
+
+    fn with_abscissa(t: i64, units: &str) -> Header58 {
+        header(
+            Direction::Y,
+            Direction::Y,
+            DataAxis::new(t, "x", units),
+            DataAxis::new(12, "a", "m/s^2"),
+            DataAxis::new(13, "f", "N"),
+        )
+    }
+
+    #[test]
+    fn every_known_unit_has_its_si_scale() {
+        let length = [
+            ("m", 1.0),
+            ("mm", 1e-3),
+            ("cm", 1e-2),
+            ("um", 1e-6),
+            ("µm", 1e-6),
+            ("micron", 1e-6),
+            ("in", 0.0254),
+            ("ft", 0.3048),
+        ];
+        for (name, scale) in length {
+            assert_eq!(unit(name), Some(Dim { l: 1, f: 0, t: 0, scale }), "{name}");
+        }
+        for (name, scale) in [("s", 1.0), ("sec", 1.0), ("ms", 1e-3)] {
+            assert_eq!(unit(name), Some(Dim { l: 0, f: 0, t: 1, scale }), "{name}");
+        }
+        for (name, scale) in [("N", 1.0), ("kN", 1e3), ("mN", 1e-3), ("lbf", LBF), ("lb", LBF), ("kgf", G0)] {
+            assert_eq!(unit(name), Some(Dim { l: 0, f: 1, t: 0, scale }), "{name}");
+        }
+        // a kilogram is a newton per (m/s^2); g is the standard gravity
+        assert_eq!(unit("kg"), Some(Dim { l: -1, f: 1, t: 2, scale: 1.0 }));
+        assert_eq!(unit("g"), Some(Dim { l: 1, f: 0, t: -2, scale: G0 }));
+        assert_eq!(unit("deg"), Some(Dim { l: 0, f: 0, t: 0, scale: PI / 180.0 }));
+        assert_eq!(unit("Hz"), Some(Dim { l: 0, f: 0, t: -1, scale: 1.0 }));
+        assert_eq!(unit("furlong"), None);
+    }
+
+    #[test]
+    fn the_abscissa_becomes_hertz_or_is_refused_as_time() {
+        assert_eq!(abscissa_to_hz(&with_abscissa(18, "Hz")), Ok((1.0, false)));
+        assert_eq!(abscissa_to_hz(&with_abscissa(18, "kHz")), Ok((1e3, false)));
+        assert_eq!(abscissa_to_hz(&with_abscissa(18, "rad/s")), Ok((1.0 / (2.0 * PI), false)));
+        assert_eq!(abscissa_to_hz(&with_abscissa(18, "rad / sec")), Ok((1.0 / (2.0 * PI), false)));
+        // no units: hertz is assumed for a frequency or an unknown type only
+        assert_eq!(abscissa_to_hz(&with_abscissa(18, "NONE")), Ok((1.0, true)));
+        assert_eq!(abscissa_to_hz(&with_abscissa(0, "")), Ok((1.0, true)));
+        let e = abscissa_to_hz(&with_abscissa(17, "NONE")).unwrap_err();
+        assert!(e.contains("the abscissa is time (`NONE`)"), "{e}");
+        for time in ["s", "ms", "sec"] {
+            let e = abscissa_to_hz(&with_abscissa(0, time)).unwrap_err();
+            assert!(e.contains(&format!("the abscissa is time (`{time}`)")), "{e}");
+        }
+        let e = abscissa_to_hz(&with_abscissa(1, "NONE")).unwrap_err();
+        assert!(e.contains("are not a frequency"), "{e}");
+    }
+
+    #[test]
+    fn units_labels_decide_the_kind_and_the_scale() {
+        let y = Direction::Y;
+        let kind = |num: &str, den: &str| {
+            frf_units(&header(
+                y,
+                y,
+                DataAxis::new(18, "f", "Hz"),
+                DataAxis::new(0, "r", num),
+                DataAxis::new(0, "e", den),
+            ))
+        };
+        let u = kind("g", "lbf").unwrap();
+        assert_eq!((u.kind, u.assumed_si), (FrfKind::Accelerance, false));
+        assert!((u.scale - G0 / LBF).abs() < 1e-15);
+        assert_eq!(kind("mm/s", "N").unwrap().kind, FrfKind::Mobility);
+        let u = kind("m/N", "NONE").unwrap();
+        assert_eq!((u.kind, u.basis.as_str()), (FrfKind::Receptance, "`m/N`"));
+        // a response with no denominator units is per newton, assumed unless a force type says so
+        let u = kind("m/s^2", "NONE").unwrap();
+        assert_eq!((u.kind, u.scale, u.assumed_si), (FrfKind::Accelerance, 1.0, true));
+        assert!(u.basis.contains("per N assumed"), "{}", u.basis);
+        let stated = frf_units(&header(
+            y,
+            y,
+            DataAxis::new(18, "f", "Hz"),
+            DataAxis::new(0, "r", "m/s^2"),
+            DataAxis::new(13, "F", "NONE"),
+        ))
+        .unwrap();
+        assert!(!stated.assumed_si, "{stated:?}");
+        assert_eq!(stated.basis, format!("`m/s^2` / {}", specific_data_type_name(13)));
+        // a moment as reference takes one more length: rotation over moment is rad/(N m)
+        let rz = Direction::RZ;
+        let u = frf_units(&header(
+            rz,
+            rz,
+            DataAxis::new(18, "f", "Hz"),
+            DataAxis::new(0, "r", "rad"),
+            DataAxis::new(0, "M", "N*m"),
+        ))
+        .unwrap();
+        assert_eq!(u.kind, FrfKind::Receptance);
+        let e = frf_units(&header(
+            y,
+            rz,
+            DataAxis::new(18, "f", "Hz"),
+            DataAxis::new(0, "r", "m"),
+            DataAxis::new(0, "F", "N"),
+        ))
+        .unwrap_err();
+        assert!(e.contains("expected displacement, velocity or acceleration per moment"), "{e}");
+        let e = kind("m*s", "N").unwrap_err();
+        assert!(e.contains("are not those of an FRF"), "{e}");
+    }
+
+    #[test]
+    fn data_types_decide_the_kind_when_there_are_no_units() {
+        let y = Direction::Y;
+        let by_types = |num: i64, den: i64| {
+            frf_units(&header(
+                y,
+                y,
+                DataAxis::new(18, "f", "Hz"),
+                DataAxis::new(num, "r", "NONE"),
+                DataAxis::new(den, "e", "NONE"),
+            ))
+        };
+        for (num, kind) in [(8, FrfKind::Receptance), (11, FrfKind::Mobility), (12, FrfKind::Accelerance)] {
+            for den in [0, 1, 9, 13] {
+                let u = by_types(num, den).unwrap();
+                assert_eq!((u.kind, u.scale, u.assumed_si), (kind, 1.0, true), "types {num}/{den}");
+            }
+        }
+        let e = by_types(12, 8).unwrap_err();
+        assert!(e.contains("are not a response over a force"), "{e}");
+        assert!(by_types(3, 13).unwrap_err().contains("cannot tell whether the FRF is a receptance"));
+        // units and types that disagree are refused
+        let e = frf_units(&header(
+            y,
+            y,
+            DataAxis::new(18, "f", "Hz"),
+            DataAxis::new(11, "v", "m/s^2"),
+            DataAxis::new(13, "F", "N"),
+        ))
+        .unwrap_err();
+        assert!(e.contains("but the data types"), "{e}");
+    }
 }

@@ -1,0 +1,184 @@
+//! `cargo xtask bench`: quick versions of the sensitivity benchmarks, each
+//! configuration in its own process, then the whole diagnosis end to end.
+
+use std::path::Path;
+use std::process::Command;
+
+/// One `bench_point` run: what the table shows about it.
+struct Point {
+    name: String,
+    json: serde_json::Value,
+}
+
+impl Point {
+    fn num(&self, key: &str) -> f64 {
+        self.json[key].as_f64().unwrap_or(f64::NAN)
+    }
+}
+
+fn bench_point(exe: &Path, name: &str, args: &[&str]) -> Result<Point, String> {
+    let out = Command::new(exe).args(args).output().map_err(|e| format!("cannot run {}: {e}", exe.display()))?;
+    if !out.status.success() {
+        return Err(format!(
+            "{name}: bench_point {} failed:\n{}",
+            args.join(" "),
+            String::from_utf8_lossy(&out.stderr)
+        ));
+    }
+    let text = String::from_utf8_lossy(&out.stdout);
+    let line = text.lines().last().ok_or_else(|| format!("{name}: no output"))?;
+    let json = serde_json::from_str(line).map_err(|e| format!("{name}: {e} in {line}"))?;
+    Ok(Point { name: name.to_string(), json })
+}
+
+/// Least-squares slope of log(y) against log(x).
+fn loglog_slope(points: &[(f64, f64)]) -> f64 {
+    let n = points.len() as f64;
+    let (lx, ly): (Vec<f64>, Vec<f64>) = points.iter().map(|&(x, y)| (x.ln(), y.ln())).unzip();
+    let (mx, my) = (lx.iter().sum::<f64>() / n, ly.iter().sum::<f64>() / n);
+    let sxy: f64 = lx.iter().zip(&ly).map(|(x, y)| (x - mx) * (y - my)).sum();
+    let sxx: f64 = lx.iter().map(|x| (x - mx) * (x - mx)).sum();
+    sxy / sxx
+}
+
+fn first_line(path: &str, prefix: &str) -> Option<String> {
+    let text = std::fs::read_to_string(path).ok()?;
+    let line = text.lines().find(|l| l.starts_with(prefix))?;
+    Some(line.split_once(':').map_or(line, |(_, v)| v).trim().to_string())
+}
+
+fn machine() -> String {
+    let cpus = std::thread::available_parallelism().map_or(0, |n| n.get());
+    let model = first_line("/proc/cpuinfo", "model name").unwrap_or_else(|| "unknown CPU".into());
+    let mem = first_line("/proc/meminfo", "MemTotal").unwrap_or_default();
+    format!("{cpus} CPUs ({model}), {mem} memory")
+}
+
+fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_else(|_| "unknown".into())
+}
+
+/// Builds an example of rfm-update in release mode; returns its path.
+fn release_example(name: &str) -> Result<std::path::PathBuf, String> {
+    crate::release_build(&["-p", "rfm-update", "--example", name], name)
+}
+
+pub(crate) fn bench(args: &[String]) -> Result<(), String> {
+    let full = args.iter().any(|a| a == "--full");
+    let exe = release_example("bench_point")?;
+    let reps = |quick: u32, more: u32| if full { more } else { quick }.to_string();
+    println!("machine: {}", machine());
+    println!("load average before: {}", load_average());
+
+    // the benchmark configurations (a)-(d), quick versions
+    let (r_a, r_b, r_c) = (reps(20, 100), reps(5, 20), reps(2, 5));
+    let mut rows = Vec::new();
+    rows.push(bench_point(&exe, "(a) paper beam", &["--model", "paper", "--repeat", &r_a])?);
+    let common = ["--params", "30", "--measured", "20"];
+    let b_fast = ["--model", "beam:690", "--freqs", "20", "--repeat", &r_b];
+    rows.push(bench_point(&exe, "(b) 2k beam, sparse", &[&b_fast[..], &common[..]].concat())?);
+    let b_dense = ["--model", "beam:690", "--freqs", "1", "--repeat", "1", "--naive"];
+    rows.push(bench_point(&exe, "(b) 2k beam, dense", &[&b_dense[..], &common[..]].concat())?);
+    let c = ["--model", "beam:34483", "--freqs", "10", "--repeat", &r_c];
+    rows.push(bench_point(&exe, "(c) 100k beam", &[&c[..], &common[..]].concat())?);
+    let d = ["--model", "frame:10x11x15", "--params", "1000", "--measured", "20", "--freqs", "200", "--repeat", "1"];
+    rows.push(bench_point(&exe, "(d) diagnosis frame", &d)?);
+
+    // scaling in N at 30 parameters, and in parameters at 10k equations
+    let mut in_n = Vec::new();
+    for elements in [4310, 8620, 17_241, 34_483] {
+        let model = format!("beam:{elements}");
+        let a = ["--model", &model, "--freqs", "10", "--repeat", &r_c];
+        in_n.push(bench_point(&exe, &format!("N sweep, {elements} elements"), &[&a[..], &common[..]].concat())?);
+    }
+    let mut in_p = Vec::new();
+    for params in [30, 100, 300, 1000] {
+        let p = params.to_string();
+        let a = ["--model", "frame:10x11x15", "--params", &p, "--measured", "20", "--freqs", "20", "--repeat", &r_b];
+        in_p.push(bench_point(&exe, &format!("parameter sweep, {params}"), &a)?);
+    }
+    println!("load average after: {}", load_average());
+
+    println!(
+        "\n{:<26} {:>8} {:>7} {:>6} {:>13} {:>13} {:>10} {:>10}",
+        "configuration", "DOFs", "params", "lines", "ms per line", "CPU ms/line", "total s", "peak MiB"
+    );
+    for p in rows.iter().chain(&in_n).chain(&in_p) {
+        println!(
+            "{:<26} {:>8} {:>7} {:>6} {:>13.3} {:>13.3} {:>10.3} {:>10.1}",
+            p.name,
+            p.num("dofs"),
+            p.num("params"),
+            p.num("freqs"),
+            p.num("ms_per_freq"),
+            p.num("cpu_ms_per_freq"),
+            p.num("seconds"),
+            p.num("peak_kib") / 1024.0,
+        );
+    }
+    let ratio = rows[2].num("ms_per_freq") / rows[1].num("ms_per_freq");
+    println!("\n(b) dense / sparse time per line: {ratio:.0}x");
+    // exponents from wall time and from CPU time (all threads), which a
+    // busy machine disturbs less
+    let fit = |points: &[Point], x: &str, y: &str| {
+        loglog_slope(&points.iter().map(|p| (p.num(x), p.num(y))).collect::<Vec<_>>())
+    };
+    println!(
+        "time per line ~ N^{:.2} (wall), N^{:.2} (CPU): long beam, 30 parameters, 12.5k-100k DOFs",
+        fit(&in_n, "dofs", "ms_per_freq"),
+        fit(&in_n, "dofs", "cpu_ms_per_freq")
+    );
+    println!(
+        "time per line ~ P^{:.2} (wall), P^{:.2} (CPU): 10k-DOF frame, 30-1000 parameters",
+        fit(&in_p, "params", "ms_per_freq"),
+        fit(&in_p, "params", "cpu_ms_per_freq")
+    );
+    let (p0, p1) = (&in_p[0], &in_p[in_p.len() - 1]);
+    let marginal = |y: &str| 1e3 * (p1.num(y) - p0.num(y)) / (p1.num("params") - p0.num("params"));
+    println!(
+        "marginal cost per parameter per line: {:.2} us (wall), {:.2} us (CPU)",
+        marginal("ms_per_freq"),
+        marginal("cpu_ms_per_freq")
+    );
+    println!("(wall: best run, rayon over lines; CPU: that run's time on the CPU summed over threads)");
+
+    // (d) above is the diagnosis's sensitivity workload, one linearised pass
+    // over 1,000 candidate parameters; the diagnosis itself fits every
+    // candidate nonlinearly (by low-rank updates of the nominal model):
+    // measured here end to end
+    let exe = release_example("diagnose_point")?;
+    println!("\nwhole diagnosis (nonlinear fit of every candidate), a 40 % stiffness loss hidden in one element:");
+    println!(
+        "{:<30} {:>6} {:>11} {:>6} {:>10} {:>9}  leader",
+        "configuration", "DOFs", "candidates", "lines", "total s", "peak MiB"
+    );
+    let mut wrong = Vec::new();
+    for frame in ["3x3x4", "5x5x5", "8x8x8", "10x11x15"] {
+        let p = bench_point(&exe, &format!("frame {frame}"), &["--frame", frame])?;
+        let right = p.json["found"].as_bool() == Some(true);
+        if !right {
+            wrong.push(format!(
+                "frame {frame}: the diagnosis ranked \"{}\" first",
+                p.json["leader"].as_str().unwrap_or("?")
+            ));
+        }
+        let found = if right { "(right)" } else { "(WRONG)" };
+        println!(
+            "{:<30} {:>6} {:>11} {:>6} {:>10.2} {:>9.1}  {} {found}",
+            p.json["label"].as_str().unwrap_or("?"),
+            p.num("dofs"),
+            p.num("candidates"),
+            p.num("freqs"),
+            p.num("seconds"),
+            p.num("peak_kib") / 1024.0,
+            p.json["leader"].as_str().unwrap_or("?"),
+        );
+    }
+    // a diagnosis that misses the hidden effect is a failure, however fast
+    if !wrong.is_empty() {
+        return Err(format!("the diagnosis named the wrong effect:\n  {}", wrong.join("\n  ")));
+    }
+    Ok(())
+}

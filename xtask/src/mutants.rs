@@ -1,0 +1,224 @@
+//! `cargo xtask mutants`: does each numerical module's test suite catch
+//! wrong equations?
+//!
+//! - `cargo xtask mutants` runs cargo-mutants (`cargo install cargo-mutants`)
+//!   with `.cargo/mutants.toml`: the numerical modules only (element
+//!   matrices, the damping kernel, `Z` and its derivatives, the
+//!   sensitivities, the low-rank (Woodbury) update of the diagnosis, the FRF
+//!   kind and unit conversions, the least squares and the covariance), each
+//!   mutant tested by its own crate's unit and integration tests. Results go
+//!   to `<target>/mutants.out` (`missed.txt` lists the survivors). Further
+//!   arguments go to cargo-mutants: `--list` to see the mutants, `--iterate`
+//!   to retest only those not caught last time, `-f FILE` to narrow the run.
+//!   A whole run takes hours on two cores.
+//! - `cargo xtask mutants --classic` plants the classic equation bugs that
+//!   cargo-mutants does not generate (it changes operators and return
+//!   values, not coefficients), one at a time in a copy of the workspace,
+//!   and fails unless the owning crate's tests catch each: a sign in the
+//!   kernel derivative, a consistent-mass coefficient, the sign of the
+//!   Woodbury update, the accelerance conversion, the covariance scale. It
+//!   takes minutes.
+//!
+//! Both skip one test, the hidden-effect study of rfm-update: it takes a
+//! minute or more per run, and the low-rank update it exercises is checked
+//! directly against whole candidate models by
+//! `diagnose::local::tests::low_rank_updates_equal_the_candidate_models`
+//! (for cargo-mutants the skip is in `.cargo/mutants.toml`).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+/// The test that `--classic` leaves out (see the module docs).
+const SLOW_TEST: &str = "hidden_effects::diagnosis_names_hidden_effects_and_updating_recovers_them";
+
+/// A bug planted by hand: `from` becomes `to` everywhere in `file`.
+struct Bug {
+    what: &'static str,
+    package: &'static str,
+    file: &'static str,
+    from: &'static str,
+    to: &'static str,
+}
+
+/// The classic equation bugs of issue 15; each must fail its crate's tests.
+const CLASSIC: [Bug; 5] = [
+    Bug {
+        what: "sign of the relaxation-parameter derivative of the kernel",
+        package: "damping",
+        file: "crates/damping/src/kernel.rs",
+        from: "let c = J * omega * (J * omega * mu) / (den * den);",
+        to: "let c = -J * omega * (J * omega * mu) / (den * den);",
+    },
+    Bug {
+        what: "consistent mass coefficient 13L changed to 12L (kept symmetric)",
+        package: "fe-model",
+        file: "crates/fe-model/src/element.rs",
+        from: " 13.0 * l, ",
+        to: " 12.0 * l, ",
+    },
+    Bug {
+        what: "sign of the Woodbury (low-rank) update of a candidate's receptance",
+        package: "rfm-update",
+        file: "crates/rfm-update/src/diagnose/local.rs",
+        from: "h[c] -= (0..d).map(|i| x[i * k + r] * w.col[i]).sum::<C64>();",
+        to: "h[c] += (0..d).map(|i| x[i * k + r] * w.col[i]).sum::<C64>();",
+    },
+    Bug {
+        what: "accelerance conversion +w^2 instead of -w^2",
+        package: "frf",
+        file: "crates/frf/src/set.rs",
+        from: "FrfKind::Accelerance => C64::new(-omega * omega, 0.0),",
+        to: "FrfKind::Accelerance => C64::new(omega * omega, 0.0),",
+    },
+    Bug {
+        what: "covariance doubled",
+        package: "rfm-update",
+        file: "crates/rfm-update/src/oe.rs",
+        from: "sigma2 * sol.scaled_inverse_normal[(i, j)]",
+        to: "2.0 * sigma2 * sol.scaled_inverse_normal[(i, j)]",
+    },
+];
+
+pub(crate) fn mutants(args: &[String]) -> Result<(), String> {
+    if args.iter().any(|a| a == "--classic") {
+        return classic();
+    }
+    let installed = crate::cargo().args(["mutants", "--version"]).stdout(Stdio::null()).stderr(Stdio::null()).status();
+    if !installed.is_ok_and(|s| s.success()) {
+        return Err("cargo-mutants is not installed: cargo install cargo-mutants".into());
+    }
+    let target = crate::target_dir()?;
+    // the filters and the test that is skipped are in .cargo/mutants.toml,
+    // so that a plain `cargo mutants` does the same
+    let mut cmd = crate::cargo();
+    cmd.current_dir(crate::root()).arg("mutants").arg("--output").arg(&target).args(args);
+    let status = cmd.status().map_err(|e| format!("cannot run cargo mutants: {e}"))?;
+    println!("results: {}", target.join("mutants.out").display());
+    // cargo-mutants exits non-zero when a mutant survived: pass that on
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!("cargo mutants: {status} (survivors in mutants.out/missed.txt)"))
+    }
+}
+
+/// Every file a test may read, copied into `dest` (not `target/`, `.git/`
+/// or the fuzzing workspace).
+fn copy_workspace(from: &Path, dest: &Path) -> Result<(), String> {
+    std::fs::create_dir_all(dest).map_err(|e| format!("{}: {e}", dest.display()))?;
+    for entry in ["Cargo.toml", "Cargo.lock", ".cargo", "crates", "xtask", "cases", "docs", "README.md"] {
+        copy_tree(&from.join(entry), &dest.join(entry))?;
+    }
+    Ok(())
+}
+
+fn copy_tree(from: &Path, to: &Path) -> Result<(), String> {
+    let err = |e: std::io::Error| format!("copying {} to {}: {e}", from.display(), to.display());
+    if from.is_dir() {
+        std::fs::create_dir_all(to).map_err(err)?;
+        for entry in std::fs::read_dir(from).map_err(err)? {
+            let entry = entry.map_err(err)?;
+            copy_tree(&entry.path(), &to.join(entry.file_name()))?;
+        }
+    } else if from.exists() {
+        std::fs::copy(from, to).map_err(err)?;
+    }
+    Ok(())
+}
+
+/// Plants each bug of [`CLASSIC`] in turn in a copy of the workspace and
+/// runs the owning crate's tests (sharing cargo's target directory, where
+/// the copy's crates build beside the original's).
+fn classic() -> Result<(), String> {
+    let target = crate::target_dir()?;
+    let copy = target.join("mutants-classic").join("workspace");
+    if copy.exists() {
+        std::fs::remove_dir_all(&copy).map_err(|e| format!("{}: {e}", copy.display()))?;
+    }
+    copy_workspace(&crate::root(), &copy)?;
+    let mut missed = Vec::new();
+    for bug in &CLASSIC {
+        let path = copy.join(bug.file);
+        let original = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let planted = plant(&original, bug)?;
+        std::fs::write(&path, &planted).map_err(|e| format!("{}: {e}", path.display()))?;
+        println!("\n{} ({}): {}", bug.what, bug.package, bug.file);
+        let result = run_tests(&copy, &target, bug.package);
+        std::fs::write(&path, &original).map_err(|e| format!("{}: {e}", path.display()))?;
+        let (passed, failing) = result?;
+        if passed {
+            println!("  MISSED: every test of {} passes", bug.package);
+            missed.push(bug.what);
+        } else {
+            println!("  caught by {}", failing.join(", "));
+        }
+    }
+    if missed.is_empty() {
+        println!("\nall {} classic bugs are caught", CLASSIC.len());
+        Ok(())
+    } else {
+        Err(format!("no test catches: {}", missed.join("; ")))
+    }
+}
+
+/// The file with the bug planted, or an error when its text is gone (the
+/// code changed: update [`CLASSIC`]).
+fn plant(original: &str, bug: &Bug) -> Result<String, String> {
+    if !original.contains(bug.from) {
+        return Err(format!(
+            "{}: `{}` is no longer in the file; update CLASSIC in xtask/src/mutants.rs",
+            bug.file, bug.from
+        ));
+    }
+    Ok(original.replace(bug.from, bug.to))
+}
+
+/// `cargo test -p PACKAGE --lib --tests` in `copy`: whether it passed, and
+/// the tests that failed. A build failure is an error: a planted bug must
+/// compile.
+fn run_tests(copy: &Path, target: &PathBuf, package: &str) -> Result<(bool, Vec<String>), String> {
+    let manifest = copy.join("Cargo.toml");
+    let base = |cmd: &mut Command| {
+        cmd.env("CARGO_TARGET_DIR", target)
+            .arg("test")
+            .arg("--manifest-path")
+            .arg(&manifest)
+            .args(["-p", package, "--lib", "--tests"]);
+    };
+    let mut build = crate::cargo();
+    base(&mut build);
+    let built = build.arg("--no-run").status().map_err(|e| format!("cannot run cargo: {e}"))?;
+    if !built.success() {
+        return Err(format!("the planted bug in {package} does not compile"));
+    }
+    let mut test = crate::cargo();
+    base(&mut test);
+    let out = test
+        .args(["--", "--skip", SLOW_TEST])
+        .stderr(Stdio::null())
+        .output()
+        .map_err(|e| format!("cannot run cargo: {e}"))?;
+    let text = String::from_utf8_lossy(&out.stdout);
+    let failing =
+        text.lines().filter_map(|l| l.strip_prefix("test ")?.strip_suffix(" ... FAILED").map(str::to_string)).collect();
+    Ok((out.status.success(), failing))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each classic bug still names code that exists once or twice (the
+    /// mass coefficient appears in two symmetric places), so that the
+    /// `--classic` run plants what it says.
+    #[test]
+    fn every_classic_bug_applies_to_the_current_code() {
+        for bug in &CLASSIC {
+            let text = std::fs::read_to_string(crate::root().join(bug.file)).unwrap();
+            let count = text.matches(bug.from).count();
+            assert!((1..=2).contains(&count), "{}: `{}` found {count} times", bug.file, bug.from);
+            assert_ne!(plant(&text, bug).unwrap(), text);
+        }
+        assert!(plant("nothing here", &CLASSIC[0]).unwrap_err().contains("no longer in the file"));
+    }
+}

@@ -1,0 +1,246 @@
+//! `cargo xtask reproduce`: the paper's case studies and the tutorial loop,
+//! each held to its case file's `[check]` table.
+
+use std::ffi::OsStr;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+use fe_model::CaseFile;
+use fe_model::case::RunCheck;
+
+use crate::check;
+
+/// The paper's case studies, in the paper's order.
+const PAPER_CASES: [&str; 6] = [
+    "two-material-beam",
+    "two-material-beam-high-damping",
+    "two-material-beam-noisy",
+    "monopile",
+    "cantilever-flexible-clamp",
+    "f-frame",
+];
+
+/// The tutorial: a model missing a joint and data from the frame that has it.
+const TUTORIAL: &str = "tutorial";
+
+/// One finished `rfm update` run, as its summary row, with the check it was
+/// held to and what it missed.
+struct Run {
+    label: String,
+    method: &'static str,
+    json: serde_json::Value,
+    report: PathBuf,
+    /// `None` when the case sets no check for this run.
+    failures: Option<Vec<String>>,
+}
+
+fn run_rfm(rfm: &Path, args: &[&OsStr], what: &str) -> Result<(), String> {
+    let status = Command::new(rfm).args(args).status().map_err(|e| format!("cannot run {}: {e}", rfm.display()))?;
+    if status.success() { Ok(()) } else { Err(format!("{what} failed")) }
+}
+
+fn read_json(path: &Path) -> Result<serde_json::Value, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// `rfm update CASE --method METHOD --out OUT`, then its results, held to
+/// `check` (with the truth's noise level for its `noise` entry).
+fn update(
+    rfm: &Path,
+    case: &Path,
+    out: &Path,
+    method: &'static str,
+    label: &str,
+    check: Option<(&RunCheck, Option<f64>)>,
+) -> Result<Run, String> {
+    println!("\n==================== {label} ({method}) ====================");
+    let args = [OsStr::new("update"), case.as_os_str(), OsStr::new("--method"), OsStr::new(method)];
+    run_rfm(rfm, &[&args[..], &[OsStr::new("--out"), out.as_os_str()]].concat(), &format!("case {label} ({method})"))?;
+    let json = read_json(&out.join("results.json"))?;
+    let failures = check.map(|(c, noise)| check::run_failures(c, &json, noise));
+    Ok(Run { label: label.to_string(), method, json, report: out.join("report.html"), failures })
+}
+
+pub(crate) fn reproduce(cases: &[String]) -> Result<(), String> {
+    let mut names: Vec<String> = if cases.is_empty() {
+        PAPER_CASES.iter().chain(&[TUTORIAL]).map(|s| s.to_string()).collect()
+    } else {
+        cases.to_vec()
+    };
+    let tutorial = names.iter().any(|n| n == TUTORIAL);
+    names.retain(|n| n != TUTORIAL);
+    // read every case (and its checks) before the long build and runs, so
+    // that a mistake in one is reported at once, with its line
+    let mut loaded = Vec::new();
+    for name in &names {
+        let path = crate::root().join("cases").join(format!("{name}.toml"));
+        if !path.exists() {
+            return Err(format!("no case file {}", path.display()));
+        }
+        loaded.push((name, CaseFile::load(&path).map_err(|e| e.to_string())?));
+    }
+    let tutorial_case = crate::root().join("cases/tutorial/l-frame.toml");
+    let tutorial_check = if tutorial {
+        let case = CaseFile::load(&tutorial_case).map_err(|e| e.to_string())?;
+        Some(case.check.and_then(|c| c.diagnosis).ok_or("the tutorial case has no [check.diagnosis]")?)
+    } else {
+        None
+    };
+
+    let rfm = crate::release_build(&["-p", "rfm-cli", "--bin", "rfm"], "rfm")?;
+    println!("running {}", rfm.display());
+    let started = Instant::now();
+    let base = crate::target_dir()?.join("reproduce");
+    let mut runs = Vec::new();
+    for (name, case) in &loaded {
+        let checks = case.check.clone().unwrap_or_default();
+        let noise = case.truth.as_ref().map(|t| t.noise);
+        let rfm_check = checks.rfm.as_ref().map(|c| (c, noise));
+        runs.push(update(&rfm, &case.path, &base.join(name), "rfm", name, rfm_check)?);
+        if let Some(c) = &checks.output_error {
+            let out = base.join(format!("{name}-output-error"));
+            runs.push(update(&rfm, &case.path, &out, "output-error", name, Some((c, noise)))?);
+        }
+    }
+    let loop_summary = match &tutorial_check {
+        Some(check) => Some(tutorial_loop(&rfm, &tutorial_case, &base.join(TUTORIAL), check, &mut runs)?),
+        None => None,
+    };
+
+    println!("\n==================== summary ====================");
+    println!(
+        "{:<32} {:>12} {:>14} {:>11} {:>20} {:>18} {:>8}",
+        "case", "method", "status", "misfit", "max error vs truth", "max |z| (std)", "check"
+    );
+    for run in &runs {
+        let json = &run.json;
+        let residual = json["residual"].as_f64().unwrap_or(f64::NAN);
+        let params = json["parameters"].as_array().cloned().unwrap_or_default();
+        let max_err = params
+            .iter()
+            .filter_map(|p| {
+                let (u, t) = (p["updated"].as_f64()?, p["truth"].as_f64()?);
+                Some(((u - t) / t).abs())
+            })
+            .fold(f64::NAN, f64::max);
+        // distance from the truth in standard deviations, over the parameters the data determine
+        let unc = json["uncertainty"]["parameters"].as_array().cloned().unwrap_or_default();
+        let (mut max_z, mut undetermined) = (f64::NAN, 0);
+        for (p, u) in params.iter().zip(&unc) {
+            if u["well_determined"].as_bool() != Some(true) {
+                undetermined += 1;
+                continue;
+            }
+            if let (Some(v), Some(t), Some(s)) =
+                (p["updated"].as_f64(), p["truth"].as_f64(), u["relative_std"].as_f64())
+            {
+                max_z = f64::max(max_z, (v / t).ln().abs() / s);
+            }
+        }
+        let z = if unc.is_empty() || max_z.is_nan() {
+            // no uncertainty (RFM) or no truth to measure against
+            "-".to_string()
+        } else if undetermined > 0 {
+            format!("{max_z:.2} ({undetermined} undet.)")
+        } else {
+            format!("{max_z:.2}")
+        };
+        let err = if max_err.is_nan() { "-".to_string() } else { format!("{max_err:.2e}") };
+        let verdict = match &run.failures {
+            None => "-",
+            Some(f) if f.is_empty() => "pass",
+            Some(_) => "FAIL",
+        };
+        println!(
+            "{:<32} {:>12} {:>14} {residual:>11.3e} {err:>20} {z:>18} {verdict:>8}",
+            run.label,
+            run.method,
+            check::status_name(json)
+        );
+    }
+    if let Some(text) = &loop_summary {
+        println!("\n{text}");
+    }
+    println!("\nreports (self-contained HTML with the figures; open in a browser):");
+    for run in runs.iter().filter(|r| r.report.exists()) {
+        println!("  {}", run.report.display());
+    }
+    if tutorial {
+        println!("  {}", base.join(TUTORIAL).join("compare/report.html").display());
+    }
+    println!("\nresults: {}", base.display());
+    println!("time after the build: {:.0} s", started.elapsed().as_secs_f64());
+
+    // "-" in the check column: the case file sets no check for that run
+    println!("\nchecks ([check] of each case file; `-` above: none set for that run):");
+    let mut missed = 0;
+    for run in &runs {
+        let Some(failures) = &run.failures else { continue };
+        for f in failures {
+            println!("  FAIL {} ({}): {f}", run.label, run.method);
+        }
+        missed += failures.len();
+    }
+    let checked = runs.iter().filter(|r| r.failures.is_some()).count();
+    if missed > 0 {
+        return Err(format!("{missed} check(s) missed (listed above)"));
+    }
+    println!("  all {checked} checked runs pass");
+    Ok(())
+}
+
+/// The walkthrough of `docs/walkthrough.md`: compare the tutorial model with
+/// its data, diagnose, add the leading effect, update, and hold the result
+/// to the tutorial case's `[check.diagnosis]`.
+fn tutorial_loop(
+    rfm: &Path,
+    case: &Path,
+    out: &Path,
+    check: &fe_model::case::DiagnosisCheck,
+    runs: &mut Vec<Run>,
+) -> Result<String, String> {
+    println!("\n==================== tutorial: compare ====================");
+    let compare = out.join("compare");
+    run_rfm(rfm, &[OsStr::new("compare"), case.as_os_str(), OsStr::new("--out"), compare.as_os_str()], "rfm compare")?;
+
+    println!("\n==================== tutorial: diagnose ====================");
+    let added = out.join("l-frame-with-effect.toml");
+    let diagnosis = Command::new(rfm)
+        .args([OsStr::new("diagnose"), case.as_os_str(), OsStr::new("--json"), OsStr::new("--apply"), OsStr::new("1")])
+        .args([OsStr::new("--out"), added.as_os_str()])
+        .output()
+        .map_err(|e| format!("cannot run {}: {e}", rfm.display()))?;
+    if !diagnosis.status.success() {
+        return Err(format!("rfm diagnose failed:\n{}", String::from_utf8_lossy(&diagnosis.stderr)));
+    }
+    let json: serde_json::Value = serde_json::from_slice(&diagnosis.stdout).map_err(|e| format!("diagnosis: {e}"))?;
+    let path = out.join("diagnosis.json");
+    std::fs::write(&path, &diagnosis.stdout).map_err(|e| format!("{}: {e}", path.display()))?;
+    let ranking = json["ranking"].as_array().cloned().unwrap_or_default();
+    println!("{:>4}  {:<56} {:>10} {:>12}", "rank", "effect", "explained", "significant");
+    for (i, c) in ranking.iter().take(5).enumerate() {
+        let explained = 100.0 * c["explained"].as_f64().unwrap_or(f64::NAN);
+        let description = c["description"].as_str().unwrap_or("?");
+        println!("{:>4}  {description:<56} {explained:>9.2}% {:>12}", i + 1, c["significant"]);
+    }
+    if !added.exists() {
+        return Err(format!("rfm diagnose --apply 1 wrote no {}", added.display()));
+    }
+    println!("wrote {} with the leading effect added", added.display());
+
+    let mut run = update(rfm, &added, &out.join("update"), "output-error", "tutorial (effect added)", None)?;
+    // both are RMS FRF misfits per residual over the measured channels (the
+    // diagnosis over every line, the update over its chosen lines)
+    let nominal = json["nominal_misfit"].as_f64().unwrap_or(f64::NAN);
+    let last = run.json["residual"].as_f64().unwrap_or(f64::NAN);
+    run.failures = Some(check::diagnosis_failures(check, &json, last));
+    runs.push(run);
+    let leader = ranking.first().and_then(|l| l["description"].as_str()).unwrap_or("?");
+    Ok(format!(
+        "tutorial: the diagnosis named \"{leader}\" first; with it added and updated the misfit fell\n\
+         {:.0} times, from {nominal:.3e} (nominal model) to {last:.3e}",
+        nominal / last,
+    ))
+}
