@@ -21,6 +21,9 @@
 //!   Then the whole diagnosis end to end on small frames (`diagnose_point`
 //!   example): candidates, time, and whether it named the hidden effect; it
 //!   exits non-zero when a diagnosis names the wrong one.
+//! - `montecarlo [N]`: how many of `N` seeds (100) of the flexible-clamp and
+//!   f-frame twins at 1 % noise the output-error fit brings to the global
+//!   minimum (see `montecarlo.rs`).
 //! - `mutants [ARGS...]`: the mutation check of the numerical modules with
 //!   cargo-mutants (see `mutants.rs`).
 //!
@@ -30,6 +33,7 @@
 
 mod bench;
 mod check;
+mod montecarlo;
 mod mutants;
 mod reproduce;
 
@@ -50,8 +54,9 @@ fn main() -> ExitCode {
         Some("reproduce") => reproduce::reproduce(&args[1..]),
         Some("bench") => bench::bench(&args[1..]),
         Some("mutants") => mutants::mutants(&args[1..]),
+        Some("montecarlo") => montecarlo::montecarlo(&args[1..]),
         _ => Err("usage: cargo xtask reproduce [CASE... | tutorial] | cargo xtask bench [--full] | \
-                  cargo xtask mutants [--list | cargo-mutants options]"
+                  cargo xtask mutants [--list | cargo-mutants options] | cargo xtask montecarlo [N]"
             .to_string()),
     };
     match result {

@@ -171,15 +171,7 @@ fn apply_gains(frfs: &mut FrfSet, gains: &[Gain]) {
 }
 
 fn status_text(s: &Status) -> String {
-    match s {
-        Status::Converged => "converged".into(),
-        Status::Stalled => "stalled (the misfit stopped falling; the best iterate is reported)".into(),
-        Status::WithinNoise => {
-            "converged to within the noise (the last steps gained less than the noise can show)".into()
-        }
-        Status::MaxIterations => "iteration limit reached (the best iterate is reported)".into(),
-        Status::Failed(why) => format!("failed ({why}); the best iterate is reported"),
-    }
+    s.describe()
 }
 
 /// Budget of the convergence plot's re-evaluation, in DOF x line solves:
