@@ -274,6 +274,45 @@ mod tests {
         assert_eq!(Exit::of_status(&Status::Failed("singular".into())), Exit::Numerics);
     }
 
+    fn outcome(status: Status, worse_than_start: bool) -> rfm_update::UpdateOutcome {
+        rfm_update::UpdateOutcome {
+            method: "rfm".into(),
+            status,
+            parameters: Vec::new(),
+            history: Vec::new(),
+            residual: 0.01,
+            frequencies_hz: Vec::new(),
+            natural_frequencies_hz: rfm_update::study::FrequencyTable {
+                initial: Vec::new(),
+                updated: Vec::new(),
+                truth: None,
+                paper: None,
+                kind: "none".into(),
+            },
+            uncertainty: None,
+            gains: Vec::new(),
+            noise_estimate: Some(0.01),
+            masked: Vec::new(),
+            notes: Vec::new(),
+            warnings: Vec::new(),
+            noise_ratio: Some(1.0),
+            restarts: Vec::new(),
+            worse_than_start,
+            system: damping::DampedSystem::new(fe_model::samples::two_dof_oscillator()).unwrap(),
+        }
+    }
+
+    /// A run that made the misfit worse than the start never exits with 0,
+    /// even when its residual is at the noise level.
+    #[test]
+    fn an_update_worse_than_its_start_is_not_a_success() {
+        assert_eq!(Exit::of_outcome(&outcome(Status::Converged, false)), Exit::Success);
+        assert_eq!(Exit::of_outcome(&outcome(Status::Converged, true)), Exit::WorseThanStart);
+        assert_eq!(Exit::WorseThanStart.code(), 11);
+        // a run that did not converge keeps its own code
+        assert_eq!(Exit::of_outcome(&outcome(Status::Stalled, true)), Exit::Stalled);
+    }
+
     #[test]
     fn a_singular_line_is_failed_numerics_and_a_parse_error_invalid_input() {
         let singular: Failure = FrfError::Singular { freq_hz: 15.9 }.into();

@@ -153,9 +153,14 @@ impl Status {
         }
     }
 
-    /// The name with what it means, as the terminal and the report show it.
+    /// The name with what it means, as the report shows it.
     pub fn describe(&self) -> String {
-        let what = match self {
+        format!("{}: {}", self.name(), self.meaning())
+    }
+
+    /// What the status means, in a sentence.
+    pub fn meaning(&self) -> String {
+        match self {
             Status::Converged => "the residual is consistent with the noise".to_string(),
             Status::ModelInadequate => "restarts from spread starts confirm the minimum, but the residual stays above \
                                         the noise: something the parameters cannot represent remains (try rfm \
@@ -169,8 +174,7 @@ impl Status {
             }
             Status::MaxIterations => "the iteration limit was reached (the best iterate is reported)".to_string(),
             Status::Failed(why) => format!("{why} (the best iterate is reported)"),
-        };
-        format!("{}: {what}", self.name())
+        }
     }
 }
 

@@ -446,21 +446,7 @@ impl Study {
                 100.0 * verdict::RFM_NOISE_LIMIT
             ));
         }
-        let initial = self.system_values();
-        for (i, p) in self.parameters.iter().enumerate() {
-            let factor = result.values[i] / initial[i];
-            if factor > verdict::RUNAWAY_FACTOR || factor < 1.0 / verdict::RUNAWAY_FACTOR {
-                warnings.push(format!(
-                    "{} moved by a factor of {factor:.3e} from its initial value: a run-away, not an estimate",
-                    p.name
-                ));
-            }
-        }
-        warnings.push(
-            "no uncertainty is available for the RFM's values (its equation error has no noise model); \
-             use --method output-error for standard deviations"
-                .to_string(),
-        );
+        warnings.extend(verdict::runaways(&self.parameter_names(), &self.system_values(), &result.values));
         let first = result.history.first().map_or(f64::NAN, |r| r.residual);
         let worse_than_start = result.residual > first;
         if worse_than_start {

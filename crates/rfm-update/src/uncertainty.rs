@@ -8,8 +8,9 @@
 //!
 //! Two standard deviations are reported. The noise-only one scales the
 //! covariance by the data's noise variance (estimated from their roughness,
-//! [`crate::diagnose::estimate_noise`]); it is right when the model explains
-//! the data down to their noise. When it does not, the residual holds model
+//! [`crate::diagnose::estimate_noise`], or from the residual when that is
+//! smaller); it is right when the model explains the data down to their
+//! noise. When it does not, the residual holds model
 //! error as well, which is neither small nor independent from line to line,
 //! and the noise-only value shrinks as `1 / sqrt(lines)` however wrong the
 //! model. The standard deviation shown first ([`ParameterUncertainty::std`],
@@ -116,7 +117,9 @@ pub fn analyse(params: &ParameterSet, result: &OeResult, band_hz: (f64, f64), no
     let residual_rms = (2.0 * result.sigma2).sqrt();
     // the covariance is scaled by the residual variance: rescale it to the
     // noise's for the noise-only value
-    let to_noise = noise.filter(|&s| s > 0.0 && residual_rms > 0.0).map_or(1.0, |s| s / residual_rms);
+    // noise for the noise-only value, when the fit leaves more than that
+    // (below it, the residual's own variance is the better noise estimate)
+    let to_noise = noise.filter(|&s| s > 0.0 && residual_rms > 0.0).map_or(1.0, |s| (s / residual_rms).min(1.0));
     let inflation = model_error_inflation(residual_rms, noise, result.residual_correlation, result.n_data / 2);
     let (w_min, w_max) = (2.0 * std::f64::consts::PI * band_hz.0, 2.0 * std::f64::consts::PI * band_hz.1);
     let mut out = Vec::with_capacity(n);

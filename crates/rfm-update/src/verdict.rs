@@ -48,6 +48,21 @@ pub fn classify(raw: &Status, noise_ratio: Option<f64>, restarts_agree: Option<b
     }
 }
 
+/// One warning per parameter that moved by more than [`RUNAWAY_FACTOR`]
+/// either way from its initial value.
+pub fn runaways(names: &[String], initial: &[f64], updated: &[f64]) -> Vec<String> {
+    names
+        .iter()
+        .zip(initial.iter().zip(updated))
+        .filter_map(|(name, (&p0, &p))| {
+            let factor = p / p0;
+            (!(1.0 / RUNAWAY_FACTOR..=RUNAWAY_FACTOR).contains(&factor)).then(|| {
+                format!("{name} moved by a factor of {factor:.3e} from its initial value: a run-away, not an estimate")
+            })
+        })
+        .collect()
+}
+
 /// Point `i` (from 1) of the Halton sequence in base `base`: a spread of
 /// points in `[0, 1)` that fills the space evenly for every prefix.
 pub(crate) fn halton(mut i: usize, base: usize) -> f64 {
@@ -99,6 +114,15 @@ mod tests {
         assert_eq!(classify(&Status::MaxIterations, Some(0.9), Some(true)), Status::MaxIterations);
         let failed = Status::Failed("x".into());
         assert_eq!(classify(&failed, Some(0.9), None), failed);
+    }
+
+    #[test]
+    fn parameters_moved_more_than_a_hundredfold_are_flagged() {
+        let names: Vec<String> = ["a", "b", "c", "d"].iter().map(|s| s.to_string()).collect();
+        let w = runaways(&names, &[1.0, 1.0, 2.0, 1e-5], &[99.0, 0.009, 2.0, 1e10]);
+        assert_eq!(w.len(), 2, "{w:?}");
+        assert!(w[0].starts_with("b moved by a factor of 9.000e-3"), "{w:?}");
+        assert!(w[1].starts_with("d moved by a factor of 1.000e15"), "{w:?}");
     }
 
     #[test]

@@ -94,7 +94,7 @@ pub(crate) fn update(case: &Path, out: Option<&Path>, json: bool, over: &Overrid
         bar.set_position(r.iteration as u64);
         bar.set_message(format!("misfit {:.3e}", r.residual));
     };
-    let outcome = match method {
+    let mut outcome = match method {
         Method::Rfm => {
             let opts = RfmOptions { max_iterations, ..study.rfm_options() };
             study.run_rfm(&opts, on_iteration)?
@@ -109,6 +109,15 @@ pub(crate) fn update(case: &Path, out: Option<&Path>, json: bool, over: &Overrid
     // the misfit the case's history speaks of, after this update
     let noise = rfm_update::diagnose::estimate_noise(&study.measured);
     let misfit = rfm_update::diagnose::log_misfit(&outcome.system, &study.measured, HISTORY_LINES)?;
+    // worse than the start over the whole band, not only at the fitted lines
+    let misfit_initial = rfm_update::diagnose::log_misfit(&study.system, &study.measured, HISTORY_LINES)?;
+    if misfit > misfit_initial && !outcome.worse_than_start {
+        outcome.worse_than_start = true;
+        outcome.warnings.push(format!(
+            "the update made the misfit over the band worse than the initial model's ({misfit_initial:.3e} -> \
+             {misfit:.3e}): the updated model is not an improvement"
+        ));
+    }
     let step = fe_model::HistoryEntry { step: format!("updated ({})", outcome.method), misfit, noise };
     if json {
         outln!("{}", serde_json::to_string_pretty(&outcome)?);
@@ -187,7 +196,7 @@ fn print_history(history: &[fe_model::HistoryEntry]) -> Result<()> {
 }
 
 fn print_outcome(outcome: &UpdateOutcome) -> Result<()> {
-    let status = outcome.status.describe();
+    let status = outcome.status.name();
     let first = outcome.history.first().map_or(f64::NAN, |r| r.residual);
     outln!(
         "{status} after {} iterations; misfit {:.3e} -> {:.3e} ({:+.1} dB)\n",
@@ -196,6 +205,7 @@ fn print_outcome(outcome: &UpdateOutcome) -> Result<()> {
         outcome.residual,
         db(outcome.residual) - db(first)
     );
+    outln!("{}: {}\n", outcome.status.name(), outcome.status.meaning());
     let unc = outcome.uncertainty.as_ref();
     let has_truth = outcome.parameters.iter().any(|p| p.truth.is_some());
     let has_paper = outcome.parameters.iter().any(|p| p.paper.is_some());
@@ -267,6 +277,12 @@ fn print_outcome(outcome: &UpdateOutcome) -> Result<()> {
         }
         outln!("\nresidual RMS per value {:.3e} (the noise level the fit leaves)", u.residual_rms);
     }
+    if unc.is_none() {
+        outln!(
+            "\nno uncertainty is available for these values: the RFM's equation error has no noise model \
+             (--method output-error gives standard deviations)"
+        );
+    }
     if let (Some(noise), Some(ratio)) = (outcome.noise_estimate, outcome.noise_ratio) {
         let reading = match outcome.status {
             _ if ratio <= rfm_update::verdict::NOISE_FACTOR => {
@@ -288,7 +304,7 @@ fn print_outcome(outcome: &UpdateOutcome) -> Result<()> {
         );
     }
     if !outcome.warnings.is_empty() {
-        outln!("\nwhat the data determine only weakly:");
+        outln!("\nwhat the data determine only weakly, and what not to trust:");
         for w in &outcome.warnings {
             outln!("  - {w}");
         }

@@ -134,11 +134,11 @@ fn update_out_writes_figures_parameters_and_a_self_contained_report() {
     let dir = tempfile::tempdir().unwrap();
     let case_file = case("cantilever-flexible-clamp");
     let out = rfm(&["update", case_file.to_str().unwrap(), "--out", dir.path().to_str().unwrap()]);
-    // this twin stalls short of the tolerance: its outputs are written, and
-    // the exit code says it did not converge
-    assert_eq!(out.status.code(), Some(5), "{}", text(&out.stderr));
+    // the RFM stalls on this twin far above the noise: its outputs are
+    // written, and the exit code says it stalled
+    assert_eq!(out.status.code(), Some(8), "{}", text(&out.stderr));
     assert!(text(&out.stdout).contains("stalled"), "{}", text(&out.stdout));
-    assert!(text(&out.stderr).contains("exit code 5: not converged"), "{}", text(&out.stderr));
+    assert!(text(&out.stderr).contains("exit code 8: stalled"), "{}", text(&out.stderr));
     assert!(text(&out.stdout).contains("report.html"), "{}", text(&out.stdout));
 
     let d = dir.path();
@@ -365,7 +365,8 @@ fn a_diverged_rfm_run_still_writes_its_report() {
     let dir = tempfile::tempdir().unwrap();
     let out =
         rfm(&["update", case("f-frame").to_str().unwrap(), "--method", "rfm", "--out", dir.path().to_str().unwrap()]);
-    assert!(out.status.success(), "{}", text(&out.stderr));
+    // written, with the code of a run that stalled above the noise
+    assert_eq!(out.status.code(), Some(8), "{}", text(&out.stderr));
     let json: serde_json::Value = serde_json::from_str(&read(&dir.path().join("results.json"))).unwrap();
     assert_eq!(json["status"], "stalled");
     check_self_contained(&read(&dir.path().join("report.html")));

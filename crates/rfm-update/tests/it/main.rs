@@ -1,5 +1,6 @@
 //! Integration tests of rfm-update.
 
+mod calibration;
 mod fast_vs_naive;
 mod held_out;
 mod hidden_effects;
@@ -7,4 +8,5 @@ mod numerics;
 mod output_error;
 mod paper_cases;
 mod sensitivity;
+mod trust;
 mod truths;
