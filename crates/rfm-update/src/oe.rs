@@ -600,7 +600,8 @@ pub(crate) fn run_with(
     let dof = (n_data as f64 - free as f64).max(1.0);
     let sigma2 = final_point.cost_data / dof;
     let covariance = covariance(&sol, sigma2);
-    let residual_correlation = adjacent_correlation(&final_point.residual, measured.n_freq(), measured.channels().len());
+    let residual_correlation =
+        adjacent_correlation(&final_point.residual, measured.n_freq(), measured.channels().len());
     let gains = (0..ev.refs.len())
         .filter(|_| opts.gains)
         .map(|v| {

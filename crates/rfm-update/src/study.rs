@@ -573,7 +573,7 @@ impl Study {
         let ratio = |r: &oe::OeResult| noise.filter(|&s| s > 0.0).map(|s| (2.0 * r.sigma2).sqrt() / s);
         let first = oe::run(&mut sys, &params, &data, opts, on_iteration)?;
         let settled =
-            |r: &oe::OeResult| r.status == Status::Converged && ratio(r).is_none_or(|x| x <= verdict::NOISE_FACTOR);
+            |r: &oe::OeResult| r.status == Status::Converged && ratio(r).is_none_or(|x| x <= verdict::RESTART_ABOVE);
         let mut restarts = Vec::new();
         let mut agree = None;
         let mut history = first.history.clone();

@@ -19,6 +19,13 @@ use crate::rfm::Status;
 /// A residual up to this many times the noise is consistent with it.
 pub const NOISE_FACTOR: f64 = 1.5;
 
+/// The output-error fit restarts when its residual exceeds this many times
+/// the noise, stricter than [`NOISE_FACTOR`]: a local minimum close above the
+/// noise (the flexible-clamp twin has them at 1.2-1.5 times) is cheap to
+/// escape, while a fit at the global minimum sits at about 0.9-1.05 times
+/// the roughness estimate of the noise.
+pub const RESTART_ABOVE: f64 = 1.1;
+
 /// Two minima whose costs differ by less than this fraction are taken as the
 /// same minimum when restarts are compared.
 pub const SAME_MINIMUM: f64 = 0.01;

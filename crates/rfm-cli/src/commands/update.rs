@@ -291,7 +291,10 @@ fn print_outcome(outcome: &UpdateOutcome) -> Result<()> {
             Status::ModelInadequate => format!(
                 "the fit leaves {ratio:.1} times the noise at a minimum its restarts confirm: something the parameters cannot represent remains (try rfm diagnose on the updated case)"
             ),
-            _ => format!("the fit leaves {ratio:.1} times the noise; it is not known to be the best fit ({})", outcome.status.name()),
+            _ => format!(
+                "the fit leaves {ratio:.1} times the noise; it is not known to be the best fit ({})",
+                outcome.status.name()
+            ),
         };
         outln!("\nnoise level estimated from the data {noise:.3e}: {reading}");
     }

@@ -107,6 +107,14 @@ pub(crate) fn write(study: &Study, outcome: &UpdateOutcome, out: &mut Outputs, c
     out.write("parameters.csv", csv.as_bytes())?;
     let mut ps = Section::new("Parameters");
     ps.push(Block::Table(params));
+    let basis = match &outcome.uncertainty {
+        Some(u) => format!("Standard deviations {}.", u.shown_first),
+        None => "No uncertainty is available for these values: the RFM's equation error has no noise model.".into(),
+    };
+    ps.push(Block::Text(basis));
+    for w in &outcome.warnings {
+        ps.push(Block::Text(format!("{w}.")));
+    }
     if let Some(u) = &outcome.uncertainty {
         for w in u.parameters.iter().flat_map(|p| p.warnings.iter().map(move |w| format!("{}: {w}.", p.name))) {
             ps.push(Block::Text(w));

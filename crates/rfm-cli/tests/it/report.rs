@@ -160,6 +160,12 @@ fn update_out_writes_figures_parameters_and_a_self_contained_report() {
 
     let html = read(&d.join("report.html"));
     check_self_contained(&html);
+    // the same status words as the terminal, and no claim of uncertainty
+    assert!(html.contains("stalled: no step lowers the misfit"), "the report does not say how the run ended");
+    assert!(html.contains("No uncertainty is available"), "the report does not say the RFM has no uncertainty");
+    assert!(!html.contains("within the noise"));
+    let updated = read(&d.join("updated.toml"));
+    assert!(updated.contains("status stalled,"), "updated.toml does not name the status");
     let svg_files =
         std::fs::read_dir(d).unwrap().filter(|e| e.as_ref().unwrap().path().extension().is_some_and(|x| x == "svg"));
     assert_eq!(html.matches("<svg").count(), svg_files.count(), "every figure is inline in the report");
