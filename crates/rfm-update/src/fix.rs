@@ -327,12 +327,19 @@ pub fn fix(
                     Err(e) => {
                         let effect = d.ranking[r - 1].description.clone();
                         alternatives.push(LookAhead { effect, misfit_ahead: f64::NAN, failed: Some(e.to_string()) });
-                        progress(FixProgress::LookedAhead { step: steps.len(), ahead: alternatives.last().expect("pushed") });
+                        progress(FixProgress::LookedAhead {
+                            step: steps.len(),
+                            ahead: alternatives.last().expect("pushed"),
+                        });
                         continue;
                     }
                 };
                 let score = ahead.leader().map_or(a.misfit_updated, |l| l.misfit.min(a.misfit_updated));
-                alternatives.push(LookAhead { effect: a.effect.description.clone(), misfit_ahead: score, failed: None });
+                alternatives.push(LookAhead {
+                    effect: a.effect.description.clone(),
+                    misfit_ahead: score,
+                    failed: None,
+                });
                 progress(FixProgress::LookedAhead { step: steps.len(), ahead: alternatives.last().expect("pushed") });
                 if best.as_ref().is_none_or(|(b, ..)| score < *b) {
                     best = Some((score, a, ahead));

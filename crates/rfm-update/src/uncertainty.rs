@@ -220,25 +220,6 @@ pub fn analyse(params: &ParameterSet, result: &OeResult, band_hz: (f64, f64), no
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn inflation_is_the_lack_of_fit_times_the_correlation_of_adjacent_residuals() {
-        // at the noise and white: nothing added
-        assert_eq!(model_error_inflation(0.01, Some(0.01), 0.0, 400), 1.0);
-        assert_eq!(model_error_inflation(0.008, Some(0.01), 0.05, 400), 1.0);
-        // 10 times the noise: at least sqrt(chi2 / dof) = 10
-        assert!((model_error_inflation(0.1, Some(0.01), 0.0, 400) - 10.0).abs() < 1e-12);
-        // correlated residuals: fewer independent lines, (1 + rho) / (1 - rho) = 19
-        let f = model_error_inflation(0.1, Some(0.01), 0.9, 400);
-        assert!((f - 10.0 * 19f64.sqrt()).abs() < 1e-9, "{f}");
-        // unknown noise: the correlation alone
-        assert!((model_error_inflation(0.1, None, 0.6, 400) - 2.0).abs() < 1e-12);
-    }
-}
-
 /// Names the parameter combination along the weakest direction of a
 /// column-scaled sensitivity matrix (singular values `sv`, right singular
 /// vectors as the columns of `v`, one row per parameter of `names`) when it
@@ -264,4 +245,23 @@ pub(crate) fn unresolved_combination(sv: &[f64], v: &Mat<f64>, names: &[String])
         terms.join(" "),
         smin / smax
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn inflation_is_the_lack_of_fit_times_the_correlation_of_adjacent_residuals() {
+        // at the noise and white: nothing added
+        assert_eq!(model_error_inflation(0.01, Some(0.01), 0.0, 400), 1.0);
+        assert_eq!(model_error_inflation(0.008, Some(0.01), 0.05, 400), 1.0);
+        // 10 times the noise: at least sqrt(chi2 / dof) = 10
+        assert!((model_error_inflation(0.1, Some(0.01), 0.0, 400) - 10.0).abs() < 1e-12);
+        // correlated residuals: fewer independent lines, (1 + rho) / (1 - rho) = 19
+        let f = model_error_inflation(0.1, Some(0.01), 0.9, 400);
+        assert!((f - 10.0 * 19f64.sqrt()).abs() < 1e-9, "{f}");
+        // unknown noise: the correlation alone
+        assert!((model_error_inflation(0.1, None, 0.6, 400) - 2.0).abs() < 1e-12);
+    }
 }

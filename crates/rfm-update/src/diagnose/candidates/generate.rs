@@ -648,16 +648,6 @@ pub fn generate(model: &Model, opts: &CandidateOptions) -> Vec<Candidate> {
     build(&ctx, specs)
 }
 
-/// Candidates around the given leaders that the first pass did not try
-/// (`tried`: descriptions of the candidates already made):
-///
-/// - around a window: every window of its kind (damping: viscous and
-///   non-viscous) of every size at every offset within reach of it;
-/// - around a joint, support or mass: single-element stiffness and mass
-///   changes of the elements at its nodes and their neighbours, and on large
-///   models the in-line joints there;
-/// - the fuller variants of a joint (translational springs) and a mass
-///   (rotary inertia).
 /// The in-line joints (viscous and non-viscous) at those of `nodes` that
 /// join two collinear members.
 fn in_line_joints(ctx: &Ctx<'_>, nodes: impl IntoIterator<Item = u32>) -> Vec<Spec> {
@@ -672,6 +662,16 @@ fn in_line_joints(ctx: &Ctx<'_>, nodes: impl IntoIterator<Item = u32>) -> Vec<Sp
     out
 }
 
+/// Candidates around the given leaders that the first pass did not try
+/// (`tried`: descriptions of the candidates already made):
+///
+/// - around a window: every window of its kind (damping: viscous and
+///   non-viscous) of every size at every offset within reach of it;
+/// - around a joint, support or mass: single-element stiffness and mass
+///   changes of the elements at its nodes and their neighbours, and on large
+///   models the in-line joints there;
+/// - the fuller variants of a joint (translational springs) and a mass
+///   (rotary inertia).
 pub(crate) fn refine(
     model: &Model,
     opts: &CandidateOptions,
