@@ -111,7 +111,7 @@ pub(crate) fn update(case: &Path, out: Option<&Path>, json: bool, over: &Overrid
     let misfit = rfm_update::diagnose::log_misfit(&outcome.system, &study.measured, HISTORY_LINES)?;
     // worse than the start over the whole band, not only at the fitted lines
     let misfit_initial = rfm_update::diagnose::log_misfit(&study.system, &study.measured, HISTORY_LINES)?;
-    if misfit > misfit_initial && !outcome.worse_than_start {
+    if misfit > WORSE_BY * misfit_initial && !outcome.worse_than_start {
         outcome.worse_than_start = true;
         outcome.warnings.push(format!(
             "the update made the misfit over the band worse than the initial model's ({misfit_initial:.3e} -> \
@@ -176,6 +176,12 @@ fn write_updated_model(
     let text = editor.text_at(&output.path("updated.toml"))?;
     Ok(output.write("updated.toml", text.as_bytes())?)
 }
+
+/// A band misfit this many times the initial model's is worse than the
+/// start: a fit that starts at its optimum (values from `rfm diagnose
+/// --apply`) may move the band misfit by far less, its fitted lines not
+/// being the band's.
+const WORSE_BY: f64 = 1.01;
 
 /// Lines of the misfit in the case history (as in `rfm diagnose`).
 const HISTORY_LINES: usize = 200;
