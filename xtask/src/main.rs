@@ -28,6 +28,9 @@
 //!   exits non-zero when a diagnosis names the wrong one.
 //! - `heldout`: the full held-out study of the diagnosis loop (the CI test
 //!   `held_out` at full size, see `heldout.rs`).
+//! - `montecarlo [N]`: how many of `N` seeds (100) of the flexible-clamp and
+//!   f-frame twins at 1 % noise the output-error fit brings to the global
+//!   minimum (see `montecarlo.rs`).
 //! - `mutants [ARGS...]`: the mutation check of the numerical modules with
 //!   cargo-mutants (see `mutants.rs`).
 //!
@@ -39,6 +42,7 @@ mod bench;
 mod check;
 mod figures;
 mod heldout;
+mod montecarlo;
 mod mutants;
 mod reproduce;
 
@@ -61,11 +65,11 @@ fn main() -> ExitCode {
         Some("mutants") => mutants::mutants(&args[1..]),
         Some("heldout") => heldout::heldout(&args[1..]),
         Some("figures") => figures::figures(),
-        _ => Err(
-            "usage: cargo xtask reproduce [CASE... | tutorial] | cargo xtask bench [--full] | cargo xtask heldout | cargo xtask figures | \
+        Some("montecarlo") => montecarlo::montecarlo(&args[1..]),
+        _ => Err("usage: cargo xtask reproduce [CASE... | tutorial] | cargo xtask bench [--full] | \
+                  cargo xtask heldout | cargo xtask figures | cargo xtask montecarlo [N] | \
                   cargo xtask mutants [--list | cargo-mutants options]"
-                .to_string(),
-        ),
+            .to_string()),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

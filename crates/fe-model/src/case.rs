@@ -529,7 +529,8 @@ pub struct HistoryEntry {
 
 /// How an updating run may end, as its results name it (the statuses of
 /// `rfm_update::rfm::Status`, whose tests keep the two lists equal).
-pub const RUN_STATUSES: [&str; 5] = ["converged", "stalled", "within_noise", "max_iterations", "failed"];
+pub const RUN_STATUSES: [&str; 6] =
+    ["converged", "model_inadequate", "local_minimum", "stalled", "max_iterations", "failed"];
 
 /// What `cargo xtask reproduce` requires of a case's results (`[check]`):
 /// the case's acceptance, as data. See `docs/case-files.md`.
@@ -1631,7 +1632,7 @@ node = 1
     fn check_tables_are_read_per_run() {
         let text = checked(
             "[check.rfm]\nstatus = [\"converged\"]\nmax_error = 1e-8\n\
-             [check.output-error]\nstatus = [\"converged\", \"within_noise\"]\nwithin_sd = 3\nweak = [\"group.beam.stiffness\"]\nnoise = 0.1\n\
+             [check.output-error]\nstatus = [\"converged\", \"model_inadequate\"]\nwithin_sd = 3\nweak = [\"group.beam.stiffness\"]\nnoise = 0.1\n\
              [check.diagnosis]\nleader = \"joint at node 3\"\nmisfit_fall = 10\n",
         );
         let c = parse(&text).unwrap().check.unwrap();
@@ -1641,7 +1642,7 @@ node = 1
             (vec!["converged".into()], Some(1e-8), None, None)
         );
         let oe = c.output_error.unwrap();
-        assert_eq!(oe.status, vec!["converged".to_string(), "within_noise".into()]);
+        assert_eq!(oe.status, vec!["converged".to_string(), "model_inadequate".into()]);
         assert_eq!((oe.within_sd, oe.noise, oe.weak), (Some(3.0), Some(0.1), vec!["group.beam.stiffness".to_string()]));
         let d = c.diagnosis.unwrap();
         assert_eq!((d.leader.as_str(), d.misfit_fall), ("joint at node 3", Some(10.0)));
@@ -1667,7 +1668,7 @@ node = 1
             (
                 "[check.rfm]\nstatus = [\"ok\"]\n",
                 "status = [\"ok\"]",
-                "(available: converged, stalled, within_noise, max_iterations, failed)",
+                "(available: converged, model_inadequate, local_minimum, stalled, max_iterations, failed)",
             ),
             ("[check.rfm]\nstatus = []\n", "[check.rfm]", "needs at least one `status`"),
             ("[check.rfm]\nmax_error = 1e-8\n", "[check.rfm]", "missing field `status`"),

@@ -31,15 +31,24 @@ pub(crate) enum Exit {
     /// The model could not be evaluated or the fit produced non-finite
     /// numbers (a singular dynamic stiffness at a line, a NaN misfit).
     Numerics,
-    /// An update ended without converging (stalled, iteration limit); its
-    /// outputs hold the best iterate. Statuses that say why a fit did not
-    /// converge will map here too.
+    /// An update reached its iteration limit; its outputs hold the best
+    /// iterate.
     NotConverged,
     /// The outputs could not be written (a full disk, no permission, an
     /// output that would replace an input); none of them were.
     Output,
     /// Another run is writing into the same output; nothing was done.
     Busy,
+    /// An update stopped where no step lowers the misfit, above the noise.
+    Stalled,
+    /// An update's restarts confirm its minimum, but the residual stays
+    /// above the noise: the model cannot represent the data.
+    ModelInadequate,
+    /// An update stopped above the noise and its restarts disagree.
+    LocalMinimum,
+    /// An update ended with a larger misfit than the initial model's (the
+    /// RFM can); its outputs say so.
+    WorseThanStart,
     /// Ctrl-C, SIGTERM or SIGHUP stopped the run (128 + SIGINT).
     Interrupted,
 }
@@ -47,15 +56,22 @@ pub(crate) enum Exit {
 impl Exit {
     /// Every code with its meaning, in order: printed by `rfm --help` and
     /// copied in `docs/reliability.md`.
-    pub(crate) const TABLE: [(Exit, &'static str); 9] = [
+    pub(crate) const TABLE: [(Exit, &'static str); 13] = [
         (Exit::Success, "success (for update: the fit converged)"),
         (Exit::Internal, "internal error (a bug in rfm; please report it)"),
         (Exit::Usage, "wrong command line"),
         (Exit::InvalidInput, "invalid input: a case file or measured file is malformed or inconsistent"),
         (Exit::Numerics, "failed numerics: the model cannot be evaluated, or the fit gave non-finite numbers"),
-        (Exit::NotConverged, "not converged: the update stopped without converging (best iterate written)"),
+        (Exit::NotConverged, "not converged: the update reached its iteration limit (best iterate written)"),
         (Exit::Output, "outputs not written: cannot write, or an output would replace an input"),
         (Exit::Busy, "busy: another rfm run is writing into the same output"),
+        (Exit::Stalled, "stalled: no step lowers the misfit, which stays above the noise (best iterate written)"),
+        (
+            Exit::ModelInadequate,
+            "model inadequate: restarts confirm the minimum but the misfit stays above the noise (results written)",
+        ),
+        (Exit::LocalMinimum, "local minimum: above the noise, and restarts disagree (best fit written)"),
+        (Exit::WorseThanStart, "worse than the start: the update raised the misfit (results written, marked so)"),
         (Exit::Interrupted, "interrupted by Ctrl-C, SIGTERM or SIGHUP (outputs all old or all new)"),
     ];
 
@@ -70,6 +86,10 @@ impl Exit {
             Exit::NotConverged => 5,
             Exit::Output => 6,
             Exit::Busy => 7,
+            Exit::Stalled => 8,
+            Exit::ModelInadequate => 9,
+            Exit::LocalMinimum => 10,
+            Exit::WorseThanStart => 11,
             Exit::Interrupted => 130,
         }
     }
@@ -82,9 +102,21 @@ impl Exit {
     /// The code for how an updating run ended: 0 only when it converged.
     pub(crate) fn of_status(status: &Status) -> Exit {
         match status {
-            Status::Converged | Status::WithinNoise => Exit::Success,
-            Status::Stalled | Status::MaxIterations => Exit::NotConverged,
+            Status::Converged => Exit::Success,
+            Status::MaxIterations => Exit::NotConverged,
+            Status::Stalled => Exit::Stalled,
+            Status::ModelInadequate => Exit::ModelInadequate,
+            Status::LocalMinimum => Exit::LocalMinimum,
             Status::Failed(_) => Exit::Numerics,
+        }
+    }
+
+    /// The code for an update's outcome: a run that made the misfit worse
+    /// than the start's is never a success, whatever its status.
+    pub(crate) fn of_outcome(outcome: &rfm_update::UpdateOutcome) -> Exit {
+        match Exit::of_status(&outcome.status) {
+            Exit::Success if outcome.worse_than_start => Exit::WorseThanStart,
+            exit => exit,
         }
     }
 
@@ -229,10 +261,56 @@ mod tests {
     #[test]
     fn only_a_converged_update_exits_with_zero() {
         assert_eq!(Exit::of_status(&Status::Converged), Exit::Success);
-        assert_eq!(Exit::of_status(&Status::WithinNoise), Exit::Success);
-        assert_eq!(Exit::of_status(&Status::Stalled), Exit::NotConverged);
+        assert_eq!(Exit::of_status(&Status::Stalled), Exit::Stalled);
         assert_eq!(Exit::of_status(&Status::MaxIterations), Exit::NotConverged);
+        assert_eq!(Exit::of_status(&Status::ModelInadequate), Exit::ModelInadequate);
+        assert_eq!(Exit::of_status(&Status::LocalMinimum), Exit::LocalMinimum);
+        // one code per outcome that is not a success
+        let codes: Vec<u8> = [Status::Stalled, Status::MaxIterations, Status::ModelInadequate, Status::LocalMinimum]
+            .iter()
+            .map(|s| Exit::of_status(s).code())
+            .collect();
+        assert_eq!(codes, [8, 5, 9, 10]);
         assert_eq!(Exit::of_status(&Status::Failed("singular".into())), Exit::Numerics);
+    }
+
+    fn outcome(status: Status, worse_than_start: bool) -> rfm_update::UpdateOutcome {
+        rfm_update::UpdateOutcome {
+            method: "rfm".into(),
+            status,
+            parameters: Vec::new(),
+            history: Vec::new(),
+            residual: 0.01,
+            frequencies_hz: Vec::new(),
+            natural_frequencies_hz: rfm_update::study::FrequencyTable {
+                initial: Vec::new(),
+                updated: Vec::new(),
+                truth: None,
+                paper: None,
+                kind: "none".into(),
+            },
+            uncertainty: None,
+            gains: Vec::new(),
+            noise_estimate: Some(0.01),
+            masked: Vec::new(),
+            notes: Vec::new(),
+            warnings: Vec::new(),
+            noise_ratio: Some(1.0),
+            restarts: Vec::new(),
+            worse_than_start,
+            system: damping::DampedSystem::new(fe_model::samples::two_dof_oscillator()).unwrap(),
+        }
+    }
+
+    /// A run that made the misfit worse than the start never exits with 0,
+    /// even when its residual is at the noise level.
+    #[test]
+    fn an_update_worse_than_its_start_is_not_a_success() {
+        assert_eq!(Exit::of_outcome(&outcome(Status::Converged, false)), Exit::Success);
+        assert_eq!(Exit::of_outcome(&outcome(Status::Converged, true)), Exit::WorseThanStart);
+        assert_eq!(Exit::WorseThanStart.code(), 11);
+        // a run that did not converge keeps its own code
+        assert_eq!(Exit::of_outcome(&outcome(Status::Stalled, true)), Exit::Stalled);
     }
 
     #[test]

@@ -223,6 +223,9 @@ fn add_and_update(
     }
     let mut oe_opts = study.output_error_options()?;
     oe_opts.max_iterations = opts.update_iterations;
+    // the loop decides from the misfit against the noise; restarting each
+    // intermediate (knowingly incomplete) model would only cost time
+    oe_opts.restarts = 0;
     let outcome = study.run_output_error(&oe_opts, |_| {})?;
     let misfit_updated = diagnose::log_misfit(&outcome.system, measured, lines)?;
     let model = outcome.system.model();

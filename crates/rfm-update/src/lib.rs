@@ -59,6 +59,7 @@ pub mod rfm;
 pub mod sensitivity;
 pub mod study;
 pub mod uncertainty;
+pub mod verdict;
 
 pub use error::UpdateError;
 

@@ -44,9 +44,9 @@
 //! relaxation together) make a long, curved, nearly flat valley, along which
 //! Levenberg-Marquardt creeps: the f-frame twin needs about 1,700 steps to a
 //! stationary point, the last 1,600 of which lower the chi-square
-//! (`cost / s^2`) by about 2.5 in all. So the fit also stops, with
-//! [`Status::WithinNoise`], when the chi-square fell by less than 0.5 over
-//! the last 10 steps (`OeOptions::stop_within_noise`, on by default; not
+//! (`cost / s^2`) by about 2.5 in all. So the fit also stops (a stationary
+//! point to within what the noise can show, [`OeResult::flat_valley`]), when
+//! the chi-square fell by less than 0.5 over the last 10 steps (`OeOptions::stop_within_noise`, on by default; not
 //! applied with Tikhonov regularisation, where the cost is not a
 //! chi-square). A point whose chi-square is within a few units of the
 //! minimum's lies well inside its joint confidence region, and the
@@ -92,7 +92,7 @@ impl Misfit {
 /// Steps over which the chi-square gain is tested against the noise.
 const NOISE_WINDOW: usize = 10;
 /// Chi-square gain over [`NOISE_WINDOW`] steps below which the fit stops
-/// ([`Status::WithinNoise`]).
+/// ([`OeResult::flat_valley`]).
 const NOISE_WINDOW_GAIN: f64 = 0.5;
 
 /// Options of the output-error estimator.
@@ -113,9 +113,13 @@ pub struct OeOptions {
     /// Relative singular-value cut-off.
     pub rcond: f64,
     /// Stop when the last steps gain less than the noise can show
-    /// ([`Status::WithinNoise`]); off, the fit runs to a stationary point
+    /// ([`OeResult::flat_valley`]); off, the fit runs to a stationary point
     /// or the iteration limit.
     pub stop_within_noise: bool,
+    /// Restarts from spread starts when the fit ends above the noise or
+    /// without converging (see [`crate::study::Study::run_output_error`]);
+    /// 0: none.
+    pub restarts: usize,
 }
 
 impl Default for OeOptions {
@@ -129,6 +133,7 @@ impl Default for OeOptions {
             gains: false,
             rcond: 1e-12,
             stop_within_noise: true,
+            restarts: 6,
         }
     }
 }
@@ -148,8 +153,14 @@ pub struct Gain {
 /// Outcome of an output-error fit.
 #[derive(Clone, Debug)]
 pub struct OeResult {
-    /// How the iteration ended.
+    /// How the iteration ended: [`Status::Converged`] at a stationary point
+    /// (whatever the residual; the study compares it with the noise),
+    /// [`Status::Stalled`], [`Status::MaxIterations`] or [`Status::Failed`].
     pub status: Status,
+    /// The fit stopped because its last steps lowered the chi-square by less
+    /// than the noise can show (a long flat valley; `status` is then
+    /// [`Status::Converged`]).
+    pub flat_valley: bool,
     /// Fitted parameter values.
     pub values: Vec<f64>,
     /// Fitted gains (empty unless requested).
@@ -171,6 +182,10 @@ pub struct OeResult {
     pub v: Mat<f64>,
     /// Parameters that ended on a bound.
     pub at_bound: Vec<bool>,
+    /// Correlation of the residuals at adjacent lines (same channel, real
+    /// and imaginary parts), `sum r_k r_k+1 / sum r_k^2`: near 0 for noise,
+    /// near 1 when a smooth misfit the model cannot represent remains.
+    pub residual_correlation: f64,
 }
 
 /// The data of a fit: measured receptances at the fitted lines and weights.
@@ -498,6 +513,7 @@ pub(crate) fn run_with(
     on_iteration(&history[0]);
     let mut lambda = 0.0;
     let mut status = Status::MaxIterations;
+    let mut flat_valley = false;
     // data misfit after each accepted step, for the test against the noise
     let mut costs = vec![point.cost_data];
     for iteration in 1..=opts.max_iterations {
@@ -563,7 +579,8 @@ pub(crate) fn run_with(
             let sigma2 = point.cost_data / (n_data as f64 - m_free as f64).max(1.0);
             let gain = (costs[costs.len() - 1 - NOISE_WINDOW] - point.cost_data) / sigma2;
             if gain < NOISE_WINDOW_GAIN {
-                status = Status::WithinNoise;
+                status = Status::Converged;
+                flat_valley = true;
                 break;
             }
         }
@@ -583,6 +600,8 @@ pub(crate) fn run_with(
     let dof = (n_data as f64 - free as f64).max(1.0);
     let sigma2 = final_point.cost_data / dof;
     let covariance = covariance(&sol, sigma2);
+    let residual_correlation =
+        adjacent_correlation(&final_point.residual, measured.n_freq(), measured.channels().len());
     let gains = (0..ev.refs.len())
         .filter(|_| opts.gains)
         .map(|v| {
@@ -592,6 +611,7 @@ pub(crate) fn run_with(
         .collect();
     Ok(OeResult {
         status,
+        flat_valley,
         values: ev.p0.iter().zip(&x).map(|(p, t)| p * t.exp()).collect(),
         gains,
         history,
@@ -602,7 +622,28 @@ pub(crate) fn run_with(
         singular_values: sol.singular_values.clone(),
         v: sol.v.clone(),
         at_bound,
+        residual_correlation,
     })
+}
+
+/// Lag-one correlation along the lines of residuals laid out as the
+/// evaluator writes them (real parts `[line * nc + channel]`, then the
+/// imaginary parts); see [`OeResult::residual_correlation`].
+fn adjacent_correlation(residual: &[f64], nf: usize, nc: usize) -> f64 {
+    let rows = nf * nc;
+    let (mut num, mut den) = (0.0, 0.0);
+    for part in [0, rows] {
+        for c in 0..nc {
+            for k in 0..nf {
+                let r = residual[part + k * nc + c];
+                den += r * r;
+                if k + 1 < nf {
+                    num += r * residual[part + (k + 1) * nc + c];
+                }
+            }
+        }
+    }
+    if den > 0.0 { num / den } else { 0.0 }
 }
 
 /// `sigma2 (J^T J)^+` from the column-scaled SVD of the Jacobian `J`, with
@@ -629,6 +670,24 @@ mod tests {
     /// The fast logarithm agrees with `Complex::ln` over every magnitude a
     /// ratio of receptances can take, including where `|z|^2` would
     /// overflow or underflow, and on both sides of the branch cut.
+    #[test]
+    fn adjacent_correlation_is_one_for_a_smooth_misfit_and_small_for_noise() {
+        let (nf, nc) = (200, 2);
+        let smooth: Vec<f64> = (0..2 * nf * nc).map(|i| 1.0 + 1e-3 * (i / nc) as f64).collect();
+        assert!(adjacent_correlation(&smooth, nf, nc) > 0.99);
+        // alternating signs along the lines: anti-correlated
+        let alternating: Vec<f64> = (0..2 * nf * nc).map(|i| if (i / nc) % 2 == 0 { 1.0 } else { -1.0 }).collect();
+        assert!(adjacent_correlation(&alternating, nf, nc) < -0.99);
+        let mut state = 12345u64;
+        let noise: Vec<f64> = (0..2 * nf * nc)
+            .map(|_| {
+                state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+            })
+            .collect();
+        assert!(adjacent_correlation(&noise, nf, nc).abs() < 0.1);
+    }
+
     #[test]
     fn fast_log_equals_the_complex_log() {
         for mag in [1e-300, 1e-160, 1e-20, 1e-3, 0.5, 1.0, 3.0, 1e40, 1e160, 1e300] {

@@ -105,25 +105,77 @@ pub struct IterationRecord {
     pub values: Vec<f64>,
 }
 
-/// How an iteration ended.
+/// How an updating run ended, in the words every output uses (terminal,
+/// JSON, report, `updated.toml`).
+///
+/// The solvers themselves end with [`Status::Converged`] (a stationary
+/// point), [`Status::Stalled`], [`Status::MaxIterations`] or
+/// [`Status::Failed`]; the study then compares the residual with the data's
+/// noise ([`crate::verdict`]) and, for the output-error fit, restarts it to
+/// tell a global minimum from a local one. So `converged` in a result means
+/// that the residual is consistent with the noise, never only that the
+/// iteration stopped.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Status {
-    /// The largest correction fell below the tolerance.
+    /// The iteration reached a stationary point and the residual is within
+    /// [`crate::verdict::NOISE_FACTOR`] times the noise (or the noise is not
+    /// known).
     Converged,
-    /// The residual stopped decreasing (numerical floor or noise) before the
-    /// corrections fell below the tolerance; the best iterate is returned.
+    /// Restarts from spread starts end at the same minimum, but its residual
+    /// stays above the noise: the parameters cannot represent the data
+    /// (something is missing from the model).
+    ModelInadequate,
+    /// The iteration stopped at a point above the noise, and restarts from
+    /// spread starts disagree about the minimum: the fit is not known to be
+    /// global.
+    LocalMinimum,
+    /// No step lowers the misfit further while the residual stays above the
+    /// noise (for the RFM: its iteration stopped there, with no restart to
+    /// confirm a minimum); the best iterate is returned.
     Stalled,
-    /// The misfit still falls, but by less than the noise could show: over the
-    /// last iterations the chi-square (the misfit in units of the noise
-    /// variance estimated from the residual) fell by less than one half. The
-    /// parameters that still move do so along directions the data hardly
-    /// determine, and the covariance says so. Output-error only.
-    WithinNoise,
     /// The iteration limit was reached; the best iterate is returned.
     MaxIterations,
     /// The model could not be evaluated any more; the best iterate is returned.
     Failed(String),
+}
+
+impl Status {
+    /// The name outputs and case checks use (`converged`, `model_inadequate`, ...).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Status::Converged => "converged",
+            Status::ModelInadequate => "model_inadequate",
+            Status::LocalMinimum => "local_minimum",
+            Status::Stalled => "stalled",
+            Status::MaxIterations => "max_iterations",
+            Status::Failed(_) => "failed",
+        }
+    }
+
+    /// The name with what it means, as the report shows it.
+    pub fn describe(&self) -> String {
+        format!("{}: {}", self.name(), self.meaning())
+    }
+
+    /// What the status means, in a sentence.
+    pub fn meaning(&self) -> String {
+        match self {
+            Status::Converged => "the residual is consistent with the noise".to_string(),
+            Status::ModelInadequate => "restarts from spread starts confirm the minimum, but the residual stays above \
+                                        the noise: something the parameters cannot represent remains (try rfm \
+                                        diagnose on the updated case)"
+                .to_string(),
+            Status::LocalMinimum => "the residual stays above the noise and restarts from spread starts disagree \
+                                     about the minimum (the best fit is reported)"
+                .to_string(),
+            Status::Stalled => {
+                "no step lowers the misfit, which stays above the noise (the best iterate is reported)".to_string()
+            }
+            Status::MaxIterations => "the iteration limit was reached (the best iterate is reported)".to_string(),
+            Status::Failed(why) => format!("{why} (the best iterate is reported)"),
+        }
+    }
 }
 
 /// Outcome of an RFM run.
@@ -462,8 +514,9 @@ mod tests {
     fn every_status_is_a_name_case_checks_may_use() {
         let all = [
             Status::Converged,
+            Status::ModelInadequate,
+            Status::LocalMinimum,
             Status::Stalled,
-            Status::WithinNoise,
             Status::MaxIterations,
             Status::Failed("x".into()),
         ];
@@ -471,8 +524,9 @@ mod tests {
         for s in &all {
             match s {
                 Status::Converged
+                | Status::ModelInadequate
+                | Status::LocalMinimum
                 | Status::Stalled
-                | Status::WithinNoise
                 | Status::MaxIterations
                 | Status::Failed(_) => {}
             }
@@ -487,5 +541,7 @@ mod tests {
             })
             .collect();
         assert_eq!(names, fe_model::case::RUN_STATUSES);
+        let by_name: Vec<&str> = all.iter().map(Status::name).collect();
+        assert_eq!(by_name, fe_model::case::RUN_STATUSES);
     }
 }

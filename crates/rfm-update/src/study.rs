@@ -15,6 +15,7 @@ use crate::oe::{self, Gain, Misfit, OeData, OeOptions};
 use crate::params::ParameterSet;
 use crate::rfm::{self, IterationRecord, RfmOptions, Status};
 use crate::uncertainty::{self, UncertaintyReport};
+use crate::verdict;
 
 /// An updating method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -164,12 +165,39 @@ pub struct UpdateOutcome {
     pub notes: Vec<String>,
     /// What the data leave undetermined, for methods without an uncertainty
     /// report (the RFM): parameters that ended on a bound, the combination
-    /// of parameters the sensitivity cannot separate.
+    /// of parameters the sensitivity cannot separate; and for the RFM, why
+    /// its result may not be trusted (noise above its limit, parameters
+    /// that ran away, no uncertainty, a misfit worse than the start).
     pub warnings: Vec<String>,
+    /// The final residual as a multiple of the estimated noise (what the
+    /// status is decided on; `None` when the noise is unknown).
+    pub noise_ratio: Option<f64>,
+    /// The restarts of the output-error fit (empty when none were needed).
+    pub restarts: Vec<Restart>,
+    /// The update ended with a larger misfit than the initial model's.
+    pub worse_than_start: bool,
     /// The updated model.
     #[serde(skip)]
     pub system: DampedSystem,
 }
+
+/// One restart of the output-error fit from a spread start.
+#[derive(Clone, Debug, Serialize)]
+pub struct Restart {
+    /// Residual RMS at the start.
+    pub start_residual: f64,
+    /// Residual RMS where it ended.
+    pub residual: f64,
+    /// Whether it was run to the end (the best of the short ones are).
+    pub refined: bool,
+}
+
+/// Restart fits of a few steps each; the best are then run to the end.
+const RESTART_STEPS: usize = 15;
+/// How many of the short restarts are run to the end.
+const RESTARTS_REFINED: usize = 2;
+/// Restart starts spread by up to this factor either way from the initial values.
+const RESTART_SPREAD: f64 = 10.0;
 
 /// Reads a measured FRF file for a model with the case's channel map and
 /// mask rules (`[measurement] map` and `mask`; none without a spec), and
@@ -409,17 +437,40 @@ impl Study {
             })
             .collect();
         warnings.extend(result.unresolved.clone());
+        let noise = crate::diagnose::estimate_noise(&self.measured);
+        if let Some(s) = noise.filter(|&s| s > verdict::RFM_NOISE_LIMIT) {
+            warnings.push(format!(
+                "the data's noise ({:.2} %) is above the {:.1} % where the RFM is biased (its equations have \
+                 measured data on both sides): its values cannot be trusted; use --method output-error",
+                100.0 * s,
+                100.0 * verdict::RFM_NOISE_LIMIT
+            ));
+        }
+        warnings.extend(verdict::runaways(&self.parameter_names(), &self.system_values(), &result.values));
+        let first = result.history.first().map_or(f64::NAN, |r| r.residual);
+        let worse_than_start = result.residual > first;
+        if worse_than_start {
+            warnings.push(format!(
+                "the RFM made the misfit worse than the initial model's ({:.3e} -> {:.3e}): the updated model \
+                 is not an improvement",
+                first, result.residual
+            ));
+        }
+        let noise_ratio = noise.filter(|&s| s > 0.0).map(|s| result.residual / s);
         let natural_frequencies_hz = self.frequency_table(&sys);
         Ok(UpdateOutcome {
             natural_frequencies_hz,
             uncertainty: None,
             gains: Vec::new(),
-            noise_estimate: crate::diagnose::estimate_noise(&self.measured),
+            noise_estimate: noise,
             masked: describe_masked(&self.masked),
             notes: self.notes.clone(),
             warnings,
+            noise_ratio,
+            restarts: Vec::new(),
+            worse_than_start,
             method: "rfm".into(),
-            status: result.status,
+            status: verdict::classify(&result.status, noise_ratio, None),
             parameters: self.reports(&result.values),
             history: result.history,
             residual: result.residual,
@@ -518,26 +569,95 @@ impl Study {
         let params = self.parameter_set();
         let mut sys = self.system.clone();
         let data = OeData { measured: &measured, weights: weights.as_deref() };
-        let result = oe::run(&mut sys, &params, &data, opts, on_iteration)?;
+        let noise = crate::diagnose::estimate_noise(&self.measured);
+        let ratio = |r: &oe::OeResult| noise.filter(|&s| s > 0.0).map(|s| (2.0 * r.sigma2).sqrt() / s);
+        let first = oe::run(&mut sys, &params, &data, opts, on_iteration)?;
+        let settled =
+            |r: &oe::OeResult| r.status == Status::Converged && ratio(r).is_none_or(|x| x <= verdict::RESTART_ABOVE);
+        let mut restarts = Vec::new();
+        let mut agree = None;
+        let mut history = first.history.clone();
+        let mut result = first;
+        if !settled(&result) && opts.restarts > 0 && !matches!(result.status, Status::Failed(_)) {
+            // restarts spread in log space around the initial values, a few
+            // steps each; the best are run to the end and the lowest kept
+            let p_init = params.values(&self.system);
+            let bounds: Vec<(f64, f64)> = p_init
+                .iter()
+                .enumerate()
+                .map(|(i, &p)| opts.bounds.get(i).copied().flatten().unwrap_or((p / 1e6, p * 1e6)))
+                .collect();
+            let fit = |start: &[f64], o: &OeOptions| -> Option<oe::OeResult> {
+                let mut s = self.system.clone();
+                params.set_values(&mut s, start).ok()?;
+                oe::run(&mut s, &params, &data, o, |_| {}).ok().filter(|r| r.cost.is_finite())
+            };
+            let short = OeOptions { max_iterations: RESTART_STEPS, ..opts.clone() };
+            let mut tried: Vec<oe::OeResult> = (1..=opts.restarts)
+                .filter_map(|i| fit(&verdict::spread_start(&p_init, &bounds, i, RESTART_SPREAD), &short))
+                .collect();
+            tried.sort_by(|a, b| a.cost.total_cmp(&b.cost));
+            for t in &tried[RESTARTS_REFINED.min(tried.len())..] {
+                restarts.push(Restart {
+                    start_residual: t.history[0].residual,
+                    residual: t.history.last().map_or(f64::NAN, |r| r.residual),
+                    refined: false,
+                });
+            }
+            let mut ends = vec![result.cost];
+            for t in tried.into_iter().take(RESTARTS_REFINED) {
+                let Some(r) = fit(&t.values, opts) else { continue };
+                restarts.push(Restart {
+                    start_residual: t.history[0].residual,
+                    residual: r.history.last().map_or(f64::NAN, |x| x.residual),
+                    refined: true,
+                });
+                ends.push(r.cost);
+                if r.cost < result.cost {
+                    let offset = history.len();
+                    history.extend(r.history.iter().cloned().map(|mut rec| {
+                        rec.iteration += offset;
+                        rec
+                    }));
+                    result = r;
+                }
+            }
+            let best = result.cost;
+            let same = ends.iter().filter(|&&c| (c - best) <= verdict::SAME_MINIMUM * best).count();
+            agree = Some(same >= 2);
+            params.set_values(&mut sys, &result.values)?;
+        }
+        let noise_ratio = ratio(&result);
+        let status = verdict::classify(&result.status, noise_ratio, agree);
         let band = (lines[0], lines[lines.len() - 1]);
-        let report = uncertainty::analyse(&params, &result, band);
+        let report = uncertainty::analyse(&params, &result, band, noise);
         let natural_frequencies_hz = self.frequency_table(&sys);
+        let first_residual = history.first().map_or(f64::NAN, |r| r.residual);
+        let residual = result.history.last().map_or(f64::NAN, |r| r.residual);
         Ok(UpdateOutcome {
             method: "output-error".into(),
-            status: result.status.clone(),
+            status,
             parameters: self.reports(&result.values),
-            residual: result.history.last().map_or(f64::NAN, |r| r.residual),
-            history: result.history,
+            residual,
+            history,
             frequencies_hz: lines,
             natural_frequencies_hz,
             uncertainty: Some(report),
             gains: result.gains,
-            noise_estimate: crate::diagnose::estimate_noise(&self.measured),
+            noise_estimate: noise,
             masked: describe_masked(&self.masked),
             notes: self.notes.clone(),
             warnings: Vec::new(),
+            noise_ratio,
+            restarts,
+            worse_than_start: residual > first_residual,
             system: sys,
         })
+    }
+
+    /// The initial values of the updating parameters.
+    pub fn system_values(&self) -> Vec<f64> {
+        self.parameter_set().values(&self.system)
     }
 
     /// RFM options from the case's `[update]` section (iteration limit,

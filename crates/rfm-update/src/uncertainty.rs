@@ -6,6 +6,23 @@
 //! interval `p_i exp(-1.96 s_i) .. p_i exp(1.96 s_i)` (asymmetric, as a
 //! positive parameter's should be). Correlations are `C_ij / sqrt(C_ii C_jj)`.
 //!
+//! Two standard deviations are reported. The noise-only one scales the
+//! covariance by the data's noise variance (estimated from their roughness,
+//! [`crate::diagnose::estimate_noise`], or from the residual when that is
+//! smaller); it is right when the model explains the data down to their
+//! noise. When it does not, the residual holds model
+//! error as well, which is neither small nor independent from line to line,
+//! and the noise-only value shrinks as `1 / sqrt(lines)` however wrong the
+//! model. The standard deviation shown first ([`ParameterUncertainty::std`],
+//! used in every "within N standard deviations" statement) therefore
+//! includes model error: the noise-only one times at least
+//! `sqrt(chi2 / dof)` (the covariance scaled by the residual variance the
+//! fit leaves, when that is larger than the noise), times
+//! `sqrt((1 + rho) / (1 - rho))` when the residuals at adjacent lines are
+//! correlated with coefficient `rho` (an AR(1) residual of `n` values
+//! carries the information of about `n (1 - rho) / (1 + rho)` independent
+//! ones), where `rho` is larger than its noise-only spread `2 / sqrt(n)`.
+//!
 //! The data do not determine every parameter well. Each is flagged as weakly
 //! determined, with the reason, when:
 //! - its relative standard deviation exceeds 30 %;
@@ -33,11 +50,17 @@ pub struct ParameterUncertainty {
     pub name: String,
     /// Fitted value.
     pub value: f64,
-    /// Standard deviation (physical units, first order).
+    /// Standard deviation including model error (physical units, first
+    /// order): the one shown first; see the module docs.
     pub std: f64,
-    /// Relative standard deviation (standard deviation of `ln p`).
+    /// Relative standard deviation including model error (standard
+    /// deviation of `ln p`).
     pub relative_std: f64,
-    /// 95 % interval.
+    /// Standard deviation from the noise alone (physical units).
+    pub std_noise: f64,
+    /// Relative standard deviation from the noise alone.
+    pub relative_std_noise: f64,
+    /// 95 % interval (from the standard deviation with model error).
     pub interval95: (f64, f64),
     /// Ended on a bound.
     pub at_bound: bool,
@@ -59,17 +82,51 @@ pub struct UncertaintyReport {
     /// Estimated RMS residual per complex value (the noise level the fit
     /// leaves, relative for the relative and log misfits).
     pub residual_rms: f64,
+    /// Which standard deviation `std` is, in words (shown with the table).
+    pub shown_first: String,
+    /// `chi2 / dof`: the residual variance over the noise variance (`None`
+    /// when the noise is unknown).
+    pub chi2_per_dof: Option<f64>,
+    /// Correlation of the residuals at adjacent lines.
+    pub residual_correlation: f64,
+    /// `std / std_noise`, the same for every parameter.
+    pub inflation: f64,
 }
 
-/// Analyses an output-error result; `band_hz` is the fitted band.
-pub fn analyse(params: &ParameterSet, result: &OeResult, band_hz: (f64, f64)) -> UncertaintyReport {
+/// The factor by which the standard deviation with model error exceeds the
+/// noise-only one, for a residual RMS per complex value `residual_rms`,
+/// noise level `noise`, lag-one residual correlation `rho` over `n` real
+/// residuals; see the module docs.
+pub fn model_error_inflation(residual_rms: f64, noise: Option<f64>, rho: f64, n: usize) -> f64 {
+    let lack_of_fit = noise.filter(|&s| s > 0.0).map_or(1.0, |s| (residual_rms / s).max(1.0));
+    let spread = 2.0 / (n.max(1) as f64).sqrt();
+    let correlated = if rho > spread {
+        let r = rho.min(0.999);
+        ((1.0 + r) / (1.0 - r)).sqrt()
+    } else {
+        1.0
+    };
+    lack_of_fit * correlated
+}
+
+/// Analyses an output-error result; `band_hz` is the fitted band, `noise`
+/// the data's relative noise level when known.
+pub fn analyse(params: &ParameterSet, result: &OeResult, band_hz: (f64, f64), noise: Option<f64>) -> UncertaintyReport {
     let n = params.len();
     let c = &result.covariance;
+    let residual_rms = (2.0 * result.sigma2).sqrt();
+    // the covariance is scaled by the residual variance: rescale it to the
+    // noise's for the noise-only value
+    // noise for the noise-only value, when the fit leaves more than that
+    // (below it, the residual's own variance is the better noise estimate)
+    let to_noise = noise.filter(|&s| s > 0.0 && residual_rms > 0.0).map_or(1.0, |s| (s / residual_rms).min(1.0));
+    let inflation = model_error_inflation(residual_rms, noise, result.residual_correlation, result.n_data / 2);
     let (w_min, w_max) = (2.0 * std::f64::consts::PI * band_hz.0, 2.0 * std::f64::consts::PI * band_hz.1);
     let mut out = Vec::with_capacity(n);
     for (i, p) in params.params().iter().enumerate() {
         let value = result.values[i];
-        let s = c[(i, i)].max(0.0).sqrt();
+        let s_noise = c[(i, i)].max(0.0).sqrt() * to_noise;
+        let s = s_noise * inflation;
         let mut warnings = Vec::new();
         if result.at_bound[i] {
             warnings.push("ended on its bound; its uncertainty is not meaningful".to_string());
@@ -97,6 +154,8 @@ pub fn analyse(params: &ParameterSet, result: &OeResult, band_hz: (f64, f64)) ->
             value,
             std: value * s,
             relative_std: s,
+            std_noise: value * s_noise,
+            relative_std_noise: s_noise,
             interval95: if s.is_finite() {
                 (value * (-1.96 * s).exp(), value * (1.96 * s).exp())
             } else {
@@ -138,7 +197,27 @@ pub fn analyse(params: &ParameterSet, result: &OeResult, band_hz: (f64, f64)) ->
     if let Some(w) = unresolved_combination(&result.singular_values, &result.v, &names) {
         warnings.push(w);
     }
-    UncertaintyReport { parameters: out, correlation, warnings, residual_rms: (2.0 * result.sigma2).sqrt() }
+    let chi2_per_dof = noise.filter(|&s| s > 0.0).map(|s| (residual_rms / s).powi(2));
+    let shown_first = if inflation > 1.0 {
+        format!(
+            "with model error: the noise-only standard deviation times {inflation:.2} (the fit leaves {:.2} times the \
+             noise, adjacent residuals correlated {:.2})",
+            chi2_per_dof.map_or(1.0, f64::sqrt),
+            result.residual_correlation
+        )
+    } else {
+        "with model error, which adds nothing here: the residual is at the noise level and uncorrelated".to_string()
+    };
+    UncertaintyReport {
+        parameters: out,
+        correlation,
+        warnings,
+        residual_rms,
+        shown_first,
+        chi2_per_dof,
+        residual_correlation: result.residual_correlation,
+        inflation,
+    }
 }
 
 /// Names the parameter combination along the weakest direction of a
@@ -166,4 +245,23 @@ pub(crate) fn unresolved_combination(sv: &[f64], v: &Mat<f64>, names: &[String])
         terms.join(" "),
         smin / smax
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn inflation_is_the_lack_of_fit_times_the_correlation_of_adjacent_residuals() {
+        // at the noise and white: nothing added
+        assert_eq!(model_error_inflation(0.01, Some(0.01), 0.0, 400), 1.0);
+        assert_eq!(model_error_inflation(0.008, Some(0.01), 0.05, 400), 1.0);
+        // 10 times the noise: at least sqrt(chi2 / dof) = 10
+        assert!((model_error_inflation(0.1, Some(0.01), 0.0, 400) - 10.0).abs() < 1e-12);
+        // correlated residuals: fewer independent lines, (1 + rho) / (1 - rho) = 19
+        let f = model_error_inflation(0.1, Some(0.01), 0.9, 400);
+        assert!((f - 10.0 * 19f64.sqrt()).abs() < 1e-9, "{f}");
+        // unknown noise: the correlation alone
+        assert!((model_error_inflation(0.1, None, 0.6, 400) - 2.0).abs() < 1e-12);
+    }
 }

@@ -125,12 +125,16 @@ impl CaseEditor {
 
     /// Makes the case read its measured FRFs from `path` (a file written
     /// beside the new case, holding the data the case synthesised from its
-    /// `[truth]`), and removes the `[truth]`: once effects are added to the
+    /// `[truth]`), and removes the `[truth]` (and the `[check]`, which
+    /// compares with it): once effects are added to the
     /// model, a truth defined on top of the model would no longer describe
     /// what was measured.
     pub fn use_data(&mut self, path: &Path) {
         self.data = Some(path.to_path_buf());
         self.doc.remove("truth");
+        // the acceptance of the case's results compares them with the truth
+        // it no longer has
+        self.doc.remove("check");
         let measurement = self.doc.entry("measurement").or_insert(Item::Table(Table::new()));
         if let Some(m) = measurement.as_table_like_mut() {
             // a placeholder that `text_at` replaces by the path relative to the new file

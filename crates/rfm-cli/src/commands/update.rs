@@ -100,7 +100,7 @@ pub(crate) fn update(
         bar.set_position(r.iteration as u64);
         bar.set_message(format!("misfit {:.3e}", r.residual));
     };
-    let outcome = match method {
+    let mut outcome = match method {
         Method::Rfm => {
             let opts = RfmOptions { max_iterations, ..study.rfm_options() };
             study.run_rfm(&opts, on_iteration)?
@@ -115,6 +115,15 @@ pub(crate) fn update(
     // the misfit the case's history speaks of, after this update
     let noise = rfm_update::diagnose::estimate_noise(&study.measured);
     let misfit = rfm_update::diagnose::log_misfit(&outcome.system, &study.measured, HISTORY_LINES)?;
+    // worse than the start over the whole band, not only at the fitted lines
+    let misfit_initial = rfm_update::diagnose::log_misfit(&study.system, &study.measured, HISTORY_LINES)?;
+    if misfit > WORSE_BY * misfit_initial && !outcome.worse_than_start {
+        outcome.worse_than_start = true;
+        outcome.warnings.push(format!(
+            "the update made the misfit over the band worse than the initial model's ({misfit_initial:.3e} -> \
+             {misfit:.3e}): the updated model is not an improvement"
+        ));
+    }
     let step = fe_model::HistoryEntry { step: format!("updated ({})", outcome.method), misfit, noise };
     if json {
         outln!("{}", serde_json::to_string_pretty(&outcome)?);
@@ -135,7 +144,7 @@ pub(crate) fn update(
             outln!("wrote {} (figures beside it)", report.display());
         }
     }
-    let exit = Exit::of_status(&outcome.status);
+    let exit = Exit::of_outcome(&outcome);
     if exit != Exit::Success {
         eprintln!("exit code {}: {}", exit.code(), exit.meaning());
     }
@@ -155,19 +164,30 @@ fn write_updated_model(
         .iter()
         .flat_map(|p| p.quantities.iter().map(|&q| (model.quantity_name(q).to_string(), model.get(q))))
         .collect();
-    let comment = format!(
-        "Updated by rfm ({}, status {:?}, misfit {:.3e}) from {}",
+    let mut comment = format!(
+        "Updated by rfm ({}, status {}, misfit {:.3e}) from {}",
         outcome.method,
-        outcome.status,
+        outcome.status.name(),
         outcome.residual,
         study.case.path.display()
     );
+    if outcome.worse_than_start {
+        comment.push_str(
+            "\nWARNING: this update made the misfit WORSE than the initial model's: these values are not an improvement",
+        );
+    }
     let mut editor = study.case.editor()?;
     editor.set_values(&values, &comment)?;
     editor.push_history(step)?;
     let text = editor.text_at(&output.path("updated.toml"))?;
     Ok(output.write("updated.toml", text.as_bytes())?)
 }
+
+/// A band misfit this many times the initial model's is worse than the
+/// start: a fit that starts at its optimum (values from `rfm diagnose
+/// --apply`) may move the band misfit by far less, its fitted lines not
+/// being the band's.
+const WORSE_BY: f64 = 1.01;
 
 /// Lines of the misfit in the case history (as in `rfm diagnose`).
 const HISTORY_LINES: usize = 200;
@@ -188,16 +208,7 @@ fn print_history(history: &[fe_model::HistoryEntry]) -> Result<()> {
 }
 
 fn print_outcome(outcome: &UpdateOutcome) -> Result<()> {
-    let status = match &outcome.status {
-        Status::Converged => "converged".to_string(),
-        Status::Stalled => "stalled: no step lowers the misfit further (best iterate kept)".to_string(),
-        Status::WithinNoise => {
-            "converged to within the noise: the last steps lowered the misfit by less than the noise can show"
-                .to_string()
-        }
-        Status::MaxIterations => "iteration limit reached (best iterate kept)".to_string(),
-        Status::Failed(e) => format!("failed: {e} (best iterate kept)"),
-    };
+    let status = outcome.status.name();
     let first = outcome.history.first().map_or(f64::NAN, |r| r.residual);
     outln!(
         "{status} after {} iterations; misfit {:.3e} -> {:.3e} ({:+.1} dB)\n",
@@ -206,6 +217,7 @@ fn print_outcome(outcome: &UpdateOutcome) -> Result<()> {
         outcome.residual,
         db(outcome.residual) - db(first)
     );
+    outln!("{}: {}\n", outcome.status.name(), outcome.status.meaning());
     let unc = outcome.uncertainty.as_ref();
     let has_truth = outcome.parameters.iter().any(|p| p.truth.is_some());
     let has_paper = outcome.parameters.iter().any(|p| p.paper.is_some());
@@ -253,6 +265,16 @@ fn print_outcome(outcome: &UpdateOutcome) -> Result<()> {
     }
     outln!("{}", t.render());
     if let Some(u) = unc {
+        outln!("standard deviations {}", u.shown_first);
+        if u.inflation > 1.0 {
+            let noise_only: Vec<String> = outcome
+                .parameters
+                .iter()
+                .zip(&u.parameters)
+                .map(|(p, q)| format!("{} {}", p.name, num(q.std_noise)))
+                .collect();
+            outln!("noise-only standard deviations (too small here): {}", noise_only.join(", "));
+        }
         let notes: Vec<String> = u
             .parameters
             .iter()
@@ -266,22 +288,38 @@ fn print_outcome(outcome: &UpdateOutcome) -> Result<()> {
             }
         }
         outln!("\nresidual RMS per value {:.3e} (the noise level the fit leaves)", u.residual_rms);
-        if let Some(noise) = outcome.noise_estimate {
-            let ratio = u.residual_rms / noise;
-            let reading = if ratio < 1.5 {
+    }
+    if unc.is_none() {
+        outln!(
+            "\nno uncertainty is available for these values: the RFM's equation error has no noise model \
+             (--method output-error gives standard deviations)"
+        );
+    }
+    if let (Some(noise), Some(ratio)) = (outcome.noise_estimate, outcome.noise_ratio) {
+        let reading = match outcome.status {
+            _ if ratio <= rfm_update::verdict::NOISE_FACTOR => {
                 "the model explains the data down to their noise".to_string()
-            } else if !matches!(outcome.status, Status::Converged | Status::WithinNoise) {
-                format!("the fit leaves {ratio:.1} times the noise, but the iteration stopped before converging")
-            } else {
-                format!(
-                    "the fit leaves {ratio:.1} times the noise: something the parameters cannot represent remains (try rfm diagnose on the updated case)"
-                )
-            };
-            outln!("noise level estimated from the data {noise:.3e}: {reading}");
-        }
+            }
+            Status::ModelInadequate => format!(
+                "the fit leaves {ratio:.1} times the noise at a minimum its restarts confirm: something the parameters cannot represent remains (try rfm diagnose on the updated case)"
+            ),
+            _ => format!(
+                "the fit leaves {ratio:.1} times the noise; it is not known to be the best fit ({})",
+                outcome.status.name()
+            ),
+        };
+        outln!("\nnoise level estimated from the data {noise:.3e}: {reading}");
+    }
+    if !outcome.restarts.is_empty() {
+        let ends: Vec<String> = outcome.restarts.iter().map(|r| format!("{:.3e}", r.residual)).collect();
+        outln!(
+            "restarts from {} spread starts (residual RMS where they ended: {})",
+            outcome.restarts.len(),
+            ends.join(", ")
+        );
     }
     if !outcome.warnings.is_empty() {
-        outln!("\nwhat the data determine only weakly:");
+        outln!("\nwhat the data determine only weakly, and what not to trust:");
         for w in &outcome.warnings {
             outln!("  - {w}");
         }

@@ -118,6 +118,14 @@ pub(crate) fn write(
     out.write("parameters.csv", csv.as_bytes())?;
     let mut ps = Section::new("Parameters");
     ps.push(Block::Table(params));
+    let basis = match &outcome.uncertainty {
+        Some(u) => format!("Standard deviations {}.", u.shown_first),
+        None => "No uncertainty is available for these values: the RFM's equation error has no noise model.".into(),
+    };
+    ps.push(Block::Text(basis));
+    for w in &outcome.warnings {
+        ps.push(Block::Text(format!("{w}.")));
+    }
     if let Some(u) = &outcome.uncertainty {
         for w in u.parameters.iter().flat_map(|p| p.warnings.iter().map(move |w| format!("{}: {w}.", p.name))) {
             ps.push(Block::Text(w));
@@ -188,15 +196,7 @@ fn apply_gains(frfs: &mut FrfSet, gains: &[Gain]) {
 }
 
 fn status_text(s: &Status) -> String {
-    match s {
-        Status::Converged => "converged".into(),
-        Status::Stalled => "stalled (the misfit stopped falling; the best iterate is reported)".into(),
-        Status::WithinNoise => {
-            "converged to within the noise (the last steps gained less than the noise can show)".into()
-        }
-        Status::MaxIterations => "iteration limit reached (the best iterate is reported)".into(),
-        Status::Failed(why) => format!("failed ({why}); the best iterate is reported"),
-    }
+    s.describe()
 }
 
 /// Budget of the convergence plot's re-evaluation, in DOF x line solves:

@@ -1,6 +1,7 @@
 //! Integration tests of rfm-update.
 
 mod apply_every;
+mod calibration;
 mod fast_vs_naive;
 mod held_out;
 mod hidden_effects;
@@ -8,4 +9,5 @@ mod numerics;
 mod output_error;
 mod paper_cases;
 mod sensitivity;
+mod trust;
 mod truths;
