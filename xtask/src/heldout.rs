@@ -13,7 +13,18 @@ pub(crate) fn heldout(args: &[String]) -> Result<(), String> {
     }
     let status = crate::cargo()
         .current_dir(crate::root())
-        .args(["test", "--release", "-p", "rfm-update", "--test", "it", "held_out", "--", "--nocapture"])
+        .args([
+            "test",
+            "--release",
+            "-p",
+            "rfm-update",
+            "--test",
+            "it",
+            "held_out",
+            "--",
+            "--nocapture",
+            "--include-ignored",
+        ])
         .env("HELD_OUT_SINGLE", "12")
         .env("HELD_OUT_PAIRS", "16")
         .env("HELD_OUT_NULL", "20")

@@ -66,7 +66,11 @@ impl Diagnosis {
             }
         }
         let method = case.update.as_ref().and_then(|u| u.method.as_ref()).map_or("output-error", |(m, _)| m.as_str());
-        editor.set_update(&names, method)?;
+        // an effect whose parameters the data cannot determine adds nothing
+        // to update (and an empty [update] is not a valid case)
+        if !names.is_empty() {
+            editor.set_update(&names, method)?;
+        }
         if case.history.is_empty() {
             editor.push_history(&HistoryEntry {
                 step: "nominal".into(),
