@@ -844,6 +844,12 @@ fn build_model(ctx: &Ctx<'_>, raw: &RawCase, model: &mut Model) -> Result<(), Ca
     for s in &raw.springs {
         add_spring(ctx, model, s)?;
     }
+    // joints before masses, supports and ties: a joint makes a node (its
+    // `new_node`, or the next free id) that those may name, as a case
+    // written by `rfm diagnose --apply` does for a mass at a joint
+    for j in &raw.joints {
+        add_joint(ctx, model, j)?;
+    }
     for m in &raw.masses {
         add_mass(ctx, model, m)?;
     }
@@ -859,9 +865,6 @@ fn build_model(ctx: &Ctx<'_>, raw: &RawCase, model: &mut Model) -> Result<(), Ca
         let r = t.get_ref();
         let dofs = parse_dofs(ctx, &r.dofs)?;
         model.add_tie(r.nodes[0], r.nodes[1], &dofs).map_err(|e| ctx.model_err(t.span(), e))?;
-    }
-    for j in &raw.joints {
-        add_joint(ctx, model, j)?;
     }
     for a in &raw.assign {
         let r = a.get_ref();
@@ -1511,6 +1514,20 @@ node = 1
         assert_eq!(c.model.ties()[0].dofs, vec![Dof::Ux, Dof::Uy]);
         let bad = text.replace("elements = [3]", "elements = [1]");
         assert!(parse(&bad).unwrap_err().message.contains("does not end at node 3"));
+    }
+
+    /// A mass may sit at the node a joint makes (as `rfm diagnose --apply`
+    /// writes it), wherever the joint comes in the file.
+    #[test]
+    fn a_mass_may_sit_at_the_node_a_joint_makes() {
+        let text = format!(
+            "{BEAM}\n[[masses]]\nname = \"m\"\nnode = 6\nm = 0.2\ngroup = \"j\"\n\
+             [groups.j]\nalpha = 1e-3\n[[joints]]\nname = \"j3\"\nnode = 3\nelements = [3]\nkr = 5e3\ngroup = \"j\"\n"
+        );
+        let c = parse(&text).unwrap();
+        assert_eq!(c.model.masses()[0].node, NodeId(6));
+        let e3 = &c.model.beams()[c.model.beam_index(crate::model::ElementId(3)).unwrap()];
+        assert_eq!(e3.nodes[0], NodeId(6));
     }
 
     #[test]

@@ -171,7 +171,6 @@ fn apply_every(case: CaseFile, dir: &Path) -> BTreeSet<String> {
 }
 
 #[test]
-#[ignore = "open bug: on the portal sample a lumped mass at node 14 (rank 57) is written for a node the case text does not define"]
 fn every_ranked_effect_applies_to_the_tutorial_the_papers_cases_and_samples() {
     let tmp = tempfile::tempdir().unwrap();
     let mut kinds = BTreeSet::new();
