@@ -211,7 +211,7 @@ fn add_and_update(
     let mut oe_opts = study.output_error_options()?;
     oe_opts.max_iterations = opts.update_iterations;
     let outcome = study.run_output_error(&oe_opts, |_| {})?;
-    let misfit_updated = diagnose::log_misfit(&outcome.system, measured, lines)?;
+    let misfit_updated = diagnose::log_misfit_with(&outcome.system, measured, lines, d.gains)?;
     let model = outcome.system.model();
     let values: Vec<(String, f64)> = study
         .parameters

@@ -584,6 +584,34 @@ impl Study {
         Ok(Some(w))
     }
 
+    /// Decides the gains again for measured data read from another file
+    /// (`--measured`): from the case and that file's per-volt references,
+    /// as [`Study::from_case`] does for the case's own data.
+    pub fn set_gains_for(&mut self, read: &frf::io::Measured) -> Result<(), UpdateError> {
+        self.per_volt = read.per_volt_references();
+        (self.gains, self.gains_reason) =
+            gain::decide(self.case.measurement.as_ref(), self.case.update.as_ref(), &self.per_volt)?;
+        Ok(())
+    }
+
+    /// The diagnosis options of this study: the defaults, with a gain per
+    /// reference fitted with every candidate when the study has gains. A
+    /// gain per channel is refused: the diagnosis fits them per reference.
+    pub fn diagnose_options(&self) -> Result<crate::diagnose::DiagnoseOptions, UpdateError> {
+        let gains = match self.gains {
+            Gains::None => false,
+            Gains::PerReference => true,
+            Gains::PerChannel => {
+                return Err(UpdateError::Setup(
+                    "`gains = \"per-channel\"`: the diagnosis and the output-error update fit one gain per \
+                     reference (compare fits them per channel); diagnose with `gains = \"per-reference\"`"
+                        .into(),
+                ));
+            }
+        };
+        Ok(crate::diagnose::DiagnoseOptions { gains, ..Default::default() })
+    }
+
     /// Line weights of the output-error fit (see [`Study::line_weights`]).
     pub fn weights(&self, measured: &FrfSet) -> Result<Option<Vec<f64>>, UpdateError> {
         self.line_weights(measured)
@@ -655,8 +683,8 @@ impl Study {
             Gains::PerReference => true,
             Gains::PerChannel => {
                 return Err(UpdateError::Setup(
-                    "`gains = \"per-channel\"`: the output-error update fits one gain per reference; compare and \
-                     diagnose fit gains per channel. Update with `gains = \"per-reference\"`"
+                    "`gains = \"per-channel\"`: the output-error update fits one gain per reference (compare fits \
+                     them per channel); update with `gains = \"per-reference\"`"
                         .into(),
                 ));
             }

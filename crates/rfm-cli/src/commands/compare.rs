@@ -10,9 +10,11 @@ use std::path::{Path, PathBuf};
 
 use damping::DampedSystem;
 use fe_model::CaseFile;
+use fe_model::case::Gains;
 use frf::correlation::{BandSpec, Correlation, correlate};
 use frf::{FrfSet, synthesize};
 use rfm_update::Study;
+use rfm_update::gain::{self, GainReport};
 use rfm_update::study::{describe_masked, read_measured_for};
 use serde::Serialize;
 
@@ -38,9 +40,19 @@ struct CompareJson {
     model: String,
     /// Band choice (`auto`, `octave`, edges...).
     bands: String,
+    /// The FRF kind compared: the data's, whichever way they arrive.
+    kind: String,
     correlation: CorrelationJson,
-    /// Measured (LSCF) against model modes, or why they could not be compared.
-    modes: std::result::Result<ModesJson, String>,
+    /// The unknown gains the model's FRFs were multiplied by (`none`,
+    /// `per-reference`, `per-channel`) and why.
+    gain_setting: String,
+    /// The fitted gains (empty without gains).
+    gains: Vec<GainReport>,
+    /// Measured (LSCF) against model modes; `null` when they could not be
+    /// compared, with the reason in `modes_error`.
+    modes: Option<ModesJson>,
+    /// Why the modes could not be compared.
+    modes_error: Option<String>,
     /// What the case's mask rules left out of the measured data.
     masked: Vec<String>,
     /// What reading the measured data changed or passed over.
@@ -76,8 +88,11 @@ fn compare_modes(system: &DampedSystem, measured: &FrfSet) -> std::result::Resul
     let band = (f[0], f[f.len() - 1]);
     let est = frf::lscf(&rec, &frf::LscfOptions::new(band.0, band.1)).map_err(|e| format!("modal estimation: {e}"))?;
     let meas = frf::measured_modes(&est);
-    let model = frf::model_modes(system, &est.responses, band.1).map_err(|e| format!("model modes: {e}"))?;
+    // model modes up to twice the band's top, so that a measured mode whose
+    // partner lies outside the band is paired with it and said so
+    let model = frf::model_modes(system, &est.responses, 2.0 * band.1).map_err(|e| format!("model modes: {e}"))?;
     let pairing = frf::pair_modes(&model, &meas, 0.5);
+    let outside = |hz: f64| hz < band.0 || hz > band.1;
     let mut rows = Vec::new();
     for (i, m) in meas.iter().enumerate() {
         let row = match pairing.pairs.iter().find(|p| p.measured == i) {
@@ -91,7 +106,16 @@ fn compare_modes(system: &DampedSystem, measured: &FrfSet) -> std::result::Resul
                     frequency_error_pct: Some(p.frequency_error_pct),
                     damping_error_pct: Some(p.damping_error_pct),
                     mac: Some(p.mac),
-                    reading: frf::symptom(x, m, p.mac).reading().to_string(),
+                    reading: if outside(x.frequency_hz) {
+                        format!(
+                            "its model partner ({:.2} Hz) lies outside the band {}-{} Hz",
+                            x.frequency_hz,
+                            report::short(band.0),
+                            report::short(band.1)
+                        )
+                    } else {
+                        frf::symptom(x, m, p.mac).reading().to_string()
+                    },
                 }
             }
             None => ModeRow {
@@ -102,13 +126,19 @@ fn compare_modes(system: &DampedSystem, measured: &FrfSet) -> std::result::Resul
                 frequency_error_pct: None,
                 damping_error_pct: None,
                 mac: None,
-                reading: "no model mode with a similar shape (MAC < 0.5)".into(),
+                reading: format!(
+                    "no model mode up to {} Hz with a similar shape (MAC < 0.5)",
+                    report::short(2.0 * band.1)
+                ),
             },
         };
         rows.push(row);
     }
     for &j in &pairing.unpaired_model {
         let x = &model[j];
+        if outside(x.frequency_hz) {
+            continue;
+        }
         rows.push(ModeRow {
             measured_hz: None,
             measured_damping_ratio: None,
@@ -126,6 +156,27 @@ fn compare_modes(system: &DampedSystem, measured: &FrfSet) -> std::result::Resul
         fa.total_cmp(&fb)
     });
     Ok(ModesJson { band_hz: band, rows })
+}
+
+/// The mode table, or why there is none.
+fn modes_result(doc: &CompareJson) -> std::result::Result<&ModesJson, &String> {
+    match (&doc.modes, &doc.modes_error) {
+        (Some(m), _) => Ok(m),
+        (None, Some(e)) => Err(e),
+        (None, None) => unreachable!("compare sets the modes or the reason"),
+    }
+}
+
+/// The fitted gains, one line each.
+fn print_gains(gains: &[GainReport]) -> Result<()> {
+    if gains.is_empty() {
+        return Ok(());
+    }
+    outln!("\nfitted gains (model FRFs multiplied by them before the comparison)");
+    for g in gains {
+        outln!("    {}: x{} ({:+.1} dB), {:+.1} deg", g.key, sig(g.magnitude, 4), g.magnitude_db, g.phase_deg);
+    }
+    Ok(())
 }
 
 fn opt(v: Option<f64>, f: impl Fn(f64) -> String) -> String {
@@ -154,7 +205,7 @@ fn mode_table_rows(m: &ModesJson) -> (Vec<&'static str>, Vec<Vec<String>>) {
     (header, rows)
 }
 
-fn modes_section(m: &std::result::Result<ModesJson, String>) -> Section {
+fn modes_section(m: &std::result::Result<&ModesJson, &String>) -> Section {
     let mut s = Section::new("Modes");
     match m {
         Err(e) => {
@@ -214,6 +265,8 @@ struct MeasuredData {
     masked: Vec<String>,
     /// What reading them changed or passed over.
     notes: Vec<String>,
+    /// The gains to fit and why.
+    gains: (Gains, String),
 }
 
 /// The measured FRFs: the case's data or truth, or the `--measured` files.
@@ -231,19 +284,31 @@ fn measured_data(case: CaseFile, system: &DampedSystem, files: &[PathBuf]) -> Re
             (None, None) => "the case's data".into(),
         };
         let masked = describe_masked(&study.masked);
-        return Ok(MeasuredData { case: study.case, set: study.measured, source, masked, notes: study.notes });
+        // compared in the kind the data were measured in, as with --measured
+        let set = study.measured_as_read();
+        let gains = (study.gains, study.gains_reason.clone());
+        return Ok(MeasuredData { case: study.case, set, source, masked, notes: study.notes, gains });
     }
     let mut sets = Vec::new();
     let mut masked = Vec::new();
     let mut notes = Vec::new();
+    let mut per_volt = Vec::new();
     for f in files {
         let read = read_measured_for(system, f, case.measurement.as_ref())?;
+        per_volt.extend(read.per_volt_references());
         masked.extend(describe_masked(&read.masked).into_iter().map(|m| format!("{}: {m}", f.display())));
         notes.extend(read.notes.iter().map(|n| format!("{}: {n}", f.display())));
         sets.push((f.clone(), read.set));
     }
     let names = files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(", ");
-    Ok(MeasuredData { case, set: merge(sets)?, source: format!("measured file(s) {names}"), masked, notes })
+    per_volt.sort_by_key(ToString::to_string);
+    per_volt.dedup();
+    let gains = gain::decide(case.measurement.as_ref(), case.update.as_ref(), &per_volt)?;
+    if gains.0 != Gains::None {
+        notes.push(format!("model FRFs are multiplied by fitted gains ({}): {}", gains.0, gains.1));
+    }
+    let source = format!("measured file(s) {names}");
+    Ok(MeasuredData { case, set: merge(sets)?, source, masked, notes, gains })
 }
 
 /// Joins the channels of several measured files on the same lines, in the
@@ -305,20 +370,31 @@ pub(crate) fn compare(
     inputs.extend(measured_files.iter().cloned());
     let output = out.map(|dir| Outputs::folder(dir, &inputs, &["compare.json", "report.html"])).transpose()?;
     let system = DampedSystem::new(case.model.clone())?;
-    let MeasuredData { case, set: measured, source, masked, notes } = measured_data(case, &system, measured_files)?;
+    let MeasuredData { case, set: measured, source, masked, notes, gains } =
+        measured_data(case, &system, measured_files)?;
     print_notes(&notes, json)?;
     print_masked(&masked, json)?;
-    let frfs = synthesize(&system, measured.channels(), measured.frequencies_hz())?;
+    let mut frfs = synthesize(&system, measured.channels(), measured.frequencies_hz())?;
+    // the gains that bring the model closest to the data (closed form), in the data's kind
+    let fitted = gain::fit_gains(&frfs.converted(measured.kind()), &measured, None, gains.0)?;
+    fitted.apply(&mut frfs);
     let correlation = correlate(&measured, &frfs, &spec)?;
-    let modes = compare_modes(&system, &measured);
+    let (modes, modes_error) = match compare_modes(&system, &measured) {
+        Ok(m) => (Some(m), None),
+        Err(e) => (None, Some(e)),
+    };
     let doc = CompareJson {
         case: case_path.display().to_string(),
         title: case.model.title.clone(),
         measured: source.clone(),
         model: "the case's model (initial values)".into(),
         bands: bands.to_string(),
+        kind: measured.kind().to_string(),
         correlation: CorrelationJson::from(&correlation),
+        gain_setting: format!("{} ({})", gains.0, gains.1),
+        gains: fitted.reports(),
         modes,
+        modes_error,
         masked,
         notes,
     };
@@ -326,7 +402,8 @@ pub(crate) fn compare(
         outln!("{}", serde_json::to_string_pretty(&doc)?);
     } else {
         print_tables(&case, &measured, &source, &correlation)?;
-        match &doc.modes {
+        print_gains(&doc.gains)?;
+        match modes_result(&doc) {
             Ok(m) => {
                 let (header, rows) = mode_table_rows(m);
                 let mut t = Table::new(&header);
@@ -343,7 +420,7 @@ pub(crate) fn compare(
         let model = ModelFrfs { label: "model".into(), colour: plot::UPDATED, frfs, correlation };
         let mut report = Report::new(format!("{}: model against measurement", case.model.title));
         report.subtitle = Some(format!("rfm compare, case file {}", case_path.display()));
-        report.sections = report_sections(&case, &measured, &source, &model, &doc.modes, &mut output)?;
+        report.sections = report_sections(&case, &measured, &source, &model, &doc, &mut output)?;
         let html = output.write("report.html", report.render().as_bytes())?;
         let written = output.commit()?;
         if !json {
@@ -360,16 +437,30 @@ fn report_sections(
     measured: &FrfSet,
     source: &str,
     model: &ModelFrfs,
-    modes: &std::result::Result<ModesJson, String>,
+    doc: &CompareJson,
     out: &mut Outputs,
 ) -> Result<Vec<Section>> {
     let c = &model.correlation;
     let mut sections = vec![summary(case, measured, source, c)];
-    let notes = vec!["The case's model with its initial parameter values against the measured FRFs.".to_string()];
+    let mut notes = vec!["The case's model with its initial parameter values against the measured FRFs.".to_string()];
+    if !doc.gains.is_empty() {
+        let list: Vec<String> = doc
+            .gains
+            .iter()
+            .map(|g| {
+                format!("{}: x{} ({:+.1} dB, {:+.1} deg)", g.key, sig(g.magnitude, 4), g.magnitude_db, g.phase_deg)
+            })
+            .collect();
+        notes.push(format!(
+            "The model's FRFs are multiplied by unknown complex gains fitted in closed form ({}): {}.",
+            doc.gain_setting,
+            list.join("; ")
+        ));
+    }
     sections.push(report::correlation_section(measured, std::slice::from_ref(model), out, notes)?);
     let worst = report::notable_channels(c, 2);
     let picks = report::representative_channels(measured, &worst, OVERLAYS);
-    sections.push(modes_section(modes));
+    sections.push(modes_section(&modes_result(doc)));
     sections.push(report::overlay_section(measured, std::slice::from_ref(model), &picks, &worst, &[], out)?);
     sections.push(report::definitions_section());
     Ok(sections)

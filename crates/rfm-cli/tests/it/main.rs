@@ -3,6 +3,7 @@
 mod catalogue;
 mod commands;
 mod diagnose;
+mod gains;
 mod inspect;
 mod nothing_lost;
 mod report;

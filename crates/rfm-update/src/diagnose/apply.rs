@@ -1,6 +1,7 @@
 //! Adding a diagnosed effect to the user's case: `rfm diagnose --apply` and
 //! every step of `rfm fix`.
 
+use fe_model::case::{FittedGain, GainKey, Gains};
 use fe_model::{CaseEditor, CaseFile, HistoryEntry};
 
 use super::Diagnosis;
@@ -67,6 +68,19 @@ impl Diagnosis {
         }
         let method = case.update.as_ref().and_then(|u| u.method.as_ref()).map_or("output-error", |(m, _)| m.as_str());
         editor.set_update(&names, method)?;
+        if self.gains {
+            // the next run fits the gains too; their values are kept for reading
+            let fitted: Vec<FittedGain> = r
+                .gains
+                .iter()
+                .map(|g| FittedGain {
+                    key: GainKey::Reference(g.reference),
+                    magnitude: g.magnitude,
+                    phase_deg: g.phase_deg,
+                })
+                .collect();
+            editor.set_gains(Gains::PerReference, &fitted)?;
+        }
         if case.history.is_empty() {
             editor.push_history(&HistoryEntry {
                 step: "nominal".into(),
