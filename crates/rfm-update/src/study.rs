@@ -553,35 +553,7 @@ impl Study {
     /// scaled to 1 there); channel-major, `None` when all are 1. Used by the
     /// output-error fit, the gain fits and the comparison.
     pub fn line_weights(&self, measured: &FrfSet) -> Result<Option<Vec<f64>>, UpdateError> {
-        let bands = self.case.update.as_ref().map_or(&[][..], |u| &u.weights[..]);
-        let asked = self.case.update.as_ref().and_then(|u| u.coherence);
-        let has = (0..measured.channels().len()).any(|c| measured.coherence(c).is_some());
-        if asked == Some(true) && !has {
-            return Err(UpdateError::Setup(
-                "coherence weighting is requested ([update] coherence = true) but the measured data carry no \
-                 coherence"
-                    .into(),
-            ));
-        }
-        let coherence = asked.unwrap_or(true) && has;
-        if bands.is_empty() && !coherence {
-            return Ok(None);
-        }
-        let nf = measured.n_freq();
-        let mut w = vec![1.0; nf * measured.channels().len()];
-        for (c, chunk) in w.chunks_mut(nf).enumerate() {
-            for (k, wk) in chunk.iter_mut().enumerate() {
-                let f = measured.frequencies_hz()[k];
-                for b in bands.iter().filter(|b| b.from <= f && f <= b.to) {
-                    *wk *= b.weight;
-                }
-                if coherence && let Some(coh) = measured.coherence(c) {
-                    let g = coh[k].clamp(0.0, 0.999);
-                    *wk *= (g / (1.0 - g)).sqrt().min(30.0) / 30.0;
-                }
-            }
-        }
-        Ok(Some(w))
+        line_weights_for(&self.case, measured)
     }
 
     /// Decides the gains again for measured data read from another file
@@ -750,6 +722,41 @@ impl Study {
             })
             .collect()
     }
+}
+
+/// The residual weights of a case's measured data `measured` (see
+/// [`Study::line_weights`]): band weights times the coherence weight,
+/// whenever the data carry coherence unless `[update] coherence = false`.
+pub fn line_weights_for(case: &CaseFile, measured: &FrfSet) -> Result<Option<Vec<f64>>, UpdateError> {
+    let bands = case.update.as_ref().map_or(&[][..], |u| &u.weights[..]);
+    let asked = case.update.as_ref().and_then(|u| u.coherence);
+    let has = (0..measured.channels().len()).any(|c| measured.coherence(c).is_some());
+    if asked == Some(true) && !has {
+        return Err(UpdateError::Setup(
+            "coherence weighting is requested ([update] coherence = true) but the measured data carry no \
+             coherence"
+                .into(),
+        ));
+    }
+    let coherence = asked.unwrap_or(true) && has;
+    if bands.is_empty() && !coherence {
+        return Ok(None);
+    }
+    let nf = measured.n_freq();
+    let mut w = vec![1.0; nf * measured.channels().len()];
+    for (c, chunk) in w.chunks_mut(nf).enumerate() {
+        for (k, wk) in chunk.iter_mut().enumerate() {
+            let f = measured.frequencies_hz()[k];
+            for b in bands.iter().filter(|b| b.from <= f && f <= b.to) {
+                *wk *= b.weight;
+            }
+            if coherence && let Some(coh) = measured.coherence(c) {
+                let g = coh[k].clamp(0.0, 0.999);
+                *wk *= (g / (1.0 - g)).sqrt().min(30.0) / 30.0;
+            }
+        }
+    }
+    Ok(Some(w))
 }
 
 #[cfg(test)]

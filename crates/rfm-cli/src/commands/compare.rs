@@ -376,8 +376,15 @@ pub(crate) fn compare(
     print_masked(&masked, json)?;
     let mut frfs = synthesize(&system, measured.channels(), measured.frequencies_hz())?;
     // the gains that bring the model closest to the data (closed form), in the data's kind
-    let fitted = gain::fit_gains(&frfs.converted(measured.kind()), &measured, None, gains.0)?;
+    // weighted as the fits weight them: by the measured coherence when the data carry it
+    let weights = rfm_update::study::line_weights_for(&case, &measured)?;
+    let fitted = gain::fit_gains(&frfs.converted(measured.kind()), &measured, weights.as_deref(), gains.0)?;
     fitted.apply(&mut frfs);
+    let coherent = (0..measured.channels().len()).any(|c| measured.coherence(c).is_some());
+    let mut notes = notes;
+    if coherent && gains.0 != Gains::None && weights.is_some() {
+        notes.push("the gains are fitted with each line weighted by its measured coherence".into());
+    }
     let correlation = correlate(&measured, &frfs, &spec)?;
     let (modes, modes_error) = match compare_modes(&system, &measured) {
         Ok(m) => (Some(m), None),

@@ -152,3 +152,51 @@ fn diagnosis_of_per_volt_data_names_the_joint_whatever_the_gain_and_keeps_the_ga
     // written paths are relative to the written file: it can be moved with its data
     assert!(updated.contains("data = \"../v1.csv\""), "{updated}");
 }
+
+/// Lines of poor coherence hardly move the fitted gain: the gain is the
+/// coherence-weighted mean of `ln(M/H)`, computed here from its definition.
+#[test]
+fn compare_weights_the_gain_fit_by_the_measured_coherence() {
+    use frf::io::uff::{self, DataAxis, Encoding, UffWriteOptions};
+    let dir = tempfile::tempdir().unwrap();
+    let case = tutorial().join("l-frame.toml");
+    let model_csv = dir.path().join("model.csv");
+    let out = rfm(&["simulate", case.to_str().unwrap(), "--kind", "accelerance", "--out", model_csv.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let mut set = frf::io::csv::read_csv(&model_csv).unwrap();
+    let (nc, nf) = (set.channels().len(), set.n_freq());
+    let g = frf::C64::from_polar(80.0, 0.5);
+    let mut coherence = Vec::with_capacity(nc * nf);
+    for c in 0..nc {
+        let lines = set.frequencies_hz().to_vec();
+        for (v, f) in set.channel_mut(c).iter_mut().zip(&lines) {
+            // below 100 Hz the data are ten times off, with a coherence of 0.05
+            let poor = *f < 100.0;
+            *v *= if poor { g * 10.0 } else { g };
+            coherence.push(if poor { 0.05 } else { 0.99 });
+        }
+    }
+    set.set_coherence(coherence.clone()).unwrap();
+    let mut functions = uff::frf_set_to_functions(&set, &UffWriteOptions::default()).unwrap();
+    for f in functions.iter_mut().filter(|f| f.header.function_type == uff::FUNCTION_FRF) {
+        f.header.denominator = DataAxis::new(0, "Voltage", "V");
+    }
+    std::fs::write(dir.path().join("v.uff"), uff::encode(&functions, Encoding::Ascii).unwrap()).unwrap();
+    let case = case_with(dir.path(), "v.toml", "v.uff", "");
+    let doc = json(&rfm(&["compare", case.to_str().unwrap(), "--json"]));
+    let n = doc["notes"].as_array().unwrap();
+    assert!(n.iter().any(|x| x.as_str().unwrap().contains("weighted by its measured coherence")), "{n:?}");
+    // the weight of a line: sqrt(g / (1 - g)), capped at 30, per residual; squared in the misfit
+    let w2 = |coh: f64| ((coh / (1.0 - coh)).sqrt().min(30.0) / 30.0).powi(2);
+    let (mut num, mut den) = (0.0, 0.0);
+    for &coh in &coherence {
+        let log_ratio = g.norm().ln() + if coh < 0.5 { 10f64.ln() } else { 0.0 };
+        num += w2(coh) * log_ratio;
+        den += w2(coh);
+    }
+    let want = (num / den).exp();
+    let got = f(&doc["gains"][0]["magnitude"]);
+    assert!((got / want - 1.0).abs() < 1e-9, "gain {got}, weighted mean {want}");
+    // and unweighted it would be far off: 98 of 599 lines are ten times off
+    assert!(want / g.norm() - 1.0 < 1e-3, "{want}");
+}

@@ -4,7 +4,7 @@ mod catalogue;
 mod commands;
 mod diagnose;
 mod gains;
-mod measurement;
 mod inspect;
+mod measurement;
 mod nothing_lost;
 mod report;
