@@ -7,4 +7,5 @@ mod gains;
 mod inspect;
 mod measurement;
 mod nothing_lost;
+mod pairing;
 mod report;
