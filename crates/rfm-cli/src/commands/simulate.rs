@@ -76,9 +76,10 @@ pub(crate) fn simulate(args: &SimulateArgs<'_>) -> Result<Exit> {
     let kind = FrfKind::parse(args.kind).ok_or_else(|| {
         Failure::new(Exit::Usage, format!("--kind {}: receptance, mobility or accelerance", args.kind))
     })?;
-    let format = out_format(args.out, args.binary).map_err(|e| Failure::new(Exit::Usage, e))?;
     let case_file = load_case(args.case)?;
+    // an input named as the output is refused first, whatever its extension
     let mut output = Outputs::file(args.out, &case_file.inputs())?;
+    let format = out_format(args.out, args.binary).map_err(|e| Failure::new(Exit::Usage, e))?;
     let spec =
         case_file.measurement.as_ref().ok_or("the case has no [measurement] section (which channels and lines?)")?;
     if spec.frequencies_hz.is_empty() {
