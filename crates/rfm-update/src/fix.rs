@@ -75,8 +75,12 @@ pub struct FixStep {
 pub struct LookAhead {
     /// The effect.
     pub effect: String,
-    /// The misfit after it, its update and its best follower.
+    /// The misfit after it, its update and its best follower (NaN when it
+    /// could not be added and updated, see `failed`).
     pub misfit_ahead: f64,
+    /// Why adding and updating it failed (an update that drove a spring to
+    /// zero and left a mechanism, say), when it did.
+    pub failed: Option<String>,
 }
 
 /// Why the loop stopped.
@@ -92,6 +96,9 @@ pub enum FixStop {
     NoImprovement,
     /// The number of steps asked for was done; something significant may remain.
     StepsDone,
+    /// No leading effect could be added and updated: each update left a
+    /// model that cannot be evaluated (a spring driven to zero, say).
+    CannotAdd,
 }
 
 impl FixStop {
@@ -104,6 +111,9 @@ impl FixStop {
             }
             FixStop::NoImprovement => "the last update did not lower the misfit",
             FixStop::StepsDone => "the number of steps asked for is done",
+            FixStop::CannotAdd => {
+                "no leading effect could be added and updated: each update left a model that cannot be evaluated"
+            }
         }
     }
 }
@@ -117,6 +127,8 @@ pub struct FixOutcome {
     pub nominal_misfit: f64,
     /// The steps, in order.
     pub steps: Vec<FixStep>,
+    /// The effects in the final model, in the order they were added.
+    pub effects: Vec<Ranked>,
     /// Why the loop stopped.
     pub stop: FixStop,
     /// The diagnosis of the final model (top of its ranking only).
@@ -179,7 +191,7 @@ pub enum FixProgress<'a> {
 const LOOK_AHEAD_ABOVE: f64 = 3.0;
 
 /// How many distinct first effects the look-ahead tries.
-const LOOK_AHEAD_WIDTH: usize = 4;
+const LOOK_AHEAD_WIDTH: usize = 5;
 
 /// An effect added to a case and every parameter updated.
 struct Added {
@@ -206,7 +218,8 @@ fn add_and_update(
     let added = CaseFile::parse(&current.path, &editor.text_at(&current.path)?)?;
     let mut study = Study::with_measured(added, measured.clone())?;
     if let Some(u) = study.case.update.as_mut() {
-        u.frequencies = Some(fe_model::case::FrequencyChoice::Lines(lines));
+        // the lines the misfit is measured on (see `diagnose::log_misfit`)
+        u.frequencies = Some(fe_model::case::FrequencyChoice::List(diagnose::informative_lines(measured, lines)));
     }
     let mut oe_opts = study.output_error_options()?;
     oe_opts.max_iterations = opts.update_iterations;
@@ -228,15 +241,17 @@ fn add_and_update(
     Ok(Added { effect: d.ranking[rank - 1].clone(), editor, case, misfit_updated, outcome })
 }
 
-/// The ranks of up to `width` recommendable effects (significant, plausible,
-/// fully fitted) that differ from each other in kind or place, best first.
+/// The ranks of up to `width` recommendable effects (significant and
+/// plausible, fully fitted or screened) that differ from each other in kind
+/// or place, best first: the full fits cover only the best of each kind, and
+/// when two effects hide at once the right first one can be a screened one.
 fn distinct_leaders(d: &Diagnosis, model: &fe_model::Model, width: usize) -> Vec<usize> {
     let mut out: Vec<usize> = Vec::new();
     for (i, r) in d.ranking.iter().enumerate() {
         if out.len() == width {
             break;
         }
-        if !(r.fully_fitted && r.significant && r.plausible) {
+        if !(r.significant && r.plausible) {
             continue;
         }
         let c = &d.candidates[r.candidate];
@@ -298,20 +313,50 @@ pub fn fix(
         let added = if leader_misfit > LOOK_AHEAD_ABOVE * noise && steps.len() + 2 <= opts.max_steps {
             let mut best: Option<(f64, Added, Diagnosis)> = None;
             for r in distinct_leaders(&d, &current.model, LOOK_AHEAD_WIDTH) {
-                let a = add_and_update(&current, &d, r, measured, opts, step)?;
-                let ahead = diagnose::diagnose(&a.case.model, measured, &opts.diagnose)?;
+                // one alternative that cannot be added (its update left a
+                // mechanism, say) must not end the loop: the others can
+                let tried = add_and_update(&current, &d, r, measured, opts, step).and_then(|a| {
+                    let ahead = diagnose::diagnose(&a.case.model, measured, &opts.diagnose)?;
+                    Ok((a, ahead))
+                });
+                let (a, ahead) = match tried {
+                    Ok(x) => x,
+                    Err(e) => {
+                        let effect = d.ranking[r - 1].description.clone();
+                        alternatives.push(LookAhead { effect, misfit_ahead: f64::NAN, failed: Some(e.to_string()) });
+                        progress(FixProgress::LookedAhead {
+                            step: steps.len(),
+                            ahead: alternatives.last().expect("pushed"),
+                        });
+                        continue;
+                    }
+                };
                 let score = ahead.leader().map_or(a.misfit_updated, |l| l.misfit.min(a.misfit_updated));
-                alternatives.push(LookAhead { effect: a.effect.description.clone(), misfit_ahead: score });
+                alternatives.push(LookAhead {
+                    effect: a.effect.description.clone(),
+                    misfit_ahead: score,
+                    failed: None,
+                });
                 progress(FixProgress::LookedAhead { step: steps.len(), ahead: alternatives.last().expect("pushed") });
                 if best.as_ref().is_none_or(|(b, ..)| score < *b) {
                     best = Some((score, a, ahead));
                 }
             }
-            let (_, a, ahead) = best.expect("the recommended effect is among the distinct leaders");
+            let Some((_, a, ahead)) = best else {
+                break (FixStop::CannotAdd, Some(d));
+            };
             next = Some(ahead);
             a
         } else {
-            add_and_update(&current, &d, rank, measured, opts, step)?
+            // the recommended effect, else the next distinct leaders in turn
+            // when adding and updating one fails
+            let added = std::iter::once(rank)
+                .chain(distinct_leaders(&d, &current.model, LOOK_AHEAD_WIDTH))
+                .find_map(|r| add_and_update(&current, &d, r, measured, opts, step).ok());
+            let Some(a) = added else {
+                break (FixStop::CannotAdd, Some(d));
+            };
+            a
         };
         progress(FixProgress::Updated {
             step: steps.len(),
@@ -350,6 +395,7 @@ pub fn fix(
     Ok(FixOutcome {
         noise,
         nominal_misfit,
+        effects: steps.iter().map(|s| s.effect.clone()).collect(),
         steps,
         stop,
         significant_remains: !last.consistent(),

@@ -69,10 +69,13 @@ pub(crate) fn fix(args: &FixArgs<'_>) -> Result<Exit> {
                 None if diagnosis.consistent() => format!("diagnosis {}: nothing significant", step + 1),
                 None => format!("diagnosis {}: significant effects, none at plausible values", step + 1),
             },
-            FixProgress::LookedAhead { ahead, .. } => format!(
-                "  looking one step ahead from {}: misfit {:.4e} after it and its best follower",
-                ahead.effect, ahead.misfit_ahead
-            ),
+            FixProgress::LookedAhead { ahead, .. } => match &ahead.failed {
+                Some(why) => format!("  looking one step ahead from {}: could not add it ({why})", ahead.effect),
+                None => format!(
+                    "  looking one step ahead from {}: misfit {:.4e} after it and its best follower",
+                    ahead.effect, ahead.misfit_ahead
+                ),
+            },
             FixProgress::Updated { step, effect, misfit, status } => {
                 format!("step {}: added {effect} and updated ({status:?}); misfit {misfit:.4e}", step + 1)
             }

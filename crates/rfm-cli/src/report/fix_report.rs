@@ -102,7 +102,14 @@ pub(crate) fn write(study: &Study, outcome: &FixOutcome, out: &mut Outputs) -> R
                  left the smallest misfit was kept.",
                 );
             for a in &s.alternatives {
-                t.row(vec![a.effect.clone(), sig(a.misfit_ahead, 4), format!("{:.1}", a.misfit_ahead / outcome.noise)]);
+                match &a.failed {
+                    Some(why) => t.row(vec![a.effect.clone(), format!("could not be added: {why}"), "-".into()]),
+                    None => t.row(vec![
+                        a.effect.clone(),
+                        sig(a.misfit_ahead, 4),
+                        format!("{:.1}", a.misfit_ahead / outcome.noise),
+                    ]),
+                }
             }
             sec.push(Block::Table(t));
         }

@@ -192,6 +192,11 @@ pub struct Ranked {
     /// RMS of `ln(model / measured)` per complex value with the effect
     /// added at its fitted values, on the lines it was fitted on.
     pub misfit: f64,
+    /// How many lines it was fitted on: [`informative_lines`] of the
+    /// measured data (the full fits use [`DiagnoseOptions::lines`], the
+    /// screening fewer), so that [`log_misfit`] with this number gives
+    /// `misfit` again for the model with the effect added.
+    pub lines: usize,
     /// Change of the information criterion (negative is better).
     pub delta_bic: f64,
     /// `delta_bic` below the significance threshold.
@@ -259,12 +264,13 @@ impl Diagnosis {
     }
 }
 
-/// `n` lines of a measured set that carry most of what the data can tell:
+/// `n` lines of a measured set that carry most of what the data can tell
+/// (the lines the diagnosis fits and [`log_misfit`] measures on):
 /// up to half of them at and around the resonance peaks (where damping
 /// and small frequency shifts show, on a line grid that an even spread
 /// would step across), the rest spread evenly over the band. Peaks are
 /// local maxima of the sum over channels of `ln |M|`, ranked by prominence.
-pub(crate) fn informative(measured: &FrfSet, n: usize) -> Vec<f64> {
+pub fn informative_lines(measured: &FrfSet, n: usize) -> Vec<f64> {
     let lines = measured.frequencies_hz();
     if n >= lines.len() {
         return lines.to_vec();
@@ -380,6 +386,7 @@ fn rank(pool: Pool<'_>, noise: f64, full: &LineSet, opts: &DiagnoseOptions) -> D
             damping: c.damping(),
             explained: (1.0 - f.cost / f.cost0).max(0.0),
             misfit: (f.cost / (f.n as f64 / 2.0)).sqrt(),
+            lines: f.lines,
             delta_bic,
             significant: delta_bic < opts.significance,
             plausible: implausible_reason.is_none(),

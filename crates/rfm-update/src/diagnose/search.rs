@@ -10,7 +10,7 @@ use rayon::prelude::*;
 
 use super::candidates::{self, Candidate, CandidateOptions, EffectKind, Role};
 use super::local::{LocalCandidate, LocalData};
-use super::{DiagnoseOptions, informative};
+use super::{DiagnoseOptions, informative_lines};
 use crate::error::UpdateError;
 use crate::oe::{self, Misfit, OeData, OeOptions};
 use crate::params::ParameterSet;
@@ -30,6 +30,8 @@ pub(crate) struct Fit {
     pub(crate) cost0: f64,
     /// Number of real residuals.
     pub(crate) n: usize,
+    /// Lines fitted on (see [`super::informative_lines`]).
+    pub(crate) lines: usize,
     pub(crate) relative_std: Vec<f64>,
     /// Per parameter: the data determine it (see [`determined`]).
     pub(crate) determined: Vec<bool>,
@@ -55,7 +57,7 @@ impl LineSet {
         n_lines: usize,
         gains: bool,
     ) -> Result<Self, UpdateError> {
-        let data = measured.at_frequencies(&informative(measured, n_lines))?;
+        let data = measured.at_frequencies(&informative_lines(measured, n_lines))?;
         let mut model = frf::synthesize(nominal, data.channels(), data.frequencies_hz())?;
         if gains {
             // the closed-form gains of the nominal model: its misfit is what no gain removes
@@ -148,49 +150,11 @@ fn fit(
         cost: r.cost,
         cost0: lines.cost0,
         n: r.n_data,
+        lines: lines.data.n_freq(),
         relative_std,
         determined,
         gains: r.gains,
     })
-}
-
-/// Fits from `start` and, for a candidate with a relaxation parameter, also
-/// from each of `mu_starts` in its place (the other parameters as in
-/// `start`); keeps the fit of lowest cost. The misfit of a relaxation
-/// parameter has local minima: a kernel relaxing below the band acts as a
-/// stiffening, one above it as viscous damping, and a fit started on the
-/// wrong side stays there.
-fn fit_from_starts(
-    candidate: &Candidate,
-    nominal: &fe_model::Model,
-    lines: &LineSet,
-    local: Local<'_>,
-    iterations: usize,
-    start: Option<&[f64]>,
-    mu_starts: &[f64],
-) -> Result<Fit, String> {
-    let first = fit(candidate, nominal, lines, local, iterations, start);
-    let mu: Vec<usize> = (0..candidate.roles.len()).filter(|&i| candidate.roles[i] == Role::Mu).collect();
-    if mu.is_empty() || mu_starts.is_empty() {
-        return first;
-    }
-    let base: Vec<f64> = match start {
-        Some(s) => s.to_vec(),
-        None => candidate.start_values(),
-    };
-    let mut best = first;
-    for &m in mu_starts {
-        let mut s = base.clone();
-        for &i in &mu {
-            s[i] = m;
-        }
-        if let Ok(f) = fit(candidate, nominal, lines, local, iterations, Some(&s))
-            && best.as_ref().map_or(true, |b| f.cost < b.cost)
-        {
-            best = Ok(f);
-        }
-    }
-    best
 }
 
 /// The candidates of a diagnosis with their fits so far.
@@ -265,7 +229,6 @@ impl<'a> Pool<'a> {
         iterations: usize,
         which: &[usize],
         starts: &[Option<Vec<f64>>],
-        mu_starts: &[f64],
     ) -> Result<Vec<Result<Fit, String>>, UpdateError> {
         let forms: Vec<_> = which.iter().filter_map(|&i| self.locals[i].as_ref().map(|l| &l.form)).collect();
         let data = LocalData::new(self.nominal, lines.data.channels(), lines.data.frequencies_hz(), &forms)?;
@@ -278,7 +241,7 @@ impl<'a> Pool<'a> {
                 let start = start.as_deref();
                 // a low-rank update that cannot be evaluated (a singular
                 // local system at some line) falls back to the whole model
-                let attempt = |local, start| fit_from_starts(c, self.model, lines, local, iterations, start, mu_starts);
+                let attempt = |local, start| fit(c, self.model, lines, local, iterations, start);
                 attempt(local, start)
                     .or_else(|e| if local.is_some() { attempt(None, start) } else { Err(e) })
                     .or_else(|e| if start.is_some() { attempt(None, None) } else { Err(e) })
@@ -289,7 +252,7 @@ impl<'a> Pool<'a> {
     /// Screens `which`: a short fit on `lines` from the starting values.
     pub(crate) fn screen(&mut self, lines: &LineSet, iterations: usize, which: &[usize]) -> Result<(), UpdateError> {
         let starts = vec![None; which.len()];
-        for (&i, f) in which.iter().zip(self.fit_all(lines, iterations, which, &starts, &[])?) {
+        for (&i, f) in which.iter().zip(self.fit_all(lines, iterations, which, &starts)?) {
             match f {
                 Ok(f) => {
                     self.screened[i] = Some(f);
@@ -302,17 +265,60 @@ impl<'a> Pool<'a> {
     }
 
     /// Fits `which` fully on `lines`, each warm-started from its screening
-    /// fit (or from `starts` where given).
+    /// fit (or from `starts` where given). A candidate with a relaxation
+    /// parameter is first fitted briefly on the `coarse` lines from each of
+    /// [`Pool::mu_starts`] in its place as well, and fitted fully from the
+    /// best of those: the misfit of a relaxation parameter has local minima
+    /// (a kernel relaxing below the band acts as a stiffening, one above it
+    /// as viscous damping, and a fit started on the wrong side stays there).
     pub(crate) fn full_fit(
         &mut self,
         lines: &LineSet,
-        iterations: usize,
+        coarse: &LineSet,
+        iterations: (usize, usize),
         which: &[usize],
         starts: Option<Vec<Option<Vec<f64>>>>,
     ) -> Result<(), UpdateError> {
-        let starts = starts
+        let (full_iterations, short_iterations) = iterations;
+        let mut starts = starts
             .unwrap_or_else(|| which.iter().map(|&i| self.screened[i].as_ref().map(|f| f.values.clone())).collect());
-        for (&i, f) in which.iter().zip(self.fit_all(lines, iterations, which, &starts, &self.mu_starts)?) {
+        let with_mu: Vec<usize> =
+            (0..which.len()).filter(|&k| self.candidates[which[k]].roles.contains(&Role::Mu)).collect();
+        if !with_mu.is_empty() {
+            let subset: Vec<usize> = with_mu.iter().map(|&k| which[k]).collect();
+            let base: Vec<Vec<f64>> = with_mu
+                .iter()
+                .map(|&k| starts[k].clone().unwrap_or_else(|| self.candidates[which[k]].start_values()))
+                .collect();
+            let mut best: Vec<Option<Fit>> = vec![None; with_mu.len()];
+            for m in std::iter::once(None).chain(self.mu_starts.clone().into_iter().map(Some)) {
+                let tries: Vec<Option<Vec<f64>>> = with_mu
+                    .iter()
+                    .zip(&base)
+                    .map(|(&k, b)| {
+                        let mut s = b.clone();
+                        if let Some(m) = m {
+                            let c = &self.candidates[which[k]];
+                            (0..c.roles.len()).filter(|&p| c.roles[p] == Role::Mu).for_each(|p| s[p] = m);
+                        }
+                        Some(s)
+                    })
+                    .collect();
+                for (slot, f) in best.iter_mut().zip(self.fit_all(coarse, short_iterations, &subset, &tries)?) {
+                    if let Ok(f) = f
+                        && slot.as_ref().is_none_or(|b| f.cost < b.cost)
+                    {
+                        *slot = Some(f);
+                    }
+                }
+            }
+            for (&k, b) in with_mu.iter().zip(best) {
+                if let Some(b) = b {
+                    starts[k] = Some(b.values);
+                }
+            }
+        }
+        for (&i, f) in which.iter().zip(self.fit_all(lines, full_iterations, which, &starts)?) {
             match f {
                 Ok(f) => {
                     self.full[i] = Some(f);
@@ -371,41 +377,15 @@ impl<'a> Pool<'a> {
         self.add(new)
     }
 
-    /// The candidates of the same kind as the best fully fitted windows
-    /// (stiffness, mass or damping changes) whose windows overlap them or
-    /// lie within [`WINDOW_SLACK`] elements, not yet fully fitted: the
-    /// screening's short fits on fewer lines do not separate windows that
-    /// differ by an element or two, the full fits do.
-    pub(crate) fn window_neighbours(&self, leaders: usize) -> Vec<usize> {
-        let order = self.by_full_fit();
-        let mut out = Vec::new();
-        for &l in order.iter().take(leaders) {
-            let c = &self.candidates[l];
-            let (Some(&lo), Some(&hi)) = (c.elements.iter().min(), c.elements.iter().max()) else { continue };
-            if !matches!(
-                c.kind,
-                EffectKind::StiffnessChange
-                    | EffectKind::MassChange
-                    | EffectKind::ViscousDamping
-                    | EffectKind::NonViscousDamping
-            ) {
-                continue;
-            }
-            for (i, o) in self.candidates.iter().enumerate() {
-                let near = o.elements.iter().any(|&e| e + WINDOW_SLACK >= lo && e <= hi + WINDOW_SLACK);
-                if o.kind == c.kind && near && self.full[i].is_none() && self.screened[i].is_some() && !out.contains(&i)
-                {
-                    out.push(i);
-                }
-            }
-        }
-        out
-    }
-
     /// For every full fit with parameters the data do not determine, the
     /// variant that holds them (see [`Candidate::holding`]) is fitted fully
     /// from the determined values and supersedes the fuller one.
-    pub(crate) fn hold_undetermined(&mut self, lines: &LineSet, iterations: usize) -> Result<(), UpdateError> {
+    pub(crate) fn hold_undetermined(
+        &mut self,
+        lines: &LineSet,
+        coarse: &LineSet,
+        iterations: (usize, usize),
+    ) -> Result<(), UpdateError> {
         let mut fits: Vec<(usize, Vec<f64>)> = Vec::new();
         let mut new: Vec<(Candidate, Vec<f64>)> = Vec::new();
         for i in self.by_full_fit() {
@@ -436,7 +416,7 @@ impl<'a> Pool<'a> {
         }
         let (which, starts): (Vec<usize>, Vec<Option<Vec<f64>>>) = fits.into_iter().map(|(j, s)| (j, Some(s))).unzip();
         if !which.is_empty() {
-            self.full_fit(lines, iterations, &which, Some(starts))?;
+            self.full_fit(lines, coarse, iterations, &which, Some(starts))?;
         }
         Ok(())
     }
@@ -469,7 +449,7 @@ pub(crate) fn search(
     trace(&format!("screened {} candidates on {} lines", to_screen.len(), coarse.data.n_freq()));
     let order = pool.by_screening(&all);
     let keep = pool.leaders(&order, opts.keep);
-    pool.full_fit(full, opts.iterations, &keep, None)?;
+    pool.full_fit(full, &coarse, (opts.iterations, opts.screen_iterations), &keep, None)?;
     trace(&format!("fitted the best {} on {} lines", keep.len(), full.data.n_freq()));
 
     // around the leaders: fuller variants, and on large models finer windows
@@ -477,23 +457,15 @@ pub(crate) fn search(
     if !refined.is_empty() {
         pool.screen(&coarse, opts.screen_iterations, &refined)?;
         let best: Vec<usize> = pool.by_screening(&refined).into_iter().take(REFINED_FITS).collect();
-        pool.full_fit(full, opts.iterations, &best, None)?;
+        pool.full_fit(full, &coarse, (opts.iterations, opts.screen_iterations), &best, None)?;
         trace(&format!("refined around the leaders: {} candidates, {} fitted", refined.len(), best.len()));
     }
-    let neighbours = pool.window_neighbours(REFINED_LEADERS);
-    if !neighbours.is_empty() {
-        pool.full_fit(full, opts.iterations, &neighbours, None)?;
-        trace(&format!("fitted {} windows next to the leading ones", neighbours.len()));
-    }
-    pool.hold_undetermined(full, opts.iterations)?;
+    pool.hold_undetermined(full, &coarse, (opts.iterations, opts.screen_iterations))?;
     trace("held what the data do not determine");
     Ok(())
 }
 
-/// Elements beyond a leading window within which other windows of its kind
-/// are fitted fully.
-const WINDOW_SLACK: u32 = 2;
 /// Leaders (by full-fit `dBIC`) around which candidates are refined.
 const REFINED_LEADERS: usize = 3;
 /// Refined candidates fitted fully after screening.
-const REFINED_FITS: usize = 6;
+const REFINED_FITS: usize = 10;

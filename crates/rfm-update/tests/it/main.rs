@@ -1,5 +1,6 @@
 //! Integration tests of rfm-update.
 
+mod apply_every;
 mod fast_vs_naive;
 mod held_out;
 mod hidden_effects;

@@ -32,6 +32,19 @@ const MAX_WINDOW: usize = 8;
 /// refinement tries every window and in-line joint.
 const REFINE_REACH: usize = 8;
 
+/// Elements on either side of a leading window within which a small
+/// model's refinement tries every window of its kind.
+const WINDOW_REACH: usize = 3;
+
+/// The first pass of windows on small models: (size, stride). Single
+/// elements at every offset catch a local stiffness loss; longer windows at
+/// a stride catch a patch in part, and the refinement finds its extent.
+const FIRST_PASS_WINDOWS: [(usize, usize); 3] = [(1, 1), (3, 2), (6, 3)];
+
+/// The kinds of change a window carries, in the order of [`window`].
+const WINDOW_KINDS: [EffectKind; 4] =
+    [EffectKind::StiffnessChange, EffectKind::MassChange, EffectKind::ViscousDamping, EffectKind::NonViscousDamping];
+
 /// Two beams at a node within this angle (cosine) form one member.
 const COLLINEAR: f64 = 0.985; // 10 degrees
 
@@ -260,9 +273,9 @@ fn nodes_of(model: &Model, idx: &[usize]) -> Vec<u32> {
     n
 }
 
-/// The four changes of a window of consecutive elements (beam indices):
-/// stiffness, mass, viscous and non-viscous damping.
-fn window(ctx: &Ctx<'_>, w: &[usize]) -> Vec<Spec> {
+/// The changes of a window of consecutive elements (beam indices) of the
+/// given kinds (stiffness, mass, viscous and non-viscous damping).
+fn window(ctx: &Ctx<'_>, w: &[usize], kinds: &[EffectKind]) -> Vec<Spec> {
     let model = ctx.model;
     let ids = ids(model, w);
     if ids.windows(2).any(|p| p[1] != p[0] + 1) {
@@ -303,6 +316,7 @@ fn window(ctx: &Ctx<'_>, w: &[usize]) -> Vec<Spec> {
             }],
         ),
     ];
+    out.retain(|(h, ..)| kinds.contains(&h.kind));
     let base = &model.groups()[model.beams()[w[0]].group];
     for non_viscous in [false, true] {
         let name = unique_name(model, &format!("damping_{first}_{last}"));
@@ -314,6 +328,9 @@ fn window(ctx: &Ctx<'_>, w: &[usize]) -> Vec<Spec> {
         g.stiffness = base.stiffness;
         g.mass = base.mass;
         let kind = if non_viscous { EffectKind::NonViscousDamping } else { EffectKind::ViscousDamping };
+        if !kinds.contains(&kind) {
+            continue;
+        }
         let mut fitted = vec![ctx.alpha(format!("group.{name}.alpha"))];
         if non_viscous {
             fitted.push(ctx.mu(format!("group.{name}.mu")));
@@ -325,18 +342,28 @@ fn window(ctx: &Ctx<'_>, w: &[usize]) -> Vec<Spec> {
     out
 }
 
-/// Every window of every size at every offset within `range` of a run.
-fn all_windows(ctx: &Ctx<'_>, run: &[usize], range: std::ops::Range<usize>) -> Vec<Spec> {
-    let mut out = Vec::new();
-    for size in WINDOW_SIZES {
-        if size > range.len() {
-            break;
-        }
-        for start in range.start..=range.end - size {
-            out.extend(window(ctx, &run[start..start + size]));
-        }
+/// Windows of `size` elements within `range` of a run, every `stride`
+/// elements, the last one flush with the end of the range.
+fn strided(run: &[usize], range: std::ops::Range<usize>, size: usize, stride: usize) -> Vec<&[usize]> {
+    if size > range.len() {
+        return Vec::new();
     }
-    out
+    let last = range.end - size;
+    let mut starts: Vec<usize> = (range.start..=last).step_by(stride.max(1)).collect();
+    if starts.last() != Some(&last) {
+        starts.push(last);
+    }
+    starts.into_iter().map(|s| &run[s..s + size]).collect()
+}
+
+/// Every window of every size at every offset within `range` of a run, of
+/// the given kinds.
+fn all_windows(ctx: &Ctx<'_>, run: &[usize], range: std::ops::Range<usize>, kinds: &[EffectKind]) -> Vec<Spec> {
+    WINDOW_SIZES
+        .iter()
+        .flat_map(|&size| strided(run, range.clone(), size, 1))
+        .flat_map(|w| window(ctx, w, kinds))
+        .collect()
 }
 
 /// The flexible, lossy support candidates of a supported node: every fixed
@@ -598,17 +625,23 @@ pub fn generate(model: &Model, opts: &CandidateOptions) -> Vec<Candidate> {
         specs.push(mass(&ctx, node, false));
     }
 
-    // windows: every size at every offset on small models; coarse tiles on large ones
+    // windows: on small models single elements at every offset and longer
+    // windows at a stride (every size at every offset follows around the
+    // leaders, see `refine`); coarse tiles on large models
     for run in &ctx.runs {
         if ctx.small() {
-            specs.extend(all_windows(&ctx, run, 0..run.len()));
+            for (size, stride) in FIRST_PASS_WINDOWS {
+                for w in strided(run, 0..run.len(), size, stride) {
+                    specs.extend(window(&ctx, w, &WINDOW_KINDS));
+                }
+            }
         } else {
             let change = coarse_change_size(model.beams().len(), opts);
             for t in tiles(run, change) {
-                specs.extend(window(&ctx, &t).into_iter().take(2));
+                specs.extend(window(&ctx, &t, &WINDOW_KINDS[..2]));
             }
             for t in tiles(run, opts.region_size) {
-                specs.extend(window(&ctx, &t).into_iter().skip(2));
+                specs.extend(window(&ctx, &t, &WINDOW_KINDS[2..]));
             }
         }
     }
@@ -616,10 +649,29 @@ pub fn generate(model: &Model, opts: &CandidateOptions) -> Vec<Candidate> {
 }
 
 /// Candidates around the given leaders that the first pass did not try
-/// (`tried`: descriptions of the candidates already made): the fuller
-/// variants of a joint (translational springs) or a mass (rotary inertia),
-/// and on large models every window and in-line joint within
-/// [`REFINE_REACH`] elements.
+/// (`tried`: descriptions of the candidates already made):
+///
+/// - around a window: every window of its kind (damping: viscous and
+///   non-viscous) of every size at every offset within reach of it;
+/// - around a joint, support or mass: single-element stiffness and mass
+///   changes of the elements at its nodes and their neighbours, and on large
+///   models the in-line joints there;
+/// - the fuller variants of a joint (translational springs) and a mass
+///   (rotary inertia).
+/// The in-line joints (viscous and non-viscous) at those of `nodes` that
+/// join two collinear members.
+fn in_line_joints(ctx: &Ctx<'_>, nodes: impl IntoIterator<Item = u32>) -> Vec<Spec> {
+    let mut out = Vec::new();
+    for node in nodes {
+        if let Some(d) = ctx.in_line(node) {
+            for non_viscous in [false, true] {
+                out.push(joint(ctx, node, &[d], true, false, non_viscous));
+            }
+        }
+    }
+    out
+}
+
 pub(crate) fn refine(
     model: &Model,
     opts: &CandidateOptions,
@@ -627,6 +679,7 @@ pub(crate) fn refine(
     tried: &HashSet<String>,
 ) -> Vec<Candidate> {
     let ctx = Ctx::new(model, opts);
+    let reach = if ctx.small() { WINDOW_REACH } else { REFINE_REACH };
     let mut specs: Vec<Spec> = Vec::new();
     for c in leaders {
         match &c.edit {
@@ -638,32 +691,42 @@ pub(crate) fn refine(
             Edit::Mass { node, j, .. } if *j == 0.0 => specs.push(mass(&ctx, *node, true)),
             _ => {}
         }
-        if ctx.small() {
+        let kinds: &[EffectKind] = match c.kind {
+            EffectKind::StiffnessChange => &WINDOW_KINDS[..1],
+            EffectKind::MassChange => &WINDOW_KINDS[1..2],
+            EffectKind::ViscousDamping | EffectKind::NonViscousDamping => &WINDOW_KINDS[2..],
+            _ => &[],
+        };
+        let beams: Vec<usize> = c.elements.iter().filter_map(|&e| model.beam_index(fe_model::ElementId(e))).collect();
+        if !kinds.is_empty() && !beams.is_empty() {
+            // every window of the leader's kind within reach of it
+            let (r, _) = ctx.run_of[beams[0]];
+            let pos: Vec<usize> = beams.iter().map(|&b| ctx.run_of[b].1).collect();
+            let (lo, hi) = (pos.iter().min().expect("some"), pos.iter().max().expect("some"));
+            let run = &ctx.runs[r];
+            let range = lo.saturating_sub(reach)..(hi + reach + 1).min(run.len());
+            specs.extend(all_windows(&ctx, run, range, kinds));
+            // a lossy joint in a large model first shows as a stiffness loss
+            // around it (small models try every in-line joint at once)
+            if !ctx.small() && c.kind == EffectKind::StiffnessChange {
+                for &b in &beams {
+                    specs.extend(in_line_joints(&ctx, model.beams()[b].nodes.map(|n| n.0)));
+                }
+            }
             continue;
         }
-        // the beams where the leader acts, then their runs within reach
-        let mut focus: Vec<usize> =
-            c.elements.iter().filter_map(|&e| model.beam_index(fe_model::ElementId(e))).collect();
+        // around a point effect: single elements nearby, and in-line joints
         for &n in &c.nodes {
-            focus.extend(ctx.at(n).iter().copied());
-        }
-        let mut ranges: HashMap<usize, (usize, usize)> = HashMap::new();
-        for b in focus {
-            let (r, p) = ctx.run_of[b];
-            let len = ctx.runs[r].len();
-            let (lo, hi) = (p.saturating_sub(REFINE_REACH), (p + REFINE_REACH + 1).min(len));
-            let e = ranges.entry(r).or_insert((lo, hi));
-            *e = (e.0.min(lo), e.1.max(hi));
-        }
-        for (r, (lo, hi)) in ranges {
-            let run = &ctx.runs[r];
-            specs.extend(all_windows(&ctx, run, lo..hi));
-            for &b in &run[lo..hi] {
-                for n in model.beams()[b].nodes {
-                    if let Some(d) = ctx.in_line(n.0) {
-                        for non_viscous in [false, true] {
-                            specs.push(joint(&ctx, n.0, &[d], true, false, non_viscous));
-                        }
+            for &b in ctx.at(n) {
+                let (r, p) = ctx.run_of[b];
+                let run = &ctx.runs[r];
+                let range = p.saturating_sub(1)..(p + 2).min(run.len());
+                specs.extend(
+                    strided(run, range.clone(), 1, 1).into_iter().flat_map(|w| window(&ctx, w, &WINDOW_KINDS[..2])),
+                );
+                if !ctx.small() {
+                    for &b in &run[range] {
+                        specs.extend(in_line_joints(&ctx, model.beams()[b].nodes.map(|n| n.0)));
                     }
                 }
             }

@@ -1,0 +1,197 @@
+//! `rfm diagnose --apply` for every candidate of every kind: on the
+//! tutorial, the paper's case studies and small sample models, every ranked
+//! effect is written into a new case file in another folder; the written
+//! case loads, reads its measured data through a path relative to itself,
+//! and its misfit with the fitted values equals the diagnosis's to 1e-6.
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+
+use fe_model::CaseFile;
+use rfm_update::Study;
+use rfm_update::diagnose::{DiagnoseOptions, EffectKind, diagnose, log_misfit};
+
+fn cases_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../cases")
+}
+
+/// Small sample models as case files, each with a truth that differs from
+/// it so that the diagnosis has something to find.
+const SAMPLES: [(&str, &str); 2] = [
+    (
+        "portal.toml",
+        r#"
+title = "portal frame with a joint spring"
+[materials]
+steel = { E = 2.0e11, rho = 7800 }
+[sections]
+square = { b = 0.03, h = 0.03 }
+[groups.frame]
+alpha = 2e-5
+beta = 0.3
+[groups.joint]
+alpha = 1e-3
+mu = 300.0
+[[lines]]
+from = [0.0, 0.0]
+to = [0.0, 1.0]
+elements = 4
+material = "steel"
+section = "square"
+group = "frame"
+[[lines]]
+from = 5
+to = [1.0, 1.0]
+elements = 4
+material = "steel"
+section = "square"
+group = "frame"
+[[lines]]
+from = 9
+to = [1.0, 0.0]
+elements = 4
+material = "steel"
+section = "square"
+group = "frame"
+[[joints]]
+name = "knee"
+node = 9
+elements = [9]
+kr = 2e5
+group = "joint"
+[[supports]]
+node = 1
+[[supports]]
+node = 13
+[measurement]
+frequencies = { from = 2.0, to = 300.0, step = 1.0 }
+references = ["7:uy"]
+responses = ["3:ux", "5:ux", "7:uy", "11:ux", "8:uy"]
+[truth]
+noise = 0.01
+seed = 3
+[truth.set]
+"spring.knee.kr" = 5e4
+"element.3.stiffness" = 0.7
+"#,
+    ),
+    (
+        "beam.toml",
+        r#"
+title = "cantilever with a sensor mass"
+[materials]
+steel = { E = 2.0e11, rho = 7800 }
+[sections]
+bar = { b = 0.04, h = 0.008 }
+[groups.beam]
+alpha = 1e-5
+beta = 0.5
+[[lines]]
+from = [0.0, 0.0]
+to = [0.6, 0.0]
+elements = 6
+material = "steel"
+section = "bar"
+group = "beam"
+[[supports]]
+node = 1
+[measurement]
+frequencies = { from = 1.0, to = 500.0, step = 1.0 }
+references = ["7:uy"]
+responses = ["3..7:uy"]
+[truth]
+noise = 0.01
+seed = 4
+[[truth.masses]]
+name = "sensor"
+node = 5
+m = 0.1
+group = "beam"
+"#,
+    ),
+];
+
+/// Applies every ranked effect of the case's diagnosis and checks the
+/// written case; returns the kinds applied.
+fn apply_every(case: CaseFile, dir: &Path) -> BTreeSet<String> {
+    let title = case.model.title.clone();
+    let study = Study::from_case(case).unwrap_or_else(|e| panic!("{title}: {e}"));
+    let opts = DiagnoseOptions::default();
+    let d = diagnose(&study.case.model, &study.measured, &opts).unwrap_or_else(|e| panic!("{title}: {e}"));
+    // the new cases go into another folder than the case's
+    let out = dir.join("written");
+    std::fs::create_dir_all(&out).unwrap();
+    let synthesised = study.case.measurement.as_ref().and_then(|m| m.data.as_ref()).is_none();
+    let data = out.join("measured.csv");
+    if synthesised {
+        std::fs::write(&data, frf::io::csv::to_csv_string(&study.measured)).unwrap();
+    }
+    let target = out.join("applied.toml");
+    let mut kinds = BTreeSet::new();
+    for (i, r) in d.ranking.iter().enumerate() {
+        let rank = i + 1;
+        let mut editor =
+            d.apply(&study.case, rank).unwrap_or_else(|e| panic!("{title}, rank {rank} ({}): {e}", r.description));
+        if synthesised {
+            editor.use_data(&data);
+        }
+        let text = editor.text_at(&target).unwrap_or_else(|e| panic!("{title}, rank {rank}: {e}"));
+        // the data path is relative to the new file and names the same data
+        let table: toml::Table = text.parse().unwrap();
+        let written = table["measurement"]["data"].as_str().expect("a data path");
+        assert!(Path::new(written).is_relative(), "{title}, rank {rank}: data path {written}");
+        std::fs::write(&target, &text).unwrap();
+        let applied = Study::load(&target).unwrap_or_else(|e| panic!("{title}, rank {rank} ({}): {e}", r.description));
+        let misfit = log_misfit(&applied.system, &applied.measured, r.lines).unwrap();
+        // relative agreement, down to the round-off floor of a noise-free
+        // fit (the data pass through 17-digit CSV text; 1e-9 is far below
+        // any misfit a noisy measurement leaves)
+        assert!(
+            (misfit - r.misfit).abs() < 1e-6 * r.misfit + 1e-9,
+            "{title}, rank {rank} ({}): misfit {misfit} of the written case, {} in the diagnosis",
+            r.description,
+            r.misfit
+        );
+        // the case records the fall from the nominal model
+        let history: Vec<f64> = applied.case.history.iter().map(|h| h.misfit).collect();
+        assert_eq!(history, vec![d.nominal_misfit, r.misfit], "{title}, rank {rank}");
+        kinds.insert(format!("{:?}", r.kind));
+    }
+    println!("{title}: {} effects applied ({:?})", d.ranking.len(), kinds);
+    kinds
+}
+
+#[test]
+fn every_ranked_effect_applies_to_the_tutorial_the_papers_cases_and_samples() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mut kinds = BTreeSet::new();
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(cases_dir())
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    paths.sort();
+    paths.push(cases_dir().join("tutorial/l-frame.toml"));
+    assert!(paths.len() >= 7, "the six paper cases and the tutorial");
+    for (k, path) in paths.iter().enumerate() {
+        let case = CaseFile::load(path).unwrap();
+        kinds.extend(apply_every(case, &tmp.path().join(format!("case-{k}"))));
+    }
+    for (k, (name, text)) in SAMPLES.iter().enumerate() {
+        let path = tmp.path().join(format!("sample-{k}")).join(name);
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::write(&path, text).unwrap();
+        kinds.extend(apply_every(CaseFile::load(&path).unwrap(), &tmp.path().join(format!("sample-{k}"))));
+    }
+    for kind in [
+        EffectKind::FlexibleSupport,
+        EffectKind::FlexibleJoint,
+        EffectKind::LumpedMass,
+        EffectKind::StiffnessChange,
+        EffectKind::MassChange,
+        EffectKind::ViscousDamping,
+        EffectKind::NonViscousDamping,
+    ] {
+        assert!(kinds.contains(&format!("{kind:?}")), "no {kind:?} was applied");
+    }
+}
