@@ -649,8 +649,7 @@ impl Study {
     /// Output-error options from the case's `[update]` section, with the
     /// study's gains ([`Study::gains`]; the estimator fits them per reference).
     pub fn output_error_options(&self) -> Result<OeOptions, UpdateError> {
-        let mut opts = OeOptions::default();
-        opts.gains = match self.gains {
+        let gains = match self.gains {
             Gains::None => false,
             Gains::PerReference => true,
             Gains::PerChannel => {
@@ -661,6 +660,7 @@ impl Study {
                 ));
             }
         };
+        let mut opts = OeOptions { gains, ..OeOptions::default() };
         if let Some(spec) = self.case.update.as_ref() {
             if let Some(n) = spec.max_iterations {
                 opts.max_iterations = n as usize;

@@ -154,7 +154,7 @@ impl CaseEditor {
             let mut pair = toml_edit::Array::new();
             pair.push(g.magnitude);
             pair.push(g.phase_deg);
-            t.insert(&g.key.to_string(), toml_edit::Value::Array(pair));
+            t.insert(g.key.to_string(), toml_edit::Value::Array(pair));
         }
         m.insert("fitted_gains", value(t));
         Ok(())

@@ -95,6 +95,9 @@ impl Geometry {
     }
 }
 
+/// Three axes as rows (unit vectors in the global frame).
+type Axes = [[f64; 3]; 3];
+
 const IDENTITY: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 
 impl UffFile {
@@ -212,7 +215,7 @@ fn nodes_15(d: &RawDataset, scale: f64) -> Result<Vec<(TestNode, i64)>, (usize, 
 /// systems, colour; then x, y, z).
 fn nodes_2411(d: &RawDataset, scale: f64) -> Result<Vec<(TestNode, i64)>, (usize, String)> {
     let lines: Vec<&(usize, String)> = d.lines.iter().filter(|l| !l.1.trim().is_empty()).collect();
-    if lines.len() % 2 != 0 {
+    if !lines.len().is_multiple_of(2) {
         let last = lines.last().map_or(d.line, |l| l.0);
         return Err((last, "dataset 2411 (nodes): a node's record 1 has no coordinates (record 2) after it".into()));
     }
@@ -397,7 +400,7 @@ pub struct Pairing {
     explicit: Vec<ChannelMap>,
     /// Per used test node: its model node and the axes of its directions,
     /// or why it has none.
-    nodes: HashMap<i64, Result<(u32, [[f64; 3]; 3]), String>>,
+    nodes: HashMap<i64, Result<(u32, Axes), String>>,
     /// Model x, y and the plane's normal in the test frame.
     frame: [[f64; 3]; 3],
     axes: [Direction; 2],

@@ -658,6 +658,7 @@ pub fn generate(model: &Model, opts: &CandidateOptions) -> Vec<Candidate> {
 ///   models the in-line joints there;
 /// - the fuller variants of a joint (translational springs) and a mass
 ///   (rotary inertia).
+///
 /// The in-line joints (viscous and non-viscous) at those of `nodes` that
 /// join two collinear members.
 fn in_line_joints(ctx: &Ctx<'_>, nodes: impl IntoIterator<Item = u32>) -> Vec<Spec> {
