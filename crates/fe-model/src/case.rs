@@ -18,7 +18,13 @@ use crate::model::{Group, Model, NodeId, Section};
 use crate::quantity::{Parameter, Quantity};
 
 mod edit;
+mod measurement;
 pub use edit::CaseEditor;
+pub use measurement::{
+    Calibration, CalibrationTarget, ChannelMap, DEFAULT_COHERENCE_THRESHOLD, FittedGain, GainKey, Gains, MaskRule,
+    MeasurementSpec, PairingSpec,
+};
+use measurement::{RawMeasurement, parse_measurement};
 
 // ---------------------------------------------------------------- raw schema
 
@@ -191,28 +197,6 @@ struct RawJoint {
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
-struct RawMeasurement {
-    frequencies: Spanned<toml::Value>,
-    references: Vec<Spanned<String>>,
-    responses: Vec<Spanned<String>>,
-    data: Option<Spanned<String>>,
-    #[serde(default)]
-    map: Vec<Spanned<RawChannelMap>>,
-    #[serde(default)]
-    mask: Vec<Spanned<String>>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawChannelMap {
-    test: Spanned<String>,
-    model: Spanned<String>,
-    #[serde(default = "one")]
-    sign: f64,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
 struct RawTruth {
     #[serde(default)]
     noise: f64,
@@ -246,8 +230,7 @@ struct RawUpdate {
     #[serde(default)]
     gains: bool,
     misfit: Option<Spanned<String>>,
-    #[serde(default)]
-    coherence: bool,
+    coherence: Option<bool>,
     #[serde(default)]
     weights: Vec<Spanned<RawBandWeight>>,
 }
@@ -307,132 +290,6 @@ struct RawDiagnosisCheck {
 }
 
 // ------------------------------------------------------------- public specs
-
-/// Where the measured FRFs come from and which channels they hold.
-#[derive(Clone, Debug)]
-pub struct MeasurementSpec {
-    /// Frequency lines (Hz) of synthesised data.
-    pub frequencies_hz: Vec<f64>,
-    /// Excitation DOFs (columns of the FRF matrix).
-    pub references: Vec<DofRef>,
-    /// Response DOFs (rows).
-    pub responses: Vec<DofRef>,
-    /// Measured data file (resolved relative to the case file), if any.
-    pub data: Option<PathBuf>,
-    /// Test (node, direction) to model DOF mapping for measured files.
-    pub map: Vec<ChannelMap>,
-    /// What to leave out of the measured data instead of refusing it
-    /// (`mask = ["non-finite", ...]`); empty: refuse every defect.
-    pub mask: Vec<MaskRule>,
-}
-
-/// A kind of defect in measured data that a case accepts by leaving the
-/// affected values out (`[measurement] mask = [...]`), instead of refusing
-/// the file. What is left out is reported.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum MaskRule {
-    /// `non-finite`: a frequency line where any channel's value is NaN or
-    /// infinite is left out, for every channel.
-    NonFinite,
-    /// `duplicate-lines`: a line that repeats the frequency of the line
-    /// before it is left out (the first is kept). Lines that go backwards
-    /// are still refused.
-    DuplicateLines,
-    /// `unmodelled-channels`: a channel whose response or reference is at a
-    /// node the model lacks, or at a DOF it holds fixed, is left out.
-    UnmodelledChannels,
-    /// `bad-coherence`: a coherence record with a value outside 0..1 (or
-    /// not a number) is left out; its channel is weighted as if its
-    /// coherence were 1.
-    BadCoherence,
-}
-
-impl MaskRule {
-    /// Every rule, in the order of the documentation.
-    pub const ALL: [MaskRule; 4] =
-        [MaskRule::NonFinite, MaskRule::DuplicateLines, MaskRule::UnmodelledChannels, MaskRule::BadCoherence];
-
-    /// The name used in case files.
-    pub fn name(self) -> &'static str {
-        match self {
-            MaskRule::NonFinite => "non-finite",
-            MaskRule::DuplicateLines => "duplicate-lines",
-            MaskRule::UnmodelledChannels => "unmodelled-channels",
-            MaskRule::BadCoherence => "bad-coherence",
-        }
-    }
-
-    /// The rule of a case-file name.
-    pub fn parse(name: &str) -> Option<MaskRule> {
-        MaskRule::ALL.into_iter().find(|r| r.name() == name.trim())
-    }
-}
-
-impl std::fmt::Display for MaskRule {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-/// Mapping of a test point and direction to a model DOF: the unit vector of
-/// the test direction `test` equals `sign` times the model DOF `model`.
-///
-/// A measured FRF whose response or reference is at `test` is multiplied by
-/// the direction's sign (`-Z` counts -1) and by `sign`, once for the response
-/// and once for the reference. Without an entry, measurement readers map
-/// `X`, `Y`, `RZ` to `ux`, `uy`, `rz` of the same node (see
-/// `docs/measured-data.md`).
-#[derive(Clone, Debug, PartialEq)]
-pub struct ChannelMap {
-    /// Test point and direction as written in the measurement file, e.g. `101:+Y`.
-    pub test: String,
-    /// Model DOF.
-    pub model: DofRef,
-    /// +1 or -1.
-    pub sign: f64,
-}
-
-impl ChannelMap {
-    /// Parses a test point `node:direction` into the node and a signed
-    /// direction code: `X`, `Y`, `Z`, `RX`, `RY`, `RZ` are 1 to 6 (the codes
-    /// of UFF dataset 58), negative with a leading `-`; `S` (scalar) is 0.
-    /// Letters are case-insensitive, `+` is optional, and the numeric codes
-    /// themselves (`101:-3`) are accepted.
-    pub fn parse_test_point(s: &str) -> Result<(i64, i8), String> {
-        let bad = || {
-            format!(
-                "`{s}` is not a test point; write node:direction, e.g. `101:+Z` \
-                 (directions X, Y, Z, RX, RY, RZ with an optional sign, or S for scalar)"
-            )
-        };
-        let (node, dir) = s.trim().split_once(':').ok_or_else(bad)?;
-        let node: i64 = node.trim().parse().map_err(|_| bad())?;
-        let dir = dir.trim().to_ascii_uppercase();
-        let (sign, axis) = match dir.strip_prefix('-') {
-            Some(rest) => (-1, rest),
-            None => (1, dir.strip_prefix('+').unwrap_or(&dir)),
-        };
-        let code: i8 = match axis {
-            "X" => 1,
-            "Y" => 2,
-            "Z" => 3,
-            "RX" => 4,
-            "RY" => 5,
-            "RZ" => 6,
-            "S" | "SCALAR" => 0,
-            digits => match digits.parse::<i8>() {
-                Ok(c) if (0..=6).contains(&c) => c,
-                _ => return Err(bad()),
-            },
-        };
-        Ok((node, sign * code))
-    }
-
-    /// The node and signed direction code of `test` (see [`ChannelMap::parse_test_point`]).
-    pub fn test_point(&self) -> Result<(i64, i8), String> {
-        Self::parse_test_point(&self.test)
-    }
-}
 
 /// The truth of a simulated study: the model that generates "measured" data.
 #[derive(Clone, Debug)]
@@ -494,8 +351,10 @@ pub struct UpdateSpec {
     pub gains: bool,
     /// Misfit form as written (`relative` or `log`), checked by the solver crate.
     pub misfit: Option<(String, Range<usize>)>,
-    /// Weight lines by the measured coherence.
-    pub coherence: bool,
+    /// Weight lines by the measured coherence: `Some(false)` turns off the
+    /// default (on whenever the data carry coherence), `Some(true)` requires
+    /// coherence in the data.
+    pub coherence: Option<bool>,
     /// Weights per frequency band.
     pub weights: Vec<BandWeight>,
 }
@@ -645,7 +504,8 @@ impl CaseFile {
     /// measured data file. Outputs must never be written over them.
     pub fn inputs(&self) -> Vec<PathBuf> {
         let data = self.measurement.as_ref().and_then(|m| m.data.clone());
-        std::iter::once(self.path.clone()).chain(data).collect()
+        let geometry = self.measurement.as_ref().and_then(|m| m.geometry.clone());
+        std::iter::once(self.path.clone()).chain(data).chain(geometry).collect()
     }
 
     /// Parses case-file text; `path` is used in messages and to resolve data files.
@@ -1163,60 +1023,6 @@ fn parse_dof_refs(ctx: &Ctx<'_>, list: &[Spanned<String>], model: &Model) -> Res
         }
     }
     Ok(out)
-}
-
-fn parse_measurement(ctx: &Ctx<'_>, m: &Spanned<RawMeasurement>, model: &Model) -> Result<MeasurementSpec, CaseError> {
-    let r = m.get_ref();
-    let frequencies_hz = parse_frequencies(ctx, &r.frequencies)?;
-    let references = parse_dof_refs(ctx, &r.references, model)?;
-    let responses = parse_dof_refs(ctx, &r.responses, model)?;
-    if references.is_empty() || responses.is_empty() {
-        return Err(ctx.err(m.span(), "the measurement needs at least one reference and one response"));
-    }
-    let data = r.data.as_ref().map(|d| {
-        let p = Path::new(d.get_ref());
-        if p.is_absolute() { p.to_path_buf() } else { ctx.path.parent().unwrap_or(Path::new(".")).join(p) }
-    });
-    let mut map: Vec<ChannelMap> = Vec::new();
-    for entry in &r.map {
-        let c = entry.get_ref();
-        let (node, dir) = ChannelMap::parse_test_point(c.test.get_ref()).map_err(|e| ctx.err(c.test.span(), e))?;
-        // One entry per test node and axis: `101:+Z` and `101:-Z` describe the same sensor axis.
-        if let Some(prev) = map.iter().find(|m| m.test_point().is_ok_and(|(n, d)| n == node && d.abs() == dir.abs())) {
-            return Err(ctx.err(
-                c.test.span(),
-                format!("test point `{}` is already mapped by `{}`", c.test.get_ref(), prev.test),
-            ));
-        }
-        let model_dof: DofRef = c.model.get_ref().parse().map_err(|e: String| ctx.err(c.model.span(), e))?;
-        if model.node(model_dof.node).is_none() {
-            return Err(ctx.err(c.model.span(), format!("node {} does not exist in the model", model_dof.node)));
-        }
-        if c.sign != 1.0 && c.sign != -1.0 {
-            return Err(ctx.err(entry.span(), "sign must be 1 or -1"));
-        }
-        map.push(ChannelMap { test: c.test.get_ref().clone(), model: model_dof, sign: c.sign });
-    }
-    let mut mask: Vec<MaskRule> = Vec::new();
-    for m in &r.mask {
-        let rule = MaskRule::parse(m.get_ref()).ok_or_else(|| {
-            let names = MaskRule::ALL.map(MaskRule::name);
-            let hint = crate::suggest::closest(m.get_ref(), names)
-                .map(|s| format!("; did you mean `{s}`?"))
-                .unwrap_or_else(|| format!(" (available: {})", names.join(", ")));
-            ctx.err(m.span(), format!("unknown mask `{}`{hint}", m.get_ref()))
-        })?;
-        if mask.contains(&rule) {
-            return Err(ctx.err(m.span(), format!("mask `{rule}` is listed twice")));
-        }
-        mask.push(rule);
-    }
-    if !mask.is_empty() && r.data.is_none() {
-        return Err(
-            ctx.err(r.mask[0].span(), "`mask` applies to a measured `data` file, and this measurement has none")
-        );
-    }
-    Ok(MeasurementSpec { frequencies_hz, references, responses, data, map, mask })
 }
 
 fn resolve_values(

@@ -183,6 +183,13 @@ impl CaseError {
         CaseError { file: file.to_path_buf(), location, message, snippet }
     }
 
+    /// The same place in the file with another message: a spec keeps the
+    /// place of a value (with an empty message) so that a higher layer can
+    /// refuse it where it is written.
+    pub fn with_message(&self, message: impl Into<String>) -> CaseError {
+        CaseError { message: message.into(), ..self.clone() }
+    }
+
     /// The message with the source line and a caret under the column, for terminals.
     pub fn render(&self) -> String {
         let mut out = self.to_string();

@@ -298,6 +298,9 @@ mod tests {
             noise_ratio: Some(1.0),
             restarts: Vec::new(),
             worse_than_start,
+            gain_setting: "none".into(),
+            coherence_weighted: false,
+            pairing: Vec::new(),
             system: damping::DampedSystem::new(fe_model::samples::two_dof_oscillator()).unwrap(),
         }
     }

@@ -40,7 +40,7 @@ enum Command {
     Simulate {
         /// Case file.
         case: PathBuf,
-        /// Output CSV file.
+        /// Output file: .uff or .unv for UFF dataset 58, .csv for CSV.
         #[arg(long)]
         out: PathBuf,
         /// Use the case's truth model instead of the initial model.
@@ -52,6 +52,15 @@ enum Command {
         /// Random seed of the noise.
         #[arg(long, default_value_t = 0)]
         seed: u64,
+        /// FRF kind written: receptance, mobility or accelerance.
+        #[arg(long, default_value = "receptance")]
+        kind: String,
+        /// Write UFF as binary 58b instead of ASCII.
+        #[arg(long)]
+        binary: bool,
+        /// Print what was written as JSON.
+        #[arg(long)]
+        json: bool,
     },
     /// Compare the case's model with the measured FRFs: errors per channel and band, overlays, a report.
     Compare {
@@ -241,7 +250,18 @@ fn main() -> ExitCode {
 
 fn run(cli: Cli) -> commands::Result<Exit> {
     match cli.command {
-        Command::Simulate { case, out, truth, noise, seed } => commands::simulate(&case, &out, truth, noise, seed),
+        Command::Simulate { case, out, truth, noise, seed, kind, binary, json } => {
+            commands::simulate(&commands::SimulateArgs {
+                case: &case,
+                out: &out,
+                truth,
+                noise,
+                seed,
+                kind: &kind,
+                binary,
+                json,
+            })
+        }
         Command::Compare { case, measured, out, json, bands, frequency_axis } => commands::compare(
             &case,
             &measured,

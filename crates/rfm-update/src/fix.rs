@@ -227,7 +227,7 @@ fn add_and_update(
     // intermediate (knowingly incomplete) model would only cost time
     oe_opts.restarts = 0;
     let outcome = study.run_output_error(&oe_opts, |_| {})?;
-    let misfit_updated = diagnose::log_misfit(&outcome.system, measured, lines)?;
+    let misfit_updated = diagnose::log_misfit_with(&outcome.system, measured, lines, d.gains)?;
     let model = outcome.system.model();
     let values: Vec<(String, f64)> = study
         .parameters

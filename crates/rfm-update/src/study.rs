@@ -1,16 +1,17 @@
 //! A study: a case file turned into a model, measured data and an updating
 //! set-up, ready for a solver.
 
-use std::path::Path;
-
 use damping::DampedSystem;
-use fe_model::case::{FrequencyChoice, MeasurementSpec};
-use fe_model::{CaseFile, Parameter};
-use frf::{Channel, FrfSet, NoiseModel};
+use fe_model::case::{FrequencyChoice, Gains, MeasurementSpec};
+use fe_model::{CaseFile, DofRef, Parameter};
+use frf::{Channel, FrfKind, FrfSet, NoiseModel};
 use serde::Serialize;
+
+pub use crate::measured::read_measured_for;
 
 use crate::error::UpdateError;
 use crate::freqsel;
+use crate::gain;
 use crate::oe::{self, Gain, Misfit, OeData, OeOptions};
 use crate::params::ParameterSet;
 use crate::rfm::{self, IterationRecord, RfmOptions, Status};
@@ -67,6 +68,50 @@ pub struct Study {
     /// 0 Hz dropped, units scaled, kinds converted, datasets skipped), one
     /// line each, to be shown and stored with the results.
     pub notes: Vec<String>,
+    /// The kind of the measured data as read (`measured` itself is
+    /// receptance, for the updating methods); comparisons are made in it,
+    /// whichever way the data arrive.
+    pub measured_kind: FrfKind,
+    /// The unknown gains every comparison and fit of this study applies to
+    /// the model's FRFs ([`crate::gain`]): `Gains::None` for per-newton data
+    /// unless the case asks for gains.
+    pub gains: Gains,
+    /// Why those gains, in words (for the notes and reports).
+    pub gains_reason: String,
+    /// The references whose data are per volt (uncalibrated).
+    pub per_volt: Vec<DofRef>,
+    /// How the test nodes were paired with the model's by coordinates
+    /// (empty unless the case asks for it).
+    pub pairing: Vec<PairingReport>,
+}
+
+/// A test node paired with a model node by coordinates, as stored with the
+/// results (`[measurement] pair = "coordinates"`).
+#[derive(Clone, Debug, Serialize)]
+pub struct PairingReport {
+    /// Test node label.
+    pub test_node: i64,
+    /// Model node.
+    pub model_node: u32,
+    /// Distance in the model's plane (m).
+    pub distance_m: f64,
+    /// Its test directions as model DOFs (`+Z -> uy`).
+    pub directions: Vec<String>,
+}
+
+impl PairingReport {
+    /// The reports of a reader's pairing.
+    pub fn of(paired: &[frf::io::uff::PairedNode]) -> Vec<PairingReport> {
+        paired
+            .iter()
+            .map(|p| PairingReport {
+                test_node: p.test_node,
+                model_node: p.model_node,
+                distance_m: p.distance_m,
+                directions: p.directions.clone(),
+            })
+            .collect()
+    }
 }
 
 /// One parameter's values for reporting.
@@ -176,6 +221,12 @@ pub struct UpdateOutcome {
     pub restarts: Vec<Restart>,
     /// The update ended with a larger misfit than the initial model's.
     pub worse_than_start: bool,
+    /// The gains fitted (`none`, `per-reference`, `per-channel`) and why.
+    pub gain_setting: String,
+    /// Whether the lines were weighted by the measured coherence.
+    pub coherence_weighted: bool,
+    /// How test nodes were paired with model nodes by coordinates.
+    pub pairing: Vec<PairingReport>,
     /// The updated model.
     #[serde(skip)]
     pub system: DampedSystem,
@@ -198,20 +249,6 @@ const RESTART_STEPS: usize = 15;
 const RESTARTS_REFINED: usize = 2;
 /// Restart starts spread by up to this factor either way from the initial values.
 const RESTART_SPREAD: f64 = 10.0;
-
-/// Reads a measured FRF file for a model with the case's channel map and
-/// mask rules (`[measurement] map` and `mask`; none without a spec), and
-/// checks that every channel is at a free DOF of the model (or leaves it out
-/// where the mask allows). What the rules left out is in
-/// [`frf::io::Measured::masked`].
-pub fn read_measured_for(
-    system: &DampedSystem,
-    path: &Path,
-    spec: Option<&MeasurementSpec>,
-) -> Result<frf::io::Measured, UpdateError> {
-    let (map, mask) = spec.map_or((&[][..], &[][..]), |s| (&s.map[..], &s.mask[..]));
-    Ok(frf::io::load_measured_with(path, map, mask)?.check_channels(path, &system.assembly().dofs, mask)?)
-}
 
 /// One line per thing a mask rule left out: the rule, then where and why.
 pub fn describe_masked(masked: &[frf::io::Masked]) -> Vec<String> {
@@ -250,11 +287,17 @@ impl Study {
         }
         let mut masked = Vec::new();
         let mut notes = Vec::new();
+        let mut measured_kind = FrfKind::Receptance;
+        let mut per_volt = Vec::new();
+        let mut pairing = Vec::new();
         let measured = match (&spec.data, &case.truth, &truth) {
             (Some(path), _, _) => {
                 let read = read_measured_for(&system, path, Some(spec))?;
-                masked = read.masked;
+                masked = read.masked.clone();
                 notes = read.notes.iter().map(|n| format!("{}: {n}", path.display())).collect();
+                measured_kind = read.set.kind();
+                per_volt = read.per_volt_references();
+                pairing = PairingReport::of(&read.pairing);
                 let set = read.set.to_receptance();
                 let index = set.channel_indices();
                 let idx = channels
@@ -278,8 +321,25 @@ impl Study {
             _ => unreachable!("the case loader requires data or a truth"),
         };
         let parameters = case.update.as_ref().map(|u| u.parameters.clone()).unwrap_or_default();
-        let mut study =
-            Study { case, system, truth, measured, parameters, update_frequencies_hz: Vec::new(), masked, notes };
+        let (gains, gains_reason) = gain::decide(Some(spec), case.update.as_ref(), &per_volt)?;
+        if gains != Gains::None {
+            notes.push(format!("model FRFs are multiplied by fitted gains ({gains}): {gains_reason}"));
+        }
+        let mut study = Study {
+            case,
+            system,
+            truth,
+            measured,
+            parameters,
+            update_frequencies_hz: Vec::new(),
+            masked,
+            notes,
+            measured_kind,
+            gains,
+            gains_reason,
+            per_volt,
+            pairing,
+        };
         if study.case.update.is_some() {
             study.update_frequencies_hz = study.lines_for(study.method())?;
         }
@@ -293,6 +353,9 @@ impl Study {
     pub fn with_measured(case: CaseFile, measured: FrfSet) -> Result<Self, UpdateError> {
         let system = DampedSystem::new(case.model.clone())?;
         let parameters = case.update.as_ref().map(|u| u.parameters.clone()).unwrap_or_default();
+        // the data's per-volt references are not known here: the caller that
+        // read them sets `gains` (see `gain::decide`) when they differ
+        let (gains, gains_reason) = gain::decide(case.measurement.as_ref(), case.update.as_ref(), &[])?;
         let mut study = Study {
             case,
             system,
@@ -302,6 +365,11 @@ impl Study {
             update_frequencies_hz: Vec::new(),
             masked: Vec::new(),
             notes: Vec::new(),
+            measured_kind: FrfKind::Receptance,
+            gains,
+            gains_reason,
+            per_volt: Vec::new(),
+            pairing: Vec::new(),
         };
         if study.case.update.is_some() {
             study.update_frequencies_hz = study.lines_for(study.method())?;
@@ -409,6 +477,13 @@ impl Study {
         if self.parameters.is_empty() {
             return Err(UpdateError::Setup("the case has no [update] parameters".into()));
         }
+        if self.gains != Gains::None {
+            return Err(UpdateError::Setup(format!(
+                "the response function method fits no gain, and this case needs {} gains ({}); update with the \
+                 output-error method (`method = \"output-error\"` in [update], or --method output-error)",
+                self.gains, self.gains_reason
+            )));
+        }
         let lines = self.lines_for(Method::Rfm)?;
         let measured = self.measured.at_frequencies(&lines)?;
         self.check_initial(&measured)?;
@@ -469,6 +544,9 @@ impl Study {
             noise_ratio,
             restarts: Vec::new(),
             worse_than_start,
+            gain_setting: format!("{} ({})", self.gains, self.gains_reason),
+            coherence_weighted: false,
+            pairing: self.pairing.clone(),
             method: "rfm".into(),
             status: verdict::classify(&result.status, noise_ratio, None),
             parameters: self.reports(&result.values),
@@ -522,34 +600,69 @@ impl Study {
         Ok(())
     }
 
-    /// Line weights for the measured data at `lines` (band weights and
-    /// coherence from the case's `[update]`), channel-major; `None` when all are 1.
-    pub fn weights(&self, measured: &FrfSet) -> Result<Option<Vec<f64>>, UpdateError> {
-        let Some(spec) = self.case.update.as_ref() else { return Ok(None) };
-        if spec.weights.is_empty() && !spec.coherence {
-            return Ok(None);
-        }
-        let nf = measured.n_freq();
-        let mut w = vec![1.0; nf * measured.channels().len()];
-        for (c, chunk) in w.chunks_mut(nf).enumerate() {
-            for (k, wk) in chunk.iter_mut().enumerate() {
-                let f = measured.frequencies_hz()[k];
-                for b in spec.weights.iter().filter(|b| b.from <= f && f <= b.to) {
-                    *wk *= b.weight;
-                }
-                if spec.coherence {
-                    let coh = measured.coherence(c).ok_or_else(|| {
-                        UpdateError::Setup(
-                            "coherence weighting is requested but the measured data carry no coherence".into(),
-                        )
-                    })?;
-                    // inverse of the relative standard deviation of an FRF estimate, up to a constant
-                    let g = coh[k].clamp(0.0, 0.999);
-                    *wk *= (g / (1.0 - g)).sqrt().min(30.0) / 30.0;
-                }
+    /// Whether the fits weight lines by the measured coherence: by default
+    /// whenever the data carry it, unless `[update] coherence = false`.
+    pub fn weighs_coherence(&self) -> bool {
+        let asked = self.case.update.as_ref().and_then(|u| u.coherence);
+        asked.unwrap_or(true) && (0..self.measured.channels().len()).any(|c| self.measured.coherence(c).is_some())
+    }
+
+    /// Residual weights for `measured` (lines of this study's data): the
+    /// `[update]` band weights times the coherence weight
+    /// `sqrt(g / (1 - g))`, the inverse of an FRF estimate's relative
+    /// standard deviation up to a constant (capped at coherence 0.999 and
+    /// scaled to 1 there); channel-major, `None` when all are 1. Used by the
+    /// output-error fit, the gain fits and the comparison.
+    pub fn line_weights(&self, measured: &FrfSet) -> Result<Option<Vec<f64>>, UpdateError> {
+        line_weights_for(&self.case, measured)
+    }
+
+    /// Decides the gains again for measured data read from another file
+    /// (`--measured`): from the case and that file's per-volt references,
+    /// as [`Study::from_case`] does for the case's own data.
+    pub fn set_gains_for(&mut self, read: &frf::io::Measured) -> Result<(), UpdateError> {
+        self.per_volt = read.per_volt_references();
+        (self.gains, self.gains_reason) =
+            gain::decide(self.case.measurement.as_ref(), self.case.update.as_ref(), &self.per_volt)?;
+        Ok(())
+    }
+
+    /// The diagnosis options of this study: the defaults, with a gain per
+    /// reference fitted with every candidate when the study has gains. A
+    /// gain per channel is refused: the diagnosis fits them per reference.
+    pub fn diagnose_options(&self) -> Result<crate::diagnose::DiagnoseOptions, UpdateError> {
+        let gains = match self.gains {
+            Gains::None => false,
+            Gains::PerReference => true,
+            Gains::PerChannel => {
+                return Err(UpdateError::Setup(
+                    "`gains = \"per-channel\"`: the diagnosis and the output-error update fit one gain per \
+                     reference (compare fits them per channel); diagnose with `gains = \"per-reference\"`"
+                        .into(),
+                ));
             }
-        }
-        Ok(Some(w))
+        };
+        Ok(crate::diagnose::DiagnoseOptions { gains, ..Default::default() })
+    }
+
+    /// Line weights of the output-error fit (see [`Study::line_weights`]).
+    pub fn weights(&self, measured: &FrfSet) -> Result<Option<Vec<f64>>, UpdateError> {
+        self.line_weights(measured)
+    }
+
+    /// The measured FRFs in the kind they were measured in (`measured` is
+    /// receptance): what comparisons show.
+    pub fn measured_as_read(&self) -> FrfSet {
+        self.measured.converted(self.measured_kind)
+    }
+
+    /// Fits this study's gains ([`Study::gains`]) to `model` (the model's
+    /// FRFs on the channels and lines of `measured`, in any kind) against
+    /// `measured`, weighted by [`Study::line_weights`].
+    pub fn fit_gains(&self, model: &FrfSet, measured: &FrfSet) -> Result<gain::FittedGains, UpdateError> {
+        let model = if model.kind() == measured.kind() { model.clone() } else { model.converted(measured.kind()) };
+        let weights = self.line_weights(measured)?;
+        gain::fit_gains(&model, measured, weights.as_deref(), self.gains)
     }
 
     /// Runs the output-error estimator from the initial model, with the
@@ -651,6 +764,9 @@ impl Study {
             noise_ratio,
             restarts,
             worse_than_start: residual > first_residual,
+            gain_setting: format!("{} ({})", self.gains, self.gains_reason),
+            coherence_weighted: weights.is_some() && self.weighs_coherence(),
+            pairing: self.pairing.clone(),
             system: sys,
         })
     }
@@ -675,9 +791,21 @@ impl Study {
         opts
     }
 
-    /// Output-error options from the case's `[update]` section.
+    /// Output-error options from the case's `[update]` section, with the
+    /// study's gains ([`Study::gains`]; the estimator fits them per reference).
     pub fn output_error_options(&self) -> Result<OeOptions, UpdateError> {
-        let mut opts = OeOptions::default();
+        let gains = match self.gains {
+            Gains::None => false,
+            Gains::PerReference => true,
+            Gains::PerChannel => {
+                return Err(UpdateError::Setup(
+                    "`gains = \"per-channel\"`: the output-error update fits one gain per reference (compare fits \
+                     them per channel); update with `gains = \"per-reference\"`"
+                        .into(),
+                ));
+            }
+        };
+        let mut opts = OeOptions { gains, ..OeOptions::default() };
         if let Some(spec) = self.case.update.as_ref() {
             if let Some(n) = spec.max_iterations {
                 opts.max_iterations = n as usize;
@@ -687,7 +815,6 @@ impl Study {
             }
             opts.regularization = spec.regularization.unwrap_or(0.0);
             opts.bounds = spec.bounds.clone();
-            opts.gains = spec.gains;
             if let Some((m, span)) = &spec.misfit {
                 opts.misfit = Misfit::parse(m).ok_or_else(|| {
                     UpdateError::Case(
@@ -740,6 +867,41 @@ impl Study {
             })
             .collect()
     }
+}
+
+/// The residual weights of a case's measured data `measured` (see
+/// [`Study::line_weights`]): band weights times the coherence weight,
+/// whenever the data carry coherence unless `[update] coherence = false`.
+pub fn line_weights_for(case: &CaseFile, measured: &FrfSet) -> Result<Option<Vec<f64>>, UpdateError> {
+    let bands = case.update.as_ref().map_or(&[][..], |u| &u.weights[..]);
+    let asked = case.update.as_ref().and_then(|u| u.coherence);
+    let has = (0..measured.channels().len()).any(|c| measured.coherence(c).is_some());
+    if asked == Some(true) && !has {
+        return Err(UpdateError::Setup(
+            "coherence weighting is requested ([update] coherence = true) but the measured data carry no \
+             coherence"
+                .into(),
+        ));
+    }
+    let coherence = asked.unwrap_or(true) && has;
+    if bands.is_empty() && !coherence {
+        return Ok(None);
+    }
+    let nf = measured.n_freq();
+    let mut w = vec![1.0; nf * measured.channels().len()];
+    for (c, chunk) in w.chunks_mut(nf).enumerate() {
+        for (k, wk) in chunk.iter_mut().enumerate() {
+            let f = measured.frequencies_hz()[k];
+            for b in bands.iter().filter(|b| b.from <= f && f <= b.to) {
+                *wk *= b.weight;
+            }
+            if coherence && let Some(coh) = measured.coherence(c) {
+                let g = coh[k].clamp(0.0, 0.999);
+                *wk *= (g / (1.0 - g)).sqrt().min(30.0) / 30.0;
+            }
+        }
+    }
+    Ok(Some(w))
 }
 
 #[cfg(test)]

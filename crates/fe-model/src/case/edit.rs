@@ -6,15 +6,16 @@
 //! misfit. The edits are made on the TOML document itself (`toml_edit`), so
 //! that comments, order and layout stay as the user wrote them; added model
 //! items are appended as text under a comment that says where they came
-//! from. The measured-data path is rewritten relative to the new file's
-//! folder, so that a written case can be moved together with its data, and
-//! every result is parsed again as a case file before it is handed back.
+//! from. The paths of the measured data and of the test geometry are
+//! rewritten relative to the new file's folder, so that a written case can
+//! be moved together with its data, and every result is parsed again as a
+//! case file before it is handed back.
 
 use std::path::{Component, Path, PathBuf};
 
 use toml_edit::{ArrayOfTables, DocumentMut, Item, Table, value};
 
-use super::{CaseFile, HistoryEntry};
+use super::{CaseFile, FittedGain, Gains, HistoryEntry};
 use crate::error::CaseError;
 
 /// An edit of a case file's text; see the module docs.
@@ -24,6 +25,8 @@ pub struct CaseEditor {
     path: PathBuf,
     /// Its measured-data file, resolved.
     data: Option<PathBuf>,
+    /// Its test-geometry file, resolved.
+    geometry: Option<PathBuf>,
     doc: DocumentMut,
 }
 
@@ -36,7 +39,8 @@ impl CaseFile {
         let mut doc = self.source.parse::<DocumentMut>().map_err(|e| self.error(e.span(), e.message().to_string()))?;
         doc.remove("check");
         let data = self.measurement.as_ref().and_then(|m| m.data.clone());
-        Ok(CaseEditor { path: self.path.clone(), data, doc })
+        let geometry = self.measurement.as_ref().and_then(|m| m.geometry.clone());
+        Ok(CaseEditor { path: self.path.clone(), data, geometry, doc })
     }
 }
 
@@ -142,6 +146,28 @@ impl CaseEditor {
         }
     }
 
+    /// Keeps the gains a run fitted: `[measurement] gains` set to the
+    /// setting used (so that the next run fits them too, whatever decided
+    /// it), and `fitted_gains` to their values (magnitude and phase in
+    /// degrees), replacing earlier ones.
+    pub fn set_gains(&mut self, gains: Gains, fitted: &[FittedGain]) -> Result<(), CaseError> {
+        let m = self.table("measurement")?;
+        m.insert("gains", value(gains.name()));
+        if fitted.is_empty() {
+            m.remove("fitted_gains");
+            return Ok(());
+        }
+        let mut t = toml_edit::InlineTable::new();
+        for g in fitted {
+            let mut pair = toml_edit::Array::new();
+            pair.push(g.magnitude);
+            pair.push(g.phase_deg);
+            t.insert(g.key.to_string(), toml_edit::Value::Array(pair));
+        }
+        m.insert("fitted_gains", value(t));
+        Ok(())
+    }
+
     /// Appends an entry to the `[[history]]` of the misfit.
     pub fn push_history(&mut self, entry: &HistoryEntry) -> Result<(), CaseError> {
         let mut t = Table::new();
@@ -164,15 +190,17 @@ impl CaseEditor {
         }
     }
 
-    /// The edited text for a case file at `target`: the measured-data path
-    /// made relative to `target`'s folder, parsed again as a case file.
+    /// The edited text for a case file at `target`: the paths of the
+    /// measured data and the test geometry made relative to `target`'s
+    /// folder, parsed again as a case file.
     pub fn text_at(&self, target: &Path) -> Result<String, CaseError> {
         let mut doc = self.doc.clone();
-        if let Some(data) = &self.data {
-            let rel = relative_path(data, target.parent().unwrap_or(Path::new("")));
+        for (key, file) in [("data", &self.data), ("geometry", &self.geometry)] {
+            let Some(file) = file else { continue };
+            let rel = relative_path(file, target.parent().unwrap_or(Path::new("")));
             let rel = rel.to_string_lossy().replace('\\', "/");
             if let Some(m) = doc.get_mut("measurement").and_then(Item::as_table_like_mut)
-                && let Some(d) = m.get_mut("data")
+                && let Some(d) = m.get_mut(key)
             {
                 let decor = d.as_value().map(|v| v.decor().clone());
                 *d = value(rel);

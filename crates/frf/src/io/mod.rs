@@ -72,6 +72,19 @@ pub fn detect_format(path: &Path) -> Result<MeasuredFormat, FrfError> {
     })
 }
 
+/// What a measured channel's values are relative to, as read from its file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ChannelUnits {
+    /// The values are per volt: the reference is a voltage (a shaker
+    /// amplifier's drive signal, an uncalibrated force gauge), not a force.
+    pub per_volt: bool,
+    /// The reference as a universal file names it (`1:+Z`), so that a
+    /// calibration can be given by test point; `None` for CSV.
+    pub test_reference: Option<uff::TestDof>,
+    /// The units as read, for messages (`` `m/s^2` / `V` ``, `` `g/N` ``).
+    pub basis: String,
+}
+
 /// Measured FRFs and what reading them involved.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Measured {
@@ -86,6 +99,11 @@ pub struct Measured {
     pub origins: Vec<Origin>,
     /// What the case's mask rules left out (empty without rules).
     pub masked: Vec<Masked>,
+    /// What each channel of `set` is relative to, in the same order.
+    pub units: Vec<ChannelUnits>,
+    /// How test nodes were paired with model nodes by their coordinates
+    /// (empty unless the case asks for it: `[measurement] pair`).
+    pub pairing: Vec<uff::PairedNode>,
 }
 
 impl Measured {
@@ -94,7 +112,10 @@ impl Measured {
     /// naming the file, its record or columns and the DOF, or left out when
     /// `rules` hold [`MaskRule::UnmodelledChannels`].
     pub fn check_channels(self, path: &Path, dofs: &DofMap, rules: &[MaskRule]) -> Result<Measured, FrfError> {
+        let by_channel: std::collections::HashMap<crate::Channel, ChannelUnits> =
+            self.set.channels().iter().copied().zip(self.units).collect();
         let (set, origins, masked) = check_channels(path, self.set, &self.origins, dofs, rules)?;
+        let units = set.channels().iter().filter_map(|c| by_channel.get(c).cloned()).collect();
         if set.channels().is_empty() {
             return Err(FrfError::Parse {
                 path: path.to_path_buf(),
@@ -104,8 +125,32 @@ impl Measured {
         }
         let mut all = self.masked;
         all.extend(masked);
-        Ok(Measured { set, format: self.format, notes: self.notes, origins, masked: all })
+        Ok(Measured { set, format: self.format, notes: self.notes, origins, masked: all, units, pairing: self.pairing })
     }
+
+    /// The references whose values are per volt (see [`ChannelUnits::per_volt`]).
+    pub fn per_volt_references(&self) -> Vec<fe_model::DofRef> {
+        let mut out: Vec<fe_model::DofRef> = Vec::new();
+        for (c, u) in self.set.channels().iter().zip(&self.units) {
+            if u.per_volt && !out.contains(&c.reference) {
+                out.push(c.reference);
+            }
+        }
+        out
+    }
+}
+
+/// How to read a measured file: the case's channel map and mask rules, and
+/// the channel of a CSV file whose columns name none.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ReadOptions<'a> {
+    /// Test (node, direction) to model DOF entries (`[[measurement.map]]`).
+    pub map: &'a [ChannelMap],
+    /// What to leave out instead of refusing (`[measurement] mask`).
+    pub mask: &'a [MaskRule],
+    /// The channel of a single-channel CSV file with columns `freq,re,im`
+    /// and no `# channel` line: the one channel a case measures.
+    pub channel: Option<crate::Channel>,
 }
 
 /// Reads a measured FRF file (see [`detect_format`]) and maps its channels
@@ -122,7 +167,17 @@ pub fn load_measured(path: &Path, map: &[ChannelMap]) -> Result<Measured, FrfErr
 /// the file; [`Measured::masked`] lists what was left out. Channel rules
 /// need the model: see [`Measured::check_channels`].
 pub fn load_measured_with(path: &Path, map: &[ChannelMap], rules: &[MaskRule]) -> Result<Measured, FrfError> {
-    let measured = read_format(path, map, rules)?;
+    load_measured_opts(path, &ReadOptions { map, mask: rules, channel: None })
+}
+
+/// Reads a measured FRF file with [`ReadOptions`] (see [`load_measured_with`]).
+pub fn load_measured_opts(path: &Path, opts: &ReadOptions<'_>) -> Result<Measured, FrfError> {
+    let measured = read_format(path, opts)?;
+    check_not_empty(path, measured)
+}
+
+/// The last guard of every reader: no command ever indexes an empty set.
+pub fn check_not_empty(path: &Path, measured: Measured) -> Result<Measured, FrfError> {
     // The readers refuse an empty record or table where they see it; this
     // is the last guard, so that no command ever indexes an empty set.
     if measured.set.n_freq() == 0 || measured.set.channels().is_empty() {
@@ -139,23 +194,22 @@ pub fn load_measured_with(path: &Path, map: &[ChannelMap], rules: &[MaskRule]) -
     Ok(measured)
 }
 
-fn read_format(path: &Path, map: &[ChannelMap], rules: &[MaskRule]) -> Result<Measured, FrfError> {
+fn read_format(path: &Path, opts: &ReadOptions<'_>) -> Result<Measured, FrfError> {
     match detect_format(path)? {
         MeasuredFormat::Csv => {
-            let c = csv::read_csv_with(path, rules)?;
+            let c = csv::read_csv_opts(path, &csv::CsvOptions { rules: opts.mask, channel: opts.channel })?;
+            let unit = ChannelUnits { per_volt: c.per_volt, test_reference: None, basis: c.units.clone() };
             Ok(Measured {
+                units: vec![unit; c.set.channels().len()],
                 set: c.set,
                 format: MeasuredFormat::Csv,
-                notes: Vec::new(),
+                notes: c.notes,
                 origins: c.origins,
                 masked: c.masked,
+                pairing: Vec::new(),
             })
         }
-        MeasuredFormat::Uff => {
-            let u = uff::read_uff_frfs_with(path, map, rules)?;
-            let origins = u.origins();
-            Ok(Measured { set: u.set, format: MeasuredFormat::Uff, notes: u.notes, origins, masked: u.masked })
-        }
+        MeasuredFormat::Uff => Ok(uff::read_uff_frfs_with(path, opts.map, opts.mask)?.into_measured()),
     }
 }
 

@@ -10,9 +10,11 @@ use std::path::{Path, PathBuf};
 
 use damping::DampedSystem;
 use fe_model::CaseFile;
+use fe_model::case::Gains;
 use frf::correlation::{BandSpec, Correlation, correlate};
 use frf::{FrfSet, synthesize};
 use rfm_update::Study;
+use rfm_update::gain::{self, GainReport};
 use rfm_update::study::{describe_masked, read_measured_for};
 use serde::Serialize;
 
@@ -36,13 +38,35 @@ struct CompareJson {
     model: String,
     /// Band choice (`auto`, `octave`, edges...).
     bands: String,
+    /// The FRF kind compared: the data's, whichever way they arrive.
+    kind: String,
     correlation: CorrelationJson,
-    /// Measured (LSCF) against model modes, or why they could not be compared.
-    modes: std::result::Result<ModesJson, String>,
+    /// The unknown gains the model's FRFs were multiplied by (`none`,
+    /// `per-reference`, `per-channel`) and why.
+    gain_setting: String,
+    /// The fitted gains (empty without gains).
+    gains: Vec<GainReport>,
+    /// Measured (LSCF) against model modes; `null` when they could not be
+    /// compared, with the reason in `modes_error`.
+    modes: Option<ModesJson>,
+    /// Why the modes could not be compared.
+    modes_error: Option<String>,
     /// What the case's mask rules left out of the measured data.
     masked: Vec<String>,
     /// What reading the measured data changed or passed over.
     notes: Vec<String>,
+}
+
+/// The fitted gains, one line each.
+fn print_gains(gains: &[GainReport]) -> Result<()> {
+    if gains.is_empty() {
+        return Ok(());
+    }
+    outln!("\nfitted gains (model FRFs multiplied by them before the comparison)");
+    for g in gains {
+        outln!("    {}: x{} ({:+.1} dB), {:+.1} deg", g.key, sig(g.magnitude, 4), g.magnitude_db, g.phase_deg);
+    }
+    Ok(())
 }
 
 /// Parses `--bands`: `auto`, `resonances`, `octave`, `third-octave`, or
@@ -76,6 +100,8 @@ struct MeasuredData {
     masked: Vec<String>,
     /// What reading them changed or passed over.
     notes: Vec<String>,
+    /// The gains to fit and why.
+    gains: (Gains, String),
 }
 
 /// The measured FRFs: the case's data or truth, or the `--measured` files.
@@ -93,19 +119,31 @@ fn measured_data(case: CaseFile, system: &DampedSystem, files: &[PathBuf]) -> Re
             (None, None) => "the case's data".into(),
         };
         let masked = describe_masked(&study.masked);
-        return Ok(MeasuredData { case: study.case, set: study.measured, source, masked, notes: study.notes });
+        // compared in the kind the data were measured in, as with --measured
+        let set = study.measured_as_read();
+        let gains = (study.gains, study.gains_reason.clone());
+        return Ok(MeasuredData { case: study.case, set, source, masked, notes: study.notes, gains });
     }
     let mut sets = Vec::new();
     let mut masked = Vec::new();
     let mut notes = Vec::new();
+    let mut per_volt = Vec::new();
     for f in files {
         let read = read_measured_for(system, f, case.measurement.as_ref())?;
+        per_volt.extend(read.per_volt_references());
         masked.extend(describe_masked(&read.masked).into_iter().map(|m| format!("{}: {m}", f.display())));
         notes.extend(read.notes.iter().map(|n| format!("{}: {n}", f.display())));
         sets.push((f.clone(), read.set));
     }
     let names = files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(", ");
-    Ok(MeasuredData { case, set: merge(sets)?, source: format!("measured file(s) {names}"), masked, notes })
+    per_volt.sort_by_key(ToString::to_string);
+    per_volt.dedup();
+    let gains = gain::decide(case.measurement.as_ref(), case.update.as_ref(), &per_volt)?;
+    if gains.0 != Gains::None {
+        notes.push(format!("model FRFs are multiplied by fitted gains ({}): {}", gains.0, gains.1));
+    }
+    let source = format!("measured file(s) {names}");
+    Ok(MeasuredData { case, set: merge(sets)?, source, masked, notes, gains })
 }
 
 /// Joins the channels of several measured files on the same lines, in the
@@ -168,21 +206,39 @@ pub(crate) fn compare(
     inputs.extend(measured_files.iter().cloned());
     let output = out.map(|dir| Outputs::folder(dir, &inputs, &["compare.json", "report.html"])).transpose()?;
     let system = DampedSystem::new(case.model.clone())?;
-    let MeasuredData { case, set: measured, source, masked, notes } = measured_data(case, &system, measured_files)?;
+    let MeasuredData { case, set: measured, source, masked, notes, gains } =
+        measured_data(case, &system, measured_files)?;
     print_notes(&notes, json)?;
     print_masked(&masked, json)?;
-    let frfs = synthesize(&system, measured.channels(), measured.frequencies_hz())?;
+    let mut frfs = synthesize(&system, measured.channels(), measured.frequencies_hz())?;
+    // the gains that bring the model closest to the data (closed form), in the data's kind
+    // weighted as the fits weight them: by the measured coherence when the data carry it
+    let weights = rfm_update::study::line_weights_for(&case, &measured)?;
+    let fitted = gain::fit_gains(&frfs.converted(measured.kind()), &measured, weights.as_deref(), gains.0)?;
+    fitted.apply(&mut frfs);
+    let coherent = (0..measured.channels().len()).any(|c| measured.coherence(c).is_some());
+    let mut notes = notes;
+    if coherent && gains.0 != Gains::None && weights.is_some() {
+        notes.push("the gains are fitted with each line weighted by its measured coherence".into());
+    }
     let correlation = correlate(&measured, &frfs, &spec)?;
     let comparison = compare_modes(&system, &measured);
-    let modes = comparison.as_ref().map(rows).map_err(Clone::clone);
+    let (modes, modes_error) = match comparison.as_ref().map(rows) {
+        Ok(m) => (Some(m), None),
+        Err(e) => (None, Some(e.clone())),
+    };
     let doc = CompareJson {
         case: case_path.display().to_string(),
         title: case.model.title.clone(),
         measured: source.clone(),
         model: "the case's model (initial values)".into(),
         bands: bands.to_string(),
+        kind: measured.kind().to_string(),
         correlation: CorrelationJson::from(&correlation),
+        gain_setting: format!("{} ({})", gains.0, gains.1),
+        gains: fitted.reports(),
         modes,
+        modes_error,
         masked,
         notes,
     };
@@ -190,8 +246,10 @@ pub(crate) fn compare(
         outln!("{}", serde_json::to_string_pretty(&doc)?);
     } else {
         print_tables(&case, &measured, &source, &correlation)?;
-        match &doc.modes {
-            Ok(m) => {
+        print_gains(&doc.gains)?;
+        match &comparison {
+            Ok(_) => {
+                let m = doc.modes.as_ref().expect("the rows of a comparison");
                 let (header, rows) = mode_table_rows(m);
                 let mut t = Table::new(&header);
                 for r in rows {
@@ -207,7 +265,8 @@ pub(crate) fn compare(
         let model = ModelFrfs { label: "model".into(), colour: plot::UPDATED, frfs, correlation };
         let mut report = Report::new(format!("{}: model against measurement", case.model.title));
         report.subtitle = Some(format!("rfm compare, case file {}", case_path.display()));
-        report.sections = report_sections(&case, &measured, &source, &model, comparison.as_ref(), opts, &mut output)?;
+        report.sections =
+            report_sections(&case, &measured, &source, &model, comparison.as_ref(), &doc, opts, &mut output)?;
         let html = output.write("report.html", report.render().as_bytes())?;
         let written = output.commit()?;
         if !json {
@@ -224,6 +283,7 @@ fn report_sections(
     source: &str,
     model: &ModelFrfs,
     modes: std::result::Result<&frf::ModalComparison, &String>,
+    doc: &CompareJson,
     opts: &ReportOptions,
     out: &mut Outputs,
 ) -> Result<Vec<Section>> {
@@ -231,7 +291,21 @@ fn report_sections(
     let mut first = summary(case, measured, source, c);
     first.push(report::structure_figure(&case.model, measured, &[], "The case's model.", out)?);
     let mut sections = vec![first];
-    let notes = vec!["The case's model with its initial parameter values against the measured FRFs.".to_string()];
+    let mut notes = vec!["The case's model with its initial parameter values against the measured FRFs.".to_string()];
+    if !doc.gains.is_empty() {
+        let list: Vec<String> = doc
+            .gains
+            .iter()
+            .map(|g| {
+                format!("{}: x{} ({:+.1} dB, {:+.1} deg)", g.key, sig(g.magnitude, 4), g.magnitude_db, g.phase_deg)
+            })
+            .collect();
+        notes.push(format!(
+            "The model's FRFs are multiplied by unknown complex gains fitted in closed form ({}): {}.",
+            doc.gain_setting,
+            list.join("; ")
+        ));
+    }
     sections.push(report::correlation_section(measured, std::slice::from_ref(model), opts, out, notes)?);
     sections.push(report::modes::section(modes, "the model", &case.model, measured, opts, out)?);
     sections.push(report::overlay_section(measured, std::slice::from_ref(model), &[], opts, out)?);

@@ -2,9 +2,10 @@
 
 use std::path::Path;
 
+use fe_model::case::Gains;
 use indicatif::ProgressBar;
 use rfm_update::Study;
-use rfm_update::diagnose::{DiagnoseOptions, Diagnosis, diagnose_with};
+use rfm_update::diagnose::{Diagnosis, diagnose_with};
 use rfm_update::study::{describe_masked, read_measured_for};
 
 use super::{Result, print_masked, print_notes};
@@ -24,7 +25,7 @@ pub(crate) struct DiagnoseArgs<'a> {
 }
 
 pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
-    let study = Study::load(args.case)?;
+    let mut study = Study::load(args.case)?;
     let mut inputs = study.case.inputs();
     inputs.extend(args.measured.map(Path::to_path_buf));
     let mut output = match (args.apply, args.out) {
@@ -34,7 +35,15 @@ pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
     let measured = match args.measured {
         Some(path) => {
             let read = read_measured_for(&study.system, path, study.case.measurement.as_ref())?;
-            print_notes(&read.notes, args.json)?;
+            study.set_gains_for(&read)?;
+            let mut notes = read.notes.clone();
+            if study.gains != Gains::None {
+                notes.push(format!(
+                    "model FRFs are multiplied by fitted gains ({}): {}",
+                    study.gains, study.gains_reason
+                ));
+            }
+            print_notes(&notes, args.json)?;
             print_masked(&describe_masked(&read.masked), args.json)?;
             read.set.to_receptance()
         }
@@ -58,7 +67,8 @@ pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
     let bar = if args.json { ProgressBar::hidden() } else { ProgressBar::new_spinner() };
     bar.enable_steady_tick(std::time::Duration::from_millis(120));
     let start = std::time::Instant::now();
-    let d = diagnose_with(&study.case.model, &measured, &DiagnoseOptions::default(), |stage| {
+    let opts = study.diagnose_options()?;
+    let d = diagnose_with(&study.case.model, &measured, &opts, |stage| {
         let line = format!("{stage} ({:.2} s)", start.elapsed().as_secs_f64());
         if args.verbose {
             bar.suspend(|| eprintln!("{line}"));
@@ -90,6 +100,21 @@ fn print_diagnosis(d: &Diagnosis, top: usize) -> Result<()> {
         100.0 * d.noise,
         100.0 * d.nominal_misfit
     );
+    if d.gains {
+        outln!("every fit includes an unknown complex gain per reference; the leader's:");
+        if let Some(l) = d.ranking.first() {
+            for g in &l.gains {
+                outln!(
+                    "    {}: x{} ({:+.1} dB), {:+.1} deg",
+                    g.reference,
+                    num(g.magnitude),
+                    20.0 * g.magnitude.log10(),
+                    g.phase_deg
+                );
+            }
+        }
+        outln!("");
+    }
     let mut t = Table::new(&["rank", "effect", "explained", "dBIC", "significant", "fitted values", ""]);
     for (i, r) in d.ranking.iter().enumerate().take(top) {
         let values = r

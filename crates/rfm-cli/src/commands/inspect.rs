@@ -27,6 +27,48 @@ pub(crate) fn inspect(file: &Path, json: bool) -> Result<Exit> {
 fn uff_report(file: &Path) -> Result<Value> {
     let u = uff::read_uff(file)?;
     let records: Vec<Value> = u.records.iter().map(record_json).collect();
+    // what the units say, record by record: nothing is taken as SI or per newton in silence
+    let mut notes = u.notes.clone();
+    for r in u.records.iter().filter(|r| r.function.header.function_type == uff::FUNCTION_FRF) {
+        match uff::frf_units(&r.function.header) {
+            Ok(k) if k.per_volt => notes.push(format!(
+                "{}: per volt ({}): the reference is a voltage, not a force; a case must fit a gain (the \
+                 default) or give a calibration",
+                r.label(),
+                k.basis
+            )),
+            Ok(k) if k.assumed_si => notes.push(format!("{}: units not stated ({}); SI assumed", r.label(), k.basis)),
+            Ok(k) if k.scale != 1.0 => {
+                notes.push(format!("{}: values in {} scaled by {} to SI", r.label(), k.basis, k.scale))
+            }
+            Ok(_) => {}
+            Err(e) => notes.push(format!("{}: {e}", r.label())),
+        }
+    }
+    // the test geometry, which `[measurement] pair = "coordinates"` uses
+    let nodes: Vec<Value> = match u.geometry() {
+        Ok(g) => {
+            notes.extend(g.notes.iter().map(|n| format!("geometry: {n}")));
+            g.nodes
+                .iter()
+                .map(|n| {
+                    json!({
+                        "node": n.id,
+                        "x_m": n.position[0],
+                        "y_m": n.position[1],
+                        "z_m": n.position[2],
+                        "displacement_cs": n.displacement_cs,
+                        "dataset": n.dataset,
+                        "line": n.line,
+                    })
+                })
+                .collect()
+        }
+        Err((line, message)) => {
+            notes.push(format!("geometry (line {line}): {message}"));
+            Vec::new()
+        }
+    };
     let skipped: Vec<Value> = u
         .skipped
         .iter()
@@ -37,7 +79,8 @@ fn uff_report(file: &Path) -> Result<Value> {
         "format": "uff",
         "records": records,
         "skipped": skipped,
-        "notes": u.notes,
+        "nodes": nodes,
+        "notes": notes,
     }))
 }
 
@@ -54,7 +97,9 @@ fn record_json(r: &Record58) -> Value {
         "reference": dof(h.reference, &h.reference_entity),
         "function_type": h.function_type,
         "function": uff::function_type_name(h.function_type),
-        "kind": kind.map(|k| k.kind.name()),
+        "kind": kind.as_ref().map(|k| k.kind.name()),
+        "per_volt": kind.as_ref().map(|k| k.per_volt),
+        "scale_to_si": kind.as_ref().map(|k| k.scale),
         "units": { "numerator": h.numerator.units, "denominator": h.denominator.units },
         "abscissa": {
             "units": h.abscissa_axis.units,
@@ -69,7 +114,8 @@ fn record_json(r: &Record58) -> Value {
 }
 
 fn csv_report(file: &Path) -> Result<Value> {
-    let set = frf::io::csv::read_csv(file)?;
+    let read = frf::io::csv::read_csv_with(file, &[])?;
+    let set = read.set;
     let f = set.frequencies_hz();
     let records: Vec<Value> = set
         .channels()
@@ -102,8 +148,17 @@ fn csv_report(file: &Path) -> Result<Value> {
         "format": "csv",
         "records": records,
         "skipped": [],
-        "notes": [],
+        "notes": csv_notes(&read.notes, read.per_volt, &read.units),
     }))
+}
+
+/// The notes of a CSV file: what reading it assumed or scaled, and the units.
+fn csv_notes(notes: &[String], per_volt: bool, units: &str) -> Vec<String> {
+    let mut out = notes.to_vec();
+    if !per_volt && !notes.iter().any(|n| n.contains("assumed")) {
+        out.push(format!("units {units}"));
+    }
+    out
 }
 
 /// The JSON of [`csv_report`], written record by record: a file of
@@ -151,12 +206,13 @@ fn csv_json(file: &Path) -> Result<Exit> {
         format: &'static str,
         records: Records<'a>,
         skipped: [(); 0],
-        notes: [(); 0],
+        notes: Vec<String>,
     }
 
-    let set = frf::io::csv::read_csv(file)?;
-    let report =
-        Report { file: file.display().to_string(), format: "csv", records: Records(&set), skipped: [], notes: [] };
+    let read = frf::io::csv::read_csv_with(file, &[])?;
+    let notes = csv_notes(&read.notes, read.per_volt, &read.units);
+    let set = read.set;
+    let report = Report { file: file.display().to_string(), format: "csv", records: Records(&set), skipped: [], notes };
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     let written = serde_json::to_writer_pretty(&mut out, &report)
         .map_err(std::io::Error::from)
@@ -220,6 +276,24 @@ fn print_report(report: &Value) -> Result<()> {
     }
     for n in report["notes"].as_array().map(Vec::as_slice).unwrap_or_default() {
         outln!("note: {}", n.as_str().unwrap_or_default());
+    }
+    let nodes = report["nodes"].as_array().map(Vec::as_slice).unwrap_or_default();
+    if !nodes.is_empty() {
+        let mut t = Table::new(&["node", "x (m)", "y (m)", "z (m)", "directions in", "line"]);
+        for n in nodes {
+            t.row(vec![
+                n["node"].to_string(),
+                num(n["x_m"].as_f64().unwrap_or(f64::NAN)),
+                num(n["y_m"].as_f64().unwrap_or(f64::NAN)),
+                num(n["z_m"].as_f64().unwrap_or(f64::NAN)),
+                match n["displacement_cs"].as_i64() {
+                    Some(0) | None => "global".into(),
+                    Some(cs) => format!("system {cs}"),
+                },
+                n["line"].to_string(),
+            ]);
+        }
+        outln!("test geometry: {} nodes\n{}", nodes.len(), t.render());
     }
     for d in skipped {
         outln!(

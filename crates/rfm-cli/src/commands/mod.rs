@@ -17,7 +17,7 @@ pub(crate) use compare::compare;
 pub(crate) use diagnose::{DiagnoseArgs, diagnose};
 pub(crate) use fix::{FixArgs, fix};
 pub(crate) use inspect::inspect;
-pub(crate) use simulate::simulate;
+pub(crate) use simulate::{SimulateArgs, simulate};
 pub(crate) use update::{Overrides as UpdateOverrides, update};
 
 /// A command's result: its exit code, or why it failed (see [`crate::exit`]).

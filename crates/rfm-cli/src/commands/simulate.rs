@@ -1,20 +1,95 @@
-//! `rfm simulate`: synthesise FRFs on the case's measurement lines.
+//! `rfm simulate`: synthesise FRFs on the case's measurement lines, written
+//! as UFF dataset 58 (`.uff`, `.unv`; ASCII, or 58b with `--binary`) or CSV
+//! (`.csv`), in the kind asked for.
 
 use std::path::Path;
 
 use damping::DampedSystem;
-use frf::{Channel, NoiseModel};
+use frf::io::uff::{Encoding, UffWriteOptions};
+use frf::{Channel, FrfKind, NoiseModel};
+use serde::Serialize;
 
 use super::{Result, load_case};
-use crate::exit::Exit;
+use crate::exit::{Exit, Failure};
 use crate::output::Outputs;
 
-pub(crate) fn simulate(case: &Path, out: &Path, truth: bool, noise: f64, seed: u64) -> Result<Exit> {
-    let case_file = load_case(case)?;
-    let mut output = Outputs::file(out, &case_file.inputs())?;
+/// Options of the simulate command.
+pub(crate) struct SimulateArgs<'a> {
+    pub(crate) case: &'a Path,
+    pub(crate) out: &'a Path,
+    pub(crate) truth: bool,
+    pub(crate) noise: f64,
+    pub(crate) seed: u64,
+    pub(crate) kind: &'a str,
+    pub(crate) binary: bool,
+    pub(crate) json: bool,
+}
+
+/// The file format of `--out`, from its extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum OutFormat {
+    Uff,
+    Csv,
+}
+
+fn out_format(out: &Path, binary: bool) -> std::result::Result<OutFormat, String> {
+    let ext = out.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    let format = match ext.as_deref() {
+        Some("uff" | "unv") => OutFormat::Uff,
+        Some("csv") => OutFormat::Csv,
+        _ => {
+            return Err(format!(
+                "--out {}: the extension says the format: .uff or .unv for UFF dataset 58 (--binary for 58b), .csv \
+                 for CSV",
+                out.display()
+            ));
+        }
+    };
+    if binary && format == OutFormat::Csv {
+        return Err(format!("--binary writes UFF 58b; {} is a CSV file (.uff or .unv for UFF)", out.display()));
+    }
+    Ok(format)
+}
+
+/// What `--json` prints.
+#[derive(Serialize)]
+struct SimulateJson {
+    out: String,
+    format: &'static str,
+    kind: String,
+    channels: usize,
+    lines: usize,
+    from_hz: f64,
+    to_hz: f64,
+    model: &'static str,
+    noise: f64,
+    seed: u64,
+}
+
+pub(crate) fn simulate(args: &SimulateArgs<'_>) -> Result<Exit> {
+    if !(args.noise.is_finite() && args.noise >= 0.0) {
+        return Err(Failure::new(
+            Exit::Usage,
+            format!("--noise {}: the relative noise level must be a finite number, 0 or more (0.01 = 1 %)", args.noise),
+        ));
+    }
+    let kind = FrfKind::parse(args.kind).ok_or_else(|| {
+        Failure::new(Exit::Usage, format!("--kind {}: receptance, mobility or accelerance", args.kind))
+    })?;
+    let case_file = load_case(args.case)?;
+    // an input named as the output is refused first, whatever its extension
+    let mut output = Outputs::file(args.out, &case_file.inputs())?;
+    let format = out_format(args.out, args.binary).map_err(|e| Failure::new(Exit::Usage, e))?;
     let spec =
         case_file.measurement.as_ref().ok_or("the case has no [measurement] section (which channels and lines?)")?;
-    let model = if truth {
+    if spec.frequencies_hz.is_empty() {
+        return Err(format!(
+            "{}: the case's [measurement] gives no `frequencies`: simulate needs the lines to synthesise",
+            args.case.display()
+        )
+        .into());
+    }
+    let model = if args.truth {
         case_file.truth.as_ref().ok_or("the case has no [truth] section")?.model.clone()
     } else {
         case_file.model.clone()
@@ -23,9 +98,61 @@ pub(crate) fn simulate(case: &Path, out: &Path, truth: bool, noise: f64, seed: u
     let channels: Vec<Channel> =
         spec.references.iter().flat_map(|&r| spec.responses.iter().map(move |&m| Channel::new(m, r))).collect();
     let mut set = frf::synthesize(&sys, &channels, &spec.frequencies_hz)?;
-    NoiseModel { relative: noise, floor: 0.0, seed }.apply(&mut set);
-    output.write_file(frf::io::csv::to_csv_string(&set).as_bytes())?;
+    NoiseModel { relative: args.noise, floor: 0.0, seed: args.seed }.apply(&mut set);
+    let set = set.converted(kind);
+    let bytes = match format {
+        OutFormat::Csv => frf::io::csv::to_csv_string(&set).into_bytes(),
+        OutFormat::Uff => {
+            let encoding = if args.binary { Encoding::BINARY } else { Encoding::Ascii };
+            frf::io::uff::to_uff_bytes(&set, &UffWriteOptions { encoding, ..UffWriteOptions::default() })?
+        }
+    };
+    output.write_file(&bytes)?;
     output.commit()?;
-    outln!("wrote {} channels x {} lines ({}) to {}", set.channels().len(), set.n_freq(), set.kind(), out.display());
+    let f = set.frequencies_hz();
+    let format_name = match (format, args.binary) {
+        (OutFormat::Csv, _) => "csv",
+        (OutFormat::Uff, false) => "uff58 ascii",
+        (OutFormat::Uff, true) => "uff58b binary",
+    };
+    if args.json {
+        let doc = SimulateJson {
+            out: args.out.display().to_string(),
+            format: format_name,
+            kind: set.kind().to_string(),
+            channels: set.channels().len(),
+            lines: set.n_freq(),
+            from_hz: f[0],
+            to_hz: f[f.len() - 1],
+            model: if args.truth { "truth" } else { "initial" },
+            noise: args.noise,
+            seed: args.seed,
+        };
+        outln!("{}", serde_json::to_string_pretty(&doc)?);
+    } else {
+        outln!(
+            "wrote {} channels x {} lines ({}, {format_name}) to {}",
+            set.channels().len(),
+            set.n_freq(),
+            set.kind(),
+            args.out.display()
+        );
+    }
     Ok(Exit::Success)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_extension_decides_the_format_and_binary_needs_uff() {
+        assert_eq!(out_format(Path::new("a/x.uff"), false), Ok(OutFormat::Uff));
+        assert_eq!(out_format(Path::new("x.UNV"), true), Ok(OutFormat::Uff));
+        assert_eq!(out_format(Path::new("x.csv"), false), Ok(OutFormat::Csv));
+        let e = out_format(Path::new("x.dat"), false).unwrap_err();
+        assert!(e.contains("x.dat") && e.contains(".uff or .unv"), "{e}");
+        let e = out_format(Path::new("x.csv"), true).unwrap_err();
+        assert!(e.contains("--binary writes UFF 58b"), "{e}");
+    }
 }

@@ -114,9 +114,10 @@ pub(crate) fn update(
     bar.finish_and_clear();
     // the misfit the case's history speaks of, after this update
     let noise = rfm_update::diagnose::estimate_noise(&study.measured);
-    let misfit = rfm_update::diagnose::log_misfit(&outcome.system, &study.measured, HISTORY_LINES)?;
+    let gains = study.gains != fe_model::case::Gains::None;
+    let misfit = rfm_update::diagnose::log_misfit_with(&outcome.system, &study.measured, HISTORY_LINES, gains)?;
     // worse than the start over the whole band, not only at the fitted lines
-    let misfit_initial = rfm_update::diagnose::log_misfit(&study.system, &study.measured, HISTORY_LINES)?;
+    let misfit_initial = rfm_update::diagnose::log_misfit_with(&study.system, &study.measured, HISTORY_LINES, gains)?;
     if misfit > WORSE_BY * misfit_initial && !outcome.worse_than_start {
         outcome.worse_than_start = true;
         outcome.warnings.push(format!(
@@ -178,6 +179,19 @@ fn write_updated_model(
     }
     let mut editor = study.case.editor()?;
     editor.set_values(&values, &comment)?;
+    if study.gains != fe_model::case::Gains::None {
+        // the next run (diagnose, compare, update) fits the gains too; their values are kept
+        let fitted: Vec<fe_model::case::FittedGain> = outcome
+            .gains
+            .iter()
+            .map(|g| fe_model::case::FittedGain {
+                key: fe_model::case::GainKey::Reference(g.reference),
+                magnitude: g.magnitude,
+                phase_deg: g.phase_deg,
+            })
+            .collect();
+        editor.set_gains(study.gains, &fitted)?;
+    }
     editor.push_history(step)?;
     let text = editor.text_at(&output.path("updated.toml"))?;
     Ok(output.write("updated.toml", text.as_bytes())?)

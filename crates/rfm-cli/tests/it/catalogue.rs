@@ -158,7 +158,11 @@ fn osc_entry(
     expect: Vec<&'static str>,
     code: i32,
 ) -> Entry {
-    let text = BEAM.replace("responses = [\"3:uy\", \"5:uy\"]", "responses = [\"4:uy\"]").replace("[truth]\n", "")
+    // the data give the lines: a case with a data file needs no `frequencies`
+    let text = BEAM
+        .replace("responses = [\"3:uy\", \"5:uy\"]", "responses = [\"4:uy\"]")
+        .replace("[truth]\n", "")
+        .replace("frequencies = { from = 10.0, to = 100.0, step = 10.0 }\n", "")
         + "data = \"m.uff\"\n[[measurement.map]]\ntest = \"101:+Z\"\nmodel = \"4:uy\"\n[[measurement.map]]\ntest = \"1:+Z\"\nmodel = \"5:uy\"\nsign = -1\n"
         + extra;
     let mut files = case(text);
@@ -754,10 +758,12 @@ fn a_full_standard_output_is_named() {
 #[test]
 fn a_single_measured_line_never_panics_any_command() {
     let dir = tempfile::tempdir().unwrap();
-    let one_line: String = csv().lines().take(3).map(|l| format!("{l}\n")).collect();
+    let csv = csv();
+    let one_line: String = csv.lines().take(line_of(&csv, "frequency_hz") + 1).map(|l| format!("{l}\n")).collect();
     std::fs::write(dir.path().join("m.csv"), one_line).unwrap();
     let text = format!("{BEAM}data = \"m.csv\"\n\n[update]\nparameters = [\"group.beam.alpha\"]\n");
-    std::fs::write(dir.path().join("cat.toml"), text.replace("[truth]\n", "")).unwrap();
+    let text = text.replace("[truth]\n", "").replace("frequencies = { from = 10.0, to = 100.0, step = 10.0 }\n", "");
+    std::fs::write(dir.path().join("cat.toml"), text).unwrap();
     let case = dir.path().join("cat.toml");
     let out = dir.path().join("out");
     let runs: [(&[&str], i32); 5] = [

@@ -1,5 +1,6 @@
 //! Each command's output, files and exit codes.
 
+use frf::FrfSet;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -149,5 +150,142 @@ fn the_walkthrough_shows_what_rfm_update_prints() {
             lines.any(|p| p == line),
             "the walkthrough shows\n{line}\nwhich rfm update does not print (in this order):\n{printed}"
         );
+    }
+}
+
+/// The largest relative difference of two sets' values (and whether their
+/// kinds, channels and lines agree).
+fn max_relative_difference(a: &FrfSet, b: &FrfSet) -> f64 {
+    assert_eq!((a.kind(), a.channels()), (b.kind(), b.channels()));
+    for (x, y) in a.frequencies_hz().iter().zip(b.frequencies_hz()) {
+        assert!((x - y).abs() <= 1e-12 * x.abs(), "line {x} vs {y}");
+    }
+    a.values().iter().zip(b.values()).map(|(x, y)| (x - y).norm() / y.norm()).fold(0.0, f64::max)
+}
+
+/// Reads a UFF file with pyuff, prints the largest relative difference of
+/// its FRFs from the CSV of the same run, and writes the sets again.
+const PYUFF_ROUND_TRIP: &str = r#"
+import csv, sys
+import numpy as np
+import pyuff
+uff, table, again = sys.argv[1:4]
+rows = [r for r in csv.reader(open(table)) if r and not r[0].startswith('#')]
+head, data = rows[0], np.array([[float(x) for x in r] for r in rows[1:]])
+columns = {name[:-3]: data[:, j] + 1j * data[:, j + 1] for j, name in enumerate(head) if name.endswith('.re')}
+sets = pyuff.UFF(uff).read_sets()
+sets = sets if isinstance(sets, list) else [sets]
+assert len(sets) == len(columns), (len(sets), len(columns))
+axis = {1: 'ux', 2: 'uy', 6: 'rz'}
+worst = 0.0
+for s in sets:
+    name = 'H(%d:%s,%d:%s)' % (s['rsp_node'], axis[s['rsp_dir']], s['ref_node'], axis[s['ref_dir']])
+    want = columns[name]
+    assert np.allclose(s['x'], data[:, 0], rtol=1e-12, atol=0), name
+    worst = max(worst, float(np.max(np.abs(s['data'] - want) / np.abs(want))))
+print(worst)
+# written as ASCII: pyuff 2.5.8 writing 58b loses the first set (its own reader finds one less)
+for s in sets:
+    s['binary'] = 0
+pyuff.UFF(again).write_sets(sets, mode='overwrite')
+"#;
+
+/// `simulate --out x.uff` writes UFF dataset 58 (ASCII, or 58b with
+/// `--binary`) in each kind, which reads back as the CSV of the same run;
+/// when pyuff is installed, pyuff reads rfm's files and writes them again,
+/// and rfm reads those back too.
+#[test]
+fn simulate_writes_uff58_ascii_and_binary_that_read_back_in_every_kind() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases/tutorial/l-frame.toml");
+    let case = case.to_str().unwrap();
+    let pyuff = Command::new("python3").args(["-c", "import pyuff"]).output().is_ok_and(|o| o.status.success());
+    if !pyuff {
+        eprintln!("pyuff not installed (pip install pyuff): its round trip is skipped");
+    }
+    for kind in ["receptance", "mobility", "accelerance"] {
+        let csv = dir.path().join(format!("{kind}.csv"));
+        let out =
+            rfm(&["simulate", case, "--kind", kind, "--noise", "0.01", "--seed", "5", "--out", csv.to_str().unwrap()]);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        let truth = frf::io::csv::read_csv(&csv).unwrap();
+        assert_eq!(truth.kind().name(), kind);
+        for (binary, tolerance) in [(false, 1e-12), (true, 0.0)] {
+            let uff = dir.path().join(format!("{kind}-{binary}.uff"));
+            let mut args = vec!["simulate", case, "--kind", kind, "--noise", "0.01", "--seed", "5", "--json"];
+            args.extend(["--out", uff.to_str().unwrap()]);
+            if binary {
+                args.push("--binary");
+            }
+            let out = rfm(&args);
+            assert!(out.status.success(), "{}", text(&out.stderr));
+            let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+            assert_eq!(
+                (doc["kind"].as_str(), doc["channels"].as_u64(), doc["lines"].as_u64()),
+                (Some(kind), Some(8), Some(599))
+            );
+            assert_eq!(doc["format"], if binary { "uff58b binary" } else { "uff58 ascii" });
+            let bytes = std::fs::read(&uff).unwrap();
+            // dataset 58 or 58b: never CSV text in a .uff file
+            assert!(
+                bytes.starts_with(b"    -1\n")
+                    && String::from_utf8_lossy(&bytes[..40]).contains(if binary { "58b" } else { "58" })
+            );
+            let back = frf::io::load_measured(&uff, &[]).unwrap().set;
+            let d = max_relative_difference(&back, &truth);
+            assert!(d <= tolerance, "{kind}, binary {binary}: {d}");
+            if pyuff {
+                // pyuff reads rfm's file as written (compared in Python with the CSV, which
+                // Python's csv module reads whole: its header is quoted) and writes it again
+                let again = dir.path().join(format!("{kind}-{binary}-pyuff.uff"));
+                let py = Command::new("python3")
+                    .args([
+                        "-c",
+                        PYUFF_ROUND_TRIP,
+                        uff.to_str().unwrap(),
+                        csv.to_str().unwrap(),
+                        again.to_str().unwrap(),
+                    ])
+                    .output()
+                    .unwrap();
+                assert!(py.status.success(), "pyuff: {}{}", text(&py.stdout), text(&py.stderr));
+                let read = text(&py.stdout).trim().parse::<f64>().unwrap();
+                assert!(read <= 1e-12, "{kind}, binary {binary}, read by pyuff: {read}");
+                // pyuff writes complex doubles as %20.11e: 12 significant digits, each part
+                // rounded by up to 5e-12 of itself, so up to sqrt(2) 5e-12 of the value
+                let back = frf::io::load_measured(&again, &[]).unwrap().set;
+                let d = max_relative_difference(&back, &truth);
+                assert!(d <= 2f64.sqrt() * 5e-12, "{kind}, binary {binary}, written by pyuff: {d}");
+            }
+        }
+    }
+}
+
+/// Numeric options are checked before any work: a noise that is not a
+/// finite number of 0 or more, an unknown kind, an extension that names no
+/// format.
+#[test]
+fn simulate_refuses_bad_options_with_the_usage_code() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases/tutorial/l-frame.toml");
+    let case = case.to_str().unwrap();
+    let out_csv = dir.path().join("h.csv");
+    let out_dat = dir.path().join("h.dat");
+    for (args, words) in [
+        (
+            vec!["--noise", "nan", "--out", out_csv.to_str().unwrap()],
+            "--noise NaN: the relative noise level must be a finite number",
+        ),
+        (vec!["--noise=-0.1", "--out", out_csv.to_str().unwrap()], "--noise -0.1"),
+        (vec!["--noise", "inf", "--out", out_csv.to_str().unwrap()], "--noise inf"),
+        (vec!["--kind", "impedance", "--out", out_csv.to_str().unwrap()], "receptance, mobility or accelerance"),
+        (vec!["--out", out_dat.to_str().unwrap()], ".uff or .unv for UFF dataset 58"),
+        (vec!["--binary", "--out", out_csv.to_str().unwrap()], "--binary writes UFF 58b"),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_rfm")).args(["simulate", case]).args(&args).output().unwrap();
+        let stderr = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains(words), "{args:?}: {stderr}");
+        assert!(!out_csv.exists() && !out_dat.exists());
     }
 }

@@ -48,3 +48,25 @@ fn apply_without_out_fails_with_a_message() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("--apply needs --out"));
 }
+
+/// The test-data tutorial (docs/walkthrough-test-data.md): voltage-referenced
+/// accelerance with coherence; the diagnosis fits the amplifier's gain with
+/// every candidate and names the lap joint of lap-joint-truth.toml
+/// (kr = 2e3 at node 9, gain 42 N/V at -30 degrees).
+#[test]
+fn lap_joint_tutorial_names_the_joint_and_the_amplifier_gain() {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases/tutorial");
+    let out = rfm(&["inspect", dir.join("lap-joint-measured.uff").to_str().unwrap()]);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("per volt (`m/s^2` / `V`)"));
+    let out = rfm(&["diagnose", dir.join("lap-joint.toml").to_str().unwrap(), "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let d: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let top = &d["ranking"][0];
+    assert!(top["description"].as_str().unwrap().starts_with("flexible, lossy in-line joint at node 9"), "{top}");
+    let kr = &top["parameters"][0];
+    let z = (kr["value"].as_f64().unwrap() / 2.0e3).ln().abs() / kr["relative_std"].as_f64().unwrap();
+    assert!(z < 3.0, "kr {kr}");
+    let g = &top["gains"][0];
+    assert!((g["magnitude"].as_f64().unwrap() / 42.0 - 1.0).abs() < 0.01, "{g}");
+    assert!((g["phase_deg"].as_f64().unwrap() + 30.0).abs() < 1.0, "{g}");
+}

@@ -163,3 +163,63 @@ fn inspect_lists_the_sample_files_it_can_read() {
     assert!(out.status.success(), "{}", text(&out.stderr));
     assert!(text(&out.stdout).contains("0 datasets 58, 7 other datasets skipped"), "{}", text(&out.stdout));
 }
+
+/// Nothing is taken as per newton or as SI in silence: a per-volt record
+/// and one whose units are NONE each get a note, and the test geometry of
+/// dataset 15 is listed.
+#[test]
+fn inspect_says_per_volt_and_si_assumed_and_lists_the_test_nodes() {
+    let dir = tempfile::tempdir().unwrap();
+    let header = |units: (&str, &str), den_type| Header58 {
+        ids: ["shaker test".into(), "NONE".into(), "NONE".into(), "NONE".into(), "NONE".into()],
+        function_type: 4,
+        function_id: 1,
+        version: 0,
+        load_case: 0,
+        response_entity: "NONE".into(),
+        response: "7:+Z".parse().unwrap(),
+        reference_entity: "NONE".into(),
+        reference: "1:+Z".parse().unwrap(),
+        ordinate_type: OrdinateType::ComplexDouble,
+        z_value: 0.0,
+        abscissa_axis: DataAxis::new(18, "Frequency", "Hz"),
+        numerator: DataAxis::new(12, "Acceleration", units.0),
+        denominator: DataAxis::new(den_type, "Voltage", units.1),
+        z_axis: DataAxis::none(),
+    };
+    let record = |h| Function58 {
+        header: h,
+        abscissa: Abscissa::Even { min: 1.0, step: 1.0 },
+        ordinates: Ordinates::Complex((0..4).map(|k| C64::new(1.0, k as f64)).collect()),
+    };
+    let mut bytes =
+        uff::encode(&[record(header(("m/s^2", "V"), 0)), record(header(("NONE", "NONE"), 13))], Encoding::Ascii)
+            .unwrap();
+    bytes.extend(b"    -1\n    15\n");
+    bytes.extend(b"         7         0         0         1  2.50000E-01  0.00000E+00  1.00000E-02\n");
+    bytes.extend(b"    -1\n");
+    let path = dir.path().join("volts.uff");
+    std::fs::write(&path, bytes).unwrap();
+    let out = rfm(&["inspect", path.to_str().unwrap(), "--json"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let notes: Vec<&str> = json["notes"].as_array().unwrap().iter().map(|n| n.as_str().unwrap()).collect();
+    assert!(notes.iter().any(|n| n.starts_with("record 1") && n.contains("per volt")), "{notes:?}");
+    assert!(notes.iter().any(|n| n.starts_with("record 2") && n.contains("SI assumed")), "{notes:?}");
+    assert!(notes.iter().any(|n| n.contains("no dataset 164")), "{notes:?}");
+    assert_eq!(
+        (json["records"][0]["per_volt"].as_bool(), json["records"][1]["per_volt"].as_bool()),
+        (Some(true), Some(false))
+    );
+    assert_eq!((json["nodes"][0]["node"].as_i64(), json["nodes"][0]["x_m"].as_f64()), (Some(7), Some(0.25)));
+    let out = rfm(&["inspect", path.to_str().unwrap()]);
+    let stdout = text(&out.stdout);
+    assert!(stdout.contains("test geometry: 1 nodes") && stdout.contains("note: record 1"), "{stdout}");
+
+    // a CSV without units says what it assumed
+    let csv = dir.path().join("h.csv");
+    std::fs::write(&csv, "frequency_hz,\"H(2:uy,5:uy).re\",\"H(2:uy,5:uy).im\"\n1,1,0\n").unwrap();
+    let out = rfm(&["inspect", csv.to_str().unwrap(), "--json"]);
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(json["notes"][0].as_str().unwrap().contains("receptance in SI (m/N) assumed"), "{json}");
+}

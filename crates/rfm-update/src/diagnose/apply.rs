@@ -1,6 +1,7 @@
 //! Adding a diagnosed effect to the user's case: `rfm diagnose --apply` and
 //! every step of `rfm fix`.
 
+use fe_model::case::{FittedGain, GainKey, Gains};
 use fe_model::{CaseEditor, CaseFile, HistoryEntry};
 
 use super::Diagnosis;
@@ -70,6 +71,19 @@ impl Diagnosis {
         // to update (and an empty [update] is not a valid case)
         if !names.is_empty() {
             editor.set_update(&names, method)?;
+        }
+        if self.gains {
+            // the next run fits the gains too; their values are kept for reading
+            let fitted: Vec<FittedGain> = r
+                .gains
+                .iter()
+                .map(|g| FittedGain {
+                    key: GainKey::Reference(g.reference),
+                    magnitude: g.magnitude,
+                    phase_deg: g.phase_deg,
+                })
+                .collect();
+            editor.set_gains(Gains::PerReference, &fitted)?;
         }
         if case.history.is_empty() {
             editor.push_history(&HistoryEntry {

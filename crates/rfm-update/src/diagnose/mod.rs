@@ -127,6 +127,10 @@ pub struct DiagnoseOptions {
     pub significance: f64,
     /// Candidate generation options (the band is taken from the data).
     pub candidates: CandidateOptions,
+    /// Fit an unknown complex gain per reference with every candidate and
+    /// with the nominal model (voltage-referenced data, see [`crate::gain`]):
+    /// a level offset common to a reference's channels is then no symptom.
+    pub gains: bool,
 }
 
 impl Default for DiagnoseOptions {
@@ -143,6 +147,7 @@ impl Default for DiagnoseOptions {
             iterations: 40,
             significance: -10.0,
             candidates: CandidateOptions::default(),
+            gains: false,
         }
     }
 }
@@ -168,6 +173,9 @@ pub struct FittedParameter {
 pub struct Ranked {
     /// Kind.
     pub kind: EffectKind,
+    /// The unknown gains fitted with it, per reference (empty unless the
+    /// diagnosis fits gains: [`DiagnoseOptions::gains`]).
+    pub gains: Vec<crate::oe::Gain>,
     /// Plain-language description with location.
     pub description: String,
     /// Nodes where it acts.
@@ -234,6 +242,9 @@ pub struct Diagnosis {
     pub recommended: Option<usize>,
     /// How many candidates were tried.
     pub tried: usize,
+    /// Whether every fit (and the nominal misfit) fitted an unknown gain
+    /// per reference.
+    pub gains: bool,
     /// Candidates that could not be fitted, with the reason.
     pub unfitted: Vec<Unfitted>,
     /// The candidates (same indices as [`Ranked::candidate`]).
@@ -315,7 +326,13 @@ pub fn informative_lines(measured: &FrfSet, n: usize) -> Vec<f64> {
 /// RMS of `ln(H / M)` per complex value of a system's receptances `H`
 /// against measured ones `M`, on `lines` lines spread over the measured band.
 pub fn log_misfit(sys: &DampedSystem, measured: &FrfSet, lines: usize) -> Result<f64, UpdateError> {
-    let set = LineSet::new(sys, measured, lines)?;
+    log_misfit_with(sys, measured, lines, false)
+}
+
+/// As [`log_misfit`], after the model's FRFs are multiplied by the gain per
+/// reference that fits them best when `gains` (see [`crate::gain`]).
+pub fn log_misfit_with(sys: &DampedSystem, measured: &FrfSet, lines: usize, gains: bool) -> Result<f64, UpdateError> {
+    let set = LineSet::new(sys, measured, lines, gains)?;
     Ok((set.cost0 / (set.n as f64 / 2.0)).sqrt())
 }
 
@@ -345,7 +362,7 @@ pub fn diagnose_with(
     // a noise floor for noise-free data keeps the criterion finite
     let s2 = (noise * noise / 2.0).max(1e-20);
     let nominal = DampedSystem::new(model.clone())?;
-    let full = LineSet::new(&nominal, measured, opts.lines)?;
+    let full = LineSet::new(&nominal, measured, opts.lines, opts.gains)?;
     let mut copts = opts.candidates.clone();
     copts.band_hz = (lines[0], lines[lines.len() - 1]);
     let mut pool = Pool::new(model, &nominal, s2, copts.band_hz);
@@ -361,6 +378,7 @@ fn rank(pool: Pool<'_>, noise: f64, full: &LineSet, opts: &DiagnoseOptions) -> D
         let implausible_reason = c.implausible(&f.values, &f.determined);
         Ranked {
             kind: c.kind,
+            gains: f.gains.clone(),
             description: c.description.clone(),
             nodes: c.nodes.clone(),
             elements: c.elements.clone(),
@@ -410,6 +428,7 @@ fn rank(pool: Pool<'_>, noise: f64, full: &LineSet, opts: &DiagnoseOptions) -> D
         ranking,
         recommended,
         tried: pool.candidates.len(),
+        gains: full.gains,
         unfitted,
         candidates: pool.candidates,
     }

@@ -14,6 +14,7 @@ use super::{DiagnoseOptions, informative_lines};
 use crate::error::UpdateError;
 use crate::oe::{self, Misfit, OeData, OeOptions};
 use crate::params::ParameterSet;
+use fe_model::case::Gains;
 
 /// The relative standard deviation (of the log-parameter) above which a
 /// fitted value is not determined by the data: it could as well be e times
@@ -34,6 +35,8 @@ pub(crate) struct Fit {
     pub(crate) relative_std: Vec<f64>,
     /// Per parameter: the data determine it (see [`determined`]).
     pub(crate) determined: Vec<bool>,
+    /// The gains fitted with it (empty unless the line set fits gains).
+    pub(crate) gains: Vec<oe::Gain>,
 }
 
 /// A line set with the nominal model's cost on it.
@@ -42,12 +45,26 @@ pub(crate) struct LineSet {
     pub(crate) cost0: f64,
     /// Real residuals.
     pub(crate) n: usize,
+    /// Whether every fit on these lines fits a gain per reference (and
+    /// `cost0` is the nominal model's after its best gains).
+    pub(crate) gains: bool,
 }
 
 impl LineSet {
-    pub(crate) fn new(nominal: &DampedSystem, measured: &FrfSet, n_lines: usize) -> Result<Self, UpdateError> {
+    pub(crate) fn new(
+        nominal: &DampedSystem,
+        measured: &FrfSet,
+        n_lines: usize,
+        gains: bool,
+    ) -> Result<Self, UpdateError> {
         let data = measured.at_frequencies(&informative_lines(measured, n_lines))?;
-        let model = frf::synthesize(nominal, data.channels(), data.frequencies_hz())?;
+        let mut model = frf::synthesize(nominal, data.channels(), data.frequencies_hz())?;
+        if gains {
+            // the closed-form gains of the nominal model: its misfit is what no gain removes
+            let model_kind = model.converted(data.kind());
+            let fitted = crate::gain::fit_gains(&model_kind, &data, None, Gains::PerReference)?;
+            fitted.apply(&mut model);
+        }
         let (mut cost, mut n) = (0.0, 0);
         for (h, m) in model.values().iter().zip(data.values()) {
             if m.norm() > 0.0 {
@@ -58,7 +75,7 @@ impl LineSet {
         if !cost.is_finite() {
             return Err(UpdateError::Setup("the nominal model's misfit is not finite at the measured lines".into()));
         }
-        Ok(LineSet { data, cost0: cost, n })
+        Ok(LineSet { data, cost0: cost, n, gains })
     }
 }
 
@@ -106,8 +123,14 @@ fn fit(
     // bounds must hold the start
     let now = params.values(&sys);
     let bounds = candidate.bounds.iter().zip(&now).map(|(b, &v)| b.map(|(lo, hi)| (lo.min(v), hi.max(v)))).collect();
-    let opts =
-        OeOptions { misfit: Misfit::Log, max_iterations: iterations, tolerance: 1e-6, bounds, ..OeOptions::default() };
+    let opts = OeOptions {
+        misfit: Misfit::Log,
+        max_iterations: iterations,
+        tolerance: 1e-6,
+        bounds,
+        gains: lines.gains,
+        ..OeOptions::default()
+    };
     let data = OeData { measured: &lines.data, weights: None };
     let r = match local {
         Some((ld, lc)) => {
@@ -130,6 +153,7 @@ fn fit(
         lines: lines.data.n_freq(),
         relative_std,
         determined,
+        gains: r.gains,
     })
 }
 
@@ -409,10 +433,10 @@ pub(crate) fn search(
     copts: &CandidateOptions,
     trace: &mut dyn FnMut(&str),
 ) -> Result<(), UpdateError> {
-    let coarse = LineSet::new(pool.nominal, measured, opts.screen_lines)?;
+    let coarse = LineSet::new(pool.nominal, measured, opts.screen_lines, opts.gains)?;
     let all = pool.add(candidates::generate(pool.model, copts));
     let to_screen = if all.len() > opts.prescreen_above {
-        let pre = LineSet::new(pool.nominal, measured, opts.prescreen_lines)?;
+        let pre = LineSet::new(pool.nominal, measured, opts.prescreen_lines, opts.gains)?;
         pool.screen(&pre, opts.prescreen_iterations, &all)?;
         trace(&format!("pre-screened {} candidates on {} lines", all.len(), pre.data.n_freq()));
         let mut best = pool.by_screening(&all);

@@ -2,6 +2,7 @@
 
 use std::path::Path;
 
+use fe_model::DofRef;
 use fe_model::case::{ChannelMap, MaskRule};
 use num_complex::Complex64 as C64;
 
@@ -28,7 +29,34 @@ pub struct UffFrfs {
     pub masked: Vec<Masked>,
 }
 
+/// Maps a test DOF of the file to a model DOF and its sign (see
+/// [`map_test_dof`]), or says why it cannot.
+pub type TestDofMapper<'m> = dyn Fn(TestDof) -> Result<(DofRef, f64), String> + 'm;
+
 impl UffFrfs {
+    /// The FRFs as a [`Measured`](crate::io::Measured) set.
+    pub fn into_measured(self) -> crate::io::Measured {
+        let origins = self.origins();
+        let units = self
+            .sources
+            .iter()
+            .map(|s| crate::io::ChannelUnits {
+                per_volt: s.per_volt,
+                test_reference: Some(s.reference),
+                basis: s.units.clone(),
+            })
+            .collect();
+        crate::io::Measured {
+            set: self.set,
+            format: crate::io::MeasuredFormat::Uff,
+            notes: self.notes,
+            origins,
+            masked: self.masked,
+            units,
+            pairing: Vec::new(),
+        }
+    }
+
     /// Where each channel comes from (`record 3 (line 90)`), for messages.
     pub fn origins(&self) -> Vec<Origin> {
         self.sources
@@ -52,6 +80,11 @@ pub struct ChannelSource {
     /// Factor applied to the file's values: the two direction signs and the
     /// units scale to SI.
     pub factor: f64,
+    /// Whether the values are per volt (the reference is a voltage, see
+    /// [`FrfUnits::per_volt`](super::FrfUnits::per_volt)).
+    pub per_volt: bool,
+    /// The units as read, for messages (`` `m/s^2` / `V` ``).
+    pub units: String,
 }
 
 /// Reads the FRFs of a universal file (see [`frfs_from_uff`]). A record of
@@ -123,6 +156,18 @@ pub fn frfs_from_uff_with(
     map: &[ChannelMap],
     rules: &[MaskRule],
 ) -> Result<UffFrfs, FrfError> {
+    frfs_from_uff_mapped(path, file, rules, &|dof| map_test_dof(dof, map))
+}
+
+/// As [`frfs_from_uff_with`], with test DOFs mapped by `mapper` (pairing
+/// by coordinates, see [`super::Pairing`], maps them by position instead of
+/// by node number).
+pub fn frfs_from_uff_mapped(
+    path: &Path,
+    file: &UffFile,
+    rules: &[MaskRule],
+    mapper: &TestDofMapper<'_>,
+) -> Result<UffFrfs, FrfError> {
     let err = |line: usize, message: String| FrfError::Parse { path: path.to_path_buf(), line, message };
     let mut notes: Vec<String> = file.notes.clone();
     notes.extend(
@@ -152,6 +197,7 @@ pub fn frfs_from_uff_with(
     let mut frfs: Vec<Frf> = Vec::new();
     let mut masked: Vec<Masked> = Vec::new();
     let mut unstated_hz = Vec::new();
+    let mut per_volt: Vec<String> = Vec::new();
     for r in file.records.iter().filter(|r| r.function.header.function_type == FUNCTION_FRF) {
         let h = &r.function.header;
         let at = |m: String| err(r.line, format!("{}: {m}", r.label()));
@@ -160,14 +206,15 @@ pub fn frfs_from_uff_with(
             unstated_hz.push(r.index.to_string());
         }
         let units = frf_units(h).map_err(at)?;
-        let (response, s_resp) =
-            map_test_dof(h.response, map).map_err(|m| at(format!("response {}: {m}", h.response)))?;
-        let (reference, s_ref) =
-            map_test_dof(h.reference, map).map_err(|m| at(format!("reference {}: {m}", h.reference)))?;
+        let (response, s_resp) = mapper(h.response).map_err(|m| at(format!("response {}: {m}", h.response)))?;
+        let (reference, s_ref) = mapper(h.reference).map_err(|m| at(format!("reference {}: {m}", h.reference)))?;
         if !(units.scale.is_finite() && units.scale > 0.0) {
             return Err(at(format!("the units {} give a scale of {} to SI", units.basis, units.scale)));
         }
         let factor = s_resp * s_ref * units.scale;
+        if units.per_volt {
+            per_volt.push(format!("{} ({})", r.index, units.basis));
+        }
         if units.assumed_si {
             notes.push(format!("{}: units not stated ({}); SI assumed", r.label(), units.basis));
         } else if units.scale != 1.0 {
@@ -200,9 +247,23 @@ pub fn frfs_from_uff_with(
             (keep.iter().map(|&k| freqs[k]).collect(), keep.iter().map(|&k| values[k]).collect())
         };
         let channel = Channel::new(response, reference);
-        let source =
-            ChannelSource { record: r.index, line: r.line, response: h.response, reference: h.reference, factor };
+        let source = ChannelSource {
+            record: r.index,
+            line: r.line,
+            response: h.response,
+            reference: h.reference,
+            factor,
+            per_volt: units.per_volt,
+            units: units.basis.clone(),
+        };
         frfs.push(Frf { record: r.index, line: r.line, channel, source, kind: units.kind, freqs, values });
+    }
+    if !per_volt.is_empty() {
+        notes.push(format!(
+            "record(s) {} are per volt: their reference is a voltage, not a force; the case must fit a gain (the \
+             default) or give a calibration",
+            per_volt.join(", ")
+        ));
     }
     if !unstated_hz.is_empty() {
         notes.push(format!("record(s) {} do not state the abscissa units; Hz assumed", unstated_hz.join(", ")));
@@ -266,7 +327,7 @@ pub fn frfs_from_uff_with(
         }
     }
 
-    attach_coherence(path, file, map, &mut set, &mut notes, &mut masked, rules.contains(&MaskRule::BadCoherence))?;
+    attach_coherence(path, file, mapper, &mut set, &mut notes, &mut masked, rules.contains(&MaskRule::BadCoherence))?;
     let locate = |c: usize, _: usize| (frfs[c].line, format!("record {} (line {})", frfs[c].record, frfs[c].line));
     let (set, more) = mask::non_finite_lines(path, set, rules.contains(&MaskRule::NonFinite), &locate)?;
     masked.extend(more);
@@ -308,7 +369,7 @@ fn span(f: &[f64]) -> String {
 fn attach_coherence(
     path: &Path,
     file: &UffFile,
-    map: &[ChannelMap],
+    mapper: &TestDofMapper<'_>,
     set: &mut FrfSet,
     notes: &mut Vec<String>,
     masked: &mut Vec<Masked>,
@@ -321,7 +382,7 @@ fn attach_coherence(
     for r in file.records.iter().filter(|r| r.function.header.function_type == FUNCTION_COHERENCE) {
         let h = &r.function.header;
         let label = r.label();
-        let channel = match (map_test_dof(h.response, map), map_test_dof(h.reference, map)) {
+        let channel = match (mapper(h.response), mapper(h.reference)) {
             (Ok((a, _)), Ok((b, _))) => Channel::new(a, b),
             _ => {
                 notes.push(format!(

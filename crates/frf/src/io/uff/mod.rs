@@ -44,9 +44,10 @@
 //! offset in the `line` field and the message, and says what was expected.
 
 mod frfs;
+mod geometry;
 mod map;
 mod read;
-mod units;
+pub(crate) mod units;
 mod write;
 
 use std::fmt;
@@ -56,7 +57,11 @@ use num_complex::Complex64 as C64;
 
 use crate::error::FrfError;
 
-pub use frfs::{ChannelSource, UffFrfs, frfs_from_uff, frfs_from_uff_with, read_uff_frfs, read_uff_frfs_with};
+pub use frfs::{
+    ChannelSource, TestDofMapper, UffFrfs, frfs_from_uff, frfs_from_uff_mapped, frfs_from_uff_with, read_uff_frfs,
+    read_uff_frfs_with,
+};
+pub use geometry::{CoordinateSystem, Geometry, PairedNode, Pairing, PairingOptions, TestNode, pair_by_coordinates};
 pub use map::{map_test_dof, model_to_test_dof};
 pub use read::{parse_uff, read_uff};
 pub use units::{FrfUnits, frf_units};
@@ -529,6 +534,18 @@ impl SkippedDataset {
     }
 }
 
+/// A dataset kept as text lines, to be parsed when asked for (the test
+/// geometry: see [`UffFile::geometry`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RawDataset {
+    /// Dataset number (15, 2411, 18, 2420, 164).
+    pub number: i64,
+    /// 1-based line of its number.
+    pub line: usize,
+    /// Its lines between the number and the closing `-1`: line number and text.
+    pub lines: Vec<(usize, String)>,
+}
+
 /// The datasets of a universal file.
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct UffFile {
@@ -536,6 +553,10 @@ pub struct UffFile {
     pub records: Vec<Record58>,
     /// Datasets of other types, in file order.
     pub skipped: Vec<SkippedDataset>,
+    /// The datasets of the test geometry (nodes 15 and 2411, coordinate
+    /// systems 18 and 2420, units 164) as text, in file order; they are
+    /// listed in `skipped` too, since the FRFs do not use them.
+    pub geometry: Vec<RawDataset>,
     /// Irregularities the reader worked around (an empty dataset, a wrong
     /// byte count in a `58b` line that the data's end confirms).
     pub notes: Vec<String>,

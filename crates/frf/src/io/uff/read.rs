@@ -7,8 +7,8 @@ use std::path::Path;
 use num_complex::Complex64 as C64;
 
 use super::{
-    Abscissa, DataAxis, Direction, Encoding, Function58, Header58, OrdinateType, Ordinates, Record58, SkippedDataset,
-    TestDof, UffFile,
+    Abscissa, DataAxis, Direction, Encoding, Function58, Header58, OrdinateType, Ordinates, RawDataset, Record58,
+    SkippedDataset, TestDof, UffFile,
 };
 use crate::error::FrfError;
 
@@ -58,7 +58,11 @@ pub(crate) fn parse_with(path: &Path, bytes: &[u8], check: &mut HeaderCheck<'_>)
             let record = p.record58(index, head, binary, check)?;
             file.records.push(record);
         } else {
-            p.skip_dataset(number, head.no)?;
+            let keep = super::geometry::GEOMETRY_DATASETS.contains(&number);
+            let lines = p.skip_dataset(number, head.no, keep)?;
+            if keep {
+                file.geometry.push(RawDataset { number, line: head.no, lines });
+            }
             file.skipped.push(SkippedDataset { number, line: head.no });
         }
     }
@@ -153,11 +157,15 @@ impl<'a> Parser<'a, '_> {
         FrfError::Parse { path: self.path.to_path_buf(), line, message }
     }
 
-    /// Skips a dataset that is not 58 up to its closing `-1`.
-    fn skip_dataset(&mut self, number: i64, start: usize) -> Result<(), FrfError> {
+    /// Skips a dataset that is not 58 up to its closing `-1`; returns its
+    /// lines (number and text) when `keep` (the datasets of test geometry,
+    /// read only when a case pairs nodes by coordinates).
+    fn skip_dataset(&mut self, number: i64, start: usize, keep: bool) -> Result<Vec<(usize, String)>, FrfError> {
+        let mut lines = Vec::new();
         loop {
             match self.cur.next_line() {
-                Some(l) if l.text.trim_ascii() == b"-1" => return Ok(()),
+                Some(l) if l.text.trim_ascii() == b"-1" => return Ok(lines),
+                Some(l) if keep => lines.push((l.no, text(l.text))),
                 Some(_) => {}
                 None => {
                     return Err(self.err(

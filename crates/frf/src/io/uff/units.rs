@@ -2,11 +2,16 @@
 //! when those are absent, from its specific data types; and the factor to SI.
 //!
 //! Units labels are parsed as products and quotients of known units with
-//! integer powers (`m/s^2`, `(1/N)*(m/s²)`, `g/lbf`, `m s-2 N-1`, `1/kg`)
-//! into exponents of length, force and time plus a scale to metres, newtons
-//! and seconds. The time exponent decides the kind: 0 receptance, -1
-//! mobility, -2 accelerance. `g` is the standard gravity (9.80665 m/s^2), as
-//! in accelerometer units, never the gram.
+//! integer powers (`m/s^2`, `(1/N)*(m/s²)`, `g/lbf`, `m s-2 N-1`, `1/kg`,
+//! `(m/s^2)/V`) into exponents of length, force, time and voltage plus a
+//! scale to metres, newtons, seconds and volts. The time exponent decides
+//! the kind: 0 receptance, -1 mobility, -2 accelerance. `g` is the standard
+//! gravity (9.80665 m/s^2), as in accelerometer units, never the gram.
+//!
+//! An FRF per volt (`(m/s^2)/V`: referenced to a shaker amplifier's drive
+//! signal or an uncalibrated force gauge) is read as such and marked
+//! [`FrfUnits::per_volt`]: its level is the structure's times an unknown
+//! gain, which a case either fits or removes with a calibration.
 
 use std::f64::consts::PI;
 
@@ -24,6 +29,9 @@ pub struct FrfUnits {
     pub basis: String,
     /// Whether SI units were assumed because the file states none.
     pub assumed_si: bool,
+    /// Whether the reference is a voltage (`V`, `mV`), not a force: the
+    /// values are response per volt, scaled to per volt.
+    pub per_volt: bool,
 }
 
 /// Decides what an FRF record relates from its header. Units labels win;
@@ -39,9 +47,13 @@ pub fn frf_units(h: &Header58) -> Result<FrfUnits, String> {
             u.basis, u.kind
         )),
         (Some(u), _) => Ok(u),
-        (None, Some((kind, names))) => {
-            Ok(FrfUnits { kind, scale: 1.0, basis: format!("data types {names}, SI assumed"), assumed_si: true })
-        }
+        (None, Some((kind, names))) => Ok(FrfUnits {
+            kind,
+            scale: 1.0,
+            basis: format!("data types {names}, SI assumed"),
+            assumed_si: true,
+            per_volt: false,
+        }),
         (None, None) => Err(format!(
             "cannot tell whether the FRF is a receptance, mobility or accelerance: the ordinate units are `{}` over \
              `{}` and the data types {} over {}; the file should give units such as `m/s^2` over `N` (records 9 and \
@@ -85,20 +97,21 @@ fn units_kind(h: &Header58) -> Result<Option<FrfUnits>, String> {
     // would be read a thousand or four times off without a word.
     let unknown = |which: &str, label: &str| {
         format!(
-            "the {which} units `{label}` are not units rfm can read (such as m, mm, m/s, m/s^2, g, in, N, lbf); \
+            "the {which} units `{label}` are not units rfm can read (such as m, mm, m/s, m/s^2, g, in, N, lbf, V); \
              correct them in the file, or write NONE to let the data types decide (SI is then assumed)"
         )
     };
     let Some(n) = parse_units(num) else { return Err(unknown("ordinate", num)) };
     // numerator units of a response alone (`m/s^2`) with no denominator units: per newton
     // (per newton metre for a moment), stated by a force data type or else assumed
-    let per_force_assumed = is_none(den) && n.f == 0;
+    let per_force_assumed = is_none(den) && n.f == 0 && n.v == 0;
     let assumed_si = per_force_assumed && !matches!(h.denominator.specific_type, 9 | 13);
     let d = if per_force_assumed {
         Some(Dim {
             l: i32::from(matches!(h.reference.direction.axis_name(), "RX" | "RY" | "RZ")),
             f: 1,
             t: 0,
+            v: 0,
             scale: 1.0,
         })
     } else if is_none(den) {
@@ -108,6 +121,12 @@ fn units_kind(h: &Header58) -> Result<Option<FrfUnits>, String> {
     };
     let Some(d) = d else { return Err(unknown("denominator", den)) };
     let dim = n.div(d);
+    if n.v != 0 {
+        return Err(format!(
+            "the ordinate units `{num}` measure the response in volts: calibrate the sensor in the test system so \
+             that the FRF is a displacement, velocity or acceleration (per force or per volt)"
+        ));
+    }
     let basis = match (is_none(den), assumed_si) {
         (true, true) => format!("`{num}` (per N assumed)"),
         (true, false) if per_force_assumed => {
@@ -118,7 +137,9 @@ fn units_kind(h: &Header58) -> Result<Option<FrfUnits>, String> {
     };
     // a rotation in the response has no length; a moment as reference has one more
     let rot = |dir: Direction| matches!(dir.axis_name(), "RX" | "RY" | "RZ");
-    let want_l = i32::from(!rot(h.response.direction)) - i32::from(rot(h.reference.direction));
+    // per volt: the reference is a voltage, which has no length whatever the direction
+    let per_volt = dim.v == -1 && dim.f == 0;
+    let want_l = i32::from(!rot(h.response.direction)) - i32::from(rot(h.reference.direction) && !per_volt);
     let kind = match dim.t {
         0 => FrfKind::Receptance,
         -1 => FrfKind::Mobility,
@@ -129,16 +150,16 @@ fn units_kind(h: &Header58) -> Result<Option<FrfUnits>, String> {
             ));
         }
     };
-    if dim.f != -1 || dim.l != want_l {
+    if !(per_volt || (dim.f == -1 && dim.v == 0)) || dim.l != want_l {
         return Err(format!(
             "the units {basis} are not those of an FRF from {} to {} (expected displacement, velocity or \
-             acceleration per {})",
+             acceleration per {}, or per volt)",
             h.reference.direction,
             h.response.direction,
             if rot(h.reference.direction) { "moment" } else { "force" }
         ));
     }
-    Ok(Some(FrfUnits { kind, scale: dim.scale, basis, assumed_si }))
+    Ok(Some(FrfUnits { kind, scale: dim.scale, basis, assumed_si, per_volt }))
 }
 
 fn types_kind(h: &Header58) -> Result<Option<(FrfKind, String)>, String> {
@@ -156,17 +177,47 @@ fn types_kind(h: &Header58) -> Result<Option<(FrfKind, String)>, String> {
     }
 }
 
-/// Exponents of length, force and time, and the factor to SI.
+/// What a whole units label of translational FRFs says (`g/N`,
+/// `(m/s^2)/V`, `mm/N`, `in/s/lbf`): the kind, the factor to SI, and
+/// whether the values are per volt. Used for a CSV file's `# units = ...`
+/// line, which speaks of every channel at once.
+pub(crate) fn label_units(label: &str) -> Result<(FrfKind, f64, bool), String> {
+    let d = parse_units(label).ok_or_else(|| {
+        format!(
+            "`{label}` is not a units label rfm can read; write the response over the reference, such as m/N, \
+             mm/N, m/s/N, m/s^2/N, g/N, in/s/lbf or (m/s^2)/V"
+        )
+    })?;
+    let per_volt = d.v == -1 && d.f == 0;
+    let kind = match d.t {
+        0 => Some(FrfKind::Receptance),
+        -1 => Some(FrfKind::Mobility),
+        -2 => Some(FrfKind::Accelerance),
+        _ => None,
+    };
+    match kind {
+        Some(kind) if d.l == 1 && (per_volt || (d.f == -1 && d.v == 0)) && d.scale.is_finite() && d.scale > 0.0 => {
+            Ok((kind, d.scale, per_volt))
+        }
+        _ => Err(format!(
+            "`{label}` are not the units of an FRF: expected a displacement, velocity or acceleration per force \
+             (m/N, m/s/N, m/s^2/N, g/N, ...) or per volt ((m/s^2)/V)"
+        )),
+    }
+}
+
+/// Exponents of length, force, time and voltage, and the factor to SI.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct Dim {
+pub(crate) struct Dim {
     l: i32,
     f: i32,
     t: i32,
+    v: i32,
     scale: f64,
 }
 
 impl Dim {
-    const ONE: Dim = Dim { l: 0, f: 0, t: 0, scale: 1.0 };
+    const ONE: Dim = Dim { l: 0, f: 0, t: 0, v: 0, scale: 1.0 };
 
     // saturating: a label like `((m^99)^99)^99` must not overflow
     fn mul(self, o: Dim) -> Dim {
@@ -174,6 +225,7 @@ impl Dim {
             l: self.l.saturating_add(o.l),
             f: self.f.saturating_add(o.f),
             t: self.t.saturating_add(o.t),
+            v: self.v.saturating_add(o.v),
             scale: self.scale * o.scale,
         }
     }
@@ -187,6 +239,7 @@ impl Dim {
             l: self.l.saturating_mul(p),
             f: self.f.saturating_mul(p),
             t: self.t.saturating_mul(p),
+            v: self.v.saturating_mul(p),
             scale: self.scale.powi(p),
         }
     }
@@ -196,7 +249,8 @@ const G0: f64 = 9.80665;
 const LBF: f64 = 4.448_221_615_260_5;
 
 fn unit(name: &str) -> Option<Dim> {
-    let d = |l, f, t, scale| Some(Dim { l, f, t, scale });
+    let d = |l, f, t, scale| Some(Dim { l, f, t, v: 0, scale });
+    let volt = |scale| Some(Dim { l: 0, f: 0, t: 0, v: 1, scale });
     match name.to_lowercase().as_str() {
         "m" => d(1, 0, 0, 1.0),
         "mm" => d(1, 0, 0, 1e-3),
@@ -216,6 +270,10 @@ fn unit(name: &str) -> Option<Dim> {
         "rad" => d(0, 0, 0, 1.0),
         "deg" => d(0, 0, 0, PI / 180.0),
         "hz" => d(0, 0, -1, 1.0),
+        // volts: `mv` cannot be confused with another unit here (no `mv` of length or force)
+        "v" => volt(1.0),
+        "mv" => volt(1e-3),
+        "uv" | "µv" | "μv" => volt(1e-6),
         _ => None,
     }
 }
@@ -363,6 +421,20 @@ fn term(t: &[Tok], pos: &mut usize, depth: usize) -> Option<Dim> {
 mod tests {
     use super::*;
 
+    #[test]
+    fn whole_labels_give_kind_scale_and_whether_per_volt() {
+        assert_eq!(label_units("g/N"), Ok((FrfKind::Accelerance, G0, false)));
+        assert_eq!(label_units("mm/N"), Ok((FrfKind::Receptance, 1e-3, false)));
+        assert_eq!(label_units("m/s/N"), Ok((FrfKind::Mobility, 1.0, false)));
+        assert_eq!(label_units("(m/s^2)/V"), Ok((FrfKind::Accelerance, 1.0, true)));
+        let (k, s, v) = label_units("in/s/lbf").unwrap();
+        assert_eq!((k, v), (FrfKind::Mobility, false));
+        assert!((s - 0.0254 / LBF).abs() < 1e-15);
+        for bad in ["m/s^2", "N/m", "V/N", "furlong/N", "m/s^3/N"] {
+            assert!(label_units(bad).is_err(), "{bad}");
+        }
+    }
+
     fn dims(s: &str) -> Option<(i32, i32, i32, f64)> {
         parse_units(s).map(|d| (d.l, d.f, d.t, d.scale))
     }
@@ -386,6 +458,11 @@ mod tests {
         for bad in ["Pa", "m/", "(m/s", "m^", "NONE", "m/s^999", "m))"] {
             assert_eq!(dims(bad), None, "{bad}");
         }
+        assert_eq!(dims("(m/s^2)/V").map(|d| (d.0, d.1, d.2)), Some((1, 0, -2)));
+        let volts = |s: &str| parse_units(s).map(|d| (d.v, d.scale));
+        assert_eq!(volts("m/s^2/V"), Some((-1, 1.0)));
+        assert_eq!(volts("g/mV"), Some((-1, G0 * 1e3)));
+        assert_eq!(volts("m/N"), Some((0, 1.0)));
         let deep = format!("{}m{}", "(".repeat(16), "^99)".repeat(16));
         assert_eq!(dims(&deep).map(|d| d.0), Some(i32::MAX));
     }
@@ -437,19 +514,19 @@ mod tests {
             ("ft", 0.3048),
         ];
         for (name, scale) in length {
-            assert_eq!(unit(name), Some(Dim { l: 1, f: 0, t: 0, scale }), "{name}");
+            assert_eq!(unit(name), Some(Dim { l: 1, f: 0, t: 0, v: 0, scale }), "{name}");
         }
         for (name, scale) in [("s", 1.0), ("sec", 1.0), ("ms", 1e-3)] {
-            assert_eq!(unit(name), Some(Dim { l: 0, f: 0, t: 1, scale }), "{name}");
+            assert_eq!(unit(name), Some(Dim { l: 0, f: 0, t: 1, v: 0, scale }), "{name}");
         }
         for (name, scale) in [("N", 1.0), ("kN", 1e3), ("mN", 1e-3), ("lbf", LBF), ("lb", LBF), ("kgf", G0)] {
-            assert_eq!(unit(name), Some(Dim { l: 0, f: 1, t: 0, scale }), "{name}");
+            assert_eq!(unit(name), Some(Dim { l: 0, f: 1, t: 0, v: 0, scale }), "{name}");
         }
         // a kilogram is a newton per (m/s^2); g is the standard gravity
-        assert_eq!(unit("kg"), Some(Dim { l: -1, f: 1, t: 2, scale: 1.0 }));
-        assert_eq!(unit("g"), Some(Dim { l: 1, f: 0, t: -2, scale: G0 }));
-        assert_eq!(unit("deg"), Some(Dim { l: 0, f: 0, t: 0, scale: PI / 180.0 }));
-        assert_eq!(unit("Hz"), Some(Dim { l: 0, f: 0, t: -1, scale: 1.0 }));
+        assert_eq!(unit("kg"), Some(Dim { l: -1, f: 1, t: 2, v: 0, scale: 1.0 }));
+        assert_eq!(unit("g"), Some(Dim { l: 1, f: 0, t: -2, v: 0, scale: G0 }));
+        assert_eq!(unit("deg"), Some(Dim { l: 0, f: 0, t: 0, v: 0, scale: PI / 180.0 }));
+        assert_eq!(unit("Hz"), Some(Dim { l: 0, f: 0, t: -1, v: 0, scale: 1.0 }));
         assert_eq!(unit("furlong"), None);
     }
 

@@ -1,0 +1,202 @@
+//! Voltage-referenced data: an unknown complex gain per reference in
+//! compare, diagnose and update, whichever way the data arrive.
+//!
+//! The truth is independent of rfm's gain fit: the tutorial's measured
+//! receptances (per newton) are turned into accelerances per volt here, by
+//! `-w^2` and a chosen complex constant, so the fitted gain must be that
+//! constant and every comparison must be the same for any constant.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn rfm(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_rfm")).args(args).output().expect("rfm runs")
+}
+
+fn tutorial() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases/tutorial")
+}
+
+/// The tutorial's receptances as accelerances per volt, times `gain`
+/// (magnitude, phase in degrees).
+fn per_volt_accelerance(gain: (f64, f64)) -> String {
+    let text = std::fs::read_to_string(tutorial().join("l-frame-measured.csv")).unwrap();
+    let (gr, gi) = (gain.0 * gain.1.to_radians().cos(), gain.0 * gain.1.to_radians().sin());
+    let mut out = String::from("# kind = accelerance\n# units = (m/s^2)/V\n");
+    for line in text.lines().filter(|l| !l.starts_with('#')) {
+        if line.starts_with("frequency") {
+            out.push_str(line);
+            out.push('\n');
+            continue;
+        }
+        let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
+        let w2 = (2.0 * std::f64::consts::PI * v[0]).powi(2);
+        let mut row = vec![v[0].to_string()];
+        for p in v[1..].chunks(2) {
+            // (re + j im) (gr + j gi) (-w^2)
+            let (re, im) = (p[0] * gr - p[1] * gi, p[0] * gi + p[1] * gr);
+            row.push(format!("{:e}", -w2 * re));
+            row.push(format!("{:e}", -w2 * im));
+        }
+        out.push_str(&row.join(","));
+        out.push('\n');
+    }
+    out
+}
+
+/// The tutorial case reading `data`, written into `dir`, with `extra` lines
+/// appended to its `[measurement]` table.
+fn case_with(dir: &Path, name: &str, data: &str, extra: &str) -> PathBuf {
+    let text = std::fs::read_to_string(tutorial().join("l-frame.toml")).unwrap();
+    let text = text.replace("data = \"l-frame-measured.csv\"", &format!("data = \"{data}\"\n{extra}"));
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn json(out: &std::process::Output) -> serde_json::Value {
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+fn f(v: &serde_json::Value) -> f64 {
+    v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
+}
+
+#[test]
+fn compare_fits_the_gain_of_per_volt_data_the_same_from_the_case_and_from_measured() {
+    let dir = tempfile::tempdir().unwrap();
+    let (g1, g2) = ((150.0, 40.0), (0.02, -120.0));
+    std::fs::write(dir.path().join("v1.csv"), per_volt_accelerance(g1)).unwrap();
+    std::fs::write(dir.path().join("v2.csv"), per_volt_accelerance(g2)).unwrap();
+    let case = case_with(dir.path(), "v1.toml", "v1.csv", "");
+    let from_case = json(&rfm(&["compare", case.to_str().unwrap(), "--json"]));
+    let v2 = dir.path().join("v2.csv");
+    let from_file = json(&rfm(&["compare", case.to_str().unwrap(), "--json", "--measured", v2.to_str().unwrap()]));
+    // no Rust shapes in the document
+    let text = from_case.to_string();
+    assert!(!text.contains("\"Ok\"") && !text.contains("\"Err\""), "{text}");
+    for doc in [&from_case, &from_file] {
+        assert!(doc["gain_setting"].as_str().unwrap().starts_with("per-reference"), "{doc}");
+        assert_eq!(doc["kind"], "accelerance");
+        assert!(doc["notes"].as_array().unwrap().iter().any(|n| n.as_str().unwrap().contains("per volt")), "{doc}");
+    }
+    // the comparison does not depend on the constant, nor on how the data arrive
+    let (a, b) = (&from_case["correlation"]["total"], &from_file["correlation"]["total"]);
+    for key in ["log_misfit", "rms_db", "mean_frac", "rms_phase_deg"] {
+        assert!((f(&a[key]) - f(&b[key])).abs() <= 1e-9 * f(&a[key]).abs().max(1e-12), "{key}: {a} vs {b}");
+    }
+    // a level offset common to the reference is taken by the gain: no mean dB error is left
+    assert!(f(&a["mean_db"]).abs() < 1e-9, "{a}");
+    // the two fitted gains differ by the ratio of the constants
+    let (ga, gb) = (&from_case["gains"][0], &from_file["gains"][0]);
+    assert_eq!(ga["key"], "23:uy");
+    assert!((f(&ga["magnitude"]) / f(&gb["magnitude"]) / (g1.0 / g2.0) - 1.0).abs() < 1e-9, "{ga} {gb}");
+    let dphase = (f(&ga["phase_deg"]) - f(&gb["phase_deg"]) - (g1.1 - g2.1)).rem_euclid(360.0);
+    assert!(dphase.min(360.0 - dphase) < 1e-7, "{ga} {gb}");
+}
+
+#[test]
+fn gains_none_is_refused_for_per_volt_data_where_it_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("v.csv"), per_volt_accelerance((10.0, 0.0))).unwrap();
+    let case = case_with(dir.path(), "v.toml", "v.csv", "gains = \"none\"");
+    let out = rfm(&["compare", case.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
+    assert!(stderr.contains("v.toml:46:9") && stderr.contains("23:uy are per volt"), "{stderr}");
+    assert!(stderr.contains("calibration"), "{stderr}");
+    // a calibration in N/V makes the data per newton: no gain is fitted then
+    let case = case_with(dir.path(), "c.toml", "v.csv", "calibration = { \"23:uy\" = \"0.1 V/N\" }");
+    let doc = json(&rfm(&["compare", case.to_str().unwrap(), "--json"]));
+    assert!(doc["gains"].as_array().unwrap().is_empty() && doc["gain_setting"].as_str().unwrap().starts_with("none"));
+    assert!(doc["notes"].as_array().unwrap().iter().any(|n| n.as_str().unwrap().contains("per volt to per newton")));
+}
+
+/// The acceptance test of the issue: the same leader with `data =` and
+/// with `--measured`, whatever the constant; the gains go into the applied
+/// case and into `updated.toml`.
+#[test]
+fn diagnosis_of_per_volt_data_names_the_joint_whatever_the_gain_and_keeps_the_gains() {
+    let dir = tempfile::tempdir().unwrap();
+    let (g1, g2) = ((150.0, 40.0), (3.0e-3, 170.0));
+    std::fs::write(dir.path().join("v1.csv"), per_volt_accelerance(g1)).unwrap();
+    std::fs::write(dir.path().join("v2.csv"), per_volt_accelerance(g2)).unwrap();
+    let case = case_with(dir.path(), "v1.toml", "v1.csv", "");
+    let applied = dir.path().join("applied.toml");
+    let a =
+        json(&rfm(&["diagnose", case.to_str().unwrap(), "--json", "--apply", "1", "--out", applied.to_str().unwrap()]));
+    let v2 = dir.path().join("v2.csv");
+    let b = json(&rfm(&["diagnose", case.to_str().unwrap(), "--json", "--measured", v2.to_str().unwrap()]));
+    for (d, g) in [(&a, g1), (&b, g2)] {
+        assert_eq!(d["gains"], true);
+        let top = &d["ranking"][0];
+        // the hidden joint (l-frame-truth.toml): kr = 2e4 at node 13
+        assert_eq!((top["kind"].as_str().unwrap(), &top["nodes"]), ("flexible_joint", &serde_json::json!([13])));
+        let gain = &top["gains"][0];
+        assert!((f(&gain["magnitude"]) / g.0 - 1.0).abs() < 0.01, "{gain} vs {g:?}");
+        let dphase = (f(&gain["phase_deg"]) - g.1).rem_euclid(360.0);
+        assert!(dphase.min(360.0 - dphase) < 1.0, "{gain} vs {g:?}");
+    }
+    let (ka, kb) = (f(&a["ranking"][0]["parameters"][0]["value"]), f(&b["ranking"][0]["parameters"][0]["value"]));
+    assert!((ka / kb - 1.0).abs() < 1e-3, "{ka} vs {kb}");
+    let text = std::fs::read_to_string(&applied).unwrap();
+    assert!(text.contains("gains = \"per-reference\"") && text.contains("fitted_gains = { \"23:uy\" = ["), "{text}");
+    let out_dir = dir.path().join("up");
+    let u = json(&rfm(&["update", applied.to_str().unwrap(), "--json", "--out", out_dir.to_str().unwrap()]));
+    assert!(u["gain_setting"].as_str().unwrap().starts_with("per-reference"), "{u}");
+    let updated = std::fs::read_to_string(out_dir.join("updated.toml")).unwrap();
+    let line = updated.lines().find(|l| l.starts_with("fitted_gains")).expect("fitted_gains in updated.toml");
+    let mag: f64 = line.split('[').nth(1).unwrap().split(',').next().unwrap().trim().parse().unwrap();
+    assert!((mag / g1.0 - 1.0).abs() < 0.01, "{line}");
+    // written paths are relative to the written file: it can be moved with its data
+    assert!(updated.contains("data = \"../v1.csv\""), "{updated}");
+}
+
+/// Lines of poor coherence hardly move the fitted gain: the gain is the
+/// coherence-weighted mean of `ln(M/H)`, computed here from its definition.
+#[test]
+fn compare_weights_the_gain_fit_by_the_measured_coherence() {
+    use frf::io::uff::{self, DataAxis, Encoding, UffWriteOptions};
+    let dir = tempfile::tempdir().unwrap();
+    let case = tutorial().join("l-frame.toml");
+    let model_csv = dir.path().join("model.csv");
+    let out = rfm(&["simulate", case.to_str().unwrap(), "--kind", "accelerance", "--out", model_csv.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let mut set = frf::io::csv::read_csv(&model_csv).unwrap();
+    let (nc, nf) = (set.channels().len(), set.n_freq());
+    let g = frf::C64::from_polar(80.0, 0.5);
+    let mut coherence = Vec::with_capacity(nc * nf);
+    for c in 0..nc {
+        let lines = set.frequencies_hz().to_vec();
+        for (v, f) in set.channel_mut(c).iter_mut().zip(&lines) {
+            // below 100 Hz the data are ten times off, with a coherence of 0.05
+            let poor = *f < 100.0;
+            *v *= if poor { g * 10.0 } else { g };
+            coherence.push(if poor { 0.05 } else { 0.99 });
+        }
+    }
+    set.set_coherence(coherence.clone()).unwrap();
+    let mut functions = uff::frf_set_to_functions(&set, &UffWriteOptions::default()).unwrap();
+    for f in functions.iter_mut().filter(|f| f.header.function_type == uff::FUNCTION_FRF) {
+        f.header.denominator = DataAxis::new(0, "Voltage", "V");
+    }
+    std::fs::write(dir.path().join("v.uff"), uff::encode(&functions, Encoding::Ascii).unwrap()).unwrap();
+    let case = case_with(dir.path(), "v.toml", "v.uff", "");
+    let doc = json(&rfm(&["compare", case.to_str().unwrap(), "--json"]));
+    let n = doc["notes"].as_array().unwrap();
+    assert!(n.iter().any(|x| x.as_str().unwrap().contains("weighted by its measured coherence")), "{n:?}");
+    // the weight of a line: sqrt(g / (1 - g)), capped at 30, per residual; squared in the misfit
+    let w2 = |coh: f64| ((coh / (1.0 - coh)).sqrt().min(30.0) / 30.0).powi(2);
+    let (mut num, mut den) = (0.0, 0.0);
+    for &coh in &coherence {
+        let log_ratio = g.norm().ln() + if coh < 0.5 { 10f64.ln() } else { 0.0 };
+        num += w2(coh) * log_ratio;
+        den += w2(coh);
+    }
+    let want = (num / den).exp();
+    let got = f(&doc["gains"][0]["magnitude"]);
+    assert!((got / want - 1.0).abs() < 1e-9, "gain {got}, weighted mean {want}");
+    // and unweighted it would be far off: 98 of 599 lines are ten times off
+    assert!(want / g.norm() - 1.0 < 1e-3, "{want}");
+}
