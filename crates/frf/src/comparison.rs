@@ -48,6 +48,9 @@ pub enum ComparisonError {
     Model(#[from] ModeError),
 }
 
+/// Model modes are computed up to this multiple of the measured band's top.
+pub const MODEL_REACH: f64 = 2.0;
+
 /// Every free DOF of a system, node by node.
 pub fn free_dofs(system: &DampedSystem) -> Vec<DofRef> {
     let dofs = &system.assembly().dofs;
@@ -76,7 +79,9 @@ pub fn compare_modes(
     };
     let estimate = lscf(&rec, &LscfOptions::new(band.0, band.1))?;
     let meas = measured_modes(&estimate);
-    let model = model_modes(system, &free_dofs(system), band.1)?;
+    // model modes above the band too, so that a measured mode near its top
+    // is paired with a partner the model has moved out of it (and says so)
+    let model = model_modes(system, &free_dofs(system), MODEL_REACH * band.1)?;
     let pairing = pair_modes(&model, &meas, min_mac);
     Ok(ModalComparison { estimate, measured: meas, model, pairing, band_hz: band })
 }

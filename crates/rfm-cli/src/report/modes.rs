@@ -53,6 +53,7 @@ pub(crate) struct ModesJson {
 /// The mode table: each measured mode with its partner and what the
 /// pair suggests, then the model modes nothing was paired with, by frequency.
 pub(crate) fn rows(c: &ModalComparison) -> ModesJson {
+    let outside = |hz: f64| hz < c.band_hz.0 || hz > c.band_hz.1;
     let mut rows = Vec::new();
     for (i, m) in c.measured.iter().enumerate() {
         let row = match c.pairing.pairs.iter().find(|p| p.measured == i) {
@@ -66,7 +67,16 @@ pub(crate) fn rows(c: &ModalComparison) -> ModesJson {
                     frequency_error_pct: Some(p.frequency_error_pct),
                     damping_error_pct: Some(p.damping_error_pct),
                     mac: Some(p.mac),
-                    reading: frf::symptom(x, m, p.mac).reading().to_string(),
+                    reading: if outside(x.frequency_hz) {
+                        format!(
+                            "its model partner ({:.2} Hz) lies outside the band {}-{} Hz",
+                            x.frequency_hz,
+                            short(c.band_hz.0),
+                            short(c.band_hz.1)
+                        )
+                    } else {
+                        frf::symptom(x, m, p.mac).reading().to_string()
+                    },
                 }
             }
             None => ModeRow {
@@ -77,13 +87,19 @@ pub(crate) fn rows(c: &ModalComparison) -> ModesJson {
                 frequency_error_pct: None,
                 damping_error_pct: None,
                 mac: None,
-                reading: format!("no model mode with a similar shape (MAC < {MIN_MAC})"),
+                reading: format!(
+                    "no model mode up to {} Hz with a similar shape (MAC < {MIN_MAC})",
+                    short(frf::comparison::MODEL_REACH * c.band_hz.1)
+                ),
             },
         };
         rows.push(row);
     }
     for &j in &c.pairing.unpaired_model {
         let x = &c.model[j];
+        if outside(x.frequency_hz) {
+            continue;
+        }
         rows.push(ModeRow {
             measured_hz: None,
             measured_damping_ratio: None,
@@ -141,21 +157,26 @@ fn figures(
 ) -> Result<Vec<Block>> {
     let mut blocks = Vec::new();
     let meas_hz: Vec<f64> = c.measured.iter().map(|m| m.frequency_hz).collect();
-    let model_hz: Vec<f64> = c.model.iter().map(|m| m.frequency_hz).collect();
-    let pairs: Vec<(usize, usize)> = c.pairing.pairs.iter().map(|p| (p.measured, p.model)).collect();
+    // the model modes in the band and those paired from above it
+    let (lo, hi) = c.band_hz;
+    let columns: Vec<usize> = (0..c.model.len())
+        .filter(|&j| {
+            let f = c.model[j].frequency_hz;
+            (lo..=hi).contains(&f) || c.pairing.pairs.iter().any(|p| p.model == j)
+        })
+        .collect();
+    let model_hz: Vec<f64> = columns.iter().map(|&j| c.model[j].frequency_hz).collect();
+    let column_of = |j: usize| columns.iter().position(|&k| k == j);
+    let pairs: Vec<(usize, usize)> =
+        c.pairing.pairs.iter().filter_map(|p| Some((p.measured, column_of(p.model)?))).collect();
+    let mac: Vec<Vec<f64>> = c.pairing.mac.iter().map(|row| columns.iter().map(|&j| row[j]).collect()).collect();
     if !meas_hz.is_empty() && !model_hz.is_empty() {
-        let svg = plot::modes::mac_matrix(
-            "MAC of measured against model modes",
-            &meas_hz,
-            &model_hz,
-            &c.pairing.mac,
-            &pairs,
-        )?;
+        let svg = plot::modes::mac_matrix("MAC of measured against model modes", &meas_hz, &model_hz, &mac, &pairs)?;
         blocks.push(out.figure(
             "mac-matrix",
             svg,
             format!(
-                "The modal assurance criterion of every measured mode (rows) with every model mode in the band \
+                "The modal assurance criterion of every measured mode (rows) with every model mode in the band (and any paired from above it) \
                  (columns), over the {} measured responses: 1 for the same shape, 0 for orthogonal ones. Outlined: \
                  the one-to-one pairing (greedy by MAC, at least {MIN_MAC}). A clear diagonal says the modes \
                  correspond; a pair off the diagonal, that the model orders its modes differently; a row without an \
