@@ -53,6 +53,7 @@ pub mod error;
 pub mod fix;
 pub mod freqsel;
 pub mod gain;
+pub mod jackknife;
 pub mod lstsq;
 pub mod measured;
 pub mod oe;

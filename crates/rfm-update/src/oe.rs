@@ -175,6 +175,11 @@ pub struct OeResult {
     pub covariance: Mat<f64>,
     /// Estimated residual variance per real residual.
     pub sigma2: f64,
+    /// Covariance of `(theta, gain parameters)` by the delete-a-block
+    /// jackknife over the lines ([`crate::jackknife`]): the spread that
+    /// model error gives the estimates. `None` with regularisation or too
+    /// few lines.
+    pub jackknife: Option<Mat<f64>>,
     /// Singular values of the column-scaled Jacobian at the solution.
     pub singular_values: Vec<f64>,
     /// Right singular vectors of the scaled Jacobian (columns), to name
@@ -602,6 +607,19 @@ pub(crate) fn run_with(
     let covariance = covariance(&sol, sigma2);
     let residual_correlation =
         adjacent_correlation(&final_point.residual, measured.n_freq(), measured.channels().len());
+    let jackknife = if opts.regularization == 0.0 {
+        let fixed: Vec<bool> = (0..jac.ncols()).map(|j| j < n && at_bound[j]).collect();
+        crate::jackknife::block_covariance(
+            jac,
+            &final_point.residual,
+            measured.n_freq(),
+            measured.channels().len(),
+            &fixed,
+            opts.rcond,
+        )
+    } else {
+        None
+    };
     let gains = (0..ev.refs.len())
         .filter(|_| opts.gains)
         .map(|v| {
@@ -619,6 +637,7 @@ pub(crate) fn run_with(
         n_data,
         covariance,
         sigma2,
+        jackknife,
         singular_values: sol.singular_values.clone(),
         v: sol.v.clone(),
         at_bound,

@@ -22,6 +22,12 @@
 //! correlated with coefficient `rho` (an AR(1) residual of `n` values
 //! carries the information of about `n (1 - rho) / (1 + rho)` independent
 //! ones), where `rho` is larger than its noise-only spread `2 / sqrt(n)`.
+//! Neither factor sees how model error pulls a parameter: a residual only
+//! 1.3 times the noise can hold an error that moves a stiffness by many
+//! noise-only standard deviations. Where either factor exceeds 1, the
+//! standard deviation is at least the delete-a-block jackknife's
+//! ([`crate::jackknife`]): the spread of the estimates with each part of
+//! the band left out, which model error makes wide and noise does not.
 //!
 //! The data do not determine every parameter well. Each is flagged as weakly
 //! determined, with the reason, when:
@@ -126,7 +132,10 @@ pub fn analyse(params: &ParameterSet, result: &OeResult, band_hz: (f64, f64), no
     for (i, p) in params.params().iter().enumerate() {
         let value = result.values[i];
         let s_noise = c[(i, i)].max(0.0).sqrt() * to_noise;
-        let s = s_noise * inflation;
+        // where the residual shows model error, the spread of the estimates
+        // over the band's parts too, when it is the larger
+        let s_jack = result.jackknife.as_ref().filter(|_| inflation > 1.0).map_or(0.0, |j| j[(i, i)].max(0.0).sqrt());
+        let s = (s_noise * inflation).max(s_jack);
         let mut warnings = Vec::new();
         if result.at_bound[i] {
             warnings.push("ended on its bound; its uncertainty is not meaningful".to_string());
@@ -201,9 +210,14 @@ pub fn analyse(params: &ParameterSet, result: &OeResult, band_hz: (f64, f64), no
     let shown_first = if inflation > 1.0 {
         format!(
             "with model error: the noise-only standard deviation times {inflation:.2} (the fit leaves {:.2} times the \
-             noise, adjacent residuals correlated {:.2})",
+             noise, adjacent residuals correlated {:.2}){}",
             chi2_per_dof.map_or(1.0, f64::sqrt),
-            result.residual_correlation
+            result.residual_correlation,
+            if result.jackknife.is_some() {
+                ", or the spread of the estimates with each block of adjacent lines left out (jackknife) where that is larger"
+            } else {
+                ""
+            }
         )
     } else {
         "with model error, which adds nothing here: the residual is at the noise level and uncorrelated".to_string()
