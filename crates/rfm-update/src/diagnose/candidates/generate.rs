@@ -667,9 +667,12 @@ fn in_line_joints(ctx: &Ctx<'_>, nodes: impl IntoIterator<Item = u32>) -> Vec<Sp
 ///
 /// - around a window: every window of its kind (damping: viscous and
 ///   non-viscous) of every size at every offset within reach of it;
+/// - around a mass change: lumped masses, with and without rotary inertia,
+///   at the nodes of its window;
 /// - around a joint, support or mass: single-element stiffness and mass
 ///   changes of the elements at its nodes and their neighbours, and on large
-///   models the in-line joints there;
+///   models the in-line joints there; around a joint, every stiffness
+///   window within reach as well;
 /// - the fuller variants of a joint (translational springs) and a mass
 ///   (rotary inertia).
 pub(crate) fn refine(
@@ -706,6 +709,14 @@ pub(crate) fn refine(
             let run = &ctx.runs[r];
             let range = lo.saturating_sub(reach)..(hi + reach + 1).min(run.len());
             specs.extend(all_windows(&ctx, run, range, kinds));
+            // a mass spread over a window may be a lumped mass (with its
+            // rotary inertia) at one of its nodes
+            if c.kind == EffectKind::MassChange {
+                for n in nodes_of(model, &beams) {
+                    specs.push(mass(&ctx, n, false));
+                    specs.push(mass(&ctx, n, true));
+                }
+            }
             // a lossy joint in a large model first shows as a stiffness loss
             // around it (small models try every in-line joint at once)
             if !ctx.small() && c.kind == EffectKind::StiffnessChange {
@@ -715,7 +726,10 @@ pub(crate) fn refine(
             }
             continue;
         }
-        // around a point effect: single elements nearby, and in-line joints
+        // around a point effect: single elements nearby, and in-line joints;
+        // around a joint, every stiffness window within reach (a stiffness
+        // loss over a few elements and a rotational spring at their middle
+        // look alike, and the first pass tries long windows only at strides)
         for &n in &c.nodes {
             for &b in ctx.at(n) {
                 let (r, p) = ctx.run_of[b];
@@ -724,6 +738,10 @@ pub(crate) fn refine(
                 specs.extend(
                     strided(run, range.clone(), 1, 1).into_iter().flat_map(|w| window(&ctx, w, &WINDOW_KINDS[..2])),
                 );
+                if c.kind == EffectKind::FlexibleJoint {
+                    let around = p.saturating_sub(reach)..(p + reach + 1).min(run.len());
+                    specs.extend(all_windows(&ctx, run, around, &WINDOW_KINDS[..1]));
+                }
                 if !ctx.small() {
                     for &b in &run[range] {
                         specs.extend(in_line_joints(&ctx, model.beams()[b].nodes.map(|n| n.0)));
