@@ -224,8 +224,13 @@ fn add_and_update(
     let mut oe_opts = study.output_error_options()?;
     oe_opts.max_iterations = opts.update_iterations;
     // the loop decides from the misfit against the noise; restarting each
-    // intermediate (knowingly incomplete) model would only cost time
-    oe_opts.restarts = 0;
+    // intermediate (knowingly incomplete) model would only cost time. The
+    // last step's model is the answer: when its fit leaves more than the
+    // noise, restarts tell an optimiser stuck in a local minimum (they find
+    // a lower one) from a model that lacks something (they do not).
+    if step < opts.max_steps {
+        oe_opts.restarts = 0;
+    }
     let outcome = study.run_output_error(&oe_opts, |_| {})?;
     let misfit_updated = diagnose::log_misfit_with(&outcome.system, measured, lines, d.gains)?;
     let model = outcome.system.model();
