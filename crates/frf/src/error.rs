@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use fe_model::DofRef;
 
-use crate::solver::FactorKind;
+use crate::factor_kind::FactorKind;
 
 /// An FRF computation or data error.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

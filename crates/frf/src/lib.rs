@@ -78,6 +78,7 @@
 pub mod comparison;
 pub mod correlation;
 pub mod error;
+mod factor_kind;
 pub mod io;
 mod ldlt;
 pub mod lscf;
