@@ -82,6 +82,7 @@ mod factor_kind;
 pub mod io;
 mod ldlt;
 pub mod lscf;
+mod mac;
 pub mod modal;
 pub mod noise;
 pub mod set;
