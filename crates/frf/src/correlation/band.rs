@@ -1,7 +1,8 @@
 //! The bands of a correlation: given edges, fractional octaves, or one band
 //! per measured resonance.
 
-use crate::error::FrfError;
+use crate::error::{FrfError, MismatchError};
+use crate::label::short;
 use crate::set::FrfSet;
 
 /// How to split the frequency range into bands.
@@ -109,7 +110,7 @@ pub fn bands(spec: &BandSpec, measured: &FrfSet) -> Result<Vec<Band>, FrfError> 
         }
         BandSpec::Octave { fraction } => {
             if *fraction == 0 {
-                return Err(FrfError::Mismatch("octave bands need at least one band per octave".into()));
+                return Err(MismatchError::NoOctaveFraction.into());
             }
             let n = f64::from(*fraction);
             let half = 2f64.powf(0.5 / n);
@@ -126,47 +127,30 @@ pub fn bands(spec: &BandSpec, measured: &FrfSet) -> Result<Vec<Band>, FrfError> 
         }
         BandSpec::Edges(edges) => {
             if edges.len() < 2 {
-                return Err(FrfError::Mismatch("band edges: give at least two frequencies".into()));
+                return Err(MismatchError::TooFewBandEdges.into());
             }
             if let Some(&x) = edges.iter().find(|x| !(x.is_finite() && **x >= 0.0)) {
-                return Err(FrfError::Mismatch(format!("band edge {x} Hz is not a finite, non-negative frequency")));
+                return Err(MismatchError::BadBandEdge { edge_hz: x }.into());
             }
             if let Some(w) = edges.windows(2).find(|w| !(w[1] > w[0])) {
-                return Err(FrfError::Mismatch(format!(
-                    "band edges must increase strictly, but {} Hz is followed by {} Hz",
-                    w[0], w[1]
-                )));
+                return Err(MismatchError::BandEdgesNotIncreasing { before: w[0], after: w[1] }.into());
             }
             let out: Vec<Band> = edges.windows(2).map(|w| plain(w[0], w[1])).collect();
             let last = out.len() - 1;
             for (i, b) in out.iter().enumerate() {
                 if !f.iter().any(|&x| x >= b.lo_hz && (x < b.hi_hz || (i == last && x <= b.hi_hz))) {
-                    return Err(FrfError::Mismatch(format!(
-                        "band {} has no measured line (the data spans {} to {} Hz)",
-                        b.label(),
-                        short(lo),
-                        short(hi)
-                    )));
+                    return Err(MismatchError::EmptyBand {
+                        lo_hz: b.lo_hz,
+                        hi_hz: b.hi_hz,
+                        data_lo_hz: lo,
+                        data_hi_hz: hi,
+                    }
+                    .into());
                 }
             }
             Ok(out)
         }
     }
-}
-
-/// A frequency in a short form for labels (`12.5`, `1000`, `0.25`).
-pub(crate) fn short(f: f64) -> String {
-    if f >= 100.0 {
-        format!("{f:.0}")
-    } else if f >= 10.0 {
-        trim(format!("{f:.1}"))
-    } else {
-        trim(format!("{f:.2}"))
-    }
-}
-
-fn trim(s: String) -> String {
-    if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.').to_string() } else { s }
 }
 
 #[cfg(test)]
@@ -194,7 +178,7 @@ mod tests {
         assert!(x.frequencies_hz().iter().all(|&f| third.iter().filter(|b| inside(b, f)).count() == 1));
         assert!((third[1].lo_hz / third[0].lo_hz).log2() * 3.0 >= 1.0 - 1e-9);
         let mismatch = |spec: BandSpec| match bands(&spec, &x) {
-            Err(FrfError::Mismatch(m)) => m,
+            Err(FrfError::Mismatch(m)) => m.to_string(),
             other => panic!("{spec:?}: expected a mismatch, got {other:?}"),
         };
         assert!(mismatch(BandSpec::Edges(vec![10.0])).contains("give at least two frequencies"));

@@ -71,7 +71,7 @@
 
 use num_complex::Complex64 as C64;
 
-use crate::error::FrfError;
+use crate::error::{FrfError, MismatchError};
 use crate::set::{Channel, FrfKind, FrfSet};
 
 mod band;
@@ -271,18 +271,14 @@ pub fn correlate(measured: &FrfSet, model: &FrfSet, spec: &BandSpec) -> Result<C
     if model.n_freq() != nf
         || model.frequencies_hz().iter().zip(f).any(|(a, b)| (a - b).abs() > 1e-6 * b.abs().max(1e-12))
     {
-        return Err(FrfError::Mismatch(format!(
-            "the model FRFs have {} lines, the measured {}; they must be on the same lines",
-            model.n_freq(),
-            nf
-        )));
+        return Err(MismatchError::LinesDiffer { model: model.n_freq(), measured: nf }.into());
     }
     let model = if model.kind() == measured.kind() { model.clone() } else { model.converted(measured.kind()) };
     let index = model.channel_indices();
     let idx: Vec<usize> = measured
         .channels()
         .iter()
-        .map(|c| index.get(c).copied().ok_or_else(|| FrfError::Mismatch(format!("the model FRFs have no channel {c}"))))
+        .map(|c| index.get(c).copied().ok_or(FrfError::Mismatch(MismatchError::MissingChannel { channel: *c })))
         .collect::<Result<_, _>>()?;
     let bands = bands(spec, measured)?;
     let n_ch = measured.channels().len();
@@ -524,7 +520,7 @@ mod tests {
         assert!(r.total.log_misfit < 1e-12, "{}", r.total.log_misfit);
         assert_eq!(r.kind(), FrfKind::Receptance);
         let mismatch = |r: Result<Correlation, FrfError>| match r {
-            Err(FrfError::Mismatch(m)) => m,
+            Err(FrfError::Mismatch(m)) => m.to_string(),
             other => panic!("expected a mismatch, got {other:?}"),
         };
         let fewer = x.select_channels(&[0, 1]);
