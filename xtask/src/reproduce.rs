@@ -11,15 +11,12 @@ use fe_model::case::RunCheck;
 
 use crate::check;
 
-/// The paper's case studies, in the paper's order.
-const PAPER_CASES: [&str; 6] = [
-    "two-material-beam",
-    "two-material-beam-high-damping",
-    "two-material-beam-noisy",
-    "monopile",
-    "cantilever-flexible-clamp",
-    "f-frame",
-];
+/// The paper's case studies, in the paper's order: the names in
+/// `cases/paper-cases.txt`, the one list of them (rfm-update's tests read it
+/// too).
+fn paper_cases() -> impl Iterator<Item = &'static str> {
+    include_str!("../../cases/paper-cases.txt").lines().map(str::trim).filter(|l| !l.is_empty() && !l.starts_with('#'))
+}
 
 /// The tutorial: a model missing a joint and data from the frame that has it.
 const TUTORIAL: &str = "tutorial";
@@ -73,11 +70,8 @@ fn update(
 }
 
 pub(crate) fn reproduce(cases: &[String]) -> Result<(), String> {
-    let mut names: Vec<String> = if cases.is_empty() {
-        PAPER_CASES.iter().chain(&[TUTORIAL]).map(|s| s.to_string()).collect()
-    } else {
-        cases.to_vec()
-    };
+    let mut names: Vec<String> =
+        if cases.is_empty() { paper_cases().chain([TUTORIAL]).map(str::to_string).collect() } else { cases.to_vec() };
     let tutorial = names.iter().any(|n| n == TUTORIAL);
     names.retain(|n| n != TUTORIAL);
     // read every case (and its checks) before the long build and runs, so

@@ -74,11 +74,12 @@ use faer::diag::Diag;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::evd::ComputeEigenvectors;
 use faer::linalg::gevd;
-use faer::linalg::{evd, triangular_solve};
+use faer::linalg::triangular_solve;
 use faer::{Mat, Par, Side, Spec};
 use fe_model::MatrixKind;
 use num_complex::Complex64 as C64;
 
+use crate::eigen::{RealEigen, real_eigen};
 use crate::modal::ModalError;
 use crate::system::DampedSystem;
 
@@ -460,32 +461,11 @@ fn solve_standard(ops: &Operators<'_>, (a, lk): (Mat<f64>, Mat<f64>)) -> Result<
     let n = ops.n();
     let big = a.nrows();
     let w_ref = a.norm_max().max(f64::MIN_POSITIVE);
-    let mut s_re = Diag::<f64>::zeros(big);
-    let mut s_im = Diag::<f64>::zeros(big);
-    let mut u = Mat::<f64>::zeros(big, big);
-    let scratch =
-        evd::evd_scratch::<f64>(big, ComputeEigenvectors::No, ComputeEigenvectors::Yes, Par::Seq, Default::default());
-    evd::evd_real(
-        a.as_ref(),
-        s_re.as_mut(),
-        s_im.as_mut(),
-        None,
-        Some(u.as_mut()),
-        Par::Seq,
-        MemStack::new(&mut MemBuffer::new(scratch)),
-        Default::default(),
-    )
-    .map_err(|_| ModalError::NoConvergence)?;
+    let RealEigen { re: s_re, im: s_im, vectors: u } = real_eigen(a.as_ref()).map_err(|_| ModalError::NoConvergence)?;
     // x = L_K^-T y1
     let mut x = u.submatrix(0, 0, n, big).to_owned();
     triangular_solve::solve_upper_triangular_in_place(lk.transpose(), x.as_mut(), Par::Seq);
-    Ok(Spectrum {
-        s_re: (0..big).map(|i| s_re[i]).collect(),
-        s_im: (0..big).map(|i| s_im[i]).collect(),
-        s_b: vec![1.0; big],
-        x,
-        w_ref,
-    })
+    Ok(Spectrum { s_re, s_im, s_b: vec![1.0; big], x, w_ref })
 }
 
 /// The pencil `A z = s B z` in the variables `(w0 x, v, q)`, for models

@@ -72,6 +72,7 @@
 //! ```
 
 pub mod complex_modes;
+pub mod eigen;
 pub mod kernel;
 pub mod modal;
 pub mod system;

@@ -1,12 +1,20 @@
-//! Errors of the FRF layer.
+//! Errors of the FRF layer, by concern: [`FrfError`] is what every frf
+//! function returns; its own variants are the model's DOFs and the solver
+//! (a singular or non-finite `Z`, the factorisation), while the errors of
+//! files ([`FileError`]) and of FRF data that do not fit together
+//! ([`MismatchError`]) are types of their own inside it, so that a caller
+//! matches `FrfError::File(_)` or `FrfError::Mismatch(_)` as a whole, or a
+//! case of either.
 
 use std::path::PathBuf;
 
 use fe_model::DofRef;
 
-use crate::solver::FactorKind;
+use crate::channel::Channel;
+use crate::factor_kind::FactorKind;
+use crate::label::short;
 
-/// An FRF computation or data error.
+/// An FRF computation or data error (see the module docs).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum FrfError {
     /// A channel names a node the model does not have.
@@ -71,6 +79,17 @@ pub enum FrfError {
         /// The frequency.
         freq_hz: f64,
     },
+    /// Reading or writing a file failed, or its content is malformed.
+    #[error(transparent)]
+    File(#[from] FileError),
+    /// FRF data, or what is asked of them, that do not fit together.
+    #[error(transparent)]
+    Mismatch(#[from] MismatchError),
+}
+
+/// A file that cannot be read or written, or whose content is malformed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FileError {
     /// Reading or writing a file failed.
     #[error("{}: {message}", path.display())]
     Io {
@@ -98,9 +117,92 @@ pub enum FrfError {
         /// Why.
         message: String,
     },
-    /// Two FRF sets that should match do not.
-    #[error("{0}")]
-    Mismatch(String),
+}
+
+/// FRF data, or what is asked of them, that do not fit together: the lines
+/// and channels of a set, two sets compared, the bands of a correlation.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MismatchError {
+    /// A channel is listed twice in one set.
+    #[error("channel {channel} appears twice")]
+    RepeatedChannel {
+        /// The channel.
+        channel: Channel,
+    },
+    /// Coherence values that do not match the FRF values one to one.
+    #[error("coherence has {values} values, the FRFs {frfs}")]
+    CoherenceLength {
+        /// Number of coherence values given.
+        values: usize,
+        /// Number of FRF values (channels x lines).
+        frfs: usize,
+    },
+    /// A line asked for that the data does not have.
+    #[error("the data has no line at {freq_hz} Hz (nearest lines must match to 1e-6)")]
+    NoLine {
+        /// The line asked for.
+        freq_hz: f64,
+    },
+    /// Frequency lines that do not increase strictly.
+    #[error("frequencies must increase strictly, but {before} Hz is followed by {after} Hz")]
+    NotIncreasing {
+        /// The first line out of order.
+        before: f64,
+        /// The line after it.
+        after: f64,
+    },
+    /// Fractional-octave bands with no band per octave.
+    #[error("octave bands need at least one band per octave")]
+    NoOctaveFraction,
+    /// Band edges that do not make a band.
+    #[error("band edges: give at least two frequencies")]
+    TooFewBandEdges,
+    /// A band edge that is not a frequency.
+    #[error("band edge {edge_hz} Hz is not a finite, non-negative frequency")]
+    BadBandEdge {
+        /// The edge.
+        edge_hz: f64,
+    },
+    /// Band edges that do not increase strictly.
+    #[error("band edges must increase strictly, but {before} Hz is followed by {after} Hz")]
+    BandEdgesNotIncreasing {
+        /// The first edge out of order.
+        before: f64,
+        /// The edge after it.
+        after: f64,
+    },
+    /// A band between given edges that holds no measured line.
+    #[error(
+        "band {}-{} Hz has no measured line (the data spans {} to {} Hz)",
+        short(*lo_hz),
+        short(*hi_hz),
+        short(*data_lo_hz),
+        short(*data_hi_hz)
+    )]
+    EmptyBand {
+        /// Lower edge of the band.
+        lo_hz: f64,
+        /// Upper edge of the band.
+        hi_hz: f64,
+        /// The lowest measured line.
+        data_lo_hz: f64,
+        /// The highest measured line.
+        data_hi_hz: f64,
+    },
+    /// Model FRFs on other lines than the measured ones.
+    #[error("the model FRFs have {model} lines, the measured {measured}; they must be on the same lines")]
+    LinesDiffer {
+        /// Number of model lines.
+        model: usize,
+        /// Number of measured lines.
+        measured: usize,
+    },
+    /// A measured channel the model FRFs do not have.
+    #[error("the model FRFs have no channel {channel}")]
+    MissingChannel {
+        /// The channel.
+        channel: Channel,
+    },
 }
 
 fn held_factors(held: &Option<FactorKind>) -> &'static str {

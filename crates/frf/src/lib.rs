@@ -75,12 +75,16 @@
 //! }
 //! ```
 
+mod channel;
 pub mod comparison;
 pub mod correlation;
 pub mod error;
+mod factor_kind;
 pub mod io;
+mod label;
 mod ldlt;
 pub mod lscf;
+mod mac;
 pub mod modal;
 pub mod noise;
 pub mod set;
@@ -89,7 +93,7 @@ pub mod synth;
 
 pub use comparison::{ComparisonError, ModalComparison, compare_modes};
 pub use correlation::{BandSpec, Correlation, correlate};
-pub use error::FrfError;
+pub use error::{FileError, FrfError, MismatchError};
 pub use lscf::{EstimatedMode, LscfError, LscfOptions, ModalEstimate, PoleStatus, lscf};
 pub use modal::{
     Mode, ModeError, ModePair, Pairing, Symptom, mac, mac_matrix, measured_modes, model_modes, pair_modes, symptom,

@@ -24,6 +24,7 @@ use num_complex::Complex64 as C64;
 
 use crate::error::FrfError;
 use crate::lscf::ModalEstimate;
+pub use crate::mac::mac;
 use crate::synth::equation_of;
 
 /// A mode for comparison.
@@ -80,15 +81,6 @@ pub fn measured_modes(estimate: &ModalEstimate) -> Vec<Mode> {
             shape: m.shape.clone(),
         })
         .collect()
-}
-
-/// MAC of two complex vectors of the same length (0 when either is zero).
-pub fn mac(a: &[C64], b: &[C64]) -> f64 {
-    assert_eq!(a.len(), b.len(), "MAC of vectors of different lengths");
-    let dot: C64 = a.iter().zip(b).map(|(x, y)| x.conj() * y).sum();
-    let na: f64 = a.iter().map(|x| x.norm_sqr()).sum();
-    let nb: f64 = b.iter().map(|x| x.norm_sqr()).sum();
-    if na == 0.0 || nb == 0.0 { 0.0 } else { dot.norm_sqr() / (na * nb) }
 }
 
 /// MAC of two modes over the DOFs they share (0 when they share none).

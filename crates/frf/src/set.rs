@@ -6,7 +6,8 @@ use std::fmt;
 use fe_model::DofRef;
 use num_complex::Complex64 as C64;
 
-use crate::error::FrfError;
+pub use crate::channel::Channel;
+use crate::error::{FrfError, MismatchError};
 
 /// What an FRF relates: displacement, velocity or acceleration to force.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -55,28 +56,6 @@ impl fmt::Display for FrfKind {
     }
 }
 
-/// One FRF: response DOF over reference (excitation) DOF.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct Channel {
-    /// Response DOF (row of the FRF matrix).
-    pub response: DofRef,
-    /// Reference DOF (column).
-    pub reference: DofRef,
-}
-
-impl Channel {
-    /// Shorthand constructor.
-    pub fn new(response: DofRef, reference: DofRef) -> Self {
-        Channel { response, reference }
-    }
-}
-
-impl fmt::Display for Channel {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "H({},{})", self.response, self.reference)
-    }
-}
-
 /// A set of FRFs over common frequency lines.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FrfSet {
@@ -98,7 +77,7 @@ impl FrfSet {
         // channels must read in linear time
         let mut seen = HashSet::with_capacity(channels.len());
         if let Some(c) = channels.iter().find(|&&c| !seen.insert(c)) {
-            return Err(FrfError::Mismatch(format!("channel {c} appears twice")));
+            return Err(MismatchError::RepeatedChannel { channel: *c }.into());
         }
         let data = vec![C64::new(0.0, 0.0); frequencies_hz.len() * channels.len()];
         Ok(FrfSet { frequencies_hz, channels, kind, data, coherence: None })
@@ -167,11 +146,7 @@ impl FrfSet {
     /// Attaches coherence values (channel-major, same layout as the data).
     pub fn set_coherence(&mut self, values: Vec<f64>) -> Result<(), FrfError> {
         if values.len() != self.data.len() {
-            return Err(FrfError::Mismatch(format!(
-                "coherence has {} values, the FRFs {}",
-                values.len(),
-                self.data.len()
-            )));
+            return Err(MismatchError::CoherenceLength { values: values.len(), frfs: self.data.len() }.into());
         }
         self.coherence = Some(values);
         Ok(())
@@ -202,11 +177,7 @@ impl FrfSet {
     pub fn at_frequencies(&self, freqs_hz: &[f64]) -> Result<FrfSet, FrfError> {
         let idx: Vec<usize> = freqs_hz
             .iter()
-            .map(|&f| {
-                self.line_of(f).ok_or_else(|| {
-                    FrfError::Mismatch(format!("the data has no line at {f} Hz (nearest lines must match to 1e-6)"))
-                })
-            })
+            .map(|&f| self.line_of(f).ok_or(FrfError::Mismatch(MismatchError::NoLine { freq_hz: f })))
             .collect::<Result<_, _>>()?;
         self.select_lines(&idx)
     }
@@ -273,10 +244,7 @@ pub(crate) fn check_frequencies(f: &[f64]) -> Result<(), FrfError> {
         return Err(FrfError::BadFrequency { freq_hz: x });
     }
     if let Some(w) = f.windows(2).find(|w| !(w[1] > w[0])) {
-        return Err(FrfError::Mismatch(format!(
-            "frequencies must increase strictly, but {} Hz is followed by {} Hz",
-            w[0], w[1]
-        )));
+        return Err(MismatchError::NotIncreasing { before: w[0], after: w[1] }.into());
     }
     Ok(())
 }
@@ -305,7 +273,7 @@ mod tests {
     fn frequencies_must_increase_and_channels_be_distinct() {
         let c = Channel::new(DofRef::new(2, Dof::Uy), DofRef::new(2, Dof::Uy));
         let mismatch = |r: Result<FrfSet, FrfError>| match r {
-            Err(FrfError::Mismatch(m)) => m,
+            Err(FrfError::Mismatch(m)) => m.to_string(),
             other => panic!("expected a mismatch, got {other:?}"),
         };
         let m = mismatch(FrfSet::zeros(vec![1.0, 1.0], vec![c], FrfKind::Receptance));

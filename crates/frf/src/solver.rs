@@ -68,12 +68,13 @@ use std::sync::OnceLock;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::sparse::linalg::lu::{LuRef, NumericLu, SymbolicLu, factorize_symbolic_lu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
-use faer::traits::pulp::Simd;
 use faer::{Conj, Mat, MatMut, MatRef, Par};
 use fe_model::Pattern;
 use num_complex::Complex64 as C64;
 
 use crate::error::FrfError;
+pub use crate::factor_kind::FactorKind;
+pub use crate::ldlt::mul_add;
 use crate::ldlt::{NOT_IN_COLUMN, NumericLdlt, SymbolicLdlt};
 
 const ZERO: C64 = C64 { re: 0.0, im: 0.0 };
@@ -92,15 +93,6 @@ pub struct ZSolver {
     ldlt: SymbolicLdlt,
     /// Symbolic LU for the fallback, made on first need.
     lu: OnceLock<Result<SymbolicLu<usize>, String>>,
-}
-
-/// Which factorisation a [`Workspace`] holds.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum FactorKind {
-    /// Complex-symmetric `L D L^T` (the normal case).
-    Ldlt,
-    /// Sparse LU with partial pivoting (the fallback).
-    Lu,
 }
 
 /// Per-thread numeric factors and scratch memory.
@@ -564,22 +556,6 @@ fn check_amplification(z_max: f64, b_max: f64, x_max: f64, freq_hz: f64) -> Resu
 /// solution; a huge but finite `L D L^T` solution passed the pivot test.
 fn check_solution(x: &[C64], freq_hz: f64) -> Result<(), FrfError> {
     if x.iter().all(|&v| is_finite(v)) { Ok(()) } else { Err(FrfError::Singular { freq_hz }) }
-}
-
-/// `dst += a * src` over equal-length slices, vectorised: the update of the
-/// solver's eliminations, shared with the sensitivity assembly's products.
-#[inline(always)]
-pub fn mul_add<S: Simd>(simd: S, dst: &mut [C64], a: C64, src: &[C64]) {
-    let av = simd.splat_c64s(a);
-    let (dh, dt) = S::as_mut_simd_c64s(dst);
-    let (sh, st) = S::as_simd_c64s(src);
-    for (d, s) in dh.iter_mut().zip(sh) {
-        *d = simd.mul_add_c64s(av, *s, *d);
-    }
-    if !dt.is_empty() {
-        let r = simd.mul_add_c64s(av, simd.partial_load_c64s(st), simd.partial_load_c64s(dt));
-        simd.partial_store_c64s(dt, r);
-    }
 }
 
 #[cfg(test)]

@@ -10,7 +10,7 @@
 use std::fmt;
 
 use fe_model::{CaseError, ModelError};
-use frf::FrfError;
+use frf::{FileError, FrfError};
 use rfm_update::UpdateError;
 use rfm_update::rfm::Status;
 
@@ -165,12 +165,11 @@ pub(crate) fn frf_exit(e: &FrfError) -> Exit {
         | FrfError::Factorization(_)
         | FrfError::NoLdltFactors { .. }
         | FrfError::CliqueOutOfRange { .. } => Exit::Numerics,
-        FrfError::Unwritable { .. } => Exit::Output,
+        FrfError::File(FileError::Unwritable { .. }) => Exit::Output,
         FrfError::UnknownDof { .. }
         | FrfError::FixedDof { .. }
         | FrfError::BadFrequency { .. }
-        | FrfError::Io { .. }
-        | FrfError::Parse { .. }
+        | FrfError::File(FileError::Io { .. } | FileError::Parse { .. })
         | FrfError::Mismatch(_) => Exit::InvalidInput,
     }
 }
@@ -320,7 +319,8 @@ mod tests {
     fn a_singular_line_is_failed_numerics_and_a_parse_error_invalid_input() {
         let singular: Failure = FrfError::Singular { freq_hz: 15.9 }.into();
         assert_eq!(singular.exit, Exit::Numerics);
-        let parse: Failure = FrfError::Parse { path: "m.csv".into(), line: 3, message: "x".into() }.into();
+        let parse: Failure =
+            FrfError::from(FileError::Parse { path: "m.csv".into(), line: 3, message: "x".into() }).into();
         assert_eq!((parse.exit, parse.message.as_str()), (Exit::InvalidInput, "m.csv:3: x"));
     }
 }

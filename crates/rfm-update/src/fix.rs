@@ -233,12 +233,7 @@ fn add_and_update(
     }
     let outcome = study.run_output_error(&oe_opts, |_| {})?;
     let misfit_updated = diagnose::log_misfit_with(&outcome.system, measured, lines, d.gains)?;
-    let model = outcome.system.model();
-    let values: Vec<(String, f64)> = study
-        .parameters
-        .iter()
-        .flat_map(|p| p.quantities.iter().map(|&q| (model.quantity_name(q).to_string(), model.get(q))))
-        .collect();
+    let values = crate::params::quantity_values(&study.parameters, outcome.system.model());
     editor.set_values(&values, &format!("updated by rfm fix, step {step}"))?;
     editor.push_history(&HistoryEntry {
         step: format!("updated after step {step}"),

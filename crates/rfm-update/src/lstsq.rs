@@ -134,6 +134,34 @@ pub fn solve(a: &Mat<f64>, b: &[f64], rcond: f64) -> LstsqSolution {
     }
 }
 
+/// Names the parameter combination along the weakest direction of a
+/// column-scaled sensitivity matrix (singular values `sv`, right singular
+/// vectors as the columns of `v`, one row per parameter of `names`) when it
+/// is nearly singular: its smallest singular value is below 1e-6 of the
+/// largest. Used by the response function method and the output-error
+/// uncertainty.
+pub(crate) fn unresolved_combination(sv: &[f64], v: &Mat<f64>, names: &[String]) -> Option<String> {
+    let n = names.len();
+    let smax = sv.first().copied()?;
+    let (k, &smin) = sv.iter().enumerate().min_by(|a, b| a.1.total_cmp(b.1))?;
+    if smax == 0.0 || smin > 1e-6 * smax {
+        return None;
+    }
+    let mut parts: Vec<(f64, usize)> = (0..n.min(v.nrows())).map(|i| (v[(i, k)], i)).collect();
+    parts.sort_by(|a, b| b.0.abs().total_cmp(&a.0.abs()));
+    let terms: Vec<String> = parts
+        .iter()
+        .take(3)
+        .filter(|(c, _)| c.abs() > 0.1)
+        .map(|(c, i)| format!("{:+.2} ln({})", c, names[*i]))
+        .collect();
+    Some(format!(
+        "the data cannot separate the combination {} (singular value ratio {:.1e})",
+        terms.join(" "),
+        smin / smax
+    ))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

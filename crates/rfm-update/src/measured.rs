@@ -9,9 +9,9 @@ use std::path::Path;
 
 use damping::DampedSystem;
 use fe_model::case::{CalibrationTarget, MeasurementSpec, PairingSpec};
-use frf::FrfError;
 use frf::io::uff::{self, Direction, PairingOptions};
 use frf::io::{Measured, MeasuredFormat, ReadOptions};
+use frf::{FileError, FrfError};
 
 use crate::error::UpdateError;
 
@@ -64,20 +64,18 @@ fn read_paired(
         Some((g, f)) => (*g, f),
         None => (path, &file),
     };
-    let geometry = geo_file.geometry().map_err(|(line, message)| FrfError::Parse {
-        path: geo_path.to_path_buf(),
-        line,
-        message,
-    })?;
+    let geometry = geo_file
+        .geometry()
+        .map_err(|(line, message)| FrfError::File(FileError::Parse { path: geo_path.to_path_buf(), line, message }))?;
     if geometry.nodes.is_empty() {
-        return Err(UpdateError::Frf(FrfError::Parse {
+        return Err(UpdateError::Frf(FrfError::File(FileError::Parse {
             path: geo_path.to_path_buf(),
             line: 1,
             message: "`pair = \"coordinates\"`, but the file holds no node coordinates (datasets 15 or 2411); \
                       export the geometry with the FRFs, name a `geometry` file, or map the test points with \
                       [[measurement.map]]"
                 .into(),
-        }));
+        })));
     }
     let mut used: Vec<i64> = Vec::new();
     for r in &file.records {

@@ -8,11 +8,21 @@
 
 use damping::DampedSystem;
 use faer::Mat;
-use fe_model::{Parameter, Quantity};
+use fe_model::{Model, Parameter, Quantity};
 use num_complex::Complex64 as C64;
 
 use crate::error::UpdateError;
 use crate::sensitivity::FrequencyBlock;
+
+/// The value of every quantity of `params` in `model`, by name: what an
+/// updated case file records (`rfm update`'s `updated.toml`, each step of
+/// `rfm fix`).
+pub fn quantity_values(params: &[Parameter], model: &Model) -> Vec<(String, f64)> {
+    params
+        .iter()
+        .flat_map(|p| p.quantities.iter().map(|&q| (model.quantity_name(q).to_string(), model.get(q))))
+        .collect()
+}
 
 /// The parameters of an updating run, with their quantities flattened.
 #[derive(Clone, Debug)]

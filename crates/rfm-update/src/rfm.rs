@@ -453,7 +453,7 @@ pub fn run(
         .map(|(&v, &(lo, hi))| (v - lo).abs() <= 1e-9 * lo.abs() || (v - hi).abs() <= 1e-9 * hi.abs())
         .collect();
     let names: Vec<String> = params.params().iter().map(|p| p.name.clone()).collect();
-    let unresolved = crate::uncertainty::unresolved_combination(&best_svd.0, &best_svd.1, &names);
+    let unresolved = crate::lstsq::unresolved_combination(&best_svd.0, &best_svd.1, &names);
     Ok(RfmResult {
         history,
         status,

@@ -42,10 +42,10 @@
 //! scaled Jacobian is nearly singular, the parameter combination it cannot
 //! resolve.
 
-use faer::Mat;
 use fe_model::Quantity;
 use serde::Serialize;
 
+use crate::lstsq;
 use crate::oe::OeResult;
 use crate::params::ParameterSet;
 
@@ -203,7 +203,7 @@ pub fn analyse(params: &ParameterSet, result: &OeResult, band_hz: (f64, f64), no
         }
     }
     let names: Vec<String> = out.iter().map(|p| p.name.clone()).collect();
-    if let Some(w) = unresolved_combination(&result.singular_values, &result.v, &names) {
+    if let Some(w) = lstsq::unresolved_combination(&result.singular_values, &result.v, &names) {
         warnings.push(w);
     }
     let chi2_per_dof = noise.filter(|&s| s > 0.0).map(|s| (residual_rms / s).powi(2));
@@ -232,33 +232,6 @@ pub fn analyse(params: &ParameterSet, result: &OeResult, band_hz: (f64, f64), no
         residual_correlation: result.residual_correlation,
         inflation,
     }
-}
-
-/// Names the parameter combination along the weakest direction of a
-/// column-scaled sensitivity matrix (singular values `sv`, right singular
-/// vectors as the columns of `v`, one row per parameter of `names`) when it
-/// is nearly singular: its smallest singular value is below 1e-6 of the
-/// largest. Also used for the response function method.
-pub(crate) fn unresolved_combination(sv: &[f64], v: &Mat<f64>, names: &[String]) -> Option<String> {
-    let n = names.len();
-    let smax = sv.first().copied()?;
-    let (k, &smin) = sv.iter().enumerate().min_by(|a, b| a.1.total_cmp(b.1))?;
-    if smax == 0.0 || smin > 1e-6 * smax {
-        return None;
-    }
-    let mut parts: Vec<(f64, usize)> = (0..n.min(v.nrows())).map(|i| (v[(i, k)], i)).collect();
-    parts.sort_by(|a, b| b.0.abs().total_cmp(&a.0.abs()));
-    let terms: Vec<String> = parts
-        .iter()
-        .take(3)
-        .filter(|(c, _)| c.abs() > 0.1)
-        .map(|(c, i)| format!("{:+.2} ln({})", c, names[*i]))
-        .collect();
-    Some(format!(
-        "the data cannot separate the combination {} (singular value ratio {:.1e})",
-        terms.join(" "),
-        smin / smax
-    ))
 }
 
 #[cfg(test)]

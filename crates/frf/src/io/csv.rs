@@ -36,7 +36,7 @@ use fe_model::case::MaskRule;
 use num_complex::Complex64 as C64;
 
 use super::mask::{Masked, Origin};
-use crate::error::FrfError;
+use crate::error::{FileError, FrfError};
 use crate::set::{Channel, FrfKind, FrfSet};
 
 /// Writes a set as CSV (real and imaginary parts), atomically.
@@ -200,12 +200,11 @@ pub fn read_csv_with(path: &Path, rules: &[MaskRule]) -> Result<CsvFrfs, FrfErro
 
 /// Reads a CSV FRF file with [`CsvOptions`].
 pub fn read_csv_opts(path: &Path, opts: &CsvOptions<'_>) -> Result<CsvFrfs, FrfError> {
-    let bytes = std::fs::read(path)
-        .map_err(|e| FrfError::Io { path: path.to_path_buf(), message: format!("cannot read: {e}") })?;
-    let text = fe_model::text::decode(&bytes).map_err(|e| FrfError::Parse {
-        path: path.to_path_buf(),
-        line: e.line,
-        message: e.to_string(),
+    let bytes = std::fs::read(path).map_err(|e| {
+        FrfError::File(FileError::Io { path: path.to_path_buf(), message: format!("cannot read: {e}") })
+    })?;
+    let text = fe_model::text::decode(&bytes).map_err(|e| {
+        FrfError::File(FileError::Parse { path: path.to_path_buf(), line: e.line, message: e.to_string() })
     })?;
     parse_csv_opts(path, text, opts)
 }
@@ -237,7 +236,8 @@ struct Declared {
 /// Parses CSV text with [`CsvOptions`]; `path` is used in messages.
 pub fn parse_csv_opts(path: &Path, text: &str, opts: &CsvOptions<'_>) -> Result<CsvFrfs, FrfError> {
     let rules = opts.rules;
-    let err = |line: usize, message: String| FrfError::Parse { path: path.to_path_buf(), line, message };
+    let err =
+        |line: usize, message: String| FrfError::File(FileError::Parse { path: path.to_path_buf(), line, message });
     let mut declared = Declared::default();
     let mut header: Option<(usize, Vec<String>, char)> = None;
     let mut rows: Vec<(usize, Vec<f64>)> = Vec::new();

@@ -13,7 +13,7 @@ use std::path::Path;
 use fe_model::case::MaskRule;
 use fe_model::{DofMap, DofRef, Slot};
 
-use crate::error::FrfError;
+use crate::error::{FileError, FrfError};
 use crate::set::{Channel, FrfSet};
 
 /// Something left out of measured data by a mask rule.
@@ -76,11 +76,11 @@ pub(crate) fn non_finite_lines(
         let (k, c) = bad[0];
         let (line, what) = describe(k, c);
         let more = if bad.len() > 1 { format!(" ({} lines have such values)", bad.len()) } else { String::new() };
-        return Err(FrfError::Parse {
+        return Err(FrfError::File(FileError::Parse {
             path: path.to_path_buf(),
             line,
             message: format!("{what}{more}; {}", hint(MaskRule::NonFinite, "such lines")),
-        });
+        }));
     }
     let masked = bad
         .iter()
@@ -93,11 +93,11 @@ pub(crate) fn non_finite_lines(
         .collect();
     let keep: Vec<usize> = (0..nf).filter(|k| bad.binary_search_by_key(k, |b| b.0).is_err()).collect();
     if keep.is_empty() {
-        return Err(FrfError::Parse {
+        return Err(FrfError::File(FileError::Parse {
             path: path.to_path_buf(),
             line: locate(0, 0).0,
             message: "every frequency line has a non-finite value: nothing is left to compare".into(),
-        });
+        }));
     }
     Ok((set.select_lines(&keep)?, masked))
 }
@@ -137,23 +137,23 @@ pub fn check_channels(
         let origin = origins.get(c).cloned().unwrap_or(Origin { line: 1, label: format!("channel {}", c + 1) });
         let detail = format!("{}: {ch}: {why}", origin.label);
         if !allow {
-            return Err(FrfError::Parse {
+            return Err(FrfError::File(FileError::Parse {
                 path: path.to_path_buf(),
                 line: origin.line,
                 message: format!(
                     "{detail}; map the test point to a model DOF with [[measurement.map]], {}",
                     hint(MaskRule::UnmodelledChannels, "such channels")
                 ),
-            });
+            }));
         }
         masked.push(Masked { rule: MaskRule::UnmodelledChannels, freq_hz: None, channel: Some(*ch), detail });
     }
     if keep.is_empty() {
-        return Err(FrfError::Parse {
+        return Err(FrfError::File(FileError::Parse {
             path: path.to_path_buf(),
             line: origins.first().map_or(1, |o| o.line),
             message: "no channel of the file is at a free DOF of the model: nothing is left to compare".into(),
-        });
+        }));
     }
     let kept = keep.iter().filter_map(|&c| origins.get(c).cloned()).collect();
     Ok((set.select_channels(&keep), kept, masked))
@@ -172,7 +172,7 @@ pub(crate) fn duplicate_lines(
 ) -> Result<(Vec<usize>, Vec<Masked>), FrfError> {
     let err = |k: usize, message: String| {
         let (line, prefix) = at(k);
-        FrfError::Parse { path: path.to_path_buf(), line, message: format!("{prefix}{message}") }
+        FrfError::File(FileError::Parse { path: path.to_path_buf(), line, message: format!("{prefix}{message}") })
     };
     let mut keep: Vec<usize> = Vec::with_capacity(freqs.len());
     let mut masked = Vec::new();

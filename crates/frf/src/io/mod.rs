@@ -22,7 +22,7 @@ use fe_model::case::{ChannelMap, MaskRule};
 
 pub use mask::{Masked, Origin, check_channels};
 
-use crate::error::FrfError;
+use crate::error::{FileError, FrfError};
 use crate::set::FrfSet;
 
 /// A measured-data file format.
@@ -61,7 +61,7 @@ pub fn detect_format(path: &Path) -> Result<MeasuredFormat, FrfError> {
     if looks_csv {
         return Ok(MeasuredFormat::Csv);
     }
-    Err(FrfError::Io {
+    Err(FrfError::File(FileError::Io {
         path: path.to_path_buf(),
         message: format!(
             "cannot tell the format of this file{}: it is neither a universal file (dataset 58, first line `-1`) \
@@ -69,7 +69,7 @@ pub fn detect_format(path: &Path) -> Result<MeasuredFormat, FrfError> {
             if ext.is_empty() { String::new() } else { format!(" (extension `.{ext}`)") },
             UFF_EXTENSIONS.map(|e| format!(".{e}")).join(", ")
         ),
-    })
+    }))
 }
 
 /// What a measured channel's values are relative to, as read from its file.
@@ -117,11 +117,11 @@ impl Measured {
         let (set, origins, masked) = check_channels(path, self.set, &self.origins, dofs, rules)?;
         let units = set.channels().iter().filter_map(|c| by_channel.get(c).cloned()).collect();
         if set.channels().is_empty() {
-            return Err(FrfError::Parse {
+            return Err(FrfError::File(FileError::Parse {
                 path: path.to_path_buf(),
                 line: 1,
                 message: "no channel is left: every channel is at a node the model lacks or at a supported DOF".into(),
-            });
+            }));
         }
         let mut all = self.masked;
         all.extend(masked);
@@ -181,7 +181,7 @@ pub fn check_not_empty(path: &Path, measured: Measured) -> Result<Measured, FrfE
     // The readers refuse an empty record or table where they see it; this
     // is the last guard, so that no command ever indexes an empty set.
     if measured.set.n_freq() == 0 || measured.set.channels().is_empty() {
-        return Err(FrfError::Parse {
+        return Err(FrfError::File(FileError::Parse {
             path: path.to_path_buf(),
             line: 1,
             message: format!(
@@ -189,7 +189,7 @@ pub fn check_not_empty(path: &Path, measured: Measured) -> Result<Measured, FrfE
                 measured.set.n_freq(),
                 measured.set.channels().len()
             ),
-        });
+        }));
     }
     Ok(measured)
 }
@@ -273,10 +273,10 @@ pub fn refuse_inputs(outputs: &[PathBuf], inputs: &[PathBuf]) -> Result<(), FrfE
     let inputs: Vec<FileId> = inputs.iter().filter_map(|p| FileId::of(p)).collect();
     for path in outputs {
         if FileId::of(path).is_some_and(|id| inputs.contains(&id)) {
-            return Err(FrfError::Io {
+            return Err(FrfError::File(FileError::Io {
                 path: path.to_path_buf(),
                 message: "refusing to overwrite an input file; choose another output path".into(),
-            });
+            }));
         }
     }
     Ok(())
@@ -285,7 +285,7 @@ pub fn refuse_inputs(outputs: &[PathBuf], inputs: &[PathBuf]) -> Result<(), FrfE
 /// Writes `bytes` to `path` atomically (temporary file in the same folder,
 /// flushed and synced, then renamed). Fails if `path` is one of `inputs`.
 pub fn atomic_write(path: &Path, bytes: &[u8], inputs: &[PathBuf]) -> Result<(), FrfError> {
-    let io = |message: String| FrfError::Io { path: path.to_path_buf(), message };
+    let io = |message: String| FrfError::File(FileError::Io { path: path.to_path_buf(), message });
     refuse_inputs(&[path.to_path_buf()], inputs)?;
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),

@@ -11,7 +11,7 @@ use frf::io::uff::{
     self, Abscissa, DataAxis, Direction, Encoding, Function58, Header58, OrdinateType, Ordinates, Spacing, TestDof,
     UffWriteOptions,
 };
-use frf::{C64, Channel, FrfError, FrfKind, FrfSet};
+use frf::{C64, Channel, FileError, FrfError, FrfKind, FrfSet};
 
 const ENCODINGS: [Encoding; 3] =
     [Encoding::Ascii, Encoding::Binary { big_endian: false }, Encoding::Binary { big_endian: true }];
@@ -397,7 +397,7 @@ fn truncated_and_corrupted_files_give_errors_never_panics() {
                 Ok(f) => {
                     assert!(f.records.len() < 4 || cut + 1 >= bytes.len(), "{encoding:?}: cut at {cut} read whole")
                 }
-                Err(FrfError::Parse { message, .. }) => assert!(!message.is_empty()),
+                Err(FrfError::File(FileError::Parse { message, .. })) => assert!(!message.is_empty()),
                 Err(e) => panic!("unexpected error kind {e:?}"),
             }
             let _ = frfs(&bytes[..cut]);
@@ -420,7 +420,7 @@ fn truncated_and_corrupted_files_give_errors_never_panics() {
     let bin = sample_bytes(Encoding::BINARY);
     let data_start = bin.iter().enumerate().filter(|(_, b)| **b == b'\n').nth(12).unwrap().0 + 1;
     let e = read(&bin[..data_start + 10]).unwrap_err();
-    let FrfError::Parse { line, message, .. } = &e else { panic!("{e:?}") };
+    let FrfError::File(FileError::Parse { line, message, .. }) = &e else { panic!("{e:?}") };
     assert_eq!(*line, data_start);
     assert!(
         message.starts_with(&format!("byte offset {data_start}: record 1 (line 2)")) && message.contains("truncated"),
@@ -705,7 +705,7 @@ fn pyuff_byte_counts_and_empty_datasets_are_worked_around_with_notes() {
     let r7 = b.windows(30).position(|w| w == b"         6         8         1").unwrap();
     b[r7 + 19] = b'9';
     let e = read(&b).unwrap_err();
-    let FrfError::Parse { line, message, .. } = &e else { panic!("{e:?}") };
+    let FrfError::File(FileError::Parse { line, message, .. }) = &e else { panic!("{e:?}") };
     let start = bytes.iter().enumerate().filter(|(_, b)| **b == b'\n').nth(12).unwrap().0 + 1;
     assert_eq!(*line, start);
     assert!(message.contains("declares 128 bytes of data, but record 7's 9 values of type complex double (6) with even spacing need 144 bytes"), "{message}");

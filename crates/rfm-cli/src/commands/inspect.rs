@@ -116,33 +116,7 @@ fn record_json(r: &Record58) -> Value {
 fn csv_report(file: &Path) -> Result<Value> {
     let read = frf::io::csv::read_csv_with(file, &[])?;
     let set = read.set;
-    let f = set.frequencies_hz();
-    let records: Vec<Value> = set
-        .channels()
-        .iter()
-        .enumerate()
-        .map(|(c, ch)| {
-            json!({
-                "record": c + 1,
-                "line": Value::Null,
-                "response": { "dof": ch.response.to_string() },
-                "reference": { "dof": ch.reference.to_string() },
-                "function_type": uff::FUNCTION_FRF,
-                "function": uff::function_type_name(uff::FUNCTION_FRF),
-                "kind": set.kind().name(),
-                "units": Value::Null,
-                "abscissa": {
-                    "units": "Hz",
-                    "min": f.first(),
-                    "max": f.last(),
-                    "count": f.len(),
-                    "spacing": "listed",
-                },
-                "data_type": { "code": Value::Null, "name": "complex (decimal text)" },
-                "encoding": "CSV",
-            })
-        })
-        .collect();
+    let records: Vec<Value> = (0..set.channels().len()).map(|c| csv_record(&set, c)).collect();
     Ok(json!({
         "file": file.display().to_string(),
         "format": "csv",
@@ -150,6 +124,32 @@ fn csv_report(file: &Path) -> Result<Value> {
         "skipped": [],
         "notes": csv_notes(&read.notes, read.per_volt, &read.units),
     }))
+}
+
+/// The record of channel `c` of a CSV file: what `inspect` shows of a UFF
+/// record, for a file that has no records.
+fn csv_record(set: &frf::FrfSet, c: usize) -> Value {
+    let f = set.frequencies_hz();
+    let ch = set.channels()[c];
+    json!({
+        "record": c + 1,
+        "line": Value::Null,
+        "response": { "dof": ch.response.to_string() },
+        "reference": { "dof": ch.reference.to_string() },
+        "function_type": uff::FUNCTION_FRF,
+        "function": uff::function_type_name(uff::FUNCTION_FRF),
+        "kind": set.kind().name(),
+        "units": Value::Null,
+        "abscissa": {
+            "units": "Hz",
+            "min": f.first(),
+            "max": f.last(),
+            "count": f.len(),
+            "spacing": "listed",
+        },
+        "data_type": { "code": Value::Null, "name": "complex (decimal text)" },
+        "encoding": "CSV",
+    })
 }
 
 /// The notes of a CSV file: what reading it assumed or scaled, and the units.
@@ -173,28 +173,9 @@ fn csv_json(file: &Path) -> Result<Exit> {
     impl serde::Serialize for Records<'_> {
         fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
             let set = self.0;
-            let f = set.frequencies_hz();
             let mut seq = s.serialize_seq(Some(set.channels().len()))?;
-            for (c, ch) in set.channels().iter().enumerate() {
-                seq.serialize_element(&json!({
-                    "record": c + 1,
-                    "line": Value::Null,
-                    "response": { "dof": ch.response.to_string() },
-                    "reference": { "dof": ch.reference.to_string() },
-                    "function_type": uff::FUNCTION_FRF,
-                    "function": uff::function_type_name(uff::FUNCTION_FRF),
-                    "kind": set.kind().name(),
-                    "units": Value::Null,
-                    "abscissa": {
-                        "units": "Hz",
-                        "min": f.first(),
-                        "max": f.last(),
-                        "count": f.len(),
-                        "spacing": "listed",
-                    },
-                    "data_type": { "code": Value::Null, "name": "complex (decimal text)" },
-                    "encoding": "CSV",
-                }))?;
+            for c in 0..set.channels().len() {
+                seq.serialize_element(&csv_record(set, c))?;
             }
             seq.end()
         }

@@ -159,12 +159,7 @@ fn write_updated_model(
     step: &fe_model::HistoryEntry,
     output: &mut Outputs,
 ) -> Result<std::path::PathBuf> {
-    let model = outcome.system.model();
-    let values: Vec<(String, f64)> = study
-        .parameters
-        .iter()
-        .flat_map(|p| p.quantities.iter().map(|&q| (model.quantity_name(q).to_string(), model.get(q))))
-        .collect();
+    let values = rfm_update::params::quantity_values(&study.parameters, outcome.system.model());
     let mut comment = format!(
         "Updated by rfm ({}, status {}, misfit {:.3e}) from {}",
         outcome.method,

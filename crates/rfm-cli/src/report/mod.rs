@@ -160,6 +160,22 @@ fn short_label(label: &str) -> &str {
     label.split_whitespace().next().unwrap_or(label)
 }
 
+/// A table header: the `first` columns, then each of `per_model` once per
+/// model, named with the model where there are several.
+fn per_model_header(first: &[&str], per_model: &[&str], models: &[ModelFrfs]) -> Vec<String> {
+    let mut header: Vec<String> = first.iter().map(|s| s.to_string()).collect();
+    for m in models {
+        for what in per_model {
+            header.push(if models.len() > 1 {
+                format!("{what} ({})", short_label(&m.label))
+            } else {
+                what.to_string()
+            });
+        }
+    }
+    header
+}
+
 /// The FRF correlation section: totals per model, error against frequency,
 /// error per channel, the band table and the channel table. Figures are
 /// written through `out`; `notes` are paragraphs put first.
@@ -248,16 +264,8 @@ pub(crate) fn correlation_section(
 
     // bands
     let worst_bands = notable_bands(&last.correlation, 3);
-    let mut header: Vec<String> = vec!["band".into(), "range".into(), "lines".into()];
-    for m in models {
-        for what in ["RMS dB", "mean dB", "RMS phase (deg)", "share"] {
-            header.push(if models.len() > 1 {
-                format!("{what} ({})", short_label(&m.label))
-            } else {
-                what.to_string()
-            });
-        }
-    }
+    let header =
+        per_model_header(&["band", "range", "lines"], &["RMS dB", "mean dB", "RMS phase (deg)", "share"], models);
     let header_refs: Vec<&str> = header.iter().map(String::as_str).collect();
     let mut t = Table::new(&header_refs).caption(format!(
         "Errors per frequency band over all channels; share is the band's part of the total squared \
@@ -289,16 +297,7 @@ pub(crate) fn correlation_section(
 
     // channels
     let worst = notable_channels(&last.correlation, 3);
-    let mut header: Vec<String> = vec!["channel".into()];
-    for m in models {
-        for what in ["RMS dB", "mean dB", "RMS phase (deg)", "FRAC", "share"] {
-            header.push(if models.len() > 1 {
-                format!("{what} ({})", short_label(&m.label))
-            } else {
-                what.to_string()
-            });
-        }
-    }
+    let header = per_model_header(&["channel"], &["RMS dB", "mean dB", "RMS phase (deg)", "FRAC", "share"], models);
     let header_refs: Vec<&str> = header.iter().map(String::as_str).collect();
     let mut t = Table::new(&header_refs).caption(format!(
         "Errors per channel over all lines. Highlighted: the worst channels of the {} by complex-log \

@@ -48,14 +48,9 @@ fn monopile_recovers_the_submerged_relaxation_parameter_from_a_viscous_start() {
 
 #[test]
 fn every_paper_case_loads_and_has_truth_and_parameters() {
-    for name in [
-        "two-material-beam",
-        "two-material-beam-high-damping",
-        "two-material-beam-noisy",
-        "monopile",
-        "cantilever-flexible-clamp",
-        "f-frame",
-    ] {
+    // the list `cargo xtask reproduce` runs
+    let names = include_str!("../../../../cases/paper-cases.txt").lines().map(str::trim);
+    for name in names.filter(|l| !l.is_empty() && !l.starts_with('#')) {
         let study = Study::load(&case(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
         assert!(study.truth.is_some(), "{name}");
         // its acceptance, which `cargo xtask reproduce` holds its runs to

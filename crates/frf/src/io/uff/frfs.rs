@@ -11,7 +11,7 @@ use super::units::abscissa_to_hz;
 use super::{
     FUNCTION_COHERENCE, FUNCTION_FRF, Header58, Record58, TestDof, UffFile, frf_units, function_type_name, map_test_dof,
 };
-use crate::error::FrfError;
+use crate::error::{FileError, FrfError};
 use crate::set::{Channel, FrfKind, FrfSet};
 
 /// The FRFs of a universal file on model DOFs, and what was done to get them.
@@ -100,10 +100,12 @@ pub fn read_uff_frfs(path: &Path, map: &[ChannelMap]) -> Result<UffFrfs, FrfErro
 pub fn read_uff_frfs_with(path: &Path, map: &[ChannelMap], rules: &[MaskRule]) -> Result<UffFrfs, FrfError> {
     let bytes = super::read_bytes(path)?;
     let file = super::read::parse_with(path, &bytes, &mut |index, line, h| {
-        check_function_type(h).map_err(|m| FrfError::Parse {
-            path: path.to_path_buf(),
-            line,
-            message: format!("record {index} (line {line}): {m}"),
+        check_function_type(h).map_err(|m| {
+            FrfError::File(FileError::Parse {
+                path: path.to_path_buf(),
+                line,
+                message: format!("record {index} (line {line}): {m}"),
+            })
         })
     })?;
     frfs_from_uff_with(path, &file, map, rules)
@@ -168,7 +170,8 @@ pub fn frfs_from_uff_mapped(
     rules: &[MaskRule],
     mapper: &TestDofMapper<'_>,
 ) -> Result<UffFrfs, FrfError> {
-    let err = |line: usize, message: String| FrfError::Parse { path: path.to_path_buf(), line, message };
+    let err =
+        |line: usize, message: String| FrfError::File(FileError::Parse { path: path.to_path_buf(), line, message });
     let mut notes: Vec<String> = file.notes.clone();
     notes.extend(
         file.skipped.iter().map(|d| format!("skipped dataset {} ({}) at line {}", d.number, d.description(), d.line)),
@@ -408,11 +411,11 @@ fn attach_coherence(
         if let Some(k) = values.iter().position(|g| !(-1e-6..=1.0 + 1e-6).contains(g)) {
             let detail = format!("{label}: coherence of {channel} at {} Hz is {}, outside 0..1", freqs[k], values[k]);
             if !allow_bad {
-                return Err(FrfError::Parse {
+                return Err(FrfError::File(FileError::Parse {
                     path: path.to_path_buf(),
                     line: r.line,
                     message: format!("{detail}; {}", mask::hint(MaskRule::BadCoherence, "such coherence records")),
-                });
+                }));
             }
             masked.push(Masked {
                 rule: MaskRule::BadCoherence,

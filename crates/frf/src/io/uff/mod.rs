@@ -40,7 +40,7 @@
 //! # Errors
 //!
 //! Nothing here panics on bad input. A malformed or truncated file gives
-//! [`FrfError::Parse`] with the line (ASCII) or, for binary data, the byte
+//! [`FileError::Parse`](crate::FileError::Parse) with the line (ASCII) or, for binary data, the byte
 //! offset in the `line` field and the message, and says what was expected.
 
 mod frfs;
@@ -55,7 +55,7 @@ use std::path::Path;
 
 use num_complex::Complex64 as C64;
 
-use crate::error::FrfError;
+use crate::error::{FileError, FrfError};
 
 pub use frfs::{
     ChannelSource, TestDofMapper, UffFrfs, frfs_from_uff, frfs_from_uff_mapped, frfs_from_uff_with, read_uff_frfs,
@@ -570,5 +570,6 @@ pub fn looks_like_uff(bytes: &[u8]) -> bool {
 /// Reads and parses `path` as a universal file (the caller already checked
 /// the extension or the content).
 pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, FrfError> {
-    std::fs::read(path).map_err(|e| FrfError::Io { path: path.to_path_buf(), message: format!("cannot read: {e}") })
+    std::fs::read(path)
+        .map_err(|e| FrfError::File(FileError::Io { path: path.to_path_buf(), message: format!("cannot read: {e}") }))
 }

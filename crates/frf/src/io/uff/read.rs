@@ -1,6 +1,6 @@
 //! Reading universal files: splitting into datasets, parsing dataset 58
 //! headers and data (ASCII and binary). Every access to the input is
-//! bounds-checked; malformed input becomes `FrfError::Parse`.
+//! bounds-checked; malformed input becomes `FileError::Parse`.
 
 use std::path::Path;
 
@@ -10,7 +10,7 @@ use super::{
     Abscissa, DataAxis, Direction, Encoding, Function58, Header58, OrdinateType, Ordinates, RawDataset, Record58,
     SkippedDataset, TestDof, UffFile,
 };
-use crate::error::FrfError;
+use crate::error::{FileError, FrfError};
 
 /// Reads a universal file: every dataset 58 with its data, and the list of
 /// other datasets (skipped).
@@ -154,7 +154,7 @@ struct Parser<'a, 'p> {
 
 impl<'a> Parser<'a, '_> {
     fn err(&self, line: usize, message: String) -> FrfError {
-        FrfError::Parse { path: self.path.to_path_buf(), line, message }
+        FrfError::File(FileError::Parse { path: self.path.to_path_buf(), line, message })
     }
 
     /// Skips a dataset that is not 58 up to its closing `-1`; returns its
@@ -420,10 +420,12 @@ impl<'a> Parser<'a, '_> {
         let uneven = matches!(spacing, Spacing::Uneven);
         let per = values_per_point(h.ordinate_type, uneven);
         let path = self.path;
-        let boff = |off: usize, m: String| FrfError::Parse {
-            path: path.to_path_buf(),
-            line: off,
-            message: format!("byte offset {off}: {label}: {m}"),
+        let boff = |off: usize, m: String| {
+            FrfError::File(FileError::Parse {
+                path: path.to_path_buf(),
+                line: off,
+                message: format!("byte offset {off}: {label}: {m}"),
+            })
         };
         let expected = n.checked_mul(per).and_then(|v| v.checked_mul(size));
         // pyuff declares 8 bytes per abscissa point whatever the data holds; its reader ignores

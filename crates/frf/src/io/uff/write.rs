@@ -15,7 +15,7 @@ use super::{
     Abscissa, DataAxis, Encoding, FUNCTION_COHERENCE, FUNCTION_FRF, Function58, Header58, OrdinateType, Ordinates,
     model_to_test_dof,
 };
-use crate::error::FrfError;
+use crate::error::{FileError, FrfError};
 use crate::set::{FrfKind, FrfSet};
 
 const FORMAT: &str = "UFF dataset 58";
@@ -74,7 +74,7 @@ pub fn to_uff_bytes(set: &FrfSet, options: &UffWriteOptions) -> Result<Vec<u8>, 
 /// (the inverse of the default channel mapping), units in SI by kind; and a
 /// coherence record (type 6) after each when the set has coherence.
 pub fn frf_set_to_functions(set: &FrfSet, options: &UffWriteOptions) -> Result<Vec<Function58>, FrfError> {
-    let unwritable = |message: String| FrfError::Unwritable { format: FORMAT, message };
+    let unwritable = |message: String| FrfError::File(FileError::Unwritable { format: FORMAT, message });
     if !options.ordinate_type.is_complex() {
         return Err(unwritable(format!(
             "FRFs are complex; ordinate type {} would drop their imaginary parts (use complex single (5) or \
@@ -183,8 +183,9 @@ fn reproduces(f: &[f64], min: f64, step: f64) -> bool {
 pub fn encode(functions: &[Function58], encoding: Encoding) -> Result<Vec<u8>, FrfError> {
     let mut out = Vec::new();
     for (i, f) in functions.iter().enumerate() {
-        encode_one(&mut out, f, encoding)
-            .map_err(|m| FrfError::Unwritable { format: FORMAT, message: format!("function {}: {m}", i + 1) })?;
+        encode_one(&mut out, f, encoding).map_err(|m| {
+            FrfError::File(FileError::Unwritable { format: FORMAT, message: format!("function {}: {m}", i + 1) })
+        })?;
     }
     Ok(out)
 }

@@ -10,7 +10,9 @@
 
 use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, Ranged};
 
-use super::{C64, LogAxis, log_tick, tick};
+use ::frf::FrfKind;
+
+use super::C64;
 
 /// How the frequency axis of a figure is scaled.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
@@ -237,6 +239,136 @@ impl Ranged for PhaseAxis {
     }
 }
 
+/// Padded range of finite values, or `fallback` when there are none.
+pub(super) fn range(values: impl Iterator<Item = f64>, fallback: (f64, f64)) -> (f64, f64) {
+    let (lo, hi) =
+        values.filter(|v| v.is_finite()).fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+    if !lo.is_finite() {
+        return fallback;
+    }
+    let pad = ((hi - lo) * 0.05).max(1e-9 * hi.abs().max(1.0));
+    (lo - pad, hi + pad)
+}
+
+/// A range for a logarithmic axis: from the 1-2-5 step at or below the
+/// smallest positive value to the one at or above the largest.
+pub(super) fn log_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) =
+        values.filter(|v| v.is_finite() && *v > 0.0).fold((f64::INFINITY, 0.0f64), |(a, b), v| (a.min(v), b.max(v)));
+    if !lo.is_finite() {
+        return (0.1, 10.0);
+    }
+    let steps = |v: f64| {
+        let d = 10f64.powf(v.log10().floor());
+        [d, 2.0 * d, 5.0 * d, 10.0 * d]
+    };
+    let lo = steps(lo).into_iter().rev().find(|&s| s <= lo * (1.0 + 1e-9)).unwrap_or(lo);
+    let hi = steps(hi).into_iter().find(|&s| s >= hi * (1.0 - 1e-9)).unwrap_or(hi);
+    if hi <= lo { (lo / 2.0, hi * 2.0) } else { (lo, hi) }
+}
+
+/// Tick labels of a logarithmic axis: `1e-5`, `0.01`, `0.2`, `5`, `100`;
+/// whole mantissas only (which ticks exist is up to [`LogAxis`]).
+pub(super) fn log_tick(v: &f64) -> String {
+    let e = v.log10().floor();
+    let m = v / 10f64.powf(e);
+    let Some(m) = (1..=10).map(f64::from).find(|x| (m - x).abs() < 1e-6 * x) else {
+        return String::new();
+    };
+    let (m, e) = if m == 10.0 { (1.0, e as i32 + 1) } else { (m, e as i32) };
+    match e {
+        -2..=3 => crate::table::num(m * 10f64.powi(e)),
+        _ if m == 1.0 => format!("1e{e}"),
+        _ => format!("{m}e{e}"),
+    }
+}
+
+/// Tick labels of a linear axis without a trailing `.0`.
+pub(super) fn tick(v: &f64) -> String {
+    let s = format!("{v:.6}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" { "0".into() } else { s.to_string() }
+}
+
+/// Splits a curve where it is not finite or where a wrapped phase jumps by
+/// more than half a turn, so that no line is drawn across the gap.
+pub(super) fn segments(x: &[f64], y: &[f64], wrap: Option<f64>) -> Vec<Vec<(f64, f64)>> {
+    let mut out: Vec<Vec<(f64, f64)>> = Vec::new();
+    let mut current: Vec<(f64, f64)> = Vec::new();
+    for (&a, &b) in x.iter().zip(y) {
+        if !b.is_finite() {
+            if !current.is_empty() {
+                out.push(std::mem::take(&mut current));
+            }
+            continue;
+        }
+        if let (Some(turn), Some(&(_, prev))) = (wrap, current.last())
+            && (b - prev).abs() > turn / 2.0
+        {
+            out.push(std::mem::take(&mut current));
+        }
+        current.push((a, b));
+    }
+    if !current.is_empty() {
+        out.push(current);
+    }
+    out
+}
+
+pub(crate) fn unit(kind: FrfKind) -> &'static str {
+    match kind {
+        FrfKind::Receptance => "m/N",
+        FrfKind::Mobility => "m/s/N",
+        FrfKind::Accelerance => "m/s\u{b2}/N",
+    }
+}
+
+/// A logarithmic axis with ticks on whole decades for wide ranges and on
+/// the 1-2-5 steps for narrow ones (plotters' own logarithmic axis leaves
+/// narrow ranges with one or two labels).
+pub(super) struct LogAxis {
+    pub(super) lo: f64,
+    pub(super) hi: f64,
+}
+
+impl Ranged for LogAxis {
+    type FormatOption = plotters::coord::ranged1d::DefaultFormatting;
+    type ValueType = f64;
+
+    fn map(&self, v: &f64, limit: (i32, i32)) -> i32 {
+        let t = (v.log10() - self.lo.log10()) / (self.hi.log10() - self.lo.log10());
+        limit.0 + (f64::from(limit.1 - limit.0) * t).round() as i32
+    }
+
+    fn key_points<H: plotters::coord::ranged1d::KeyPointHint>(&self, hint: H) -> Vec<f64> {
+        let decades = (self.hi / self.lo).log10();
+        let light = hint.weight().allow_light_points();
+        let all = &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0];
+        let mantissas: &[f64] = if decades <= 0.5 || (light && decades <= 3.0) {
+            all
+        } else if decades <= 1.2 {
+            &[1.0, 2.0, 3.0, 5.0]
+        } else if decades <= 2.5 {
+            &[1.0, 2.0, 5.0]
+        } else {
+            &[1.0]
+        };
+        let max = hint.max_num_points().max(2);
+        let step = if mantissas.len() == 1 { (decades / max as f64).ceil().max(1.0) as i32 } else { 1 };
+        let (e0, e1) = (self.lo.log10().floor() as i32, self.hi.log10().ceil() as i32);
+        let inside = |v: &f64| *v >= self.lo * (1.0 - 1e-9) && *v <= self.hi * (1.0 + 1e-9);
+        (e0..=e1)
+            .filter(|e| (e - e0) % step == 0)
+            .flat_map(|e| mantissas.iter().map(move |m| m * 10f64.powi(e)))
+            .filter(inside)
+            .collect()
+    }
+
+    fn range(&self) -> std::ops::Range<f64> {
+        self.lo..self.hi
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -302,5 +434,30 @@ mod tests {
         // a zero value has no phase and splits nothing else
         let (r, _) = phases(&[C64::new(1.0, 0.0), C64::new(0.0, 0.0), C64::new(-1.0, 1e-9)], &[]);
         assert!(r[1].is_nan() && (r[2] - 180.0).abs() < 1e-6, "{r:?}");
+    }
+
+    #[test]
+    fn wrapped_phase_and_gaps_split_the_curve() {
+        let x = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
+        let y = [170.0, 178.0, -178.0, -170.0, f64::NAN, -160.0];
+        let s = segments(&x, &y, Some(360.0));
+        assert_eq!(s.iter().map(Vec::len).collect::<Vec<_>>(), vec![2, 2, 1]);
+        // without wrapping, only the gap splits
+        assert_eq!(segments(&x, &y, None).len(), 2);
+    }
+
+    #[test]
+    fn log_axes_span_1_2_5_steps_and_label_them() {
+        assert_eq!(log_range([3e-9, 0.0015, 0.0, f64::NAN].into_iter()), (2e-9, 0.002));
+        assert_eq!(log_range([0.4, 3.3].into_iter()), (0.2, 5.0));
+        assert_eq!(log_tick(&1e-5), "1e-5");
+        assert_eq!(log_tick(&5e-7), "5e-7");
+        assert_eq!(log_tick(&100.0), "100");
+        assert_eq!(log_tick(&0.2), "0.2");
+        assert_eq!(log_tick(&3.0), "3");
+        assert_eq!(log_tick(&3.5), "");
+        assert_eq!(tick(&50.0), "50");
+        assert_eq!(tick(&-0.0), "0");
+        assert_eq!(tick(&0.25), "0.25");
     }
 }

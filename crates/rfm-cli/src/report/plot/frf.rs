@@ -14,8 +14,7 @@ use plotters::prelude::*;
 
 use super::axes::{FreqAxis, FrequencyScale, PhaseAxis, phases};
 use super::{
-    AXIS, Area, DrawResult, FONT, GRID_BOLD, GRID_LIGHT, LegendEntry, MEASURED, Mark, PlotError, frame, range,
-    segments, svg, tick, unit,
+    Area, DrawResult, FONT, HouseStyle, LegendEntry, MEASURED, Mark, PlotError, frame, range, segments, svg, tick, unit,
 };
 
 /// Shade of lines whose coherence is below [`COHERENCE_FAIR`].
@@ -193,11 +192,7 @@ fn draw_channel(
     mesh.y_desc(y_desc)
         .x_label_formatter(&x_label)
         .y_label_formatter(&tick)
-        .light_line_style(GRID_LIGHT)
-        .bold_line_style(GRID_BOLD)
-        .axis_style(AXIS)
-        .label_style((FONT, style.label))
-        .axis_desc_style((FONT, style.desc))
+        .house_style(style.label, style.desc)
         .x_labels(style.x_labels)
         .y_labels(if style.compact { 5 } else { 8 });
     let blank = |_: &f64| String::new();
@@ -236,11 +231,7 @@ fn draw_channel(
         .y_desc(if style.compact { "deg" } else { "Phase (deg)" })
         .x_label_formatter(&x_label)
         .y_label_formatter(&tick)
-        .light_line_style(GRID_LIGHT)
-        .bold_line_style(GRID_BOLD)
-        .axis_style(AXIS)
-        .label_style((FONT, style.label))
-        .axis_desc_style((FONT, style.desc))
+        .house_style(style.label, style.desc)
         .x_labels(style.x_labels)
         .y_labels(if style.compact { 4 } else { 9 })
         .draw()?;

@@ -8,7 +8,7 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::axes::{FreqAxis, FrequencyScale};
 use super::{
-    AXIS, Dash, FONT, GRID_BOLD, GRID_LIGHT, LegendEntry, MEASURED, Mark, PlotError, UPDATED, WIDTH, frame, svg,
+    AXIS, Dash, FONT, GRID_BOLD, HouseStyle, LegendEntry, MEASURED, Mark, PlotError, UPDATED, WIDTH, frame, svg,
 };
 
 /// Colour of a MAC value from 0 (white) to 1 (the updated model's blue).
@@ -167,11 +167,7 @@ pub(crate) fn stabilisation(
             .y_desc("Model order")
             .x_label_formatter(&x_label)
             .y_label_formatter(&super::tick)
-            .light_line_style(GRID_LIGHT)
-            .bold_line_style(GRID_BOLD)
-            .axis_style(AXIS)
-            .label_style((FONT, 13))
-            .axis_desc_style((FONT, 15))
+            .house_style(13, 15)
             .x_labels(12)
             .y_labels(10)
             .draw()?;

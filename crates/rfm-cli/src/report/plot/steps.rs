@@ -2,9 +2,7 @@
 
 use plotters::prelude::*;
 
-use super::{
-    AXIS, FONT, GRID_BOLD, GRID_LIGHT, LegendEntry, LogAxis, Mark, PlotError, UPDATED, frame, log_range, log_tick, svg,
-};
+use super::{HouseStyle, LegendEntry, LogAxis, Mark, PlotError, UPDATED, frame, log_range, log_tick, svg};
 
 /// Shade of the band where a misfit is consistent with the noise.
 const NOISE_SHADE: RGBColor = RGBColor(226, 240, 226);
@@ -34,22 +32,13 @@ pub(crate) fn misfit_steps(
     let (y0, y1) = log_range(misfits.iter().copied().chain([noise, consistent * noise]));
     svg(title, 420, |root| {
         let body = frame(root, title, &legend)?;
-        let mut chart = ChartBuilder::on(&body)
-            .margin_left(12)
-            .margin_right(24)
-            .margin_top(8)
-            .x_label_area_size(44)
-            .y_label_area_size(72)
+        let mut chart = super::history::iteration_chart(&body)
             .build_cartesian_2d(-0.5..(n as f64 - 0.5), LogAxis { lo: y0, hi: y1 })?;
         chart
             .configure_mesh()
             .y_desc("misfit")
             .x_desc("step")
-            .light_line_style(GRID_LIGHT)
-            .bold_line_style(GRID_BOLD)
-            .axis_style(AXIS)
-            .label_style((FONT, 13))
-            .axis_desc_style((FONT, 15))
+            .house_style(13, 15)
             .x_labels(n)
             .x_label_formatter(&|v| {
                 let i = v.round();
@@ -68,12 +57,7 @@ pub(crate) fn misfit_steps(
             )))?;
             chart.draw_series(LineSeries::new([(-0.5, noise), (n as f64 - 0.5, noise)], NOISE.stroke_width(1)))?;
         }
-        let pts: Vec<(f64, f64)> = misfits
-            .iter()
-            .enumerate()
-            .filter(|(_, v)| v.is_finite() && **v > 0.0)
-            .map(|(i, &v)| (i as f64, v))
-            .collect();
+        let pts = super::history::per_iteration(misfits);
         chart.draw_series(LineSeries::new(pts.clone(), UPDATED.stroke_width(1)))?;
         chart.draw_series(pts.into_iter().map(|p| Circle::new(p, 5, UPDATED.filled())))?;
         Ok(())

@@ -65,55 +65,20 @@
 //! resonances, so that each band holds one mode and the misfit can be read
 //! per mode region. A line belongs to the band `[lo, hi)` (the last band
 //! includes its upper edge).
+//!
+//! The measures of one value or one FRF are in [`measure`], the bands in
+//! [`band`]; this file holds the result types and [`correlate`].
 
 use num_complex::Complex64 as C64;
 
-use crate::error::FrfError;
+use crate::error::{FrfError, MismatchError};
 use crate::set::{Channel, FrfKind, FrfSet};
 
-/// How to split the frequency range into bands.
-#[derive(Clone, Debug, PartialEq)]
-pub enum BandSpec {
-    /// One band per resonance of the measured data when it shows any
-    /// (see [`BandSpec::Resonances`]), otherwise octave bands.
-    Auto,
-    /// One band around each resonance of the measured data, with edges at the
-    /// geometric means between neighbouring resonances and at the ends of the
-    /// data. One band over everything when no resonance is found.
-    Resonances,
-    /// Base-2 fractional-octave bands (`1` = octaves, `3` = third octaves),
-    /// centred on `1000 * 2^(i / fraction)` Hz, covering the data.
-    Octave {
-        /// Bands per octave (at least 1).
-        fraction: u32,
-    },
-    /// Bands between consecutive edges (Hz, strictly increasing, at least
-    /// two). Lines outside `[first, last]` belong to no band.
-    Edges(Vec<f64>),
-}
+mod band;
+mod measure;
 
-/// One frequency band of a correlation.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Band {
-    /// Lower edge (Hz).
-    pub lo_hz: f64,
-    /// Upper edge (Hz).
-    pub hi_hz: f64,
-    /// The measured resonance the band was built around, for
-    /// [`BandSpec::Resonances`].
-    pub resonance_hz: Option<f64>,
-}
-
-impl Band {
-    /// A short label, `"12.5-25 Hz"` or `"mode at 31.7 Hz (20-60 Hz)"`.
-    pub fn label(&self) -> String {
-        let range = format!("{}-{} Hz", short(self.lo_hz), short(self.hi_hz));
-        match self.resonance_hz {
-            Some(f) => format!("peak at {} Hz ({range})", short(f)),
-            None => range,
-        }
-    }
-}
+pub use band::{Band, BandSpec, bands, resonances};
+pub use measure::{db_error, frac, phase_error_deg};
 
 /// Error measures of one channel over all lines (see the module docs).
 #[derive(Clone, Debug, PartialEq)]
@@ -253,136 +218,6 @@ fn worst(values: impl Iterator<Item = f64>, n: usize) -> Vec<usize> {
     idx.into_iter().take(n).map(|(i, _)| i).collect()
 }
 
-/// `20 log10(|a| / |x|)`: the model's level above the measurement, in dB.
-pub fn db_error(model: C64, measured: C64) -> f64 {
-    20.0 * (model.norm() / measured.norm()).log10()
-}
-
-/// `arg(a conj(x))` in degrees, wrapped to `(-180, 180]`.
-pub fn phase_error_deg(model: C64, measured: C64) -> f64 {
-    let d = (model * measured.conj()).arg().to_degrees();
-    // `arg` returns [-pi, pi]; map -180 to +180 so the interval is half-open
-    if d <= -180.0 { d + 360.0 } else { d }
-}
-
-/// The frequency response assurance criterion of two FRFs over the same lines
-/// (see the module docs); 0 when either is identically zero.
-pub fn frac(measured: &[C64], model: &[C64]) -> f64 {
-    let (mut cross, mut xx, mut aa) = (C64::new(0.0, 0.0), 0.0, 0.0);
-    for (x, a) in measured.iter().zip(model) {
-        cross += x.conj() * a;
-        xx += x.norm_sqr();
-        aa += a.norm_sqr();
-    }
-    if xx > 0.0 && aa > 0.0 { cross.norm_sqr() / (xx * aa) } else { 0.0 }
-}
-
-/// Resonance frequencies (Hz) seen in a set: lines where the magnitude
-/// summed over channels has a local maximum at least 1.5 times the smallest
-/// value on *both* sides within 5 % of its frequency (at least 3 lines).
-///
-/// The window is relative because a peak's width is: with damping that
-/// grows with frequency, a fixed number of lines would be too narrow to see
-/// the high modes stand out. Requiring the drop on both sides rejects
-/// noise ripples on the flank of a peak.
-pub fn resonances(set: &FrfSet) -> Vec<f64> {
-    let f = set.frequencies_hz();
-    let nf = f.len();
-    if nf < 3 {
-        return Vec::new();
-    }
-    let y: Vec<f64> = (0..nf)
-        .map(|k| (0..set.channels().len()).map(|c| set.get(c, k).norm()).filter(|v| v.is_finite()).sum())
-        .collect();
-    (1..nf - 1)
-        .filter(|&k| y[k] >= y[k - 1] && y[k] > y[k + 1])
-        .filter(|&k| {
-            let lo = f.partition_point(|&x| x < 0.95 * f[k]).min(k.saturating_sub(3));
-            let hi = f.partition_point(|&x| x <= 1.05 * f[k]).max(k + 4).min(nf);
-            let left = y[lo..k].iter().copied().fold(f64::INFINITY, f64::min);
-            let right = y[k + 1..hi].iter().copied().fold(f64::INFINITY, f64::min);
-            y[k] >= 1.5 * left.max(right)
-        })
-        .map(|k| f[k])
-        .collect()
-}
-
-/// The bands a [`BandSpec`] gives for a measured set.
-pub fn bands(spec: &BandSpec, measured: &FrfSet) -> Result<Vec<Band>, FrfError> {
-    let f = measured.frequencies_hz();
-    let (Some(&lo), Some(&hi)) = (f.first(), f.last()) else {
-        return Ok(Vec::new());
-    };
-    let plain = |lo_hz, hi_hz| Band { lo_hz, hi_hz, resonance_hz: None };
-    match spec {
-        BandSpec::Auto => {
-            if resonances(measured).is_empty() {
-                bands(&BandSpec::Octave { fraction: 1 }, measured)
-            } else {
-                bands(&BandSpec::Resonances, measured)
-            }
-        }
-        BandSpec::Resonances => {
-            let peaks = resonances(measured);
-            if peaks.is_empty() {
-                return Ok(vec![plain(lo, hi)]);
-            }
-            let mut edges = vec![lo];
-            edges.extend(peaks.windows(2).map(|w| (w[0] * w[1]).sqrt()));
-            edges.push(hi);
-            Ok(edges
-                .windows(2)
-                .zip(&peaks)
-                .map(|(w, &p)| Band { lo_hz: w[0], hi_hz: w[1], resonance_hz: Some(p) })
-                .collect())
-        }
-        BandSpec::Octave { fraction } => {
-            if *fraction == 0 {
-                return Err(FrfError::Mismatch("octave bands need at least one band per octave".into()));
-            }
-            let n = f64::from(*fraction);
-            let half = 2f64.powf(0.5 / n);
-            // first centre whose band reaches the lowest line, last whose band reaches the highest
-            let i0 = ((lo / half / 1000.0).log2() * n).floor() as i64;
-            let i1 = ((hi * half / 1000.0).log2() * n).ceil() as i64;
-            Ok((i0..=i1)
-                .map(|i| {
-                    let c = 1000.0 * 2f64.powf(i as f64 / n);
-                    plain(c / half, c * half)
-                })
-                .filter(|b| f.iter().any(|&x| x >= b.lo_hz && x < b.hi_hz))
-                .collect())
-        }
-        BandSpec::Edges(edges) => {
-            if edges.len() < 2 {
-                return Err(FrfError::Mismatch("band edges: give at least two frequencies".into()));
-            }
-            if let Some(&x) = edges.iter().find(|x| !(x.is_finite() && **x >= 0.0)) {
-                return Err(FrfError::Mismatch(format!("band edge {x} Hz is not a finite, non-negative frequency")));
-            }
-            if let Some(w) = edges.windows(2).find(|w| !(w[1] > w[0])) {
-                return Err(FrfError::Mismatch(format!(
-                    "band edges must increase strictly, but {} Hz is followed by {} Hz",
-                    w[0], w[1]
-                )));
-            }
-            let out: Vec<Band> = edges.windows(2).map(|w| plain(w[0], w[1])).collect();
-            let last = out.len() - 1;
-            for (i, b) in out.iter().enumerate() {
-                if !f.iter().any(|&x| x >= b.lo_hz && (x < b.hi_hz || (i == last && x <= b.hi_hz))) {
-                    return Err(FrfError::Mismatch(format!(
-                        "band {} has no measured line (the data spans {} to {} Hz)",
-                        b.label(),
-                        short(lo),
-                        short(hi)
-                    )));
-                }
-            }
-            Ok(out)
-        }
-    }
-}
-
 /// Sums of squares over a set of (channel, line) values.
 #[derive(Clone, Copy, Default)]
 struct Acc {
@@ -436,18 +271,14 @@ pub fn correlate(measured: &FrfSet, model: &FrfSet, spec: &BandSpec) -> Result<C
     if model.n_freq() != nf
         || model.frequencies_hz().iter().zip(f).any(|(a, b)| (a - b).abs() > 1e-6 * b.abs().max(1e-12))
     {
-        return Err(FrfError::Mismatch(format!(
-            "the model FRFs have {} lines, the measured {}; they must be on the same lines",
-            model.n_freq(),
-            nf
-        )));
+        return Err(MismatchError::LinesDiffer { model: model.n_freq(), measured: nf }.into());
     }
     let model = if model.kind() == measured.kind() { model.clone() } else { model.converted(measured.kind()) };
     let index = model.channel_indices();
     let idx: Vec<usize> = measured
         .channels()
         .iter()
-        .map(|c| index.get(c).copied().ok_or_else(|| FrfError::Mismatch(format!("the model FRFs have no channel {c}"))))
+        .map(|c| index.get(c).copied().ok_or(FrfError::Mismatch(MismatchError::MissingChannel { channel: *c })))
         .collect::<Result<_, _>>()?;
     let bands = bands(spec, measured)?;
     let n_ch = measured.channels().len();
@@ -572,27 +403,12 @@ pub fn correlate(measured: &FrfSet, model: &FrfSet, spec: &BandSpec) -> Result<C
     })
 }
 
-/// A frequency in a short form for labels (`12.5`, `1000`, `0.25`).
-fn short(f: f64) -> String {
-    if f >= 100.0 {
-        format!("{f:.0}")
-    } else if f >= 10.0 {
-        trim(format!("{f:.1}"))
-    } else {
-        trim(format!("{f:.2}"))
-    }
-}
-
-fn trim(s: String) -> String {
-    if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.').to_string() } else { s }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use fe_model::{Dof, DofRef};
 
-    fn set(freqs: &[f64], channels: &[Channel], values: impl Fn(usize, usize) -> C64) -> FrfSet {
+    pub(super) fn set(freqs: &[f64], channels: &[Channel], values: impl Fn(usize, usize) -> C64) -> FrfSet {
         let mut s = FrfSet::zeros(freqs.to_vec(), channels.to_vec(), FrfKind::Receptance).unwrap();
         for c in 0..channels.len() {
             for k in 0..freqs.len() {
@@ -602,18 +418,18 @@ mod tests {
         s
     }
 
-    fn ch(n: u32) -> Channel {
+    pub(super) fn ch(n: u32) -> Channel {
         Channel::new(DofRef::new(n, Dof::Uy), DofRef::new(5, Dof::Uy))
     }
 
     /// A measured set with varied magnitudes and phases, so that a constant
     /// ratio is not trivially satisfied by constant data.
-    fn measured() -> FrfSet {
+    pub(super) fn measured() -> FrfSet {
         let f: Vec<f64> = (1..=40).map(|k| 2.5 * k as f64).collect();
         set(&f, &[ch(2), ch(3), ch(5)], |c, k| C64::from_polar(1e-4 / (1.0 + k as f64 + c as f64), 0.3 * k as f64))
     }
 
-    fn scaled(x: &FrfSet, q: C64) -> FrfSet {
+    pub(super) fn scaled(x: &FrfSet, q: C64) -> FrfSet {
         let mut a = x.clone();
         for c in 0..x.channels().len() {
             for v in a.channel_mut(c) {
@@ -652,30 +468,6 @@ mod tests {
         assert!((r.total.relative_residual - 2f64.sqrt()).abs() < 1e-12);
         assert!((r.total.min_frac - 1.0).abs() < 1e-12, "FRAC ignores a constant complex factor");
         assert!(r.phase_error_deg(1).iter().all(|&p| (p - 90.0).abs() < 1e-9));
-    }
-
-    #[test]
-    fn phase_differences_wrap_to_one_turn() {
-        let x = C64::from_polar(1.0, 170f64.to_radians());
-        let a = C64::from_polar(1.0, -170f64.to_radians());
-        assert!((phase_error_deg(a, x) - 20.0).abs() < 1e-9);
-        assert!((phase_error_deg(x, a) + 20.0).abs() < 1e-9);
-        // exactly half a turn is +180, never -180
-        assert_eq!(phase_error_deg(C64::new(-1.0, 0.0), C64::new(1.0, 0.0)), 180.0);
-        assert_eq!(phase_error_deg(C64::new(-1.0, -0.0), C64::new(1.0, 0.0)), 180.0);
-    }
-
-    #[test]
-    fn frac_of_hand_computed_vectors() {
-        let one = C64::new(1.0, 0.0);
-        let x = [one, one];
-        assert!((frac(&x, &x) - 1.0).abs() < 1e-15);
-        assert!((frac(&x, &[one * 3.0, one * 3.0]) - 1.0).abs() < 1e-15);
-        // |1 + 2|^2 / (2 * 5)
-        assert!((frac(&x, &[one, one * 2.0]) - 0.9).abs() < 1e-15);
-        // orthogonal shapes
-        assert!(frac(&x, &[one, -one]).abs() < 1e-15);
-        assert_eq!(frac(&x, &[C64::new(0.0, 0.0); 2]), 0.0);
     }
 
     #[test]
@@ -728,7 +520,7 @@ mod tests {
         assert!(r.total.log_misfit < 1e-12, "{}", r.total.log_misfit);
         assert_eq!(r.kind(), FrfKind::Receptance);
         let mismatch = |r: Result<Correlation, FrfError>| match r {
-            Err(FrfError::Mismatch(m)) => m,
+            Err(FrfError::Mismatch(m)) => m.to_string(),
             other => panic!("expected a mismatch, got {other:?}"),
         };
         let fewer = x.select_channels(&[0, 1]);
@@ -749,53 +541,5 @@ mod tests {
         assert!(r.db_error(1)[4].is_nan());
         assert_eq!(r.channels[1].lines_used, 39);
         assert!((r.total.rms_db - 6.0206).abs() < 1e-4);
-    }
-
-    #[test]
-    fn octave_bands_cover_the_data_and_edges_are_checked() {
-        let x = measured(); // 2.5 .. 100 Hz
-        let b = bands(&BandSpec::Octave { fraction: 1 }, &x).unwrap();
-        assert!(b.first().unwrap().lo_hz <= 2.5 && b.last().unwrap().hi_hz > 100.0);
-        // consecutive octave bands share edges and double
-        for w in b.windows(2) {
-            assert!((w[0].hi_hz - w[1].lo_hz).abs() < 1e-9);
-            assert!((w[1].lo_hz / w[0].lo_hz - 2.0).abs() < 1e-9);
-        }
-        // the 1 kHz series: 62.5 Hz is the centre of an octave band
-        assert!(b.iter().any(|b| ((b.lo_hz * b.hi_hz).sqrt() - 62.5).abs() < 1e-9));
-        // third octaves: every band holds a line and every line is in a band
-        let third = bands(&BandSpec::Octave { fraction: 3 }, &x).unwrap();
-        let inside = |b: &Band, f: f64| f >= b.lo_hz && f < b.hi_hz;
-        assert!(third.iter().all(|b| x.frequencies_hz().iter().any(|&f| inside(b, f))));
-        assert!(x.frequencies_hz().iter().all(|&f| third.iter().filter(|b| inside(b, f)).count() == 1));
-        assert!((third[1].lo_hz / third[0].lo_hz).log2() * 3.0 >= 1.0 - 1e-9);
-        let mismatch = |spec: BandSpec| match bands(&spec, &x) {
-            Err(FrfError::Mismatch(m)) => m,
-            other => panic!("{spec:?}: expected a mismatch, got {other:?}"),
-        };
-        assert!(mismatch(BandSpec::Edges(vec![10.0])).contains("give at least two frequencies"));
-        assert!(
-            mismatch(BandSpec::Edges(vec![10.0, 5.0]))
-                .contains("must increase strictly, but 10 Hz is followed by 5 Hz")
-        );
-        assert!(mismatch(BandSpec::Edges(vec![-1.0, 5.0])).contains("band edge -1 Hz is not a finite, non-negative"));
-        assert!(mismatch(BandSpec::Octave { fraction: 0 }).contains("at least one band per octave"));
-        assert!(mismatch(BandSpec::Edges(vec![200.0, 300.0])).contains("no measured line"));
-    }
-
-    #[test]
-    fn resonance_bands_hold_one_peak_each() {
-        // two separated single-degree-of-freedom peaks at 20 and 60 Hz
-        let f: Vec<f64> = (1..=200).map(|k| 0.5 * k as f64).collect();
-        let sdof = |fr: f64, fq: f64| 1.0 / C64::new(fr * fr - fq * fq, 0.04 * fr * fq);
-        let x = set(&f, &[ch(2)], |_, k| sdof(20.0, f[k]) + sdof(60.0, f[k]));
-        let peaks = resonances(&x);
-        assert_eq!(peaks.len(), 2, "{peaks:?}");
-        assert!((peaks[0] - 20.0).abs() <= 0.5 && (peaks[1] - 60.0).abs() <= 0.5);
-        let b = bands(&BandSpec::Auto, &x).unwrap();
-        assert_eq!(b.len(), 2);
-        assert_eq!((b[0].lo_hz, b[1].hi_hz), (0.5, 100.0));
-        assert!((b[0].hi_hz - (peaks[0] * peaks[1]).sqrt()).abs() < 1e-9);
-        assert!(b[1].label().starts_with("peak at 60"), "{}", b[1].label());
     }
 }
