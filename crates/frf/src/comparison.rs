@@ -26,7 +26,7 @@ pub struct ModalComparison {
     pub estimate: ModalEstimate,
     /// The measured modes, shapes at the measured responses.
     pub measured: Vec<Mode>,
-    /// The model's modes in the band, shapes at every free DOF.
+    /// The model's modes up to [`MODEL_REACH`] times the band's top, shapes at every free DOF.
     pub model: Vec<Mode>,
     /// The pairing (MAC over the measured responses).
     pub pairing: Pairing,
