@@ -93,6 +93,7 @@ pub mod error;
 pub mod fix;
 pub mod freqsel;
 pub mod gain;
+pub mod history;
 pub mod jackknife;
 pub mod lstsq;
 pub mod measured;

@@ -150,6 +150,25 @@ pub struct Gain {
     pub phase_deg: f64,
 }
 
+impl Gain {
+    /// The complex factor.
+    pub fn factor(&self) -> C64 {
+        C64::from_polar(self.magnitude, self.phase_deg.to_radians())
+    }
+
+    /// Multiplies every channel of `frfs` driven at this gain's reference by
+    /// it (what the fit compared with the data).
+    pub fn apply_all(gains: &[Gain], frfs: &mut FrfSet) {
+        for g in gains {
+            for c in 0..frfs.channels().len() {
+                if frfs.channels()[c].reference == g.reference {
+                    frfs.channel_mut(c).iter_mut().for_each(|v| *v *= g.factor());
+                }
+            }
+        }
+    }
+}
+
 /// Outcome of an output-error fit.
 #[derive(Clone, Debug)]
 pub struct OeResult {
@@ -685,6 +704,26 @@ fn covariance(sol: &lstsq::LstsqSolution, sigma2: f64) -> Mat<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A gain multiplies exactly the channels of its reference, by its
+    /// magnitude and phase.
+    #[test]
+    fn a_gain_multiplies_the_channels_of_its_reference_only() {
+        use fe_model::Dof;
+        let (a, b) = (DofRef::new(3, Dof::Uy), DofRef::new(5, Dof::Uy));
+        let channels = vec![frf::Channel::new(a, a), frf::Channel::new(b, a), frf::Channel::new(a, b)];
+        let mut set = FrfSet::zeros(vec![10.0, 20.0], channels, frf::FrfKind::Receptance).unwrap();
+        for c in 0..3 {
+            set.channel_mut(c).iter_mut().for_each(|v| *v = C64::new(1.0, 0.0));
+        }
+        Gain::apply_all(&[Gain { reference: a, magnitude: 2.0, phase_deg: 90.0 }], &mut set);
+        for c in 0..2 {
+            for v in set.channel(c) {
+                assert!((v - C64::new(0.0, 2.0)).norm() < 1e-15, "{v}");
+            }
+        }
+        assert!(set.channel(2).iter().all(|v| *v == C64::new(1.0, 0.0)));
+    }
 
     /// The fast logarithm agrees with `Complex::ln` over every magnitude a
     /// ratio of receptances can take, including where `|z|^2` would

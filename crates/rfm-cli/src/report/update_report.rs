@@ -6,9 +6,8 @@
 
 use std::path::{Path, PathBuf};
 
-use frf::C64;
 use frf::correlation::{BandSpec, correlate};
-use frf::{FrfSet, synthesize, synthesize_regular};
+use frf::synthesize_regular;
 use rfm_update::oe::Gain;
 use rfm_update::rfm::Status;
 use rfm_update::study::FrequencyTable;
@@ -18,10 +17,6 @@ use super::html::{Block, Report, Section, Table, Tone};
 use super::{ModelFrfs, ReportOptions, Result, plot, sig};
 use crate::output::Outputs;
 use crate::table::num;
-
-/// At most this many iterations are re-evaluated over the measured band for the
-/// convergence plot (evenly spread, first and last included).
-const MAX_ITERATIONS_EVALUATED: usize = 30;
 
 /// Writes the report files of an updating run into the run's outputs and
 /// returns where `report.html` will be.
@@ -47,7 +42,7 @@ pub(crate) fn write(
                 lines.iter().map(|&f| super::short(f)).collect::<Vec<_>>().join(", ")
             ));
         }
-        apply_gains(&mut frfs, gains);
+        Gain::apply_all(gains, &mut frfs);
         let correlation = correlate(measured, &frfs, &BandSpec::Auto)?;
         Ok(ModelFrfs { label: label.into(), colour, frfs, correlation })
     };
@@ -56,7 +51,7 @@ pub(crate) fn write(
         model("initial model", plot::INITIAL, &study.system, &[])?,
         model(updated_label, plot::UPDATED, &outcome.system, &outcome.gains)?,
     ];
-    let (all_lines_db, stride) = misfit_per_iteration(study, outcome, measured);
+    let (all_lines_db, stride) = rfm_update::history::rms_db_per_iteration(study, outcome, measured);
     let mut which_lines = if stride == 1 {
         "all measured lines".to_string()
     } else {
@@ -181,72 +176,8 @@ fn residual_names(method: &str) -> (&'static str, &'static str) {
     }
 }
 
-/// Multiplies each channel by the fitted gain of its reference.
-fn apply_gains(frfs: &mut FrfSet, gains: &[Gain]) {
-    for g in gains {
-        let factor = C64::from_polar(g.magnitude, g.phase_deg.to_radians());
-        for c in 0..frfs.channels().len() {
-            if frfs.channels()[c].reference == g.reference {
-                for v in frfs.channel_mut(c) {
-                    *v *= factor;
-                }
-            }
-        }
-    }
-}
-
 fn status_text(s: &Status) -> String {
     s.describe()
-}
-
-/// Budget of the convergence plot's re-evaluation, in DOF x line solves:
-/// small models use every line of every iterate, large ones a thinned grid,
-/// so that the report never costs much more than the update itself.
-const DOF_LINE_BUDGET: f64 = 1e8;
-
-/// Every how many lines to evaluate `iterates` models of `dofs` DOFs within
-/// [`DOF_LINE_BUDGET`], keeping at least 20 lines per iterate.
-fn line_stride(dofs: usize, iterates: usize, lines: usize) -> usize {
-    let per_iterate = (DOF_LINE_BUDGET / dofs.max(1) as f64 / iterates.max(1) as f64).max(20.0);
-    (lines as f64 / per_iterate).ceil().max(1.0) as usize
-}
-
-/// RMS magnitude error over the measured lines of the model at each
-/// iteration (NaN for the iterations not evaluated, see
-/// [`MAX_ITERATIONS_EVALUATED`]), and the stride of the lines used (1 = all).
-fn misfit_per_iteration(study: &Study, outcome: &UpdateOutcome, measured: &FrfSet) -> (Vec<f64>, usize) {
-    let n = outcome.history.len();
-    let chosen: Vec<usize> = if n <= MAX_ITERATIONS_EVALUATED {
-        (0..n).collect()
-    } else {
-        let m = MAX_ITERATIONS_EVALUATED;
-        let mut v: Vec<usize> = (0..m).map(|j| j * (n - 1) / (m - 1)).collect();
-        v.dedup();
-        v
-    };
-    let nf = measured.n_freq();
-    let stride = line_stride(study.system.n(), chosen.len(), nf);
-    let lines: Vec<usize> = (0..nf).step_by(stride).collect();
-    let mut out = vec![f64::NAN; n];
-    let Ok(measured) = measured.select_lines(&lines) else {
-        return (out, stride);
-    };
-    let f = measured.frequencies_hz();
-    let whole = BandSpec::Edges(vec![f[0], f[f.len() - 1]]);
-    let params = study.parameter_set();
-    for k in chosen {
-        let mut sys = study.system.clone();
-        if params.set_values(&mut sys, &outcome.history[k].values).is_err() {
-            continue;
-        }
-        // an iterate the model cannot evaluate (singular) is simply not plotted
-        if let Ok(frfs) = synthesize(&sys, measured.channels(), f)
-            && let Ok(c) = correlate(&measured, &frfs, &whole)
-        {
-            out[k] = c.total.rms_db;
-        }
-    }
-    (out, stride)
 }
 
 fn summary(study: &Study, outcome: &UpdateOutcome, models: &[ModelFrfs; 2]) -> Section {
@@ -507,15 +438,5 @@ mod tests {
         let s = lines_summary(&many);
         assert!(s.starts_with("200 lines from 3 to 600 Hz"), "{s}");
         assert!(!s.contains("9,"), "{s}");
-    }
-
-    #[test]
-    fn small_models_use_every_line_and_large_ones_a_thinned_grid() {
-        // the paper's beam: 90 DOFs, 9 iterates, 800 lines
-        assert_eq!(line_stride(90, 9, 800), 1);
-        // 100,000 DOFs, 30 iterates: 33 lines each, every 30th of 1000
-        assert_eq!(line_stride(100_000, 30, 1000), 30);
-        // never fewer than 20 lines per iterate
-        assert_eq!(line_stride(10_000_000, 30, 1000), 50);
     }
 }
