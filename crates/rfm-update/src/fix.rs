@@ -15,8 +15,13 @@
 //! loop stops when no candidate is significant (the model is consistent
 //! with the data), when the significant ones are all implausible (the
 //! missing effect is not among the candidates), when an update does not
-//! lower the misfit, or after the given number of steps. A last diagnosis of
-//! the final model says what, if anything, still stands out.
+//! lower the misfit, or after the given number of steps. When it then
+//! leaves more than 1.5 times the noise, each effect but the last is left
+//! out in turn and the data diagnosed again without it: an effect added
+//! early may only have mimicked the missing one, and the replacement is
+//! kept when it lowers the misfit (a last step that names what it replaced).
+//! A last diagnosis of the final model says what, if anything, still stands
+//! out.
 
 use fe_model::{CaseEditor, CaseFile, HistoryEntry};
 use frf::FrfSet;
@@ -65,9 +70,28 @@ pub struct FixStep {
     /// single effect left more than three times the noise), with the misfit
     /// each left after its best follower; empty when there was no need.
     pub alternatives: Vec<LookAhead>,
+    /// The effect of an earlier step this one replaced (left out, the others
+    /// kept, and this one added instead; see [`fix`]), when it did.
+    pub replaced: Option<String>,
     /// The case after this step (write it with [`CaseEditor::text_at`]).
     #[serde(skip)]
     pub case: CaseEditor,
+}
+
+impl FixStep {
+    fn of(a: Added, alternatives: Vec<LookAhead>, replaced: Option<String>) -> FixStep {
+        FixStep {
+            misfit_added: a.effect.misfit,
+            effect: a.effect,
+            misfit_updated: a.misfit_updated,
+            status: a.outcome.status,
+            parameters: a.outcome.parameters,
+            uncertainty: a.outcome.uncertainty,
+            alternatives,
+            replaced,
+            case: a.editor,
+        }
+    }
 }
 
 /// A first effect tried by looking one step ahead.
@@ -143,7 +167,11 @@ impl FixOutcome {
     pub fn stages(&self) -> Vec<(String, f64)> {
         let mut v = vec![("nominal".to_string(), self.nominal_misfit)];
         for (k, s) in self.steps.iter().enumerate() {
-            v.push((format!("+ {}", s.effect.description), s.misfit_added));
+            let label = match &s.replaced {
+                Some(r) => format!("+ {} instead of {r}", s.effect.description),
+                None => format!("+ {}", s.effect.description),
+            };
+            v.push((label, s.misfit_added));
             v.push((format!("updated after step {}", k + 1), s.misfit_updated));
         }
         v
@@ -196,6 +224,8 @@ const LOOK_AHEAD_WIDTH: usize = 5;
 /// An effect added to a case and every parameter updated.
 struct Added {
     effect: Ranked,
+    /// Its rank in the diagnosis it came from.
+    rank: usize,
     editor: CaseEditor,
     case: CaseFile,
     misfit_updated: f64,
@@ -213,8 +243,24 @@ fn add_and_update(
     opts: &FixOptions,
     step: usize,
 ) -> Result<Added, UpdateError> {
+    let editor = d.apply(current, rank)?;
+    let (editor, case, misfit_updated, outcome) = update_case(current, editor, d, measured, opts, step)?;
+    Ok(Added { effect: d.ranking[rank - 1].clone(), rank, editor, case, misfit_updated, outcome })
+}
+
+/// Updates every parameter of the `[update]` of the case `editor` holds by
+/// output error on the diagnosis's lines; returns the editor with the
+/// updated values and the misfit in the case's history (as step `step`),
+/// the case it now holds, the misfit and the outcome.
+fn update_case(
+    current: &CaseFile,
+    mut editor: CaseEditor,
+    d: &Diagnosis,
+    measured: &FrfSet,
+    opts: &FixOptions,
+    step: usize,
+) -> Result<(CaseEditor, CaseFile, f64, crate::study::UpdateOutcome), UpdateError> {
     let lines = opts.diagnose.lines;
-    let mut editor = d.apply(current, rank)?;
     let added = CaseFile::parse(&current.path, &editor.text_at(&current.path)?)?;
     let mut study = Study::with_measured(added, measured.clone())?;
     if let Some(u) = study.case.update.as_mut() {
@@ -233,7 +279,12 @@ fn add_and_update(
     }
     let outcome = study.run_output_error(&oe_opts, |_| {})?;
     let misfit_updated = diagnose::log_misfit_with(&outcome.system, measured, lines, d.gains)?;
-    let values = crate::params::quantity_values(&study.parameters, outcome.system.model());
+    let model = outcome.system.model();
+    let values: Vec<(String, f64)> = study
+        .parameters
+        .iter()
+        .flat_map(|p| p.quantities.iter().map(|&q| (model.quantity_name(q).to_string(), model.get(q))))
+        .collect();
     editor.set_values(&values, &format!("updated by rfm fix, step {step}"))?;
     editor.push_history(&HistoryEntry {
         step: format!("updated after step {step}"),
@@ -241,8 +292,59 @@ fn add_and_update(
         noise: Some(d.noise),
     })?;
     let case = CaseFile::parse(&current.path, &editor.text_at(&current.path)?)?;
-    Ok(Added { effect: d.ranking[rank - 1].clone(), editor, case, misfit_updated, outcome })
+    Ok((editor, case, misfit_updated, outcome))
 }
+
+/// When the loop leaves more than [`SWAP_ABOVE`] times the noise, an effect
+/// added early may be one that only mimicked the missing one (a stiffness
+/// change beside a loose joint, a mass change for a lumped mass), and the
+/// loop, which only adds, cannot undo it. Each effect but the last is
+/// therefore left out in turn: the others are added to the nominal case as
+/// they were diagnosed, everything is updated, the data are diagnosed again
+/// and the recommended effect added and updated. Returns the effect left
+/// out and the best such replacement, when it lowers the final misfit by
+/// more than [`SWAP_GAIN`].
+fn swap(
+    nominal: &CaseFile,
+    applied: &[(Diagnosis, usize)],
+    measured: &FrfSet,
+    opts: &FixOptions,
+    misfit: f64,
+) -> Option<(usize, Added)> {
+    let step = opts.max_steps.max(applied.len() + 1);
+    let mut best: Option<(usize, Added)> = None;
+    for out in 0..applied.len().saturating_sub(1) {
+        let tried = (|| -> Result<Added, UpdateError> {
+            let mut case = nominal.clone();
+            let mut editor = None;
+            for (j, (d, r)) in applied.iter().enumerate().filter(|(j, _)| *j != out) {
+                let e = d.apply(&case, *r)?;
+                case = CaseFile::parse(&nominal.path, &e.text_at(&nominal.path)?)?;
+                editor = Some((e, j));
+            }
+            let (e, j) = editor.expect("at least one effect kept");
+            let (_, updated, ..) = update_case(&case, e, &applied[j].0, measured, opts, step)?;
+            let d = diagnose::diagnose(&updated.model, measured, &opts.diagnose)?;
+            let rank = d.recommended.ok_or_else(|| UpdateError::Setup("nothing to add".into()))?;
+            add_and_update(&updated, &d, rank, measured, opts, step)
+        })();
+        if let Ok(a) = tried
+            && a.misfit_updated < SWAP_GAIN * misfit
+            && best.as_ref().is_none_or(|(_, b)| a.misfit_updated < b.misfit_updated)
+        {
+            best = Some((out, a));
+        }
+    }
+    best
+}
+
+/// Above this multiple of the noise after the loop, the effects added early
+/// are tried left out and replaced ([`swap`]).
+const SWAP_ABOVE: f64 = 1.5;
+
+/// A replacement is kept when it leaves less than this fraction of the
+/// loop's final misfit.
+const SWAP_GAIN: f64 = 0.9;
 
 /// The ranks of up to `width` recommendable effects (significant and
 /// plausible, fully fitted or screened) that differ from each other in kind
@@ -291,6 +393,8 @@ pub fn fix(
     let mut steps: Vec<FixStep> = Vec::new();
     let (mut noise, mut nominal_misfit) = (f64::NAN, f64::NAN);
     let mut next: Option<Diagnosis> = None;
+    // the diagnosis and rank of each effect added, to rebuild without one
+    let mut applied: Vec<(Diagnosis, usize)> = Vec::new();
     let stop = loop {
         let d = match next.take() {
             Some(d) => d,
@@ -370,23 +474,33 @@ pub fn fix(
         if let Some(ahead) = &next {
             progress(FixProgress::Diagnosed { step: steps.len() + 1, diagnosis: ahead });
         }
-        current = added.case;
+        current = added.case.clone();
         let improved = added.misfit_updated < steps.last().map_or(nominal_misfit, |s: &FixStep| s.misfit_updated);
-        steps.push(FixStep {
-            misfit_added: added.effect.misfit,
-            effect: added.effect,
-            misfit_updated: added.misfit_updated,
-            status: added.outcome.status,
-            parameters: added.outcome.parameters,
-            uncertainty: added.outcome.uncertainty,
-            alternatives,
-            case: added.editor,
-        });
+        applied.push((d, added.rank));
+        steps.push(FixStep::of(added, alternatives, None));
         if !improved {
             break (FixStop::NoImprovement, next.take());
         }
     };
-    let (stop, last) = stop;
+    let (stop, mut last) = stop;
+    let mut effects: Vec<Ranked> = steps.iter().map(|s| s.effect.clone()).collect();
+    let misfit = steps.last().map_or(nominal_misfit, |s| s.misfit_updated);
+    if steps.len() >= 2
+        && misfit > SWAP_ABOVE * noise
+        && let Some((out, a)) = swap(case, &applied, measured, opts, misfit)
+    {
+        let removed = effects.remove(out);
+        effects.push(a.effect.clone());
+        progress(FixProgress::Updated {
+            step: steps.len(),
+            effect: &format!("{} instead of {}", a.effect.description, removed.description),
+            misfit: a.misfit_updated,
+            status: &a.outcome.status,
+        });
+        current = a.case.clone();
+        steps.push(FixStep::of(a, Vec::new(), Some(removed.description)));
+        last = None;
+    }
     let last = match last {
         Some(d) => d,
         None => {
@@ -398,7 +512,7 @@ pub fn fix(
     Ok(FixOutcome {
         noise,
         nominal_misfit,
-        effects: steps.iter().map(|s| s.effect.clone()).collect(),
+        effects,
         steps,
         stop,
         significant_remains: !last.consistent(),

@@ -38,7 +38,8 @@ pub(crate) fn fix(args: &FixArgs<'_>) -> Result<Exit> {
     // the data every written case reads: the case's own file, or the data
     // synthesised from its [truth], written once beside the steps
     let synthesised = study.case.measurement.as_ref().and_then(|m| m.data.as_ref()).is_none();
-    let mut names: Vec<String> = (1..=args.steps).map(step_file).collect();
+    // one more than the steps: the loop may end by replacing an early effect
+    let mut names: Vec<String> = (1..=args.steps + 1).map(step_file).collect();
     names.extend(["results.json", "report.html"].map(String::from));
     if synthesised {
         names.push(DATA_FILE.into());

@@ -105,7 +105,8 @@ pub(crate) fn write(study: &Study, outcome: &FixOutcome, opts: &ReportOptions, o
             rfm_update::diagnose::DiagnoseOptions::default().lines
         ),
     )?);
-    let highlights: Vec<Highlight> = outcome.steps.iter().map(|s| highlight(&s.effect)).collect();
+    // the effects in the fixed model (a replaced one is not)
+    let highlights: Vec<Highlight> = outcome.effects.iter().map(highlight).collect();
     let drawn = fixed.as_ref().map_or(&study.case.model, |f| f.model());
     fall.push(super::structure_figure(
         drawn,
@@ -147,7 +148,11 @@ pub(crate) fn write(study: &Study, outcome: &FixOutcome, opts: &ReportOptions, o
 
     for (k, s) in outcome.steps.iter().enumerate() {
         let e = &s.effect;
-        let mut sec = Section::new(format!("Step {}: {}", k + 1, e.description));
+        let title = match &s.replaced {
+            Some(r) => format!("Step {}: {} instead of {r}", k + 1, e.description),
+            None => format!("Step {}: {}", k + 1, e.description),
+        };
+        let mut sec = Section::new(title);
         sec.push(Block::Facts(vec![
             ("explained".into(), format!("{:.1} % of the misfit before it", 100.0 * e.explained)),
             ("dBIC".into(), format!("{:.1} (below -10: very strong evidence)", e.delta_bic)),
