@@ -186,7 +186,11 @@ impl From<UpdateError> for Failure {
             UpdateError::Case(c) => Failure::input(c.render()),
             UpdateError::Frf(f) => f.into(),
             UpdateError::Numerics(m) => Failure::new(Exit::Numerics, m),
-            UpdateError::Model(_) | UpdateError::Setup(_) => Failure::input(e.to_string()),
+            UpdateError::Model(_)
+            | UpdateError::Data(_)
+            | UpdateError::Lines(_)
+            | UpdateError::NoParameters
+            | UpdateError::Method(_) => Failure::input(e.to_string()),
         }
     }
 }

@@ -19,7 +19,20 @@ pub enum UpdateError {
     /// finite, with where it happened.
     #[error("{0}")]
     Numerics(String),
-    /// Something the case asks for that this method cannot do.
+    /// The measured data cannot serve what the case asks (a channel or
+    /// line it names is missing, the band leaves nothing, too few lines,
+    /// no coherence to weight by, an FRF that is zero everywhere).
     #[error("{0}")]
-    Setup(String),
+    Data(String),
+    /// The updating lines the case designates are not lines of the data.
+    #[error("{0}")]
+    Lines(String),
+    /// The case has no `[update]` parameters to update.
+    #[error("the case has no [update] parameters")]
+    NoParameters,
+    /// Something asked of a method that it cannot do (gains the response
+    /// function method does not fit, a rank the ranking lacks, a loop of
+    /// no steps).
+    #[error("{0}")]
+    Method(String),
 }

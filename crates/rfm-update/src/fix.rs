@@ -325,7 +325,7 @@ fn swap(
             let (e, j) = editor.expect("at least one effect kept");
             let (_, updated, ..) = update_case(&case, e, &applied[j].0, measured, opts, step)?;
             let d = diagnose::diagnose(&updated.model, measured, &opts.diagnose)?;
-            let rank = d.recommended.ok_or_else(|| UpdateError::Setup("nothing to add".into()))?;
+            let rank = d.recommended.ok_or_else(|| UpdateError::Method("nothing to add".into()))?;
             add_and_update(&updated, &d, rank, measured, opts, step)
         })();
         if let Ok(a) = tried
@@ -387,7 +387,7 @@ pub fn fix(
     mut progress: impl FnMut(FixProgress<'_>),
 ) -> Result<FixOutcome, UpdateError> {
     if opts.max_steps == 0 {
-        return Err(UpdateError::Setup("the loop needs at least one step".into()));
+        return Err(UpdateError::Method("the loop needs at least one step".into()));
     }
     let mut current = case.clone();
     let mut steps: Vec<FixStep> = Vec::new();

@@ -181,7 +181,7 @@ pub fn fit_gains(
     }
     if model.kind() != measured.kind() || model.channels() != measured.channels() || model.n_freq() != measured.n_freq()
     {
-        return Err(UpdateError::Setup(format!(
+        return Err(UpdateError::Data(format!(
             "gains are fitted between sets of one kind, channels and lines; got a {} model of {} channels x {} lines \
              against a {} measurement of {} x {}",
             model.kind(),
@@ -223,7 +223,7 @@ pub fn decide(
     let place = measurement.and_then(|m| m.gains_place.clone());
     let located = |msg: String| match &place {
         Some(p) => UpdateError::Case(p.with_message(msg)),
-        None => UpdateError::Setup(msg),
+        None => UpdateError::Method(msg),
     };
     let legacy = update.is_some_and(|u| u.gains);
     match asked {

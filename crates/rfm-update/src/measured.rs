@@ -52,7 +52,7 @@ fn read_paired(
     p: &PairingSpec,
 ) -> Result<Measured, UpdateError> {
     if frf::io::detect_format(path)? != MeasuredFormat::Uff {
-        return Err(UpdateError::Setup(format!(
+        return Err(UpdateError::Data(format!(
             "{}: `pair = \"coordinates\"` pairs the test nodes of a universal file; a CSV file names model DOFs \
              already",
             path.display()
@@ -189,7 +189,7 @@ fn restrict(measured: Measured, path: &Path, spec: &MeasurementSpec) -> Result<M
                 );
                 match &spec.frequencies_place {
                     Some(p) => UpdateError::Case(p.with_message(msg)),
-                    None => UpdateError::Setup(msg),
+                    None => UpdateError::Data(msg),
                 }
             })?;
             idx.push(k);
@@ -210,7 +210,7 @@ fn restrict(measured: Measured, path: &Path, spec: &MeasurementSpec) -> Result<M
             let msg = format!("the band {lo} to {hi} Hz holds none of the data's lines ({})", span(&f));
             return Err(match &spec.band_place {
                 Some(p) => UpdateError::Case(p.with_message(msg)),
-                None => UpdateError::Setup(msg),
+                None => UpdateError::Data(msg),
             });
         }
         if keep.len() < before {
@@ -229,7 +229,7 @@ fn restrict(measured: Measured, path: &Path, spec: &MeasurementSpec) -> Result<M
         }
     }
     if keep.is_empty() {
-        return Err(UpdateError::Setup(format!(
+        return Err(UpdateError::Data(format!(
             "{}: the case's band and exclusions leave no line of the data ({})",
             path.display(),
             span(&f)

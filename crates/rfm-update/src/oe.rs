@@ -458,7 +458,7 @@ pub(crate) fn run_with(
     if let Some(w) = data.weights
         && w.len() != measured.values().len()
     {
-        return Err(UpdateError::Setup(format!("{} weights for {} data values", w.len(), measured.values().len())));
+        return Err(UpdateError::Method(format!("{} weights for {} data values", w.len(), measured.values().len())));
     }
     let refs = measured.references();
     let ref_of = measured.channels().iter().map(|c| refs.iter().position(|&r| r == c.reference).unwrap()).collect();
@@ -467,7 +467,7 @@ pub(crate) fn run_with(
     let n_data = ev.n_data();
     let m_free = n + ng;
     if n_data == 0 {
-        return Err(UpdateError::Setup("every measured value has zero weight".into()));
+        return Err(UpdateError::Data("every measured value has zero weight".into()));
     }
     // bounds in theta; gains are unbounded
     let mut lo = vec![f64::NEG_INFINITY; n + ng];

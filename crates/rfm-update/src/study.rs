@@ -304,7 +304,7 @@ impl Study {
                     .iter()
                     .map(|c| {
                         index.get(c).copied().ok_or_else(|| {
-                            UpdateError::Setup(format!(
+                            UpdateError::Data(format!(
                                 "{}: the data has no channel {c} that the case lists",
                                 path.display()
                             ))
@@ -408,7 +408,7 @@ impl Study {
         });
         let lines = self.choose_lines(&choice)?;
         if lines.is_empty() {
-            return Err(UpdateError::Setup(format!(
+            return Err(UpdateError::Lines(format!(
                 "no measured line to fit: the [update] frequencies designate none of the {} measured lines",
                 self.measured.n_freq()
             )));
@@ -437,7 +437,7 @@ impl Study {
             FrequencyChoice::List(points) => {
                 for &p in points {
                     if self.measured.line_of(p).is_none() {
-                        return Err(UpdateError::Setup(format!(
+                        return Err(UpdateError::Lines(format!(
                             "updating point {p} Hz is not a line of the measured data"
                         )));
                     }
@@ -475,10 +475,10 @@ impl Study {
         on_iteration: impl FnMut(&IterationRecord),
     ) -> Result<UpdateOutcome, UpdateError> {
         if self.parameters.is_empty() {
-            return Err(UpdateError::Setup("the case has no [update] parameters".into()));
+            return Err(UpdateError::NoParameters);
         }
         if self.gains != Gains::None {
-            return Err(UpdateError::Setup(format!(
+            return Err(UpdateError::Method(format!(
                 "the response function method fits no gain, and this case needs {} gains ({}); update with the \
                  output-error method (`method = \"output-error\"` in [update], or --method output-error)",
                 self.gains, self.gains_reason
@@ -592,7 +592,7 @@ impl Study {
                 )));
             }
             if measured.channel(c).iter().all(|v| v.norm_sqr() == 0.0) {
-                return Err(UpdateError::Setup(format!(
+                return Err(UpdateError::Data(format!(
                     "the measured FRF {channel} is zero at every updating line: a relative misfit cannot be formed"
                 )));
             }
@@ -635,7 +635,7 @@ impl Study {
             Gains::None => false,
             Gains::PerReference => true,
             Gains::PerChannel => {
-                return Err(UpdateError::Setup(
+                return Err(UpdateError::Method(
                     "`gains = \"per-channel\"`: the diagnosis and the output-error update fit one gain per \
                      reference (compare fits them per channel); diagnose with `gains = \"per-reference\"`"
                         .into(),
@@ -673,7 +673,7 @@ impl Study {
         on_iteration: impl FnMut(&IterationRecord),
     ) -> Result<UpdateOutcome, UpdateError> {
         if self.parameters.is_empty() {
-            return Err(UpdateError::Setup("the case has no [update] parameters".into()));
+            return Err(UpdateError::NoParameters);
         }
         let lines = self.lines_for(Method::OutputError)?;
         let measured = self.measured.at_frequencies(&lines)?;
@@ -798,7 +798,7 @@ impl Study {
             Gains::None => false,
             Gains::PerReference => true,
             Gains::PerChannel => {
-                return Err(UpdateError::Setup(
+                return Err(UpdateError::Method(
                     "`gains = \"per-channel\"`: the output-error update fits one gain per reference (compare fits \
                      them per channel); update with `gains = \"per-reference\"`"
                         .into(),
@@ -877,7 +877,7 @@ pub fn line_weights_for(case: &CaseFile, measured: &FrfSet) -> Result<Option<Vec
     let asked = case.update.as_ref().and_then(|u| u.coherence);
     let has = (0..measured.channels().len()).any(|c| measured.coherence(c).is_some());
     if asked == Some(true) && !has {
-        return Err(UpdateError::Setup(
+        return Err(UpdateError::Data(
             "coherence weighting is requested ([update] coherence = true) but the measured data carry no \
              coherence"
                 .into(),

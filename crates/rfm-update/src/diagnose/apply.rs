@@ -19,7 +19,7 @@ impl Diagnosis {
     }
 
     fn no_rank(&self, rank: usize) -> UpdateError {
-        UpdateError::Setup(format!("there is no rank {rank}: the ranking holds ranks 1 to {}", self.ranking.len()))
+        UpdateError::Method(format!("there is no rank {rank}: the ranking holds ranks 1 to {}", self.ranking.len()))
     }
 
     /// The `[set]` entries of an effect that changes quantities the model
@@ -104,7 +104,7 @@ impl Diagnosis {
             let param = back.model.parameter(&p.name)?;
             let got = back.model.get(param.quantities[0]);
             if got != p.value {
-                return Err(UpdateError::Setup(format!("{} reads back as {got}, not {}", p.name, p.value)));
+                return Err(UpdateError::Method(format!("{} reads back as {got}, not {}", p.name, p.value)));
             }
         }
         Ok(editor)

@@ -352,13 +352,13 @@ pub fn diagnose_with(
 ) -> Result<Diagnosis, UpdateError> {
     let lines = measured.frequencies_hz();
     if lines.len() < 10 {
-        return Err(UpdateError::Setup(format!(
+        return Err(UpdateError::Data(format!(
             "diagnosis needs at least 10 measured lines, the data have {}",
             lines.len()
         )));
     }
     let noise = estimate_noise(measured)
-        .ok_or_else(|| UpdateError::Setup("too few usable measured values to estimate the noise level".into()))?;
+        .ok_or_else(|| UpdateError::Data("too few usable measured values to estimate the noise level".into()))?;
     // a noise floor for noise-free data keeps the criterion finite
     let s2 = (noise * noise / 2.0).max(1e-20);
     let nominal = DampedSystem::new(model.clone())?;

@@ -73,7 +73,7 @@ impl LineSet {
             }
         }
         if !cost.is_finite() {
-            return Err(UpdateError::Setup("the nominal model's misfit is not finite at the measured lines".into()));
+            return Err(UpdateError::Data("the nominal model's misfit is not finite at the measured lines".into()));
         }
         Ok(LineSet { data, cost0: cost, n, gains })
     }
