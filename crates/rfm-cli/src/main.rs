@@ -268,7 +268,7 @@ fn run(cli: Cli) -> commands::Result<Exit> {
             out.as_deref(),
             json,
             &bands,
-            &report::ReportOptions { frequency_scale: frequency_axis },
+            &report::ReportOptions { frequency_scale: frequency_axis, ..Default::default() },
         ),
         Command::Diagnose { case, measured, json, apply, out, top, verbose } => {
             commands::diagnose(&commands::DiagnoseArgs {
@@ -286,7 +286,7 @@ fn run(cli: Cli) -> commands::Result<Exit> {
             out: &out,
             steps: steps as usize,
             json,
-            report: report::ReportOptions { frequency_scale: frequency_axis },
+            report: report::ReportOptions { frequency_scale: frequency_axis, ..Default::default() },
         }),
         Command::Inspect { file, json } => commands::inspect(&file, json),
         Command::Update { case, out, json, method, lines, iterations, frequency_axis } => commands::update(
@@ -294,7 +294,7 @@ fn run(cli: Cli) -> commands::Result<Exit> {
             out.as_deref(),
             json,
             &commands::UpdateOverrides { method, lines, max_iterations: iterations },
-            &report::ReportOptions { frequency_scale: frequency_axis },
+            &report::ReportOptions { frequency_scale: frequency_axis, ..Default::default() },
         ),
     }
 }

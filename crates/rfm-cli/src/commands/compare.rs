@@ -265,8 +265,16 @@ pub(crate) fn compare(
         let model = ModelFrfs { label: "model".into(), colour: plot::UPDATED, frfs, correlation };
         let mut report = Report::new(format!("{}: model against measurement", case.model.title));
         report.subtitle = Some(format!("rfm compare, case file {}", case_path.display()));
-        report.sections =
-            report_sections(&case, &measured, &source, &model, comparison.as_ref(), &doc, opts, &mut output)?;
+        report.sections = report_sections(
+            &case,
+            &measured,
+            &source,
+            &model,
+            comparison.as_ref(),
+            &doc,
+            &opts.for_case(&case),
+            &mut output,
+        )?;
         let html = output.write("report.html", report.render().as_bytes())?;
         let written = output.commit()?;
         if !json {

@@ -105,7 +105,7 @@ pub(crate) fn fix(args: &FixArgs<'_>) -> Result<Exit> {
         output.write(&name, text.as_bytes())?;
     }
     output.write("results.json", serde_json::to_string_pretty(&outcome)?.as_bytes())?;
-    crate::report::fix_report::write(&study, &outcome, &args.report, &mut output)?;
+    crate::report::fix_report::write(&study, &outcome, &args.report.for_case(&study.case), &mut output)?;
     let written = output.commit()?;
     if !json {
         outln!("\nwrote {} files into {}", written.len(), args.out.display());

@@ -138,7 +138,8 @@ pub(crate) fn update(
     if let Some(mut output) = output.take() {
         let path = output.write("results.json", serde_json::to_string_pretty(&outcome)?.as_bytes())?;
         let updated = write_updated_model(&study, &outcome, &step, &mut output)?;
-        let report = crate::report::update_report::write(&study, &outcome, &mut output, case, report)?;
+        let report =
+            crate::report::update_report::write(&study, &outcome, &mut output, case, &report.for_case(&study.case))?;
         output.commit()?;
         if !json {
             outln!("\nwrote {} and {}", path.display(), updated.display());

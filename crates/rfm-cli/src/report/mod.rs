@@ -38,11 +38,31 @@ impl Outputs {
     }
 }
 
-/// How a report draws what the command line lets one choose.
-#[derive(Clone, Copy, Debug, Default)]
+/// How a report draws what the command line and the case choose.
+#[derive(Clone, Copy, Debug)]
 pub(crate) struct ReportOptions {
     /// Scale of every frequency axis.
     pub(crate) frequency_scale: FrequencyScale,
+    /// Lines of measured coherence below it are shaded in the FRF figures
+    /// (the case's `[measurement] coherence_threshold`, see [`Self::for_case`]).
+    pub(crate) coherence_threshold: f64,
+}
+
+impl Default for ReportOptions {
+    fn default() -> Self {
+        ReportOptions {
+            frequency_scale: FrequencyScale::default(),
+            coherence_threshold: fe_model::case::DEFAULT_COHERENCE_THRESHOLD,
+        }
+    }
+}
+
+impl ReportOptions {
+    /// These options with what `case` chooses (its coherence threshold).
+    pub(crate) fn for_case(self, case: &fe_model::CaseFile) -> ReportOptions {
+        let threshold = case.measurement.as_ref().map(|m| m.coherence_threshold);
+        ReportOptions { coherence_threshold: threshold.unwrap_or(self.coherence_threshold), ..self }
+    }
 }
 
 /// One model's FRFs on the measured lines and their correlation with the
@@ -393,6 +413,7 @@ pub(crate) fn overlay_section(
         kind: measured.kind(),
         panels,
         ticks_hz,
+        coherence_threshold: opts.coherence_threshold,
         scale: opts.frequency_scale,
     };
 

@@ -17,13 +17,13 @@ use super::{
     Area, DrawResult, FONT, HouseStyle, LegendEntry, MEASURED, Mark, PlotError, frame, range, segments, svg, tick, unit,
 };
 
-/// Shade of lines whose coherence is below [`COHERENCE_FAIR`].
+/// Shade of lines whose coherence is below the case's threshold
+/// ([`FrfFigure::coherence_threshold`]).
 const COHERENCE_SHADE: RGBColor = RGBColor(253, 228, 214);
 /// Shade of lines whose coherence is below [`COHERENCE_POOR`].
 const COHERENCE_DARK: RGBColor = RGBColor(246, 190, 160);
-/// Below this coherence a line is shaded.
-pub(crate) const COHERENCE_FAIR: f64 = 0.9;
-/// Below this coherence a line is shaded darker.
+/// Below this coherence a line is shaded darker (and below the case's
+/// threshold, when that is lower).
 pub(crate) const COHERENCE_POOR: f64 = 0.5;
 
 /// Panels of [`frf_multiples`] per row.
@@ -63,6 +63,9 @@ pub(crate) struct FrfFigure<'a> {
     pub(crate) panels: Vec<FrfPanel<'a>>,
     /// Lines to tick on the frequency axis (the updating lines), Hz.
     pub(crate) ticks_hz: &'a [f64],
+    /// Lines whose coherence is below it are shaded (the case's
+    /// `[measurement] coherence_threshold`).
+    pub(crate) coherence_threshold: f64,
     /// Frequency axis scale.
     pub(crate) scale: FrequencyScale,
 }
@@ -76,13 +79,14 @@ fn width_of(i: usize, compact: bool) -> u32 {
     }
 }
 
-/// Coherence level of a line: 0 fair, 1 below [`COHERENCE_FAIR`], 2 below [`COHERENCE_POOR`].
-fn coherence_level(c: f64) -> u8 {
+/// Coherence level of a line: 0 fair, 1 below the case's `threshold`, 2
+/// below [`COHERENCE_POOR`] (or the threshold, when that is lower).
+fn coherence_level(c: f64, threshold: f64) -> u8 {
     if !c.is_finite() {
         0
-    } else if c < COHERENCE_POOR {
+    } else if c < COHERENCE_POOR.min(threshold) {
         2
-    } else if c < COHERENCE_FAIR {
+    } else if c < threshold {
         1
     } else {
         0
@@ -92,12 +96,12 @@ fn coherence_level(c: f64) -> u8 {
 /// Runs of lines with poor coherence as `(from Hz, to Hz, level)`, each
 /// line covering the span to halfway (geometrically on a log axis) to its
 /// neighbours.
-fn coherence_spans(f: &[f64], coherence: &[f64], axis: &FreqAxis) -> Vec<(f64, f64, u8)> {
+fn coherence_spans(f: &[f64], coherence: &[f64], threshold: f64, axis: &FreqAxis) -> Vec<(f64, f64, u8)> {
     let mid = |a: f64, b: f64| if axis.is_log() && a > 0.0 { (a * b).sqrt() } else { 0.5 * (a + b) };
     let (lo, hi) = axis.ends();
     let mut out: Vec<(f64, f64, u8)> = Vec::new();
     for (k, (&fk, &c)) in f.iter().zip(coherence).enumerate() {
-        let level = coherence_level(c);
+        let level = coherence_level(c, threshold);
         if level == 0 || !axis.shows(fk) {
             continue;
         }
@@ -124,13 +128,19 @@ fn legend(fig: &FrfFigure<'_>, axis: &FreqAxis, compact: bool) -> Vec<LegendEntr
     if fig.ticks_hz.iter().any(|&t| axis.shows(t)) {
         legend.push(LegendEntry::new("updating lines (ticks on the axis)", MEASURED, Mark::Tick));
     }
-    let levels: Vec<u8> =
-        fig.panels.iter().filter_map(|p| p.coherence).flat_map(|c| c.iter().map(|&v| coherence_level(v))).collect();
+    let threshold = fig.coherence_threshold;
+    let levels: Vec<u8> = fig
+        .panels
+        .iter()
+        .filter_map(|p| p.coherence)
+        .flat_map(|c| c.iter().map(|&v| coherence_level(v, threshold)))
+        .collect();
     if levels.contains(&1) {
-        legend.push(LegendEntry::new(format!("coherence below {COHERENCE_FAIR}"), COHERENCE_SHADE, Mark::Shade));
+        legend.push(LegendEntry::new(format!("coherence below {threshold}"), COHERENCE_SHADE, Mark::Shade));
     }
     if levels.contains(&2) {
-        legend.push(LegendEntry::new(format!("coherence below {COHERENCE_POOR}"), COHERENCE_DARK, Mark::Shade));
+        let poor = COHERENCE_POOR.min(threshold);
+        legend.push(LegendEntry::new(format!("coherence below {poor}"), COHERENCE_DARK, Mark::Shade));
     }
     legend
 }
@@ -174,7 +184,7 @@ fn draw_channel(
     let (y0, y1) = range(db.iter().flat_map(|c| visible(c)), (-100.0, 0.0));
     let (y0, y1) = ((y0 / 10.0).floor() * 10.0, (y1 / 10.0).ceil() * 10.0);
     let phase_axis = PhaseAxis::over(phase.iter().flat_map(|c| visible(c)));
-    let spans = panel.coherence.map(|c| coherence_spans(f, c, &axis)).unwrap_or_default();
+    let spans = panel.coherence.map(|c| coherence_spans(f, c, fig.coherence_threshold, &axis)).unwrap_or_default();
     let shade = |level: u8| if level == 2 { COHERENCE_DARK } else { COHERENCE_SHADE };
     let x_label = |v: &f64| axis.label(v);
     let y_desc = if style.compact { "dB".to_string() } else { format!("Magnitude (dB re 1 {})", unit(fig.kind)) };
@@ -316,6 +326,7 @@ mod tests {
             kind: FrfKind::Accelerance,
             panels: vec![FrfPanel { title: String::new(), curves: curves(&x, &a), coherence: None }],
             ticks_hz: &[2.0],
+            coherence_threshold: 0.8,
             scale: FrequencyScale::Linear,
         })
         .unwrap();
@@ -347,6 +358,7 @@ mod tests {
             kind: FrfKind::Receptance,
             panels,
             ticks_hz: &[],
+            coherence_threshold: 0.8,
             scale: FrequencyScale::Auto,
         })
         .unwrap();
@@ -367,6 +379,10 @@ mod tests {
         let f = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
         let c = [0.95, 0.7, 0.6, 0.2, 0.95, 0.1];
         let axis = FreqAxis::new(&f, FrequencyScale::Linear);
-        assert_eq!(coherence_spans(&f, &c, &axis), vec![(1.5, 3.5, 1), (3.5, 4.5, 2), (5.5, 6.0, 2)]);
+        assert_eq!(coherence_spans(&f, &c, 0.9, &axis), vec![(1.5, 3.5, 1), (3.5, 4.5, 2), (5.5, 6.0, 2)]);
+        // the case's threshold decides what is shaded: at 0.65 the line of
+        // 0.7 is fair; at 0.3 only the two lines below it are shaded, darkest
+        assert_eq!(coherence_spans(&f, &c, 0.65, &axis), vec![(2.5, 3.5, 1), (3.5, 4.5, 2), (5.5, 6.0, 2)]);
+        assert_eq!(coherence_spans(&f, &c, 0.3, &axis), vec![(3.5, 4.5, 2), (5.5, 6.0, 2)]);
     }
 }
