@@ -124,7 +124,8 @@ impl CaseFile {
         let ctx = Ctx { path, source };
         let raw: raw::RawCase = toml::from_str(source)
             .map_err(|e| CaseError::at(path, source, e.span(), with_suggestion(e.message().trim_end())))?;
-        let mut model = Model::new(raw.title.as_deref().unwrap_or("untitled"));
+        let dimension = build::dimension(&ctx, &raw)?;
+        let mut model = Model::with_dimension(raw.title.as_deref().unwrap_or("untitled"), dimension);
         build::build_model(&ctx, &raw, &mut model)?;
         for (name, v) in &raw.set {
             let q = model.quantity(name).map_err(|e| ctx.model_err(v.span(), e))?;

@@ -17,7 +17,7 @@ pub fn cantilever(n: usize) -> Model {
     for i in 0..n {
         m.add_beam(i as u32 + 1, [i as u32 + 1, i as u32 + 2], mat, sec, g).unwrap();
     }
-    m.add_support(1, &Dof::ALL).unwrap();
+    m.add_support(1, &Dof::PLANAR).unwrap();
     m
 }
 
@@ -39,7 +39,7 @@ pub fn two_material_cantilever() -> Model {
         let (mat, g) = if i < n / 2 { (steel, steel_g) } else { (alu, alu_g) };
         m.add_beam(i + 1, [i + 1, i + 2], mat, sec, g).unwrap();
     }
-    m.add_support(1, &Dof::ALL).unwrap();
+    m.add_support(1, &Dof::PLANAR).unwrap();
     m
 }
 
@@ -63,7 +63,7 @@ pub fn frame_with_joint() -> Model {
     m.add_spring("joint", 2, Some(3), [0.0, 0.0, 2.0e5], joint).unwrap();
     m.add_tie(2, 3, &[Dof::Ux, Dof::Uy]).unwrap();
     m.add_mass("tip", 4, 0.5, 1e-4, frame).unwrap();
-    m.add_support(1, &Dof::ALL).unwrap();
+    m.add_support(1, &Dof::PLANAR).unwrap();
     m
 }
 
@@ -118,7 +118,7 @@ pub fn long_beam(n_elements: usize) -> Model {
         let g = groups[i * regions / n];
         m.add_beam(i as u32 + 1, [i as u32 + 1, i as u32 + 2], mat, sec, g).unwrap();
     }
-    m.add_support(1, &Dof::ALL).unwrap();
+    m.add_support(1, &Dof::PLANAR).unwrap();
     for i in (20..=n).step_by(20) {
         m.add_support(i as u32 + 1, &[Dof::Ux, Dof::Uy]).unwrap();
     }
@@ -180,7 +180,7 @@ pub fn frame_grid(bays: usize, storeys: usize, elements_per_member: usize) -> Mo
         }
     }
     for bay in 0..=bays {
-        m.add_support(joint(bay, 0), &Dof::ALL).unwrap();
+        m.add_support(joint(bay, 0), &Dof::PLANAR).unwrap();
     }
     m
 }
@@ -239,7 +239,7 @@ pub fn tree_frame(members: &[TreeMember], order: &[usize], clamped: bool) -> Mod
         m.add_beam(k as u32 + 1, [t.from, k as u32 + 2], steel, sections[k], groups[k % 2]).unwrap();
     }
     if clamped {
-        m.add_support(1, &Dof::ALL).unwrap();
+        m.add_support(1, &Dof::PLANAR).unwrap();
     }
     m
 }

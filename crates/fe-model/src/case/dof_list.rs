@@ -41,6 +41,7 @@ pub(super) fn parse_dof_refs(ctx: &Ctx<'_>, list: &[Spanned<String>], model: &Mo
     let mut seen = std::collections::HashSet::new();
     for s in list {
         let (first, last, dof) = parse_dof_range(s.get_ref()).map_err(|e| ctx.err(s.span(), e))?;
+        model.dimension().check(dof).map_err(|e| ctx.err(s.span(), e))?;
         // Every node of the range must exist, so the walk stops at the first
         // missing one: it never goes further than the model has nodes.
         for node in first..=last {

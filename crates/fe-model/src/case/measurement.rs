@@ -370,6 +370,7 @@ pub(super) fn parse_measurement(
             ));
         }
         let model_dof: DofRef = c.model.get_ref().parse().map_err(|e: String| ctx.err(c.model.span(), e))?;
+        model.dimension().check(model_dof.dof).map_err(|e| ctx.err(c.model.span(), e))?;
         if model.node(model_dof.node).is_none() {
             return Err(ctx.err(c.model.span(), format!("node {} does not exist in the model", model_dof.node)));
         }

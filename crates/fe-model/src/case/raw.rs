@@ -3,8 +3,10 @@
 //! meaning; `build.rs` and the other readers do, with the places kept here.
 
 use std::collections::BTreeMap;
+use std::fmt;
 
 use serde::Deserialize;
+use serde::de::{self, Deserializer, IgnoredAny, SeqAccess, Visitor};
 use toml::Spanned;
 
 use super::measurement::RawMeasurement;
@@ -14,6 +16,7 @@ use super::measurement::RawMeasurement;
 pub(super) struct RawCase {
     pub(super) title: Option<String>,
     pub(super) description: Option<String>,
+    pub(super) model: Option<Spanned<RawModel>>,
     #[serde(default)]
     pub(super) materials: BTreeMap<String, Spanned<RawMaterial>>,
     #[serde(default)]
@@ -21,7 +24,7 @@ pub(super) struct RawCase {
     #[serde(default)]
     pub(super) groups: BTreeMap<String, Spanned<RawGroup>>,
     #[serde(default)]
-    pub(super) nodes: Vec<Spanned<(u32, f64, f64)>>,
+    pub(super) nodes: Vec<Spanned<RawNode>>,
     #[serde(default)]
     pub(super) lines: Vec<Spanned<RawLine>>,
     #[serde(default)]
@@ -51,10 +54,50 @@ pub(super) struct RawCase {
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
+pub(super) struct RawModel {
+    pub(super) dimension: Option<Spanned<i64>>,
+}
+
+/// A node as written: `[id, x, y]`, or `[id, x, y, z]` in a 3D model.
+pub(super) struct RawNode {
+    pub(super) id: u32,
+    pub(super) at: [f64; 3],
+    /// True when the node was written with its z.
+    pub(super) with_z: bool,
+}
+
+impl<'de> Deserialize<'de> for RawNode {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Node;
+        impl<'de> Visitor<'de> for Node {
+            type Value = RawNode;
+            fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str("a node [id, x, y] or, in a 3D model, [id, x, y, z]")
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<RawNode, A::Error> {
+                let id: u32 = seq.next_element()?.ok_or_else(|| de::Error::invalid_length(0, &self))?;
+                let x: f64 = seq.next_element()?.ok_or_else(|| de::Error::invalid_length(1, &self))?;
+                let y: f64 = seq.next_element()?.ok_or_else(|| de::Error::invalid_length(2, &self))?;
+                let z: Option<f64> = seq.next_element()?;
+                if seq.next_element::<IgnoredAny>()?.is_some() {
+                    return Err(de::Error::invalid_length(5, &self));
+                }
+                Ok(RawNode { id, at: [x, y, z.unwrap_or(0.0)], with_z: z.is_some() })
+            }
+        }
+        d.deserialize_seq(Node)
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
 pub(super) struct RawMaterial {
     #[serde(rename = "E")]
     pub(super) e: f64,
     pub(super) rho: f64,
+    pub(super) nu: Option<Spanned<f64>>,
+    #[serde(rename = "G")]
+    pub(super) g: Option<Spanned<f64>>,
 }
 
 #[derive(Deserialize)]
@@ -64,6 +107,12 @@ pub(super) struct RawSection {
     pub(super) area: Option<f64>,
     #[serde(rename = "I")]
     pub(super) inertia: Option<f64>,
+    #[serde(rename = "Iy")]
+    pub(super) iy: Option<f64>,
+    #[serde(rename = "Iz")]
+    pub(super) iz: Option<f64>,
+    #[serde(rename = "J")]
+    pub(super) torsion: Option<f64>,
     pub(super) b: Option<f64>,
     pub(super) h: Option<f64>,
     pub(super) od: Option<f64>,
@@ -101,6 +150,8 @@ pub(super) struct RawLine {
     pub(super) first_element: Option<u32>,
     #[serde(default)]
     pub(super) added_mass: f64,
+    pub(super) orientation: Option<Spanned<[f64; 3]>>,
+    pub(super) angle: Option<Spanned<f64>>,
 }
 
 #[derive(Deserialize)]
@@ -113,6 +164,8 @@ pub(super) struct RawBeam {
     pub(super) group: Spanned<String>,
     #[serde(default)]
     pub(super) added_mass: f64,
+    pub(super) orientation: Option<Spanned<[f64; 3]>>,
+    pub(super) angle: Option<Spanned<f64>>,
 }
 
 #[derive(Deserialize)]
@@ -121,13 +174,29 @@ pub(super) struct RawSpring {
     pub(super) name: String,
     pub(super) nodes: Option<[u32; 2]>,
     pub(super) node: Option<u32>,
-    #[serde(default)]
-    pub(super) kx: f64,
-    #[serde(default)]
-    pub(super) ky: f64,
-    #[serde(default)]
-    pub(super) kr: f64,
+    pub(super) kx: Option<Spanned<f64>>,
+    pub(super) ky: Option<Spanned<f64>>,
+    pub(super) kz: Option<Spanned<f64>>,
+    pub(super) kr: Option<Spanned<f64>>,
+    pub(super) krx: Option<Spanned<f64>>,
+    pub(super) kry: Option<Spanned<f64>>,
+    pub(super) krz: Option<Spanned<f64>>,
     pub(super) group: Spanned<String>,
+}
+
+impl RawSpring {
+    /// The stiffnesses as written, by key.
+    pub(super) fn stiffnesses(&self) -> [(&'static str, Option<&Spanned<f64>>); 7] {
+        [
+            ("kx", self.kx.as_ref()),
+            ("ky", self.ky.as_ref()),
+            ("kz", self.kz.as_ref()),
+            ("kr", self.kr.as_ref()),
+            ("krx", self.krx.as_ref()),
+            ("kry", self.kry.as_ref()),
+            ("krz", self.krz.as_ref()),
+        ]
+    }
 }
 
 #[derive(Deserialize)]
@@ -137,8 +206,10 @@ pub(super) struct RawMass {
     pub(super) node: u32,
     #[serde(default)]
     pub(super) m: f64,
-    #[serde(default)]
-    pub(super) j: f64,
+    pub(super) j: Option<Spanned<f64>>,
+    pub(super) jx: Option<Spanned<f64>>,
+    pub(super) jy: Option<Spanned<f64>>,
+    pub(super) jz: Option<Spanned<f64>>,
     pub(super) group: Spanned<String>,
 }
 
@@ -170,10 +241,29 @@ pub(super) struct RawJoint {
     pub(super) node: u32,
     pub(super) elements: Vec<u32>,
     pub(super) new_node: Option<u32>,
-    pub(super) kx: Option<f64>,
-    pub(super) ky: Option<f64>,
-    pub(super) kr: f64,
+    pub(super) kx: Option<Spanned<f64>>,
+    pub(super) ky: Option<Spanned<f64>>,
+    pub(super) kz: Option<Spanned<f64>>,
+    pub(super) kr: Option<Spanned<f64>>,
+    pub(super) krx: Option<Spanned<f64>>,
+    pub(super) kry: Option<Spanned<f64>>,
+    pub(super) krz: Option<Spanned<f64>>,
     pub(super) group: Spanned<String>,
+}
+
+impl RawJoint {
+    /// The stiffnesses as written, by key.
+    pub(super) fn stiffnesses(&self) -> [(&'static str, Option<&Spanned<f64>>); 7] {
+        [
+            ("kx", self.kx.as_ref()),
+            ("ky", self.ky.as_ref()),
+            ("kz", self.kz.as_ref()),
+            ("kr", self.kr.as_ref()),
+            ("krx", self.krx.as_ref()),
+            ("kry", self.kry.as_ref()),
+            ("krz", self.krz.as_ref()),
+        ]
+    }
 }
 
 #[derive(Deserialize)]

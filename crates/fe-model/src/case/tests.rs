@@ -65,7 +65,7 @@ fn a_joint_splits_a_node_ties_translations_and_adds_a_rotational_spring() {
     assert_eq!(c.model.nodes().len(), 6);
     let e3 = &c.model.beams()[c.model.beam_index(crate::model::ElementId(3)).unwrap()];
     assert_eq!(e3.nodes[0], NodeId(6));
-    assert_eq!(c.model.springs()[0].k, [0.0, 0.0, 5e3]);
+    assert_eq!(c.model.springs()[0].k, [0.0, 0.0, 5e3].into());
     assert_eq!(c.model.ties()[0].dofs, vec![Dof::Ux, Dof::Uy]);
     let bad = text.replace("elements = [3]", "elements = [1]");
     assert!(parse(&bad).unwrap_err().message.contains("does not end at node 3"));

@@ -4,6 +4,7 @@ mod correlation;
 mod lscf;
 mod modal;
 mod physics;
+mod planar_in_space;
 mod properties;
 mod selected_inverse;
 mod solver;

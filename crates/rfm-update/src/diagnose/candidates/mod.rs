@@ -256,12 +256,12 @@ impl Candidate {
             let ok = match (&mut edit, self.roles[i]) {
                 (Edit::Support { released, k, .. }, Role::Spring(d)) => {
                     released.retain(|&x| x != d);
-                    k[d.index()] = 0.0;
+                    k[d] = 0.0;
                     true
                 }
                 (Edit::Joint { sprung, k, .. }, Role::Spring(d)) if d.is_translation() => {
                     sprung.retain(|&x| x != d);
-                    k[d.index()] = 0.0;
+                    k[d] = 0.0;
                     true
                 }
                 (Edit::Mass { j, .. }, Role::Inertia) => {
