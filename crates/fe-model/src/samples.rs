@@ -1,6 +1,6 @@
 //! Tiny canonical models shared by tests, examples, benchmarks and docs.
 
-use crate::dof::Dof;
+use crate::dof::{Dimension, Dof};
 use crate::model::{Group, Model, Section};
 
 /// A uniform steel cantilever, 1 m long, 50 x 10 mm, clamped at node 1,
@@ -241,6 +241,48 @@ pub fn tree_frame(members: &[TreeMember], order: &[usize], clamped: bool) -> Mod
     if clamped {
         m.add_support(1, &Dof::PLANAR).unwrap();
     }
+    m
+}
+
+/// A small frame in space with every kind of 3D item: a portal of two
+/// 0.6 m columns along y (nodes 1-2 and 3-4, clamped at 1 and 3) and a
+/// 0.8 m beam along x between their tops (2-5), an arm along z from node 5
+/// (6-7) joined to it by rotational springs `joint` (krx, kry, krz; the
+/// translations tied) in a non-viscous group, a ground spring `foot` in
+/// every DOF at node 4 (the second column's top), and a lumped mass `tip`
+/// with three rotary inertias at node 7. Members in group `frame` (viscous
+/// Rayleigh), rectangular steel sections with unequal second moments, the
+/// arm's section turned by 20 degrees.
+pub fn space_portal() -> Model {
+    let mut m = Model::with_dimension("portal in space with a lossy joint", Dimension::Spatial);
+    let frame = m.add_group(Group::new("frame").rayleigh(2e-5, 0.3)).unwrap();
+    let joint = m.add_group(Group::new("joint").rayleigh(1e-3, 0.0).relaxation(300.0)).unwrap();
+    let steel = m.add_material("steel", 2.0e11, 7800.0).unwrap();
+    m.set_poisson(steel, 0.3).unwrap();
+    let sec = m.add_section(Section::rectangle("bar", 0.03, 0.02)).unwrap();
+    for (id, p) in [
+        (1, [0.0, 0.0, 0.0]),
+        (2, [0.0, 0.6, 0.0]),
+        (3, [0.8, 0.0, 0.0]),
+        (4, [0.8, 0.6, 0.0]),
+        (5, [0.4, 0.6, 0.0]),
+        (6, [0.4, 0.6, 0.0]),
+        (7, [0.4, 0.6, 0.5]),
+    ] {
+        m.add_node_at(id, p).unwrap();
+    }
+    m.add_beam(1, [1, 2], steel, sec, frame).unwrap();
+    m.add_beam(2, [3, 4], steel, sec, frame).unwrap();
+    m.add_beam(3, [2, 5], steel, sec, frame).unwrap();
+    m.add_beam(4, [5, 4], steel, sec, frame).unwrap();
+    let arm = m.add_beam(5, [6, 7], steel, sec, frame).unwrap();
+    m.orient_beam(arm, None, 20f64.to_radians()).unwrap();
+    m.add_spring("joint", 5, Some(6), [0.0, 0.0, 0.0, 3e4, 5e4, 2e4], joint).unwrap();
+    m.add_tie(5, 6, &[Dof::Ux, Dof::Uy, Dof::Uz]).unwrap();
+    m.add_spring("foot", 4, None, [2e6, 3e6, 4e6, 1e3, 2e3, 3e3], joint).unwrap();
+    m.add_mass("tip", 7, 0.5, [1e-4, 2e-4, 3e-4], frame).unwrap();
+    m.add_support(1, &Dof::SPATIAL).unwrap();
+    m.add_support(3, &Dof::SPATIAL).unwrap();
     m
 }
 

@@ -37,11 +37,15 @@ pub struct FixOptions {
     pub diagnose: DiagnoseOptions,
     /// Iteration limit of each update.
     pub update_iterations: usize,
+    /// Where the data a case synthesises from its `[truth]` are written:
+    /// the cases of the steps read them from there, without the truth
+    /// ([`Diagnosis::apply_with_data`]).
+    pub data: Option<std::path::PathBuf>,
 }
 
 impl Default for FixOptions {
     fn default() -> Self {
-        FixOptions { max_steps: 3, diagnose: DiagnoseOptions::default(), update_iterations: 100 }
+        FixOptions { max_steps: 3, diagnose: DiagnoseOptions::default(), update_iterations: 100, data: None }
     }
 }
 
@@ -214,7 +218,7 @@ fn add_and_update(
     step: usize,
 ) -> Result<Added, UpdateError> {
     let lines = opts.diagnose.lines;
-    let mut editor = d.apply(current, rank)?;
+    let mut editor = d.apply_with_data(current, rank, opts.data.as_deref())?;
     let added = CaseFile::parse(&current.path, &editor.text_at(&current.path)?)?;
     let mut study = Study::with_measured(added, measured.clone())?;
     if let Some(u) = study.case.update.as_mut() {

@@ -284,7 +284,7 @@ impl UnitStore {
 #[derive(Clone, Copy, Debug)]
 struct Item {
     /// Solver row of each local equation.
-    rows: [u32; 6],
+    rows: [u32; MAX_BLOCK],
     /// Number of local equations.
     nb: u32,
     /// Its used terms, `terms[t0..t1]`.
@@ -377,6 +377,10 @@ struct TermTable {
 }
 
 /// A small fast hash for the table's keys (FxHash's mixing step).
+/// Most free DOFs of one block: two nodes of a frame in space (a planar
+/// model's blocks have at most six).
+const MAX_BLOCK: usize = 12;
+
 #[derive(Default)]
 struct FxHasher(u64);
 
@@ -490,8 +494,8 @@ impl TermTable {
         for &b in &order {
             let block = &blocks[b];
             let nb = block.eqs.len();
-            assert!(nb <= 6, "blocks have at most two nodes of three DOFs");
-            let mut rows = [0u32; 6];
+            assert!(nb <= MAX_BLOCK, "blocks have at most two nodes of six DOFs");
+            let mut rows = [0u32; MAX_BLOCK];
             for (r, &e) in rows.iter_mut().zip(&block.eqs) {
                 *r = solver.position(e) as u32;
             }
@@ -792,7 +796,7 @@ fn by_class_sums(
     solver.solve_units_ordered_with(ws, &plan.ref_eqs, sol, freq_hz, |r, rows| {
         w[r * kc..(r + 1) * kc].fill(ZERO);
         let (b0, b1) = (table.bucket[r] as usize, table.bucket[r + 1] as usize);
-        let mut xb = [ZERO; 6];
+        let mut xb = [ZERO; MAX_BLOCK];
         for item in &table.items[b0..b1] {
             let nb = item.nb as usize;
             let item_rows = &item.rows[..nb];
@@ -852,9 +856,9 @@ impl WithSimd for BucketProducts<'_> {
     fn with_simd<S: Simd>(self, simd: S) {
         let BucketProducts { table, items, first_row, rows, n_ref, n_resp, measured_at, measured, acc } = self;
         let k = n_ref + n_resp;
-        let mut off = [0usize; 6];
-        let mut xb = [ZERO; 6];
-        let mut v = [ZERO; 6];
+        let mut off = [0usize; MAX_BLOCK];
+        let mut xb = [ZERO; MAX_BLOCK];
+        let mut v = [ZERO; MAX_BLOCK];
         for item in items {
             let nb = item.nb as usize;
             for (o, &r) in off[..nb].iter_mut().zip(&item.rows[..nb]) {

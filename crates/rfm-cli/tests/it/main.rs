@@ -11,3 +11,4 @@ mod measurement;
 mod nothing_lost;
 mod pairing;
 mod report;
+mod space_frame;
