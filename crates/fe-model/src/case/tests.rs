@@ -285,3 +285,160 @@ fn dof_lists_expand_ranges() {
     let e = parse_dof_list("4").unwrap_err();
     assert!(e.contains("`4` is not of the form node:dof"), "{e}");
 }
+
+/// A frame in space: two columns and a beam, a spring in six DOFs, a mass
+/// with three inertias, a joint with rotational springs.
+const SPACE: &str = r#"
+title = "portal in space"
+nodes = [[100, 0.5, 1.0, 0.25]]
+[model]
+dimension = 3
+[materials]
+steel = { E = 2e11, rho = 7800, nu = 0.3 }
+alu = { E = 0.7e11, rho = 2700, G = 2.6e10 }
+[sections]
+bar = { b = 0.03, h = 0.02 }
+flat = { A = 6e-4, Iy = 2e-8, Iz = 9e-8, J = 4e-8 }
+[groups.frame]
+alpha = 1e-5
+[[lines]]
+from = [0.0, 0.0, 0.0]
+to = [0.0, 1.0, 0.0]
+elements = 2
+first_node = 1
+material = "steel"
+section = "bar"
+group = "frame"
+[[lines]]
+from = 3
+to = [1.0, 1.0, 0.5]
+elements = 2
+first_node = 4
+material = "alu"
+section = "flat"
+group = "frame"
+orientation = [0.0, 1.0, 0.0]
+angle = 30.0
+[[springs]]
+name = "foot"
+node = 5
+kx = 1e6
+kz = 2e6
+krx = 3e3
+krz = 4e3
+group = "frame"
+[[masses]]
+name = "m"
+node = 4
+m = 0.2
+jx = 1e-4
+jz = 3e-4
+group = "frame"
+[[supports]]
+node = 1
+[[supports]]
+node = 5
+dofs = ["uy", "ry"]
+[[ties]]
+nodes = [4, 100]
+dofs = ["ux", "uy", "uz", "rx", "ry", "rz"]
+[[beams]]
+id = 9
+nodes = [100, 5]
+material = "steel"
+section = "bar"
+group = "frame"
+"#;
+
+#[test]
+fn a_3d_case_builds_a_frame_in_space() {
+    let c = parse(SPACE).unwrap();
+    let m = &c.model;
+    assert_eq!(m.dimension(), crate::Dimension::Spatial);
+    assert_eq!(m.node(NodeId(5)).unwrap().position(), [1.0, 1.0, 0.5]);
+    assert_eq!(m.supports()[0].dofs, Dof::SPATIAL.to_vec());
+    assert_eq!(m.springs()[0].k, [1e6, 0.0, 2e6, 3e3, 0.0, 4e3].into());
+    assert_eq!(m.masses()[0].j, [1e-4, 0.0, 3e-4]);
+    // G is turned into nu: E / (2 G) - 1
+    let alu = &m.materials()[m.material_index("alu").unwrap()];
+    assert!((alu.nu.unwrap() - (0.7e11 / 5.2e10 - 1.0)).abs() < 1e-15);
+    let b = &m.beams()[m.beam_index(crate::ElementId(3)).unwrap()];
+    assert_eq!((b.reference, b.angle), (Some([0.0, 1.0, 0.0]), 30f64.to_radians()));
+    for name in ["spring.foot.kz", "spring.foot.krx", "mass.m.jz"] {
+        let q = m.quantity(name).unwrap();
+        assert_eq!(m.quantity_name(q).to_string(), name);
+    }
+    assert_eq!(m.parameter("mass.m.j").unwrap().quantities.len(), 3, "j scales jx, jy, jz together");
+    crate::Assembly::new(m).unwrap();
+}
+
+/// What one dimension has is refused in the other, where it is written.
+#[test]
+fn dofs_and_keys_of_the_other_dimension_are_refused_where_written() {
+    let planar = format!(
+        "{BEAM}[measurement]\nfrequencies = [10.0]\nreferences = [\"5:uy\"]\nresponses = [\"5:uz\"]\n[truth]\n"
+    );
+    let e = parse(&planar).unwrap_err();
+    assert!(e.message.contains("`uz` is not a DOF of a planar model") && e.message.contains("dimension = 3"), "{e}");
+    assert_eq!(line_of(&planar, &e), "responses = [\"5:uz\"]");
+    let cases = [
+        // planar: what only a frame in space has
+        (
+            BEAM.replace("[[supports]]\nnode = 1", "[[supports]]\nnode = 1\ndofs = [\"rx\"]"),
+            "dofs = [\"rx\"]",
+            "`rx` is not a DOF",
+        ),
+        (
+            BEAM.replace("title = \"beam\"", "title = \"beam\"\nnodes = [[50, 0.0, 0.0, 1.0]]"),
+            "nodes = [[50, 0.0, 0.0, 1.0]]",
+            "has a z coordinate",
+        ),
+        (
+            format!("{BEAM}[[springs]]\nname = \"s\"\nnode = 5\nkz = 1e3\ngroup = \"beam\"\n"),
+            "kz = 1e3",
+            "`kz` is a stiffness of a frame in space",
+        ),
+        (
+            format!("{BEAM}[[masses]]\nname = \"m\"\nnode = 5\nm = 1.0\njx = 1e-3\ngroup = \"beam\"\n"),
+            "jx = 1e-3",
+            "`jx` is a rotary inertia of a frame in space",
+        ),
+        (
+            BEAM.replace("b = 0.05\nh = 0.01", "A = 1e-4\nIy = 1e-8\nIz = 1e-8\nJ = 1e-8"),
+            "[sections.bar]",
+            "Iy, Iz and J describe",
+        ),
+        (
+            BEAM.replace(
+                "group = \"beam\"\n[[supports]]",
+                "group = \"beam\"\norientation = [0.0, 0.0, 1.0]\n[[supports]]",
+            ),
+            "orientation = [0.0, 0.0, 1.0]",
+            "only a beam of a 3D model",
+        ),
+        (
+            BEAM.replace("title = \"beam\"", "title = \"beam\"\n[model]\ndimension = 4"),
+            "dimension = 4",
+            "`dimension` is 2",
+        ),
+        // in space: what would not say which axis, or lacks torsion
+        (SPACE.replace("krx = 3e3", "kr = 3e3"), "kr = 3e3", "krx, kry and krz (`kr` does not say"),
+        (SPACE.replace("jx = 1e-4", "j = 1e-4"), "j = 1e-4", "jx, jy and jz (`j` does not say"),
+        (
+            SPACE.replace("flat = { A = 6e-4, Iy = 2e-8, Iz = 9e-8, J = 4e-8 }", "flat = { A = 6e-4, I = 9e-8 }"),
+            "flat = { A = 6e-4, I = 9e-8 }",
+            "give Iy, Iz and J instead of I",
+        ),
+        (SPACE.replace(", nu = 0.3", ""), "[[lines]]", "no Poisson's ratio `nu`"),
+        (
+            SPACE.replace("orientation = [0.0, 1.0, 0.0]", "orientation = [1.0, 0.0, 0.5]"),
+            "orientation = [1.0, 0.0, 0.5]",
+            "along the beam",
+        ),
+    ];
+    for (text, line, words) in cases {
+        let e = parse(&text).unwrap_err();
+        assert!(e.message.contains(words), "{line}: {e}");
+        assert_eq!(line_of(&text, &e), line, "{e}");
+    }
+}
