@@ -28,6 +28,7 @@ use nalgebra::DMatrix;
 use crate::dof::{Dof, DofMap, DofRef, Slot};
 use crate::element;
 use crate::error::ModelError;
+use crate::imported::ImportedKind;
 use crate::model::{Model, NodeId};
 use crate::quantity::Quantity;
 
@@ -49,6 +50,8 @@ pub enum BlockSource {
     Spring(usize),
     /// A lumped mass.
     Mass(usize),
+    /// A block of an imported matrix (index into [`Model::imported`]).
+    Imported(usize),
 }
 
 /// One unit matrix of a block, times a value.
@@ -281,6 +284,14 @@ fn raw_blocks(model: &Model) -> Vec<RawBlock> {
         }
         out.push((BlockSource::Mass(i), m.group, dofs, terms));
     }
+    for (i, b) in model.imported.iter().enumerate() {
+        let factor = match b.kind {
+            ImportedKind::Stiffness => (MatrixKind::Stiffness, Quantity::GroupStiffness(b.group)),
+            ImportedKind::Mass => (MatrixKind::Mass, Quantity::GroupMass(b.group)),
+        };
+        let terms = vec![(factor.0, vec![factor.1], LocalMatrix(b.values.clone()))];
+        out.push((BlockSource::Imported(i), b.group, b.dofs.clone(), terms));
+    }
     out
 }
 
@@ -510,6 +521,13 @@ fn describe_source(model: &Model, source: BlockSource) -> String {
         BlockSource::Beam(i) => format!("element {}", model.beams[i].id),
         BlockSource::Spring(i) => format!("spring `{}`", model.springs[i].name),
         BlockSource::Mass(i) => format!("mass `{}`", model.masses[i].name),
+        BlockSource::Imported(i) => {
+            let b = &model.imported[i];
+            format!(
+                "the imported matrix of group `{}` at nodes {} and {}",
+                model.groups[b.group].name, b.nodes[0], b.nodes[1]
+            )
+        }
     }
 }
 

@@ -24,6 +24,7 @@ mod check;
 mod dof_list;
 mod edit;
 mod frequencies;
+mod imported;
 mod measurement;
 mod raw;
 mod spec;

@@ -53,6 +53,7 @@ pub mod case;
 pub mod dof;
 pub mod element;
 pub mod error;
+pub mod imported;
 pub mod kinematics;
 pub mod model;
 pub mod quantity;

@@ -41,6 +41,7 @@ pub struct Model {
     pub(crate) supports: Vec<Support>,
     pub(crate) ties: Vec<Tie>,
     pub(crate) groups: Vec<Group>,
+    pub(crate) imported: Vec<crate::imported::ImportedBlock>,
 }
 
 fn positive(what: String, v: f64) -> Result<(), ModelError> {
@@ -630,6 +631,7 @@ impl Model {
             supports: self.supports.iter().filter(|s| kept(&s.node)).cloned().collect(),
             ties: self.ties.iter().filter(|t| t.nodes.iter().all(kept)).cloned().collect(),
             groups: self.groups.clone(),
+            imported: self.imported.iter().filter(|b| b.nodes.iter().all(kept)).cloned().collect(),
         }
     }
 
@@ -680,7 +682,7 @@ impl Model {
             })
             .sum();
         let lumped: f64 = self.masses.iter().map(|m| m.m * self.groups[m.group].mass).sum();
-        beams + lumped
+        beams + lumped + self.imported_mass()
     }
 }
 

@@ -167,6 +167,10 @@ pub(super) fn build_model(ctx: &Ctx<'_>, raw: &RawCase, model: &mut Model) -> Re
         }
         model.add_node_at(r.id, r.at).map_err(|e| ctx.model_err(n.span(), e))?;
     }
+    let (listed, node_file) = match &raw.imported {
+        Some(imported) => super::imported::add_imported(ctx, imported, model)?,
+        None => Default::default(),
+    };
     for line in &raw.lines {
         add_line(ctx, model, line)?;
     }
@@ -225,8 +229,11 @@ pub(super) fn build_model(ctx: &Ctx<'_>, raw: &RawCase, model: &mut Model) -> Re
             model.set_beam_group(i, g).map_err(|e| ctx.model_err(a.span(), e))?;
         }
     }
-    if model.beams.is_empty() && model.springs.is_empty() {
-        return Err(ctx.whole("the case defines no beams, lines or springs"));
+    if let Some(imported) = &raw.imported {
+        super::imported::hold_unlisted(model, &listed, &node_file).map_err(|e| ctx.model_err(imported.span(), e))?;
+    }
+    if model.beams.is_empty() && model.springs.is_empty() && model.imported().is_empty() {
+        return Err(ctx.whole("the case defines no beams, lines, springs or imported matrices"));
     }
     Ok(())
 }

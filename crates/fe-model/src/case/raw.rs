@@ -17,6 +17,7 @@ pub(super) struct RawCase {
     pub(super) title: Option<String>,
     pub(super) description: Option<String>,
     pub(super) model: Option<Spanned<RawModel>>,
+    pub(super) imported: Option<Spanned<super::imported::RawImported>>,
     #[serde(default)]
     pub(super) materials: BTreeMap<String, Spanned<RawMaterial>>,
     #[serde(default)]

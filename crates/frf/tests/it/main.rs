@@ -1,6 +1,7 @@
 //! Integration tests of the frf crate.
 
 mod correlation;
+mod imported;
 mod lscf;
 mod modal;
 mod physics;

@@ -92,6 +92,8 @@ enum Item {
     Beam(u32),
     Spring(String),
     Mass(String),
+    /// An imported block: group, mass (not stiffness), its two nodes.
+    Imported(usize, bool, u32, u32),
 }
 
 fn item(model: &fe_model::Model, source: BlockSource) -> Item {
@@ -99,6 +101,10 @@ fn item(model: &fe_model::Model, source: BlockSource) -> Item {
         BlockSource::Beam(i) => Item::Beam(model.beams()[i].id.0),
         BlockSource::Spring(i) => Item::Spring(model.springs()[i].name.clone()),
         BlockSource::Mass(i) => Item::Mass(model.masses()[i].name.clone()),
+        BlockSource::Imported(i) => {
+            let b = &model.imported()[i];
+            Item::Imported(b.group, b.kind == fe_model::imported::ImportedKind::Mass, b.nodes[0].0, b.nodes[1].0)
+        }
     }
 }
 
