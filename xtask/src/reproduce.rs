@@ -22,6 +22,10 @@ const PAPER_CASES: [&str; 6] = [
     "f-frame",
 ];
 
+/// Cases beyond the paper's, run as they are: a model imported from
+/// another code's matrices (`docs/imported-models.md`).
+const MORE_CASES: [&str; 1] = ["imported/table"];
+
 /// The loops: a name (as `reproduce` takes it) and its case, a model
 /// missing an effect and data with it (a data file, or the case's
 /// `[truth]`), held to the case's `[check.diagnosis]`. The tutorial's is
@@ -80,7 +84,7 @@ fn update(
 
 pub(crate) fn reproduce(cases: &[String]) -> Result<(), String> {
     let mut names: Vec<String> = if cases.is_empty() {
-        PAPER_CASES.iter().copied().chain(LOOPS.map(|(name, _)| name)).map(str::to_string).collect()
+        PAPER_CASES.iter().chain(&MORE_CASES).copied().chain(LOOPS.map(|(name, _)| name)).map(str::to_string).collect()
     } else {
         cases.to_vec()
     };

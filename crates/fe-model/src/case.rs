@@ -73,6 +73,8 @@ pub struct CaseFile {
     pub history: Vec<HistoryEntry>,
     /// Acceptance of the case's results (`[check]`).
     pub check: Option<CheckSpec>,
+    /// The files of `[imported]` (node file, DOF tables, matrices), resolved.
+    pub imported_files: Vec<PathBuf>,
 }
 
 struct Ctx<'a> {
@@ -112,12 +114,13 @@ impl CaseFile {
         Self::parse(path, source)
     }
 
-    /// The files a run of this case reads: the case file itself and its
-    /// measured data file. Outputs must never be written over them.
+    /// The files a run of this case reads: the case file itself, its
+    /// measured data file and test geometry, and its imported matrices and
+    /// tables. Outputs must never be written over them.
     pub fn inputs(&self) -> Vec<PathBuf> {
         let data = self.measurement.as_ref().and_then(|m| m.data.clone());
         let geometry = self.measurement.as_ref().and_then(|m| m.geometry.clone());
-        std::iter::once(self.path.clone()).chain(data).chain(geometry).collect()
+        std::iter::once(self.path.clone()).chain(data).chain(geometry).chain(self.imported_files.clone()).collect()
     }
 
     /// Parses case-file text; `path` is used in messages and to resolve data files.
@@ -185,6 +188,7 @@ impl CaseFile {
             paper,
             history,
             check,
+            imported_files: raw.imported.as_ref().map(|i| imported::files(&ctx, i)).unwrap_or_default(),
         })
     }
 

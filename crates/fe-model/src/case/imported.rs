@@ -48,10 +48,25 @@ struct RawImportedGroup {
     mass: Option<Spanned<String>>,
 }
 
+/// A path the case names, relative to its folder.
+fn resolve(ctx: &Ctx<'_>, name: &str) -> PathBuf {
+    let p = Path::new(name);
+    if p.is_absolute() { p.to_path_buf() } else { ctx.path.parent().unwrap_or(Path::new(".")).join(p) }
+}
+
+/// The files `[imported]` names, resolved (inputs that no output may replace).
+pub(super) fn files(ctx: &Ctx<'_>, raw: &Spanned<RawImported>) -> Vec<PathBuf> {
+    let r = raw.get_ref();
+    let names = r.groups.iter().flat_map(|g| {
+        let g = g.get_ref();
+        [Some(&g.dofs), g.stiffness.as_ref(), g.mass.as_ref()]
+    });
+    std::iter::once(r.nodes.as_ref()).chain(names).flatten().map(|n| resolve(ctx, n.get_ref())).collect()
+}
+
 /// A file the case names, read, with its resolved path.
 fn read(ctx: &Ctx<'_>, name: &Spanned<String>) -> Result<(PathBuf, String), CaseError> {
-    let p = Path::new(name.get_ref());
-    let path = if p.is_absolute() { p.to_path_buf() } else { ctx.path.parent().unwrap_or(Path::new(".")).join(p) };
+    let path = resolve(ctx, name.get_ref());
     let text = std::fs::read(&path)
         .map_err(|e| ctx.err(name.span(), format!("cannot read `{}`: {e}", name.get_ref())))
         .and_then(|bytes| {

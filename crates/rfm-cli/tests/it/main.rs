@@ -6,6 +6,7 @@ mod commands;
 mod diagnose;
 mod fixtures;
 mod gains;
+mod imported;
 mod inspect;
 mod measurement;
 mod nothing_lost;

@@ -805,6 +805,13 @@ mod tests {
         for model in [samples::frame_grid(1, 2, 2), samples::frame_with_joint(), samples::space_portal()] {
             check_model(&model, &mut kinds, &mut new_joints);
         }
+        // a model of imported matrices: masses at its nodes, changes of its groups
+        let imported = fe_model::imported::export::as_imported(&samples::frame_grid(1, 1, 2)).unwrap();
+        let mut imported_kinds = Vec::new();
+        check_model(&imported, &mut imported_kinds, &mut 0);
+        for kind in [EffectKind::LumpedMass, EffectKind::StiffnessChange, EffectKind::MassChange] {
+            assert!(imported_kinds.contains(&kind), "no local {kind:?} candidate of an imported model was checked");
+        }
         assert!(new_joints > 0, "no new joint was checked");
         for kind in [
             EffectKind::LumpedMass,
@@ -856,7 +863,8 @@ mod tests {
             );
         }
         assert!(refined.iter().any(|c| c.roles.contains(&candidates::Role::Inertia)), "{}", model.title);
-        assert!(!held.is_empty(), "{}", model.title);
+        // (an imported model's supports hold DOFs no matrix has: nothing to release)
+        assert!(!held.is_empty() || !model.imported().is_empty(), "{}", model.title);
         all.extend(refined);
         all.extend(held);
         let locals: Vec<Option<LocalCandidate>> = all.iter().map(|c| LocalCandidate::new(&nominal, c)).collect();

@@ -181,6 +181,13 @@ impl<'a> Ctx<'a> {
                 k[d] += ke[(o + p, o + p)] * e;
             }
         }
+        // and the imported stiffness matrices' diagonal there
+        for b in m.imported().iter().filter(|b| b.kind == fe_model::imported::ImportedKind::Stiffness) {
+            let n = b.dofs.len();
+            for (p, r) in b.dofs.iter().enumerate().filter(|(_, r)| r.node == NodeId(node)) {
+                k[r.dof] += b.values[p * n + p] * m.groups()[b.group].stiffness;
+            }
+        }
         k
     }
 
@@ -573,11 +580,20 @@ fn mass_nodes(ctx: &Ctx<'_>) -> Vec<u32> {
         *fixed.entry(s.node.0).or_default() += s.dofs.iter().filter(|d| d.is_translation()).count();
     }
     let translations = ctx.dim.translations().len();
+    // nodes of imported mass matrices carry structure as a beam's do
+    let imported: HashSet<u32> = model
+        .imported()
+        .iter()
+        .filter(|b| b.kind == fe_model::imported::ImportedKind::Mass)
+        .flat_map(|b| b.dofs.iter().filter(|r| r.dof.is_translation()).map(|r| r.node.0))
+        .collect();
     model
         .nodes()
         .iter()
         .map(|n| n.id.0)
-        .filter(|n| fixed.get(n).copied().unwrap_or(0) < translations && !ctx.at(*n).is_empty())
+        .filter(|n| {
+            fixed.get(n).copied().unwrap_or(0) < translations && (!ctx.at(*n).is_empty() || imported.contains(n))
+        })
         .collect()
 }
 
@@ -635,6 +651,9 @@ pub fn generate(model: &Model, opts: &CandidateOptions) -> Vec<Candidate> {
 
     for node in mass_nodes(&ctx) {
         specs.push(mass(&ctx, node, false));
+    }
+    for (group, nodes) in super::imported::imported_groups(model) {
+        specs.extend(super::imported::group_changes(model, group, &nodes, |n| ctx.alpha(n), |n| ctx.mu(n)));
     }
 
     // windows: on small models single elements at every offset and longer
