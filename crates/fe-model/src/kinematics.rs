@@ -328,4 +328,62 @@ mod tests {
         assert!((z.first[2][Dof::Uy].abs() - 1.0).abs() < 1e-12, "{:?}", z.first);
         assert!(z.first[0].0.iter().chain(&z.first[1].0).all(|v| v.abs() < 1e-12), "{:?}", z.first);
     }
+
+    /// A bent bar in space (not in any plane), of `n` elements.
+    fn space_beam(n: u32) -> Model {
+        let mut m = Model::with_dimension("b", crate::dof::Dimension::Spatial);
+        let g = m.add_group(Group::new("g")).unwrap();
+        let mat = m.add_material("s", 2e11, 7800.0).unwrap();
+        m.set_poisson(mat, 0.3).unwrap();
+        let sec = m.add_section(Section::rectangle("r", 0.03, 0.02)).unwrap();
+        for i in 0..=n {
+            let t = f64::from(i) / f64::from(n);
+            m.add_node_at(i + 1, [t, 0.3 * (3.0 * t).sin(), 0.2 * t * t]).unwrap();
+        }
+        for i in 1..=n {
+            m.add_beam(i, [i, i + 1], mat, sec, g).unwrap();
+        }
+        m
+    }
+
+    /// In space a body has six rigid motions: a pin leaves the three
+    /// rotations about it, two pins the rotation about the line through
+    /// them, which a third support off that line stops.
+    #[test]
+    fn rigid_motions_in_space_are_six_per_body() {
+        let translations = [Dof::Ux, Dof::Uy, Dof::Uz];
+        assert_eq!(zero_energy_motions(&space_beam(40)).modes, 6);
+        let mut pinned = space_beam(40);
+        pinned.add_support(1, &translations).unwrap();
+        assert_eq!(zero_energy_motions(&pinned).modes, 3);
+        pinned.add_support(41, &translations).unwrap();
+        let z = zero_energy_motions(&pinned);
+        assert_eq!(z.modes, 1, "the turn about the line through the pins");
+        // the turn moves the middle of the bent bar, not the pins
+        assert!(
+            z.first[0].0.iter().take(3).chain(z.first[40].0.iter().take(3)).all(|v| v.abs() < 1e-12),
+            "{:?}",
+            z.first[0]
+        );
+        assert!(z.first[20][Dof::Uy].abs() + z.first[20][Dof::Uz].abs() > 1e-3, "{:?}", z.first[20]);
+        pinned.add_support(21, &[Dof::Uz]).unwrap();
+        assert_eq!(zero_energy_motions(&pinned).modes, 0);
+        let mut clamped = space_beam(40);
+        clamped.add_support(1, &Dof::SPATIAL).unwrap();
+        assert_eq!(zero_energy_motions(&clamped).modes, 0);
+        // a ball joint (translations tied) between two clamped-free bars turns freely about three axes
+        let mut m = space_beam(4);
+        m.split_node(3, &[3], 100).unwrap();
+        m.add_tie(3, 100, &translations).unwrap();
+        m.add_support(1, &Dof::SPATIAL).unwrap();
+        assert_eq!(zero_energy_motions(&m).modes, 3);
+        // named at the free end's largest translation (its direction is the
+        // first null vector's, any of the three turns)
+        match crate::Assembly::new(&m).unwrap_err() {
+            ModelError::Mechanism { hint, modes: 3, nodes } if nodes == [4, 5, 100] => {
+                assert!(["5:ux", "5:uy", "5:uz"].contains(&hint.as_str()), "{hint}");
+            }
+            other => panic!("expected a mechanism of three motions, got {other:?}"),
+        }
+    }
 }
