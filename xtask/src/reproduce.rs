@@ -1,4 +1,5 @@
-//! `cargo xtask reproduce`: the paper's case studies and the tutorial loop,
+//! `cargo xtask reproduce`: the paper's case studies and the loops
+//! (compare, diagnose, add, update) of the tutorial and the frame in space,
 //! each held to its case file's `[check]` table.
 
 use std::ffi::OsStr;
@@ -18,8 +19,17 @@ fn paper_cases() -> impl Iterator<Item = &'static str> {
     include_str!("../../cases/paper-cases.txt").lines().map(str::trim).filter(|l| !l.is_empty() && !l.starts_with('#'))
 }
 
-/// The tutorial: a model missing a joint and data from the frame that has it.
-const TUTORIAL: &str = "tutorial";
+/// Cases beyond the paper's, run as they are: a model imported from
+/// another code's matrices (`docs/imported-models.md`).
+const MORE_CASES: [&str; 1] = ["imported/table"];
+
+/// The loops: a name (as `reproduce` takes it) and its case, a model
+/// missing an effect and data with it (a data file, or the case's
+/// `[truth]`), held to the case's `[check.diagnosis]`. The tutorial's is
+/// the walkthrough of `docs/walkthrough.md`; the table's is a frame in
+/// space with a loose corner joint.
+const LOOPS: [(&str, &str); 2] =
+    [("tutorial", "cases/tutorial/l-frame.toml"), ("table-frame", "cases/table-frame.toml")];
 
 /// One finished `rfm update` run, as its summary row, with the check it was
 /// held to and what it missed.
@@ -70,10 +80,17 @@ fn update(
 }
 
 pub(crate) fn reproduce(cases: &[String]) -> Result<(), String> {
-    let mut names: Vec<String> =
-        if cases.is_empty() { paper_cases().chain([TUTORIAL]).map(str::to_string).collect() } else { cases.to_vec() };
-    let tutorial = names.iter().any(|n| n == TUTORIAL);
-    names.retain(|n| n != TUTORIAL);
+    let mut names: Vec<String> = if cases.is_empty() {
+        paper_cases().chain(MORE_CASES).chain(LOOPS.map(|(name, _)| name)).map(str::to_string).collect()
+    } else {
+        cases.to_vec()
+    };
+    let loops: Vec<(&str, PathBuf)> = LOOPS
+        .iter()
+        .filter(|(name, _)| names.iter().any(|n| n == name))
+        .map(|&(name, path)| (name, crate::root().join(path)))
+        .collect();
+    names.retain(|n| !LOOPS.iter().any(|(name, _)| name == n));
     // read every case (and its checks) before the long build and runs, so
     // that a mistake in one is reported at once, with its line
     let mut loaded = Vec::new();
@@ -84,13 +101,13 @@ pub(crate) fn reproduce(cases: &[String]) -> Result<(), String> {
         }
         loaded.push((name, CaseFile::load(&path).map_err(|e| e.to_string())?));
     }
-    let tutorial_case = crate::root().join("cases/tutorial/l-frame.toml");
-    let tutorial_check = if tutorial {
-        let case = CaseFile::load(&tutorial_case).map_err(|e| e.to_string())?;
-        Some(case.check.and_then(|c| c.diagnosis).ok_or("the tutorial case has no [check.diagnosis]")?)
-    } else {
-        None
-    };
+    let mut loop_checks = Vec::new();
+    for (name, path) in &loops {
+        let case = CaseFile::load(path).map_err(|e| e.to_string())?;
+        let check =
+            case.check.and_then(|c| c.diagnosis).ok_or(format!("{} has no [check.diagnosis]", path.display()))?;
+        loop_checks.push((*name, path, check));
+    }
 
     let rfm = crate::release_build(&["-p", "rfm-cli", "--bin", "rfm"], "rfm")?;
     println!("running {}", rfm.display());
@@ -107,10 +124,10 @@ pub(crate) fn reproduce(cases: &[String]) -> Result<(), String> {
             runs.push(update(&rfm, &case.path, &out, "output-error", name, Some((c, noise)))?);
         }
     }
-    let loop_summary = match &tutorial_check {
-        Some(check) => Some(tutorial_loop(&rfm, &tutorial_case, &base.join(TUTORIAL), check, &mut runs)?),
-        None => None,
-    };
+    let mut loop_summaries = Vec::new();
+    for (name, path, check) in &loop_checks {
+        loop_summaries.push(diagnosis_loop(&rfm, name, path, &base.join(name), check, &mut runs)?);
+    }
 
     println!("\n==================== summary ====================");
     println!(
@@ -163,15 +180,15 @@ pub(crate) fn reproduce(cases: &[String]) -> Result<(), String> {
             check::status_name(json)
         );
     }
-    if let Some(text) = &loop_summary {
+    for text in &loop_summaries {
         println!("\n{text}");
     }
     println!("\nreports (self-contained HTML with the figures; open in a browser):");
     for run in runs.iter().filter(|r| r.report.exists()) {
         println!("  {}", run.report.display());
     }
-    if tutorial {
-        println!("  {}", base.join(TUTORIAL).join("compare/report.html").display());
+    for (name, ..) in &loop_checks {
+        println!("  {}", base.join(name).join("compare/report.html").display());
     }
     println!("\nresults: {}", base.display());
     println!("time after the build: {:.0} s", started.elapsed().as_secs_f64());
@@ -194,22 +211,25 @@ pub(crate) fn reproduce(cases: &[String]) -> Result<(), String> {
     Ok(())
 }
 
-/// The walkthrough of `docs/walkthrough.md`: compare the tutorial model with
-/// its data, diagnose, add the leading effect, update, and hold the result
-/// to the tutorial case's `[check.diagnosis]`.
-fn tutorial_loop(
+/// One of the [`LOOPS`] (the tutorial's is the walkthrough of
+/// `docs/walkthrough.md`): compare the model with its data, diagnose, add
+/// the leading effect, update, and hold the result to the case's
+/// `[check.diagnosis]`.
+fn diagnosis_loop(
     rfm: &Path,
+    name: &str,
     case: &Path,
     out: &Path,
     check: &fe_model::case::DiagnosisCheck,
     runs: &mut Vec<Run>,
 ) -> Result<String, String> {
-    println!("\n==================== tutorial: compare ====================");
+    println!("\n==================== {name}: compare ====================");
     let compare = out.join("compare");
     run_rfm(rfm, &[OsStr::new("compare"), case.as_os_str(), OsStr::new("--out"), compare.as_os_str()], "rfm compare")?;
 
-    println!("\n==================== tutorial: diagnose ====================");
-    let added = out.join("l-frame-with-effect.toml");
+    println!("\n==================== {name}: diagnose ====================");
+    let stem = case.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    let added = out.join(format!("{stem}-with-effect.toml"));
     let diagnosis = Command::new(rfm)
         .args([OsStr::new("diagnose"), case.as_os_str(), OsStr::new("--json"), OsStr::new("--apply"), OsStr::new("1")])
         .args([OsStr::new("--out"), added.as_os_str()])
@@ -233,7 +253,7 @@ fn tutorial_loop(
     }
     println!("wrote {} with the leading effect added", added.display());
 
-    let mut run = update(rfm, &added, &out.join("update"), "output-error", "tutorial (effect added)", None)?;
+    let mut run = update(rfm, &added, &out.join("update"), "output-error", &format!("{name} (effect added)"), None)?;
     // both are RMS FRF misfits per residual over the measured channels (the
     // diagnosis over every line, the update over its chosen lines)
     let nominal = json["nominal_misfit"].as_f64().unwrap_or(f64::NAN);
@@ -242,7 +262,7 @@ fn tutorial_loop(
     runs.push(run);
     let leader = ranking.first().and_then(|l| l["description"].as_str()).unwrap_or("?");
     Ok(format!(
-        "tutorial: the diagnosis named \"{leader}\" first; with it added and updated the misfit fell\n\
+        "{name}: the diagnosis named \"{leader}\" first; with it added and updated the misfit fell\n\
          {:.0} times, from {nominal:.3e} (nominal model) to {last:.3e}",
         nominal / last,
     ))

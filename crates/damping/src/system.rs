@@ -230,11 +230,34 @@ mod tests {
             "mass.tip.j",
         ];
         let beam_names = ["group.steel.beta", "group.aluminium.beta", "group.steel.alpha", "group.aluminium.mu"];
+        // a frame in space: torsion through E, springs and inertias about three axes
+        let mut model = samples::space_portal();
+        let arm = model.quantity("element.5.added_mass").unwrap();
+        model.set(arm, 2.0).unwrap();
+        let portal = DampedSystem::new(model).unwrap();
+        let portal_names = [
+            "group.joint.alpha",
+            "group.joint.mu",
+            "group.frame.beta",
+            "material.steel.E",
+            "material.steel.rho",
+            "element.5.stiffness",
+            "element.5.added_mass",
+            "spring.joint.krx",
+            "spring.joint.kry",
+            "spring.joint.krz",
+            "spring.foot.kz",
+            "mass.tip.m",
+            "mass.tip.jx",
+            "mass.tip.jy",
+            "mass.tip.jz",
+        ];
         // On the slender beam the damping terms are 1e-7 of Z and less, below
         // what a difference of Z resolves; they enter Z only as j w G(w), so
         // there the differences are taken of j w G, without the stiffness
         // and mass beside them.
-        let cases = [(&frame, &frame_names[..], false), (&beam, &beam_names[..], true)];
+        let cases =
+            [(&frame, &frame_names[..], false), (&beam, &beam_names[..], true), (&portal, &portal_names[..], false)];
         for &(sys, names, via_g) in &cases {
             for (omega, name) in [30.0, 900.0, 5000.0].iter().flat_map(|&w| names.iter().map(move |&n| (w, n))) {
                 let q = sys.model().quantity(name).unwrap();

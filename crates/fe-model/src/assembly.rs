@@ -10,8 +10,12 @@
 //! beam  K:  E * f_element * f_group       * K_unit(A, I, L, angle)
 //! beam  M:  rho * f_element * f_group     * M_unit(A, L, angle)   (+ added mass term)
 //! spring:   k_d * f_group                 * [1 -1; -1 1] on direction d
-//! mass:     m * f_group (ux, uy),  j * f_group (rz)
+//! mass:     m * f_group (translations),  j_a * f_group (rotation about axis a)
 //! ```
+//!
+//! A planar model's nodes have three DOFs and its beams the planar element
+//! ([`element`]); a 3D model's nodes have six and its beams the element of
+//! [`element::frame3d`], whose unit stiffness holds the torsion `G J / E`.
 //!
 //! Any group matrix `K_g`, `M_g`, and the derivative of any of them with
 //! respect to a quantity, is then a sum over a known list of terms. Nothing
@@ -22,8 +26,9 @@ use std::collections::HashMap;
 use nalgebra::DMatrix;
 
 use crate::dof::{Dof, DofMap, DofRef, Slot};
-use crate::element::{self, Mat6};
+use crate::element;
 use crate::error::ModelError;
+use crate::imported::ImportedKind;
 use crate::model::{Model, NodeId};
 use crate::quantity::Quantity;
 
@@ -45,6 +50,8 @@ pub enum BlockSource {
     Spring(usize),
     /// A lumped mass.
     Mass(usize),
+    /// A block of an imported matrix (index into [`Model::imported`]).
+    Imported(usize),
 }
 
 /// One unit matrix of a block, times a value.
@@ -159,14 +166,16 @@ impl UnionFind {
 
 fn build_dof_map(model: &Model) -> DofMap {
     let n = model.nodes.len();
-    let slot_of = |id: NodeId, d: Dof| 3 * model.node_index[&id] + d.index();
-    let mut uf = UnionFind::new(3 * n);
+    let dim = model.dimension;
+    let nd = dim.dofs_per_node();
+    let slot_of = |id: NodeId, d: Dof| nd * model.node_index[&id] + dim.local(d).expect("checked when added");
+    let mut uf = UnionFind::new(nd * n);
     for tie in &model.ties {
         for &d in &tie.dofs {
             uf.union(slot_of(tie.nodes[0], d), slot_of(tie.nodes[1], d));
         }
     }
-    let mut fixed = vec![false; 3 * n];
+    let mut fixed = vec![false; nd * n];
     for s in &model.supports {
         for &d in &s.dofs {
             let root = uf.find(slot_of(s.node, d));
@@ -176,9 +185,9 @@ fn build_dof_map(model: &Model) -> DofMap {
     let mut map = DofMap::default();
     let mut eq_of_root: HashMap<usize, usize> = HashMap::new();
     for (i, node) in model.nodes.iter().enumerate() {
-        for d in Dof::ALL {
+        for (k, &d) in dim.dofs().iter().enumerate() {
             let r = DofRef { node: node.id, dof: d };
-            let root = uf.find(3 * i + d.index());
+            let root = uf.find(nd * i + k);
             if fixed[root] {
                 map.insert_fixed(r);
             } else if let Some(&eq) = eq_of_root.get(&root) {
@@ -201,46 +210,49 @@ type RawBlock = (BlockSource, usize, Vec<DofRef>, Vec<RawTerm>);
 /// Local DOFs and terms (full, before removing fixed DOFs) of every block.
 fn raw_blocks(model: &Model) -> Vec<RawBlock> {
     let mut out = Vec::new();
-    let node_dofs = |id: NodeId| Dof::ALL.map(|d| DofRef { node: id, dof: d });
+    let dim = model.dimension;
+    let nd = dim.dofs_per_node();
+    let node_dofs = |id: NodeId| dim.dofs().iter().map(move |&d| DofRef { node: id, dof: d });
     for (i, b) in model.beams.iter().enumerate() {
-        let (l, c, s) = model.beam_geometry(i);
-        let sec = &model.sections[b.section];
-        let dofs: Vec<DofRef> = node_dofs(b.nodes[0]).into_iter().chain(node_dofs(b.nodes[1])).collect();
+        let dofs: Vec<DofRef> = node_dofs(b.nodes[0]).chain(node_dofs(b.nodes[1])).collect();
         let g = b.group;
-        let mut terms = vec![
+        // unit stiffness, unit consistent mass, unit added (lumped transverse) mass
+        let [k, m, added] = element::beam_units(model, i).map(|u| LocalMatrix::from_dense(&u));
+        let terms = vec![
             (
                 MatrixKind::Stiffness,
                 vec![Quantity::MaterialE(b.material), Quantity::ElementStiffness(i), Quantity::GroupStiffness(g)],
-                LocalMatrix::from6(element::frame_stiffness(sec.area, sec.inertia, l, c, s)),
+                k,
             ),
             (
                 MatrixKind::Mass,
                 vec![Quantity::MaterialRho(b.material), Quantity::ElementMass(i), Quantity::GroupMass(g)],
-                LocalMatrix::from6(element::frame_mass(sec.area, l, c, s)),
+                m,
+            ),
+            // The added-mass term always exists so that it can be updated from zero.
+            (
+                MatrixKind::Mass,
+                vec![Quantity::ElementAddedMass(i), Quantity::ElementMass(i), Quantity::GroupMass(g)],
+                added,
             ),
         ];
-        // The added-mass term always exists so that it can be updated from zero.
-        terms.push((
-            MatrixKind::Mass,
-            vec![Quantity::ElementAddedMass(i), Quantity::ElementMass(i), Quantity::GroupMass(g)],
-            LocalMatrix::from6(element::transverse_lumped_mass(l, c, s)),
-        ));
         out.push((BlockSource::Beam(i), g, dofs, terms));
     }
     for (i, sp) in model.springs.iter().enumerate() {
-        let mut dofs: Vec<DofRef> = node_dofs(sp.a).to_vec();
+        let mut dofs: Vec<DofRef> = node_dofs(sp.a).collect();
         if let Some(b) = sp.b {
             dofs.extend(node_dofs(b));
         }
         let n = dofs.len();
-        let terms = Dof::ALL
+        let terms = dim
+            .dofs()
             .iter()
-            .map(|&d| {
+            .enumerate()
+            .map(|(i0, &d)| {
                 let mut u = vec![0.0; n * n];
-                let i0 = d.index();
                 u[i0 * n + i0] = 1.0;
-                if n == 6 {
-                    let i1 = 3 + d.index();
+                if n == 2 * nd {
+                    let i1 = nd + i0;
                     u[i1 * n + i1] = 1.0;
                     u[i0 * n + i1] = -1.0;
                     u[i1 * n + i0] = -1.0;
@@ -255,14 +267,30 @@ fn raw_blocks(model: &Model) -> Vec<RawBlock> {
         out.push((BlockSource::Spring(i), sp.group, dofs, terms));
     }
     for (i, m) in model.masses.iter().enumerate() {
-        let dofs = node_dofs(m.node).to_vec();
-        let t = vec![1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0];
-        let r = vec![0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0];
-        let terms = vec![
-            (MatrixKind::Mass, vec![Quantity::MassM(i), Quantity::GroupMass(m.group)], LocalMatrix(t)),
-            (MatrixKind::Mass, vec![Quantity::MassJ(i), Quantity::GroupMass(m.group)], LocalMatrix(r)),
-        ];
+        let dofs: Vec<DofRef> = node_dofs(m.node).collect();
+        // the unit matrix on the given DOFs of the node
+        let on = |which: &[Dof]| {
+            let mut u = vec![0.0; nd * nd];
+            for &d in which {
+                let k = dim.local(d).expect("a DOF of the dimension");
+                u[k * nd + k] = 1.0;
+            }
+            LocalMatrix(u)
+        };
+        let mut terms =
+            vec![(MatrixKind::Mass, vec![Quantity::MassM(i), Quantity::GroupMass(m.group)], on(dim.translations()))];
+        for &r in dim.rotations() {
+            terms.push((MatrixKind::Mass, vec![Quantity::MassJ(i, r), Quantity::GroupMass(m.group)], on(&[r])));
+        }
         out.push((BlockSource::Mass(i), m.group, dofs, terms));
+    }
+    for (i, b) in model.imported.iter().enumerate() {
+        let factor = match b.kind {
+            ImportedKind::Stiffness => (MatrixKind::Stiffness, Quantity::GroupStiffness(b.group)),
+            ImportedKind::Mass => (MatrixKind::Mass, Quantity::GroupMass(b.group)),
+        };
+        let terms = vec![(factor.0, vec![factor.1], LocalMatrix(b.values.clone()))];
+        out.push((BlockSource::Imported(i), b.group, b.dofs.clone(), terms));
     }
     out
 }
@@ -271,8 +299,9 @@ fn raw_blocks(model: &Model) -> Vec<RawBlock> {
 struct LocalMatrix(Vec<f64>);
 
 impl LocalMatrix {
-    fn from6(m: Mat6) -> Self {
-        LocalMatrix((0..36).map(|k| m[(k / 6, k % 6)]).collect())
+    fn from_dense(m: &DMatrix<f64>) -> Self {
+        let n = m.nrows();
+        LocalMatrix((0..n * n).map(|k| m[(k / n, k % n)]).collect())
     }
 
     fn get(&self, n: usize, r: usize, c: usize) -> f64 {
@@ -352,7 +381,8 @@ impl Assembly {
             });
         }
         for (i, node) in model.nodes.iter().enumerate() {
-            let has_free = Dof::ALL.iter().any(|&d| dofs.equation(DofRef { node: node.id, dof: d }).is_some());
+            let has_free =
+                model.dimension.dofs().iter().any(|&d| dofs.equation(DofRef { node: node.id, dof: d }).is_some());
             if whole && !touched[i] && has_free {
                 return Err(ModelError::DanglingNode { id: node.id.0 });
             }
@@ -491,6 +521,13 @@ fn describe_source(model: &Model, source: BlockSource) -> String {
         BlockSource::Beam(i) => format!("element {}", model.beams[i].id),
         BlockSource::Spring(i) => format!("spring `{}`", model.springs[i].name),
         BlockSource::Mass(i) => format!("mass `{}`", model.masses[i].name),
+        BlockSource::Imported(i) => {
+            let b = &model.imported[i];
+            format!(
+                "the imported matrix of group `{}` at nodes {} and {}",
+                model.groups[b.group].name, b.nodes[0], b.nodes[1]
+            )
+        }
     }
 }
 
@@ -565,7 +602,7 @@ mod tests {
         m.add_beam(1, [1, 2], mat, sec, g).unwrap();
         m.add_spring("j", 2, Some(3), [1e6, 1e6, 0.0], g).unwrap();
         m.add_mass("tip", 3, 1.0, 0.0, g).unwrap();
-        m.add_support(1, &Dof::ALL).unwrap();
+        m.add_support(1, &Dof::PLANAR).unwrap();
         let e = Assembly::new(&m).unwrap_err();
         assert_eq!(e, ModelError::Mechanism { hint: "3:rz".into(), modes: 1, nodes: vec![3] });
     }

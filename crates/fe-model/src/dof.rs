@@ -1,5 +1,6 @@
-//! Degrees of freedom: the three per node, references to them, and the map
-//! from (node, dof) to equation index.
+//! Degrees of freedom: the three of a planar node or the six of a node in
+//! space ([`Dimension`]), references to them, values per DOF ([`PerDof`]),
+//! and the map from (node, dof) to equation index.
 
 use std::collections::HashMap;
 use std::fmt;
@@ -7,33 +8,48 @@ use std::str::FromStr;
 
 use crate::model::NodeId;
 
-/// One of the three planar degrees of freedom of a node.
+/// A degree of freedom of a node: three translations and three rotations.
+/// A planar model's nodes have `ux`, `uy` and `rz` ([`Dimension::Planar`]),
+/// a 3D model's all six ([`Dimension::Spatial`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Dof {
     /// Translation along global x.
     Ux,
     /// Translation along global y.
     Uy,
-    /// Rotation about global z (counter-clockwise positive).
+    /// Translation along global z (3D models).
+    Uz,
+    /// Rotation about global x (3D models; right-hand rule).
+    Rx,
+    /// Rotation about global y (3D models; right-hand rule).
+    Ry,
+    /// Rotation about global z (counter-clockwise positive in the x-y plane).
     Rz,
 }
 
 impl Dof {
-    /// All three DOFs in the order they are numbered within a node.
-    pub const ALL: [Dof; 3] = [Dof::Ux, Dof::Uy, Dof::Rz];
+    /// The DOFs of a planar node, in the order they are numbered.
+    pub const PLANAR: [Dof; 3] = [Dof::Ux, Dof::Uy, Dof::Rz];
 
-    /// Position of this DOF within a node's block of three.
-    pub fn index(self) -> usize {
+    /// The DOFs of a 3D node, in the order they are numbered.
+    pub const SPATIAL: [Dof; 6] = [Dof::Ux, Dof::Uy, Dof::Uz, Dof::Rx, Dof::Ry, Dof::Rz];
+
+    /// Position among the six DOFs of a 3D node (`ux` 0 .. `rz` 5): the
+    /// index of a [`PerDof`], whatever the model's dimension.
+    pub fn position(self) -> usize {
         match self {
             Dof::Ux => 0,
             Dof::Uy => 1,
-            Dof::Rz => 2,
+            Dof::Uz => 2,
+            Dof::Rx => 3,
+            Dof::Ry => 4,
+            Dof::Rz => 5,
         }
     }
 
-    /// The DOF at position `i` (0, 1, 2) within a node.
-    pub fn from_index(i: usize) -> Option<Dof> {
-        Dof::ALL.get(i).copied()
+    /// The global axis (0 x, 1 y, 2 z) this DOF translates along or rotates about.
+    pub fn axis(self) -> usize {
+        self.position() % 3
     }
 
     /// Lower-case name used in case files and outputs.
@@ -41,13 +57,16 @@ impl Dof {
         match self {
             Dof::Ux => "ux",
             Dof::Uy => "uy",
+            Dof::Uz => "uz",
+            Dof::Rx => "rx",
+            Dof::Ry => "ry",
             Dof::Rz => "rz",
         }
     }
 
-    /// True for the two translations.
+    /// True for the three translations.
     pub fn is_translation(self) -> bool {
-        !matches!(self, Dof::Rz)
+        self.position() < 3
     }
 }
 
@@ -63,9 +82,162 @@ impl FromStr for Dof {
         match s.trim().to_ascii_lowercase().as_str() {
             "ux" | "x" => Ok(Dof::Ux),
             "uy" | "y" => Ok(Dof::Uy),
+            "uz" | "z" => Ok(Dof::Uz),
+            "rx" => Ok(Dof::Rx),
+            "ry" => Ok(Dof::Ry),
             "rz" | "r" | "theta" => Ok(Dof::Rz),
-            other => Err(format!("unknown dof `{other}` (expected ux, uy or rz)")),
+            other => Err(format!("unknown dof `{other}` (expected ux, uy, uz, rx, ry or rz)")),
         }
+    }
+}
+
+/// Whether a model is a planar frame in the x-y plane or a frame in space.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Dimension {
+    /// Nodes in the x-y plane with `ux`, `uy`, `rz` (`[model] dimension = 2`, the default).
+    #[default]
+    Planar,
+    /// Nodes in space with all six DOFs (`[model] dimension = 3`).
+    Spatial,
+}
+
+impl Dimension {
+    /// The DOFs of a node, in the order they are numbered.
+    pub fn dofs(self) -> &'static [Dof] {
+        match self {
+            Dimension::Planar => &Dof::PLANAR,
+            Dimension::Spatial => &Dof::SPATIAL,
+        }
+    }
+
+    /// The translations of a node.
+    pub fn translations(self) -> &'static [Dof] {
+        match self {
+            Dimension::Planar => &[Dof::Ux, Dof::Uy],
+            Dimension::Spatial => &[Dof::Ux, Dof::Uy, Dof::Uz],
+        }
+    }
+
+    /// The rotations of a node.
+    pub fn rotations(self) -> &'static [Dof] {
+        match self {
+            Dimension::Planar => &[Dof::Rz],
+            Dimension::Spatial => &[Dof::Rx, Dof::Ry, Dof::Rz],
+        }
+    }
+
+    /// DOFs per node (3 or 6).
+    pub fn dofs_per_node(self) -> usize {
+        self.dofs().len()
+    }
+
+    /// Position of `d` within a node's block of DOFs, `None` when the
+    /// dimension has no such DOF.
+    pub fn local(self, d: Dof) -> Option<usize> {
+        self.dofs().iter().position(|&x| x == d)
+    }
+
+    /// 2 or 3, as case files write it.
+    pub fn number(self) -> u8 {
+        match self {
+            Dimension::Planar => 2,
+            Dimension::Spatial => 3,
+        }
+    }
+
+    /// The dimension a case file's number names.
+    pub fn from_number(n: i64) -> Option<Self> {
+        match n {
+            2 => Some(Dimension::Planar),
+            3 => Some(Dimension::Spatial),
+            _ => None,
+        }
+    }
+
+    /// Refuses a DOF the dimension does not have, saying what to do.
+    pub fn check(self, d: Dof) -> Result<(), String> {
+        match self.local(d) {
+            Some(_) => Ok(()),
+            None => Err(format!(
+                "`{d}` is not a DOF of a planar model (its nodes have ux, uy and rz); a frame in space needs \
+                 `[model] dimension = 3`"
+            )),
+        }
+    }
+
+    /// The key of a spring stiffness along or about `d`, as case files and
+    /// parameter names write it: `kx`, `ky`, `kz`, `krx`, `kry`, `krz`, and
+    /// `kr` for the rotation of a planar model.
+    pub fn spring_key(self, d: Dof) -> &'static str {
+        match (self, d) {
+            (_, Dof::Ux) => "kx",
+            (_, Dof::Uy) => "ky",
+            (_, Dof::Uz) => "kz",
+            (_, Dof::Rx) => "krx",
+            (_, Dof::Ry) => "kry",
+            (Dimension::Planar, Dof::Rz) => "kr",
+            (Dimension::Spatial, Dof::Rz) => "krz",
+        }
+    }
+
+    /// The DOF a spring key names (see [`Dimension::spring_key`]).
+    pub fn spring_dof(self, key: &str) -> Option<Dof> {
+        self.dofs().iter().copied().find(|&d| self.spring_key(d) == key)
+    }
+
+    /// The key of a lumped mass's rotary inertia about the axis of `d` (a
+    /// rotation): `j` in a planar model, `jx`, `jy`, `jz` in space.
+    pub fn inertia_key(self, d: Dof) -> &'static str {
+        match (self, d.axis()) {
+            (Dimension::Planar, _) => "j",
+            (Dimension::Spatial, 0) => "jx",
+            (Dimension::Spatial, 1) => "jy",
+            (Dimension::Spatial, _) => "jz",
+        }
+    }
+
+    /// The rotation whose inertia a key names (see [`Dimension::inertia_key`]).
+    pub fn inertia_dof(self, key: &str) -> Option<Dof> {
+        self.rotations().iter().copied().find(|&d| self.inertia_key(d) == key)
+    }
+}
+
+/// One value per DOF of a node (a spring's stiffnesses, a motion), indexed
+/// by [`Dof`]; a planar model leaves `uz`, `rx` and `ry` at zero.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PerDof(pub [f64; 6]);
+
+impl PerDof {
+    /// The DOFs with a non-zero value, among `dofs`.
+    pub fn non_zero(&self, dofs: &[Dof]) -> Vec<Dof> {
+        dofs.iter().copied().filter(|&d| self[d] != 0.0).collect()
+    }
+}
+
+/// The planar `(ux, uy, rz)` values.
+impl From<[f64; 3]> for PerDof {
+    fn from([x, y, r]: [f64; 3]) -> Self {
+        PerDof([x, y, 0.0, 0.0, 0.0, r])
+    }
+}
+
+/// The six `(ux, uy, uz, rx, ry, rz)` values.
+impl From<[f64; 6]> for PerDof {
+    fn from(v: [f64; 6]) -> Self {
+        PerDof(v)
+    }
+}
+
+impl std::ops::Index<Dof> for PerDof {
+    type Output = f64;
+    fn index(&self, d: Dof) -> &f64 {
+        &self.0[d.position()]
+    }
+}
+
+impl std::ops::IndexMut<Dof> for PerDof {
+    fn index_mut(&mut self, d: Dof) -> &mut f64 {
+        &mut self.0[d.position()]
     }
 }
 
@@ -183,6 +355,26 @@ mod tests {
         assert_eq!(r.to_string(), "31:uy");
         assert!("31".parse::<DofRef>().unwrap_err().contains("`31` is not of the form node:dof"));
         assert!("a:uy".parse::<DofRef>().unwrap_err().contains("`a` in `a:uy` is not a node id"));
-        assert!("3:uz".parse::<DofRef>().unwrap_err().contains("uz"));
+        // every DOF name parses; whether the model has it is checked against its dimension
+        assert_eq!("3:uz".parse::<DofRef>(), Ok(DofRef::new(3, Dof::Uz)));
+        assert!("3:uw".parse::<DofRef>().unwrap_err().contains("expected ux, uy, uz, rx, ry or rz"));
+        assert!(Dimension::Planar.check(Dof::Uz).unwrap_err().contains("dimension = 3"));
+        assert_eq!(Dimension::Spatial.check(Dof::Rz), Ok(()));
+    }
+
+    #[test]
+    fn spring_and_inertia_keys_name_their_dofs_in_each_dimension() {
+        for dim in [Dimension::Planar, Dimension::Spatial] {
+            for &d in dim.dofs() {
+                assert_eq!(dim.spring_dof(dim.spring_key(d)), Some(d));
+            }
+            for &d in dim.rotations() {
+                assert_eq!(dim.inertia_dof(dim.inertia_key(d)), Some(d));
+            }
+        }
+        assert_eq!(Dimension::Planar.spring_key(Dof::Rz), "kr");
+        assert_eq!(Dimension::Spatial.spring_dof("kr"), None);
+        let k = PerDof::from([1.0, 2.0, 3.0]);
+        assert_eq!((k[Dof::Ux], k[Dof::Uy], k[Dof::Rz], k[Dof::Uz]), (1.0, 2.0, 3.0, 0.0));
     }
 }

@@ -10,8 +10,16 @@
 //!
 //! The routines return *unit* matrices: stiffness for `E = 1`, mass for
 //! `rho = 1`, so that a physical value multiplies them (see [`crate::assembly`]).
+//!
+//! This file is the planar element; [`frame3d`] is the element of a frame
+//! in space.
 
-use nalgebra::SMatrix;
+use nalgebra::{DMatrix, SMatrix};
+
+use crate::dof::Dimension;
+use crate::model::Model;
+
+pub mod frame3d;
 
 /// 6x6 element matrix.
 pub type Mat6 = SMatrix<f64, 6, 6>;
@@ -106,6 +114,41 @@ pub fn frame_mass(area: f64, l: f64, c: f64, s: f64) -> Mat6 {
 /// Lumped transverse mass in global axes for a unit mass per length.
 pub fn transverse_lumped_mass(l: f64, c: f64, s: f64) -> Mat6 {
     to_global(&transverse_lumped_mass_local(l), c, s)
+}
+
+/// The unit matrices of beam `beam` of `model` in global axes, over the
+/// DOFs of its two end nodes (the model's DOFs per node, first node
+/// first): stiffness for `E = 1` (in 3D with the torsion `G J / E`),
+/// consistent mass for `rho = 1`, and the lumped transverse mass of a unit
+/// added mass per length.
+pub fn beam_units(model: &Model, beam: usize) -> [DMatrix<f64>; 3] {
+    let b = &model.beams()[beam];
+    let sec = &model.sections()[b.section];
+    match model.dimension() {
+        Dimension::Planar => {
+            let (l, c, s) = model.beam_geometry(beam);
+            [
+                frame_stiffness(sec.area, sec.inertia, l, c, s),
+                frame_mass(sec.area, l, c, s),
+                transverse_lumped_mass(l, c, s),
+            ]
+            .map(|m| DMatrix::from_iterator(6, 6, m.iter().copied()))
+        }
+        Dimension::Spatial => {
+            let (l, _) = model.beam_axis(beam);
+            let axes = model.beam_axes(beam);
+            let g = model.materials()[b.material].shear_ratio();
+            [
+                frame3d::stiffness_local(sec.area, sec.iy, sec.inertia, sec.torsion, g, l),
+                frame3d::mass_local(sec.area, sec.polar(), l),
+                frame3d::transverse_lumped_mass_local(l),
+            ]
+            .map(|local| {
+                let m = frame3d::to_global(&local, &axes);
+                DMatrix::from_iterator(12, 12, m.iter().copied())
+            })
+        }
+    }
 }
 
 #[cfg(test)]

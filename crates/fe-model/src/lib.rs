@@ -36,7 +36,7 @@
 //! for i in 1..=4 {
 //!     m.add_beam(i, [i, i + 1], steel, bar, g).unwrap();
 //! }
-//! m.add_support(1, &Dof::ALL).unwrap();
+//! m.add_support(1, &Dof::PLANAR).unwrap();
 //!
 //! let a = Assembly::new(&m).unwrap();
 //! assert_eq!(a.n(), 12); // 5 nodes x 3 DOFs, minus the clamped node
@@ -53,6 +53,7 @@ pub mod case;
 pub mod dof;
 pub mod element;
 pub mod error;
+pub mod imported;
 pub mod kinematics;
 pub mod model;
 pub mod quantity;
@@ -62,9 +63,9 @@ pub mod text;
 
 pub use assembly::{Assembly, Block, BlockSource, MatrixKind, Pattern, Term};
 pub use case::{CaseEditor, CaseFile, HistoryEntry};
-pub use dof::{Dof, DofMap, DofRef, Slot};
+pub use dof::{Dimension, Dof, DofMap, DofRef, PerDof, Slot};
 pub use error::{CaseError, Location, ModelError};
-pub use model::{Beam, ElementId, Group, LumpedMass, Material, Model, Node, NodeId, Section, Spring};
+pub use model::{Beam, ElementId, Group, LumpedMass, Material, Model, Node, NodeId, RotaryInertia, Section, Spring};
 pub use quantity::{Parameter, Quantity, QuantityKind};
 
 /// A number for a message: as written for ordinary magnitudes, in exponent

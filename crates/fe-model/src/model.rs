@@ -4,198 +4,24 @@
 //! A [`Model`] is plain data with validated construction. It knows nothing of
 //! frequencies or damping kernels; the damping values of a group are stored
 //! here only so that a case file describes the whole structure in one place.
+//! A model is planar (nodes in the x-y plane with `ux`, `uy`, `rz`) or a
+//! frame in space (six DOFs per node), fixed when it is made
+//! ([`Model::with_dimension`]); every `add_*` refuses a DOF, coordinate or
+//! value the dimension does not have. The items themselves are in `items.rs`.
 
 use std::collections::HashMap;
-use std::fmt;
 
-use crate::dof::Dof;
+use crate::dof::{Dimension, Dof, PerDof};
+use crate::element::frame3d;
 use crate::error::ModelError;
 
-/// Identifier of a node as written by the user (not an index).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct NodeId(pub u32);
+mod items;
+pub use items::{
+    Beam, ElementId, Group, LumpedMass, Material, Node, NodeId, RotaryInertia, Section, Spring, Support, Tie,
+    rectangle_torsion,
+};
 
-impl fmt::Display for NodeId {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}", self.0)
-    }
-}
-
-/// Identifier of a beam element as written by the user (not an index).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct ElementId(pub u32);
-
-impl fmt::Display for ElementId {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}", self.0)
-    }
-}
-
-/// A node in the x-y plane.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Node {
-    /// User id.
-    pub id: NodeId,
-    /// x coordinate (m).
-    pub x: f64,
-    /// y coordinate (m).
-    pub y: f64,
-}
-
-/// An isotropic linear elastic material.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Material {
-    /// Name used by elements.
-    pub name: String,
-    /// Young's modulus E (Pa).
-    pub e: f64,
-    /// Density rho (kg/m^3).
-    pub rho: f64,
-}
-
-/// Cross-section properties of a beam.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Section {
-    /// Name used by elements.
-    pub name: String,
-    /// Area A (m^2).
-    pub area: f64,
-    /// Second moment of area about the bending axis, I (m^4).
-    pub inertia: f64,
-}
-
-impl Section {
-    /// Solid rectangle of width `b` and depth `h` in the bending plane.
-    pub fn rectangle(name: &str, b: f64, h: f64) -> Self {
-        Section { name: name.into(), area: b * h, inertia: b * h.powi(3) / 12.0 }
-    }
-
-    /// Circular tube of outer diameter `od` and inner diameter `id`.
-    pub fn tube(name: &str, od: f64, id: f64) -> Self {
-        let pi = std::f64::consts::PI;
-        Section {
-            name: name.into(),
-            area: pi / 4.0 * (od * od - id * id),
-            inertia: pi / 64.0 * (od.powi(4) - id.powi(4)),
-        }
-    }
-}
-
-/// A two-node Euler-Bernoulli frame element (axial + bending, consistent mass).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Beam {
-    /// User id.
-    pub id: ElementId,
-    /// End nodes.
-    pub nodes: [NodeId; 2],
-    /// Index into [`Model::materials`].
-    pub material: usize,
-    /// Index into [`Model::sections`].
-    pub section: usize,
-    /// Index into [`Model::groups`].
-    pub group: usize,
-    /// Non-structural transverse mass per unit length (kg/m), lumped at the
-    /// ends, for example the added mass of surrounding water.
-    pub added_mass: f64,
-    /// Stiffness factor of this element (1 = nominal).
-    pub stiffness_factor: f64,
-    /// Mass factor of this element (1 = nominal).
-    pub mass_factor: f64,
-}
-
-/// Linear springs between two nodes, or from a node to ground, along the
-/// global x, y and rotation directions. Joints and flexible supports are
-/// modelled with coincident nodes joined by a spring.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Spring {
-    /// Unique name (used in parameter names such as `spring.clamp.kr`).
-    pub name: String,
-    /// First node.
-    pub a: NodeId,
-    /// Second node, or `None` for a spring to ground.
-    pub b: Option<NodeId>,
-    /// Stiffnesses (kx N/m, ky N/m, kr N m/rad), indexed by [`Dof::index`].
-    pub k: [f64; 3],
-    /// Index into [`Model::groups`].
-    pub group: usize,
-}
-
-/// A lumped mass with rotary inertia at a node.
-#[derive(Clone, Debug, PartialEq)]
-pub struct LumpedMass {
-    /// Unique name (used in parameter names such as `mass.sensor.m`).
-    pub name: String,
-    /// Node carrying the mass.
-    pub node: NodeId,
-    /// Mass (kg), acting on ux and uy.
-    pub m: f64,
-    /// Rotary inertia (kg m^2), acting on rz.
-    pub j: f64,
-    /// Index into [`Model::groups`].
-    pub group: usize,
-}
-
-/// DOFs of a node held fixed.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Support {
-    /// The node.
-    pub node: NodeId,
-    /// Its fixed DOFs.
-    pub dofs: Vec<Dof>,
-}
-
-/// A rigid coupling of some DOFs of two (usually coincident) nodes: the
-/// second node's DOFs share the equations of the first's.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Tie {
-    /// The two nodes; the first owns the shared equations.
-    pub nodes: [NodeId; 2],
-    /// The coupled DOFs.
-    pub dofs: Vec<Dof>,
-}
-
-/// A named group of elements, springs and masses sharing damping parameters.
-///
-/// Damping of group g: `C_g = alpha K_g + beta M_g` (alpha multiplies K, as in
-/// the paper), acting through the kernel `mu / (mu + j w)`; `mu = None` is
-/// viscous. `stiffness` and `mass` are factors on `K_g` and `M_g` (1 nominal).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Group {
-    /// Name.
-    pub name: String,
-    /// Stiffness-proportional damping coefficient alpha (s).
-    pub alpha: f64,
-    /// Mass-proportional damping coefficient beta (1/s).
-    pub beta: f64,
-    /// Relaxation parameter mu (rad/s); `None` means viscous (mu = infinity).
-    pub mu: Option<f64>,
-    /// Stiffness factor of the whole group.
-    pub stiffness: f64,
-    /// Mass factor of the whole group.
-    pub mass: f64,
-}
-
-impl Group {
-    /// An undamped group with unit factors.
-    pub fn new(name: &str) -> Self {
-        Group { name: name.into(), alpha: 0.0, beta: 0.0, mu: None, stiffness: 1.0, mass: 1.0 }
-    }
-
-    /// Builder: Rayleigh coefficients.
-    pub fn rayleigh(mut self, alpha: f64, beta: f64) -> Self {
-        self.alpha = alpha;
-        self.beta = beta;
-        self
-    }
-
-    /// Builder: relaxation parameter (`f64::INFINITY` for viscous).
-    pub fn relaxation(mut self, mu: f64) -> Self {
-        self.mu = if mu.is_infinite() { None } else { Some(mu) };
-        self
-    }
-}
-
-/// A planar frame model.
+/// A frame model, planar or in space.
 ///
 /// Build it with the `add_*` methods (each checks its references), or load it
 /// from a case file with [`crate::case::CaseFile`]. Every element, spring and
@@ -204,6 +30,7 @@ impl Group {
 pub struct Model {
     /// Title shown in reports.
     pub title: String,
+    pub(crate) dimension: Dimension,
     pub(crate) nodes: Vec<Node>,
     pub(crate) node_index: HashMap<NodeId, usize>,
     pub(crate) materials: Vec<Material>,
@@ -214,6 +41,7 @@ pub struct Model {
     pub(crate) supports: Vec<Support>,
     pub(crate) ties: Vec<Tie>,
     pub(crate) groups: Vec<Group>,
+    pub(crate) imported: Vec<crate::imported::ImportedBlock>,
 }
 
 fn positive(what: String, v: f64) -> Result<(), ModelError> {
@@ -236,9 +64,31 @@ fn non_negative(what: String, v: f64) -> Result<(), ModelError> {
 }
 
 impl Model {
-    /// An empty model.
+    /// An empty planar model.
     pub fn new(title: &str) -> Self {
         Model { title: title.into(), ..Default::default() }
+    }
+
+    /// An empty model of the given dimension.
+    pub fn with_dimension(title: &str, dimension: Dimension) -> Self {
+        Model { title: title.into(), dimension, ..Default::default() }
+    }
+
+    /// Planar or in space.
+    pub fn dimension(&self) -> Dimension {
+        self.dimension
+    }
+
+    /// The DOFs of every node, in the order they are numbered.
+    pub fn node_dofs(&self) -> &'static [Dof] {
+        self.dimension.dofs()
+    }
+
+    fn check_dofs(&self, dofs: &[Dof], what: &str) -> Result<(), ModelError> {
+        for &d in dofs {
+            self.dimension.check(d).map_err(|reason| ModelError::Invalid { what: what.into(), reason })?;
+        }
+        Ok(())
     }
 
     /// Nodes in definition order.
@@ -338,20 +188,35 @@ impl Model {
         }
     }
 
-    /// Adds a node; ids must be unique and coordinates finite.
+    /// Adds a node in the x-y plane; ids must be unique and coordinates finite.
     pub fn add_node(&mut self, id: u32, x: f64, y: f64) -> Result<NodeId, ModelError> {
+        self.add_node_at(id, [x, y, 0.0])
+    }
+
+    /// Adds a node at `[x, y, z]`; a planar model refuses `z != 0`.
+    pub fn add_node_at(&mut self, id: u32, [x, y, z]: [f64; 3]) -> Result<NodeId, ModelError> {
         let id = NodeId(id);
         if self.node_index.contains_key(&id) {
             return Err(ModelError::DuplicateNode { id: id.0 });
         }
-        if !(x.is_finite() && y.is_finite()) {
+        if !(x.is_finite() && y.is_finite() && z.is_finite()) {
+            let shown =
+                if self.dimension == Dimension::Planar { format!("({x}, {y})") } else { format!("({x}, {y}, {z})") };
             return Err(ModelError::Invalid {
                 what: format!("node {id}"),
-                reason: format!("coordinates must be finite, got ({x}, {y})"),
+                reason: format!("coordinates must be finite, got {shown}"),
+            });
+        }
+        if self.dimension == Dimension::Planar && z != 0.0 {
+            return Err(ModelError::Invalid {
+                what: format!("node {id}"),
+                reason: format!(
+                    "has z = {z}, and a planar model lies in the x-y plane; a frame in space needs `[model] dimension = 3`"
+                ),
             });
         }
         self.node_index.insert(id, self.nodes.len());
-        self.nodes.push(Node { id, x, y });
+        self.nodes.push(Node { id, x, y, z });
         Ok(id)
     }
 
@@ -362,17 +227,37 @@ impl Model {
         }
         positive(format!("material `{name}`: E"), e)?;
         positive(format!("material `{name}`: rho"), rho)?;
-        self.materials.push(Material { name: name.into(), e, rho });
+        self.materials.push(Material { name: name.into(), e, rho, nu: None });
         Ok(self.materials.len() - 1)
     }
 
-    /// Adds a section (A > 0, I > 0) and returns its index.
+    /// Sets the Poisson's ratio of a material (`-1 < nu <= 0.5`), which gives
+    /// the shear modulus of a 3D beam's torsion.
+    pub fn set_poisson(&mut self, material: usize, nu: f64) -> Result<(), ModelError> {
+        if !(nu > -1.0 && nu <= 0.5) {
+            return Err(ModelError::Invalid {
+                what: format!("material `{}`: nu", self.materials[material].name),
+                reason: format!("must lie in (-1, 0.5], got {}", crate::show(nu)),
+            });
+        }
+        self.materials[material].nu = Some(nu);
+        Ok(())
+    }
+
+    /// Adds a section (A > 0, I > 0; in a 3D model also Iy > 0 and J > 0)
+    /// and returns its index.
     pub fn add_section(&mut self, section: Section) -> Result<usize, ModelError> {
         if self.section_index(&section.name).is_some() {
             return Err(ModelError::Duplicate { what: format!("section `{}`", section.name) });
         }
         positive(format!("section `{}`: A", section.name), section.area)?;
-        positive(format!("section `{}`: I", section.name), section.inertia)?;
+        if self.dimension == Dimension::Spatial {
+            positive(format!("section `{}`: Iz", section.name), section.inertia)?;
+            positive(format!("section `{}`: Iy", section.name), section.iy)?;
+            positive(format!("section `{}`: J", section.name), section.torsion)?;
+        } else {
+            positive(format!("section `{}`: I", section.name), section.inertia)?;
+        }
         self.sections.push(section);
         Ok(self.sections.len() - 1)
     }
@@ -431,8 +316,21 @@ impl Model {
             return Err(ModelError::UnknownSection { name: format!("#{section}"), context: ctx });
         }
         self.require_group(group, &ctx)?;
+        if self.dimension == Dimension::Spatial && self.materials[material].nu.is_none() {
+            return Err(ModelError::Invalid {
+                what: ctx,
+                reason: format!(
+                    "is a 3D beam of material `{}`, which has no Poisson's ratio `nu` (or shear modulus `G`) for its torsion",
+                    self.materials[material].name
+                ),
+            });
+        }
         let (a, b) = (self.node(nodes[0]).unwrap(), self.node(nodes[1]).unwrap());
-        let length = (b.x - a.x).hypot(b.y - a.y);
+        let length = if self.dimension == Dimension::Planar {
+            (b.x - a.x).hypot(b.y - a.y)
+        } else {
+            ((b.x - a.x).powi(2) + (b.y - a.y).powi(2) + (b.z - a.z).powi(2)).sqrt()
+        };
         if nodes[0] == nodes[1] || length <= 1e-12 {
             return Err(ModelError::ZeroLength { element: id.0 });
         }
@@ -451,8 +349,48 @@ impl Model {
             added_mass: 0.0,
             stiffness_factor: 1.0,
             mass_factor: 1.0,
+            reference: None,
+            angle: 0.0,
         });
+        if self.dimension == Dimension::Spatial
+            && let Err(e) = self.orient_beam(self.beams.len() - 1, None, 0.0)
+        {
+            self.beams.pop();
+            return Err(e);
+        }
         Ok(self.beams.len() - 1)
+    }
+
+    /// Orients the section of a 3D beam: `reference` is the approximate
+    /// direction of its local z axis (`None`: the default), `angle` turns the
+    /// section about the beam's axis (radians). See [`frame3d::axes`].
+    pub fn orient_beam(&mut self, beam: usize, reference: Option<[f64; 3]>, angle: f64) -> Result<(), ModelError> {
+        let ctx = format!("element {}", self.beams[beam].id);
+        if self.dimension == Dimension::Planar && (reference.is_some() || angle != 0.0) {
+            return Err(ModelError::Invalid {
+                what: ctx,
+                reason: "has an orientation, which only a beam of a 3D model has (`[model] dimension = 3`)".into(),
+            });
+        }
+        if !angle.is_finite() {
+            return Err(ModelError::Invalid { what: ctx, reason: format!("has a turn angle of {angle}") });
+        }
+        let [p, q] = self.beams[beam].nodes.map(|n| self.node(n).expect("checked when added").position());
+        match frame3d::axes(p, q, reference, angle) {
+            Ok(_) => {
+                self.beams[beam].reference = reference;
+                self.beams[beam].angle = angle;
+                Ok(())
+            }
+            Err(frame3d::AxesError::ZeroLength) => Err(ModelError::ZeroLength { element: self.beams[beam].id.0 }),
+            Err(frame3d::AxesError::Reference) => Err(ModelError::Invalid {
+                what: ctx,
+                reason: format!(
+                    "has the orientation {:?}, which is zero or along the beam; give a direction across it for the section's local z axis",
+                    reference.unwrap_or_default()
+                ),
+            }),
+        }
     }
 
     /// Sets the non-structural transverse mass per length of a beam (kg/m).
@@ -462,16 +400,18 @@ impl Model {
         Ok(())
     }
 
-    /// Adds springs `k = [kx, ky, kr]` between `a` and `b` (or to ground when
-    /// `b` is `None`).
+    /// Adds springs `k` between `a` and `b` (or to ground when `b` is
+    /// `None`): `[kx, ky, kr]` in a planar model, or a stiffness per DOF
+    /// ([`PerDof`]); a DOF the model does not have must get none.
     pub fn add_spring(
         &mut self,
         name: &str,
         a: u32,
         b: Option<u32>,
-        k: [f64; 3],
+        k: impl Into<PerDof>,
         group: usize,
     ) -> Result<usize, ModelError> {
+        let k = k.into();
         let ctx = format!("spring `{name}`");
         if self.spring_index(name).is_some() {
             return Err(ModelError::Duplicate { what: ctx });
@@ -486,10 +426,15 @@ impl Model {
                 });
             }
         }
-        for (d, v) in Dof::ALL.iter().zip(k) {
-            non_negative(format!("{ctx}: k{}", &d.name()[d.name().len() - 1..]), v)?;
+        for &d in &Dof::SPATIAL {
+            if self.dimension.local(d).is_none() && k[d] != 0.0 {
+                self.dimension.check(d).map_err(|reason| ModelError::Invalid { what: ctx.clone(), reason })?;
+            }
         }
-        if k.iter().all(|&v| v == 0.0) {
+        for &d in self.dimension.dofs() {
+            non_negative(format!("{ctx}: {}", self.dimension.spring_key(d)), k[d])?;
+        }
+        if k.0.iter().all(|&v| v == 0.0) {
             return Err(ModelError::Invalid { what: ctx, reason: "has no non-zero stiffness".into() });
         }
         self.require_group(group, &ctx)?;
@@ -497,16 +442,35 @@ impl Model {
         Ok(self.springs.len() - 1)
     }
 
-    /// Adds a lumped mass `m` (kg) with rotary inertia `j` (kg m^2) at a node.
-    pub fn add_mass(&mut self, name: &str, node: u32, m: f64, j: f64, group: usize) -> Result<usize, ModelError> {
+    /// Adds a lumped mass `m` (kg) with rotary inertia `j` (kg m^2: about
+    /// z, or about x, y and z in a 3D model) at a node.
+    pub fn add_mass(
+        &mut self,
+        name: &str,
+        node: u32,
+        m: f64,
+        j: impl Into<RotaryInertia>,
+        group: usize,
+    ) -> Result<usize, ModelError> {
+        let j = j.into().0;
         let ctx = format!("mass `{name}`");
         if self.mass_index(name).is_some() {
             return Err(ModelError::Duplicate { what: ctx });
         }
         self.require_node(NodeId(node), &ctx)?;
         non_negative(format!("{ctx}: m"), m)?;
-        non_negative(format!("{ctx}: j"), j)?;
-        if m == 0.0 && j == 0.0 {
+        if self.dimension == Dimension::Planar && (j[0] != 0.0 || j[1] != 0.0) {
+            return Err(ModelError::Invalid {
+                what: ctx,
+                reason:
+                    "has a rotary inertia about x or y, which a planar model does not have (`[model] dimension = 3`)"
+                        .into(),
+            });
+        }
+        for &d in self.dimension.rotations() {
+            non_negative(format!("{ctx}: {}", self.dimension.inertia_key(d)), j[d.axis()])?;
+        }
+        if m == 0.0 && j.iter().all(|&v| v == 0.0) {
             return Err(ModelError::Invalid { what: ctx, reason: "has neither mass nor inertia".into() });
         }
         self.require_group(group, &ctx)?;
@@ -517,6 +481,7 @@ impl Model {
     /// Fixes DOFs of a node.
     pub fn add_support(&mut self, node: u32, dofs: &[Dof]) -> Result<(), ModelError> {
         self.require_node(NodeId(node), "support")?;
+        self.check_dofs(dofs, &format!("support at node {node}"))?;
         self.supports.push(Support { node: NodeId(node), dofs: dofs.to_vec() });
         Ok(())
     }
@@ -528,12 +493,13 @@ impl Model {
         if a == b {
             return Err(ModelError::Invalid { what: format!("tie {a}-{b}"), reason: "ties a node to itself".into() });
         }
+        self.check_dofs(dofs, &format!("tie {a}-{b}"))?;
         // A tie makes two nodes share displacements and rotation, which is
         // only kinematically sound where they coincide (a joint, as in the
         // paper); between distant nodes it silently makes a wrong model.
         let (p, q) = (&self.nodes[self.node_index[&NodeId(a)]], &self.nodes[self.node_index[&NodeId(b)]]);
-        let gap = (p.x - q.x).hypot(p.y - q.y);
-        let extent = self.nodes.iter().map(|n| n.x.abs().max(n.y.abs())).fold(0.0, f64::max);
+        let gap = (p.x - q.x).hypot(p.y - q.y).hypot(p.z - q.z);
+        let extent = self.nodes.iter().map(|n| n.x.abs().max(n.y.abs()).max(n.z.abs())).fold(0.0, f64::max);
         if !(gap <= 1e-9 * extent.max(1e-300)) {
             return Err(ModelError::Invalid {
                 what: format!("tie {a}-{b}"),
@@ -577,11 +543,8 @@ impl Model {
                 reason: "would detach every element at the node; leave at least one on each side".into(),
             });
         }
-        let (x, y) = {
-            let n = self.node(NodeId(node)).expect("checked above");
-            (n.x, n.y)
-        };
-        self.add_node(new_id, x, y)?;
+        let at = self.node(NodeId(node)).expect("checked above").position();
+        self.add_node_at(new_id, at)?;
         for i in idx {
             for end in &mut self.beams[i].nodes {
                 if *end == NodeId(node) {
@@ -657,6 +620,7 @@ impl Model {
         let node_index = nodes.iter().enumerate().map(|(i, n)| (n.id, i)).collect();
         Model {
             title: self.title.clone(),
+            dimension: self.dimension,
             nodes,
             node_index,
             materials: self.materials.clone(),
@@ -667,6 +631,7 @@ impl Model {
             supports: self.supports.iter().filter(|s| kept(&s.node)).cloned().collect(),
             ties: self.ties.iter().filter(|t| t.nodes.iter().all(kept)).cloned().collect(),
             groups: self.groups.clone(),
+            imported: self.imported.iter().filter(|b| b.nodes.iter().all(kept)).cloned().collect(),
         }
     }
 
@@ -675,7 +640,26 @@ impl Model {
         self.beams.iter().enumerate().filter(|(_, b)| b.nodes.contains(&node)).map(|(i, _)| i).collect()
     }
 
-    /// Length and direction cosines (c, s) of a beam.
+    /// Length and unit direction (first node to second) of a beam.
+    pub fn beam_axis(&self, beam: usize) -> (f64, [f64; 3]) {
+        let b = &self.beams[beam];
+        let (p, q) = (self.node(b.nodes[0]).unwrap(), self.node(b.nodes[1]).unwrap());
+        let d = [q.x - p.x, q.y - p.y, q.z - p.z];
+        let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        (l, d.map(|v| v / l))
+    }
+
+    /// The local axes `[x, y, z]` of a beam (rows, in global components):
+    /// along the beam, and the section's principal axes (in a planar
+    /// model, `y` in the plane and `z` the global z).
+    pub fn beam_axes(&self, beam: usize) -> [[f64; 3]; 3] {
+        let b = &self.beams[beam];
+        let [p, q] = b.nodes.map(|n| self.node(n).expect("checked when added").position());
+        frame3d::axes(p, q, b.reference, b.angle).expect("checked when added and oriented")
+    }
+
+    /// Length and direction cosines (c, s) of a beam in the x-y plane (a
+    /// planar model's beams).
     pub fn beam_geometry(&self, beam: usize) -> (f64, f64, f64) {
         let b = &self.beams[beam];
         let (p, q) = (self.node(b.nodes[0]).unwrap(), self.node(b.nodes[1]).unwrap());
@@ -691,14 +675,14 @@ impl Model {
             .iter()
             .enumerate()
             .map(|(i, b)| {
-                let (l, _, _) = self.beam_geometry(i);
+                let (l, _) = self.beam_axis(i);
                 let g = &self.groups[b.group];
                 let rho_a = self.materials[b.material].rho * self.sections[b.section].area;
                 (rho_a + b.added_mass) * l * b.mass_factor * g.mass
             })
             .sum();
         let lumped: f64 = self.masses.iter().map(|m| m.m * self.groups[m.group].mass).sum();
-        beams + lumped
+        beams + lumped + self.imported_mass()
     }
 }
 

@@ -9,16 +9,20 @@
 //! | `material.<m>.E` / `.rho` | Young's modulus, density |
 //! | `element.<id>.stiffness` / `.mass` | factors on one element (nominal 1) |
 //! | `element.<id>.added_mass` | non-structural transverse mass per length (kg/m) |
-//! | `spring.<name>.kx` / `.ky` / `.kr` | spring stiffnesses |
-//! | `mass.<name>.m` / `.j` | lumped mass and rotary inertia |
+//! | `spring.<name>.kx` / `.ky` / `.kr` | spring stiffnesses (planar) |
+//! | `spring.<name>.kx` / `.ky` / `.kz` / `.krx` / `.kry` / `.krz` | spring stiffnesses (3D) |
+//! | `mass.<name>.m` / `.j` | lumped mass and rotary inertia (planar) |
+//! | `mass.<name>.m` / `.jx` / `.jy` / `.jz` | lumped mass and rotary inertias (3D) |
 //!
 //! An updating [`Parameter`] is one quantity, or several scaled together:
 //! `element.<first>..<last>.<field>` links the field of every element with an
-//! id in the inclusive range (a region's stiffness or mass factor).
+//! id in the inclusive range (a region's stiffness or mass factor), and in a
+//! 3D model `mass.<name>.j` links `jx`, `jy` and `jz` (a rotary inertia the
+//! same about every axis).
 
 use std::fmt;
 
-use crate::dof::Dof;
+use crate::dof::{Dimension, Dof};
 use crate::error::ModelError;
 use crate::model::{ElementId, Model};
 
@@ -49,8 +53,8 @@ pub enum Quantity {
     SpringK(usize, Dof),
     /// Mass of a lumped mass.
     MassM(usize),
-    /// Rotary inertia of a lumped mass.
-    MassJ(usize),
+    /// Rotary inertia of a lumped mass about the axis of a rotation DOF.
+    MassJ(usize, Dof),
 }
 
 /// How a quantity enters the dynamic stiffness.
@@ -92,16 +96,9 @@ impl fmt::Display for QuantityName<'_> {
             Quantity::ElementStiffness(i) => write!(f, "element.{}.stiffness", m.beams[i].id),
             Quantity::ElementMass(i) => write!(f, "element.{}.mass", m.beams[i].id),
             Quantity::ElementAddedMass(i) => write!(f, "element.{}.added_mass", m.beams[i].id),
-            Quantity::SpringK(i, d) => {
-                let k = match d {
-                    Dof::Ux => "kx",
-                    Dof::Uy => "ky",
-                    Dof::Rz => "kr",
-                };
-                write!(f, "spring.{}.{k}", m.springs[i].name)
-            }
+            Quantity::SpringK(i, d) => write!(f, "spring.{}.{}", m.springs[i].name, m.dimension.spring_key(d)),
             Quantity::MassM(i) => write!(f, "mass.{}.m", m.masses[i].name),
-            Quantity::MassJ(i) => write!(f, "mass.{}.j", m.masses[i].name),
+            Quantity::MassJ(i, d) => write!(f, "mass.{}.{}", m.masses[i].name, m.dimension.inertia_key(d)),
         }
     }
 }
@@ -128,12 +125,18 @@ impl Parameter {
 const FORMS: &str = "group.<name>.{alpha,beta,mu,stiffness,mass}, material.<name>.{E,rho}, \
                      element.<id>.{stiffness,mass,added_mass}, spring.<name>.{kx,ky,kr}, mass.<name>.{m,j}";
 
+const FORMS_3D: &str = "group.<name>.{alpha,beta,mu,stiffness,mass}, material.<name>.{E,rho}, \
+                        element.<id>.{stiffness,mass,added_mass}, spring.<name>.{kx,ky,kz,krx,kry,krz}, \
+                        mass.<name>.{m,jx,jy,jz}";
+
 impl Model {
     /// Resolves a dotted name such as `group.steel.mu` to a quantity.
     pub fn quantity(&self, name: &str) -> Result<Quantity, ModelError> {
         let err = |reason: String| ModelError::UnknownQuantity { name: name.into(), reason };
-        let (head, rest) = name.split_once('.').ok_or_else(|| err(format!("expected one of {FORMS}")))?;
-        let (item, field) = rest.rsplit_once('.').ok_or_else(|| err(format!("expected one of {FORMS}")))?;
+        let dim = self.dimension;
+        let forms = if dim == Dimension::Planar { FORMS } else { FORMS_3D };
+        let (head, rest) = name.split_once('.').ok_or_else(|| err(format!("expected one of {forms}")))?;
+        let (item, field) = rest.rsplit_once('.').ok_or_else(|| err(format!("expected one of {forms}")))?;
         let bad_field = |valid: &str| err(format!("`{field}` is not a field of a {head}; valid: {valid}"));
         match head {
             "group" => {
@@ -173,25 +176,24 @@ impl Model {
                 let i = self.spring_index(item).ok_or_else(|| {
                     err(format!("no spring `{item}` (springs: {})", names(self.springs.iter().map(|s| &s.name))))
                 })?;
-                let d = match field {
-                    "kx" => Dof::Ux,
-                    "ky" => Dof::Uy,
-                    "kr" => Dof::Rz,
-                    _ => return Err(bad_field("kx, ky, kr")),
-                };
+                let keys: Vec<&str> = dim.dofs().iter().map(|&d| dim.spring_key(d)).collect();
+                let d = dim.spring_dof(field).ok_or_else(|| bad_field(&keys.join(", ")))?;
                 Ok(Quantity::SpringK(i, d))
             }
             "mass" => {
                 let i = self.mass_index(item).ok_or_else(|| {
                     err(format!("no mass `{item}` (masses: {})", names(self.masses.iter().map(|m| &m.name))))
                 })?;
-                Ok(match field {
-                    "m" => Quantity::MassM(i),
-                    "j" => Quantity::MassJ(i),
-                    _ => return Err(bad_field("m, j")),
-                })
+                if field == "m" {
+                    return Ok(Quantity::MassM(i));
+                }
+                match dim.inertia_dof(field) {
+                    Some(d) => Ok(Quantity::MassJ(i, d)),
+                    None if dim == Dimension::Planar => Err(bad_field("m, j")),
+                    None => Err(bad_field("m, jx, jy, jz")),
+                }
             }
-            _ => Err(err(format!("`{head}` is not a kind of item; expected one of {FORMS}"))),
+            _ => Err(err(format!("`{head}` is not a kind of item; expected one of {forms}"))),
         }
     }
 
@@ -212,6 +214,15 @@ impl Model {
                 .map(|id| self.quantity(&format!("element.{id}.{field}")))
                 .collect::<Result<Vec<_>, _>>()
                 .map_err(|e| err(e.to_string()))?;
+            return Ok(Parameter { name: name.into(), quantities });
+        }
+        // in space, `mass.<name>.j` is a rotary inertia the same about every
+        // axis (a compact body): jx, jy and jz scaled together
+        if self.dimension == Dimension::Spatial
+            && let Some(item) = name.strip_prefix("mass.").and_then(|r| r.strip_suffix(".j"))
+            && let Some(i) = self.mass_index(item)
+        {
+            let quantities = Dof::SPATIAL[3..].iter().map(|&d| Quantity::MassJ(i, d)).collect();
             return Ok(Parameter { name: name.into(), quantities });
         }
         Ok(Parameter { name: name.into(), quantities: vec![self.quantity(name)?] })
@@ -235,9 +246,9 @@ impl Model {
             Quantity::ElementStiffness(i) => self.beams[i].stiffness_factor,
             Quantity::ElementMass(i) => self.beams[i].mass_factor,
             Quantity::ElementAddedMass(i) => self.beams[i].added_mass,
-            Quantity::SpringK(i, d) => self.springs[i].k[d.index()],
+            Quantity::SpringK(i, d) => self.springs[i].k[d],
             Quantity::MassM(i) => self.masses[i].m,
-            Quantity::MassJ(i) => self.masses[i].j,
+            Quantity::MassJ(i, d) => self.masses[i].j[d.axis()],
         }
     }
 
@@ -253,7 +264,7 @@ impl Model {
                 | Quantity::ElementAddedMass(_)
                 | Quantity::SpringK(..)
                 | Quantity::MassM(_)
-                | Quantity::MassJ(_)
+                | Quantity::MassJ(..)
         );
         let ok = if matches!(q, Quantity::GroupMu(_)) {
             value > 0.0 && !value.is_nan()
@@ -276,9 +287,9 @@ impl Model {
             Quantity::ElementStiffness(i) => self.beams[i].stiffness_factor = value,
             Quantity::ElementMass(i) => self.beams[i].mass_factor = value,
             Quantity::ElementAddedMass(i) => self.beams[i].added_mass = value,
-            Quantity::SpringK(i, d) => self.springs[i].k[d.index()] = value,
+            Quantity::SpringK(i, d) => self.springs[i].k[d] = value,
             Quantity::MassM(i) => self.masses[i].m = value,
-            Quantity::MassJ(i) => self.masses[i].j = value,
+            Quantity::MassJ(i, d) => self.masses[i].j[d.axis()] = value,
         }
         Ok(())
     }

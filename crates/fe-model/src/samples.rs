@@ -1,6 +1,6 @@
 //! Tiny canonical models shared by tests, examples, benchmarks and docs.
 
-use crate::dof::Dof;
+use crate::dof::{Dimension, Dof};
 use crate::model::{Group, Model, Section};
 
 /// A uniform steel cantilever, 1 m long, 50 x 10 mm, clamped at node 1,
@@ -17,7 +17,7 @@ pub fn cantilever(n: usize) -> Model {
     for i in 0..n {
         m.add_beam(i as u32 + 1, [i as u32 + 1, i as u32 + 2], mat, sec, g).unwrap();
     }
-    m.add_support(1, &Dof::ALL).unwrap();
+    m.add_support(1, &Dof::PLANAR).unwrap();
     m
 }
 
@@ -39,7 +39,7 @@ pub fn two_material_cantilever() -> Model {
         let (mat, g) = if i < n / 2 { (steel, steel_g) } else { (alu, alu_g) };
         m.add_beam(i + 1, [i + 1, i + 2], mat, sec, g).unwrap();
     }
-    m.add_support(1, &Dof::ALL).unwrap();
+    m.add_support(1, &Dof::PLANAR).unwrap();
     m
 }
 
@@ -63,7 +63,7 @@ pub fn frame_with_joint() -> Model {
     m.add_spring("joint", 2, Some(3), [0.0, 0.0, 2.0e5], joint).unwrap();
     m.add_tie(2, 3, &[Dof::Ux, Dof::Uy]).unwrap();
     m.add_mass("tip", 4, 0.5, 1e-4, frame).unwrap();
-    m.add_support(1, &Dof::ALL).unwrap();
+    m.add_support(1, &Dof::PLANAR).unwrap();
     m
 }
 
@@ -118,7 +118,7 @@ pub fn long_beam(n_elements: usize) -> Model {
         let g = groups[i * regions / n];
         m.add_beam(i as u32 + 1, [i as u32 + 1, i as u32 + 2], mat, sec, g).unwrap();
     }
-    m.add_support(1, &Dof::ALL).unwrap();
+    m.add_support(1, &Dof::PLANAR).unwrap();
     for i in (20..=n).step_by(20) {
         m.add_support(i as u32 + 1, &[Dof::Ux, Dof::Uy]).unwrap();
     }
@@ -180,7 +180,7 @@ pub fn frame_grid(bays: usize, storeys: usize, elements_per_member: usize) -> Mo
         }
     }
     for bay in 0..=bays {
-        m.add_support(joint(bay, 0), &Dof::ALL).unwrap();
+        m.add_support(joint(bay, 0), &Dof::PLANAR).unwrap();
     }
     m
 }
@@ -239,8 +239,50 @@ pub fn tree_frame(members: &[TreeMember], order: &[usize], clamped: bool) -> Mod
         m.add_beam(k as u32 + 1, [t.from, k as u32 + 2], steel, sections[k], groups[k % 2]).unwrap();
     }
     if clamped {
-        m.add_support(1, &Dof::ALL).unwrap();
+        m.add_support(1, &Dof::PLANAR).unwrap();
     }
+    m
+}
+
+/// A small frame in space with every kind of 3D item: a portal of two
+/// 0.6 m columns along y (nodes 1-2 and 3-4, clamped at 1 and 3) and a
+/// 0.8 m beam along x between their tops (2-5), an arm along z from node 5
+/// (6-7) joined to it by rotational springs `joint` (krx, kry, krz; the
+/// translations tied) in a non-viscous group, a ground spring `foot` in
+/// every DOF at node 4 (the second column's top), and a lumped mass `tip`
+/// with three rotary inertias at node 7. Members in group `frame` (viscous
+/// Rayleigh), rectangular steel sections with unequal second moments, the
+/// arm's section turned by 20 degrees.
+pub fn space_portal() -> Model {
+    let mut m = Model::with_dimension("portal in space with a lossy joint", Dimension::Spatial);
+    let frame = m.add_group(Group::new("frame").rayleigh(2e-5, 0.3)).unwrap();
+    let joint = m.add_group(Group::new("joint").rayleigh(1e-3, 0.0).relaxation(300.0)).unwrap();
+    let steel = m.add_material("steel", 2.0e11, 7800.0).unwrap();
+    m.set_poisson(steel, 0.3).unwrap();
+    let sec = m.add_section(Section::rectangle("bar", 0.03, 0.02)).unwrap();
+    for (id, p) in [
+        (1, [0.0, 0.0, 0.0]),
+        (2, [0.0, 0.6, 0.0]),
+        (3, [0.8, 0.0, 0.0]),
+        (4, [0.8, 0.6, 0.0]),
+        (5, [0.4, 0.6, 0.0]),
+        (6, [0.4, 0.6, 0.0]),
+        (7, [0.4, 0.6, 0.5]),
+    ] {
+        m.add_node_at(id, p).unwrap();
+    }
+    m.add_beam(1, [1, 2], steel, sec, frame).unwrap();
+    m.add_beam(2, [3, 4], steel, sec, frame).unwrap();
+    m.add_beam(3, [2, 5], steel, sec, frame).unwrap();
+    m.add_beam(4, [5, 4], steel, sec, frame).unwrap();
+    let arm = m.add_beam(5, [6, 7], steel, sec, frame).unwrap();
+    m.orient_beam(arm, None, 20f64.to_radians()).unwrap();
+    m.add_spring("joint", 5, Some(6), [0.0, 0.0, 0.0, 3e4, 5e4, 2e4], joint).unwrap();
+    m.add_tie(5, 6, &[Dof::Ux, Dof::Uy, Dof::Uz]).unwrap();
+    m.add_spring("foot", 4, None, [2e6, 3e6, 4e6, 1e3, 2e3, 3e3], joint).unwrap();
+    m.add_mass("tip", 7, 0.5, [1e-4, 2e-4, 3e-4], frame).unwrap();
+    m.add_support(1, &Dof::SPATIAL).unwrap();
+    m.add_support(3, &Dof::SPATIAL).unwrap();
     m
 }
 

@@ -12,7 +12,7 @@
 use std::collections::HashMap;
 
 use damping::DampedSystem;
-use fe_model::{Dof, DofRef, Slot};
+use fe_model::{DofRef, Slot};
 
 use crate::lscf::{LscfError, LscfOptions, ModalEstimate, lscf};
 use crate::modal::{Mode, ModeError, Pairing, measured_modes, model_modes, pair_modes};
@@ -54,11 +54,11 @@ pub const MODEL_REACH: f64 = 2.0;
 /// Every free DOF of a system, node by node.
 pub fn free_dofs(system: &DampedSystem) -> Vec<DofRef> {
     let dofs = &system.assembly().dofs;
-    system
-        .model()
+    let model = system.model();
+    model
         .nodes()
         .iter()
-        .flat_map(|n| Dof::ALL.map(|d| DofRef::new(n.id.0, d)))
+        .flat_map(|n| model.node_dofs().iter().map(|&d| DofRef::new(n.id.0, d)))
         .filter(|&r| matches!(dofs.slot(r), Some(Slot::Free(_))))
         .collect()
 }
@@ -118,6 +118,7 @@ pub fn measured_on_model(measured: &Mode, model: &Mode, theta: f64) -> Vec<(DofR
 #[cfg(test)]
 mod tests {
     use super::*;
+    use fe_model::Dof;
 
     #[test]
     fn a_shape_turned_by_any_angle_comes_back_real_and_the_measured_one_onto_it() {

@@ -42,11 +42,15 @@ pub struct FixOptions {
     pub diagnose: DiagnoseOptions,
     /// Iteration limit of each update.
     pub update_iterations: usize,
+    /// Where the data a case synthesises from its `[truth]` are written:
+    /// the cases of the steps read them from there, without the truth
+    /// ([`Diagnosis::apply_with_data`]).
+    pub data: Option<std::path::PathBuf>,
 }
 
 impl Default for FixOptions {
     fn default() -> Self {
-        FixOptions { max_steps: 3, diagnose: DiagnoseOptions::default(), update_iterations: 100 }
+        FixOptions { max_steps: 3, diagnose: DiagnoseOptions::default(), update_iterations: 100, data: None }
     }
 }
 
@@ -243,7 +247,7 @@ fn add_and_update(
     opts: &FixOptions,
     step: usize,
 ) -> Result<Added, UpdateError> {
-    let editor = d.apply(current, rank)?;
+    let editor = d.apply_with_data(current, rank, opts.data.as_deref())?;
     let (editor, case, misfit_updated, outcome) = update_case(current, editor, d, measured, opts, step)?;
     Ok(Added { effect: d.ranking[rank - 1].clone(), rank, editor, case, misfit_updated, outcome })
 }
@@ -318,7 +322,7 @@ fn swap(
             let mut case = nominal.clone();
             let mut editor = None;
             for (j, (d, r)) in applied.iter().enumerate().filter(|(j, _)| *j != out) {
-                let e = d.apply(&case, *r)?;
+                let e = d.apply_with_data(&case, *r, opts.data.as_deref())?;
                 case = CaseFile::parse(&nominal.path, &e.text_at(&nominal.path)?)?;
                 editor = Some((e, j));
             }

@@ -33,7 +33,10 @@ pub fn read_measured_for(
         .map(|s| frf::Channel::new(s.responses[0], s.references[0]));
     let measured = match spec.and_then(|s| s.pairing.map(|p| (s, p))) {
         Some((s, p)) => read_paired(system, path, s, &p)?,
-        None => frf::io::load_measured_opts(path, &ReadOptions { map, mask, channel })?,
+        None => {
+            let dimension = system.model().dimension();
+            frf::io::load_measured_opts(path, &ReadOptions { map, mask, channel, dimension })?
+        }
     };
     let mut measured = measured.check_channels(path, &system.assembly().dofs, mask)?;
     if let Some(s) = spec {
@@ -85,9 +88,13 @@ fn read_paired(
             }
         }
     }
-    let model: Vec<(u32, f64, f64)> = system.model().nodes().iter().map(|n| (n.id.0, n.x, n.y)).collect();
+    let model: Vec<(u32, [f64; 3])> = system.model().nodes().iter().map(|n| (n.id.0, n.position())).collect();
     let axis = |c: i8| Direction::from_code(i64::from(c)).unwrap_or(Direction::X);
-    let opts = PairingOptions { tolerance_m: p.tolerance_m, axes: [axis(p.axes[0]), axis(p.axes[1])] };
+    let opts = PairingOptions {
+        tolerance_m: p.tolerance_m,
+        axes: [axis(p.axes[0]), axis(p.axes[1])],
+        dimension: system.model().dimension(),
+    };
     let (pairing, paired, notes) = uff::pair_by_coordinates(&geometry, &used, &model, &opts, &spec.map);
     let frfs = uff::frfs_from_uff_mapped(path, &file, &spec.mask, &|d| pairing.map(d))?;
     let mut measured = frfs.into_measured();

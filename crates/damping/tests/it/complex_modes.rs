@@ -56,6 +56,7 @@ fn models() -> Vec<(&'static str, Model)> {
         ("cantilever(8)", samples::cantilever(8)),
         ("frame_with_joint", samples::frame_with_joint()),
         ("two_material_cantilever", samples::two_material_cantilever()),
+        ("space_portal", samples::space_portal()),
     ]
 }
 
@@ -254,6 +255,7 @@ fn modal_expansion_over_all_modes_reproduces_the_receptance() {
         ("frame_with_joint", samples::frame_with_joint()),
         ("two_dof", samples::two_dof_oscillator()),
         ("two_material_cantilever", samples::two_material_cantilever()),
+        ("space_portal", samples::space_portal()),
     ] {
         let sys = DampedSystem::new(model).unwrap();
         let modes = complex_modes(&sys).unwrap();

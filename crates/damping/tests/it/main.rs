@@ -1,4 +1,5 @@
 //! Integration tests of the damping crate (one binary to keep link time down).
 
 mod complex_modes;
+mod frames_3d;
 mod modal_physics;

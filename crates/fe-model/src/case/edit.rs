@@ -209,6 +209,7 @@ impl CaseEditor {
                 }
             }
         }
+        rewrite_imported_paths(&mut doc, self.path.parent().unwrap_or(Path::new("")), target);
         let text = doc.to_string();
         CaseFile::parse(target, &text)?;
         Ok(text)
@@ -222,6 +223,35 @@ impl CaseEditor {
             *item = Item::Table(std::mem::take(t).into_table());
         }
         item.as_table_mut().ok_or(err)
+    }
+}
+
+/// The paths of `[imported]` (its node file, and each group's DOF table
+/// and matrices), written relative to the case's folder `base`, rewritten
+/// relative to the new file `target`'s, with their comments kept.
+fn rewrite_imported_paths(doc: &mut DocumentMut, base: &Path, target: &Path) {
+    let to = target.parent().unwrap_or(Path::new(""));
+    let rewrite = |v: &mut toml_edit::Value| {
+        let Some(s) = v.as_str() else { return };
+        let p = Path::new(s);
+        let file = if p.is_absolute() { p.to_path_buf() } else { base.join(p) };
+        let rel = relative_path(&file, to).to_string_lossy().replace('\\', "/");
+        let decor = v.decor().clone();
+        *v = toml_edit::Value::from(rel);
+        *v.decor_mut() = decor;
+    };
+    let Some(imported) = doc.get_mut("imported").and_then(Item::as_table_like_mut) else { return };
+    if let Some(v) = imported.get_mut("nodes").and_then(Item::as_value_mut) {
+        rewrite(v);
+    }
+    if let Some(Item::ArrayOfTables(groups)) = imported.get_mut("groups") {
+        for t in groups.iter_mut() {
+            for key in ["dofs", "stiffness", "mass"] {
+                if let Some(v) = t.get_mut(key).and_then(Item::as_value_mut) {
+                    rewrite(v);
+                }
+            }
+        }
     }
 }
 

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 use toml::Spanned;
 
-use super::{Ctx, parse_dof_refs, parse_frequencies};
+use super::{Ctx, hint, parse_dof_refs, parse_frequencies};
 use crate::dof::DofRef;
 use crate::error::CaseError;
 use crate::model::Model;
@@ -370,6 +370,7 @@ pub(super) fn parse_measurement(
             ));
         }
         let model_dof: DofRef = c.model.get_ref().parse().map_err(|e: String| ctx.err(c.model.span(), e))?;
+        model.dimension().check(model_dof.dof).map_err(|e| ctx.err(c.model.span(), e))?;
         if model.node(model_dof.node).is_none() {
             return Err(ctx.err(c.model.span(), format!("node {} does not exist in the model", model_dof.node)));
         }
@@ -381,10 +382,7 @@ pub(super) fn parse_measurement(
     let mut mask: Vec<MaskRule> = Vec::new();
     for m in &r.mask {
         let rule = MaskRule::parse(m.get_ref()).ok_or_else(|| {
-            let names = MaskRule::ALL.map(MaskRule::name);
-            let hint = crate::suggest::closest(m.get_ref(), names)
-                .map(|s| format!("; did you mean `{s}`?"))
-                .unwrap_or_else(|| format!(" (available: {})", names.join(", ")));
+            let hint = hint(m.get_ref(), &MaskRule::ALL.map(MaskRule::name), "available");
             ctx.err(m.span(), format!("unknown mask `{}`{hint}", m.get_ref()))
         })?;
         if mask.contains(&rule) {
@@ -404,10 +402,7 @@ pub(super) fn parse_measurement(
         .as_ref()
         .map(|g| {
             Gains::parse(g.get_ref()).ok_or_else(|| {
-                let names = Gains::ALL.map(Gains::name);
-                let hint = crate::suggest::closest(g.get_ref(), names)
-                    .map(|s| format!("; did you mean `{s}`?"))
-                    .unwrap_or_else(|| format!(" (available: {})", names.join(", ")));
+                let hint = hint(g.get_ref(), &Gains::ALL.map(Gains::name), "available");
                 ctx.err(g.span(), format!("unknown gains `{}`{hint}", g.get_ref()))
             })
         })

@@ -1,4 +1,5 @@
 //! Integration tests of fe-model.
 
 mod elements;
+mod frame3d;
 mod properties;

@@ -151,6 +151,9 @@ pub struct ReadOptions<'a> {
     /// The channel of a single-channel CSV file with columns `freq,re,im`
     /// and no `# channel` line: the one channel a case measures.
     pub channel: Option<crate::Channel>,
+    /// The model's dimension: which test directions map to model DOFs
+    /// without a map entry ([`uff::map_test_dof_in`]).
+    pub dimension: fe_model::Dimension,
 }
 
 /// Reads a measured FRF file (see [`detect_format`]) and maps its channels
@@ -167,7 +170,7 @@ pub fn load_measured(path: &Path, map: &[ChannelMap]) -> Result<Measured, FrfErr
 /// the file; [`Measured::masked`] lists what was left out. Channel rules
 /// need the model: see [`Measured::check_channels`].
 pub fn load_measured_with(path: &Path, map: &[ChannelMap], rules: &[MaskRule]) -> Result<Measured, FrfError> {
-    load_measured_opts(path, &ReadOptions { map, mask: rules, channel: None })
+    load_measured_opts(path, &ReadOptions { map, mask: rules, channel: None, dimension: fe_model::Dimension::Planar })
 }
 
 /// Reads a measured FRF file with [`ReadOptions`] (see [`load_measured_with`]).
@@ -209,7 +212,7 @@ fn read_format(path: &Path, opts: &ReadOptions<'_>) -> Result<Measured, FrfError
                 pairing: Vec::new(),
             })
         }
-        MeasuredFormat::Uff => Ok(uff::read_uff_frfs_with(path, opts.map, opts.mask)?.into_measured()),
+        MeasuredFormat::Uff => Ok(uff::read_uff_frfs_in(path, opts.map, opts.mask, opts.dimension)?.into_measured()),
     }
 }
 

@@ -1,6 +1,6 @@
 //! `rfm diagnose`: which physical effect is missing from the model.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use fe_model::case::Gains;
 use indicatif::ProgressBar;
@@ -30,6 +30,20 @@ pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
     inputs.extend(args.measured.map(Path::to_path_buf));
     let mut output = match (args.apply, args.out) {
         (Some(_), Some(out)) => Some(Outputs::file(out, &inputs)?),
+        _ => None,
+    };
+    // A case whose data come from its [truth] cannot keep the truth once an
+    // effect is added: a truth that adds the same joint or mass would add
+    // it twice. The new case gets the synthesised data beside it instead
+    // (as every step of `rfm fix` does), written before the case.
+    let synthesised = args.measured.is_none()
+        && study.case.measurement.as_ref().is_some_and(|m| m.data.is_none())
+        && study.case.truth.is_some();
+    let mut data_output = match (args.apply, args.out) {
+        (Some(_), Some(out)) if synthesised => {
+            let path = data_beside(out);
+            Some((Outputs::file(&path, &inputs)?, path))
+        }
         _ => None,
     };
     let measured = match args.measured {
@@ -83,7 +97,16 @@ pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
     }
     if let Some(rank) = args.apply {
         let out = args.out.ok_or("--apply needs --out FILE for the new case file")?;
-        let text = d.apply(&study.case, rank)?.text_at(out)?;
+        let data = data_output.as_ref().map(|(_, path)| path.clone());
+        let editor = d.apply_with_data(&study.case, rank, data.as_deref())?;
+        if let Some((mut data, path)) = data_output.take() {
+            data.write_file(frf::io::csv::to_csv_string(&study.measured).as_bytes())?;
+            data.commit()?;
+            if !args.json {
+                outln!("\nwrote {} with the data synthesised from the case's [truth]", path.display());
+            }
+        }
+        let text = editor.text_at(out)?;
         let mut output = output.take().ok_or("--apply needs --out FILE for the new case file")?;
         output.write_file(text.as_bytes())?;
         output.commit()?;
@@ -92,6 +115,12 @@ pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
         }
     }
     Ok(Exit::Success)
+}
+
+/// `NEW-measured.csv` beside the new case `NEW.toml`.
+fn data_beside(case: &Path) -> PathBuf {
+    let stem = case.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "case".into());
+    case.with_file_name(format!("{stem}-measured.csv"))
 }
 
 fn print_diagnosis(d: &Diagnosis, top: usize) -> Result<()> {

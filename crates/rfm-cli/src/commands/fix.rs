@@ -59,7 +59,12 @@ pub(crate) fn fix(args: &FixArgs<'_>) -> Result<Exit> {
             args.steps
         );
     }
-    let opts = FixOptions { max_steps: args.steps, diagnose: study.diagnose_options()?, ..FixOptions::default() };
+    let opts = FixOptions {
+        max_steps: args.steps,
+        diagnose: study.diagnose_options()?,
+        data: synthesised.then(|| output.path(DATA_FILE)),
+        ..FixOptions::default()
+    };
     let json = args.json;
     let outcome = run_fix(&study.case, &study.measured, &opts, |p| {
         if json {

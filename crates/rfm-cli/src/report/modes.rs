@@ -10,7 +10,7 @@
 use std::collections::HashMap;
 
 use damping::DampedSystem;
-use fe_model::Model;
+use fe_model::{Model, PerDof};
 use frf::comparison::{measured_on_model, real_shape};
 use frf::{FrfSet, ModalComparison};
 use serde::Serialize;
@@ -225,13 +225,13 @@ fn figures(
     for (k, p) in c.pairing.pairs.iter().enumerate() {
         let (x, m) = (&c.model[p.model], &c.measured[p.measured]);
         let (theta, real) = real_shape(&x.dofs, &x.shape);
-        let mut per_node: HashMap<u32, [f64; 3]> = HashMap::new();
+        let mut per_node: HashMap<u32, PerDof> = HashMap::new();
         for (d, v) in x.dofs.iter().zip(&real) {
-            per_node.entry(d.node.0).or_insert([0.0; 3])[d.dof.index()] = *v;
+            per_node.entry(d.node.0).or_default()[d.dof] = *v;
         }
         // nodes without a free DOF (a clamped support) stay where they are
         for r in model.nodes().iter().map(|n| n.id.0) {
-            per_node.entry(r).or_insert([0.0; 3]);
+            per_node.entry(r).or_default();
         }
         panels.push(ShapePanel {
             title: format!("Mode {}: MAC {:.3}", k + 1, p.mac),

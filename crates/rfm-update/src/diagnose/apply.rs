@@ -1,6 +1,8 @@
 //! Adding a diagnosed effect to the user's case: `rfm diagnose --apply` and
 //! every step of `rfm fix`.
 
+use std::path::Path;
+
 use fe_model::case::{FittedGain, GainKey, Gains};
 use fe_model::{CaseEditor, CaseFile, HistoryEntry};
 
@@ -51,10 +53,29 @@ impl Diagnosis {
     /// shows the whole fall. The result is checked to load and to carry the
     /// fitted values.
     pub fn apply(&self, case: &CaseFile, rank: usize) -> Result<CaseEditor, UpdateError> {
+        self.apply_with_data(case, rank, None)
+    }
+
+    /// As [`Diagnosis::apply`], the new case reading its data from `data`
+    /// instead of its `[truth]` ([`CaseEditor::use_data`]) when the case
+    /// synthesises them from one: a truth that adds the effect's own joint
+    /// or mass would otherwise add it a second time. The caller writes the
+    /// data there.
+    pub fn apply_with_data(
+        &self,
+        case: &CaseFile,
+        rank: usize,
+        data: Option<&Path>,
+    ) -> Result<CaseEditor, UpdateError> {
         let r = self.ranking.get(rank.wrapping_sub(1)).ok_or_else(|| self.no_rank(rank))?;
         let c = &self.candidates[r.candidate];
         let values: Vec<f64> = r.parameters.iter().map(|p| p.value).collect();
         let mut editor = case.editor()?;
+        if let Some(path) = data
+            && case.truth.is_some()
+        {
+            editor.use_data(path);
+        }
         let comment =
             format!("Added by rfm diagnose: {} (explains {:.1} % of the misfit)", r.description, 100.0 * r.explained);
         c.edit.write(&mut editor, &c.parameters, &values, &comment)?;

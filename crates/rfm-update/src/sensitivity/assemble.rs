@@ -16,7 +16,7 @@ use super::cache::ZCache;
 use super::kernels::BucketProducts;
 use super::plan::ChannelPlan;
 use super::terms::{Coefficients, TermTable};
-use super::{FrequencyBlock, Hybrid, NONE, ZERO};
+use super::{FrequencyBlock, Hybrid, MAX_BLOCK, NONE, ZERO};
 use crate::error::UpdateError;
 
 /// Per-thread scratch for [`assemble_one`]: the solver workspace, the
@@ -242,7 +242,7 @@ fn by_class_sums(
     solver.solve_units_ordered_with(ws, &plan.ref_eqs, sol, freq_hz, |r, rows| {
         w[r * kc..(r + 1) * kc].fill(ZERO);
         let (b0, b1) = (table.bucket[r] as usize, table.bucket[r + 1] as usize);
-        let mut xb = [ZERO; 6];
+        let mut xb = [ZERO; MAX_BLOCK];
         for item in &table.items[b0..b1] {
             let nb = item.nb as usize;
             let item_rows = &item.rows[..nb];

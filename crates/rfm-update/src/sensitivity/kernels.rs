@@ -5,7 +5,7 @@ use frf::solver::mul_add;
 use num_complex::Complex64 as C64;
 
 use super::terms::{Item, TermTable};
-use super::{NONE, ZERO};
+use super::{MAX_BLOCK, NONE, ZERO};
 
 /// Step 4 for the blocks of one bucket, every reference: for each used term,
 /// `acc[ref, class, m] += R[m, eqs] (value U x)` over the block's equations.
@@ -32,9 +32,9 @@ impl WithSimd for BucketProducts<'_> {
     fn with_simd<S: Simd>(self, simd: S) {
         let BucketProducts { table, items, first_row, rows, n_ref, n_resp, measured_at, measured, acc } = self;
         let k = n_ref + n_resp;
-        let mut off = [0usize; 6];
-        let mut xb = [ZERO; 6];
-        let mut v = [ZERO; 6];
+        let mut off = [0usize; MAX_BLOCK];
+        let mut xb = [ZERO; MAX_BLOCK];
+        let mut v = [ZERO; MAX_BLOCK];
         for item in items {
             let nb = item.nb as usize;
             for (o, &r) in off[..nb].iter_mut().zip(&item.rows[..nb]) {

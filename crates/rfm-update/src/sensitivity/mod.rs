@@ -91,6 +91,9 @@ pub use assemble::{Scratch, assemble, assemble_one};
 pub use plan::ChannelPlan;
 
 const ZERO: C64 = C64 { re: 0.0, im: 0.0 };
+/// Most free DOFs of one block: two nodes of a frame in space (a planar
+/// model's blocks have at most six).
+const MAX_BLOCK: usize = 12;
 
 const NONE: u32 = u32::MAX;
 

@@ -12,13 +12,13 @@ use num_complex::Complex64 as C64;
 
 use super::cache::UnitStore;
 use super::hash::{FxHasher, FxMap};
-use super::{NONE, ZERO};
+use super::{MAX_BLOCK, NONE, ZERO};
 
 /// A block that some parameter touches, as step 4 reads it.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Item {
     /// Solver row of each local equation.
-    pub(super) rows: [u32; 6],
+    pub(super) rows: [u32; MAX_BLOCK],
     /// Number of local equations.
     pub(super) nb: u32,
     /// Its used terms, `terms[t0..t1]`.
@@ -196,8 +196,8 @@ impl TermTable {
         for &b in &order {
             let block = &blocks[b];
             let nb = block.eqs.len();
-            assert!(nb <= 6, "blocks have at most two nodes of three DOFs");
-            let mut rows = [0u32; 6];
+            assert!(nb <= MAX_BLOCK, "blocks have at most two nodes of six DOFs");
+            let mut rows = [0u32; MAX_BLOCK];
             for (r, &e) in rows.iter_mut().zip(&block.eqs) {
                 *r = solver.position(e) as u32;
             }

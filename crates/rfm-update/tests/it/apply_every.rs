@@ -131,11 +131,9 @@ fn apply_every(case: CaseFile, dir: &Path) -> BTreeSet<String> {
     let mut kinds = BTreeSet::new();
     for (i, r) in d.ranking.iter().enumerate() {
         let rank = i + 1;
-        let mut editor =
-            d.apply(&study.case, rank).unwrap_or_else(|e| panic!("{title}, rank {rank} ({}): {e}", r.description));
-        if synthesised {
-            editor.use_data(&data);
-        }
+        let editor = d
+            .apply_with_data(&study.case, rank, synthesised.then_some(data.as_path()))
+            .unwrap_or_else(|e| panic!("{title}, rank {rank} ({}): {e}", r.description));
         let text = editor.text_at(&target).unwrap_or_else(|e| panic!("{title}, rank {rank}: {e}"));
         // the data path is relative to the new file and names the same data
         let table: toml::Table = text.parse().unwrap();
@@ -181,7 +179,7 @@ fn every_ranked_effect_applies_to_the_tutorial_the_papers_cases_and_samples() {
         .collect();
     paths.sort();
     paths.push(cases_dir().join("tutorial/l-frame.toml"));
-    assert!(paths.len() >= 7, "the six paper cases and the tutorial");
+    assert!(paths.len() >= 8, "the six paper cases, the frame in space and the tutorial");
     for (k, path) in paths.iter().enumerate() {
         let case = CaseFile::load(path).unwrap();
         kinds.extend(apply_every(case, &tmp.path().join(format!("case-{k}"))));

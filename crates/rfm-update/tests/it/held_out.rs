@@ -95,7 +95,7 @@ fn exact(r: &Ranked, h: &HiddenEffect) -> bool {
 /// The true value of a fitted parameter's role, when the hidden effect has one.
 fn truth_of(role: Role, h: &HiddenEffect) -> Option<f64> {
     match role {
-        Role::Spring(d) => h.value(["kx", "ky", "kr"][d.index()]),
+        Role::Spring(d) => h.value(fe_model::Dimension::Planar.spring_key(d)),
         Role::Mass => h.value("m"),
         Role::Inertia => h.value("j"),
         Role::StiffnessFactor => h.value("factor"),

@@ -39,7 +39,7 @@ fn nominal() -> Model {
     for i in 0..N_EL {
         m.add_beam(i + 1, [i + 1, i + 2], steel, sec, g).unwrap();
     }
-    m.add_support(1, &Dof::ALL).unwrap();
+    m.add_support(1, &Dof::PLANAR).unwrap();
     m
 }
 

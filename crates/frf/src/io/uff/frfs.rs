@@ -2,14 +2,15 @@
 
 use std::path::Path;
 
-use fe_model::DofRef;
 use fe_model::case::{ChannelMap, MaskRule};
+use fe_model::{Dimension, DofRef};
 use num_complex::Complex64 as C64;
 
 use super::super::mask::{self, Masked, Origin};
 use super::units::abscissa_to_hz;
 use super::{
-    FUNCTION_COHERENCE, FUNCTION_FRF, Header58, Record58, TestDof, UffFile, frf_units, function_type_name, map_test_dof,
+    FUNCTION_COHERENCE, FUNCTION_FRF, Header58, Record58, TestDof, UffFile, frf_units, function_type_name,
+    map_test_dof, map_test_dof_in,
 };
 use crate::error::{FileError, FrfError};
 use crate::set::{Channel, FrfKind, FrfSet};
@@ -98,6 +99,17 @@ pub fn read_uff_frfs(path: &Path, map: &[ChannelMap]) -> Result<UffFrfs, FrfErro
 /// what `rules` allow (non-finite values, repeated lines) instead of
 /// refusing the file; [`UffFrfs::masked`] lists what was left out.
 pub fn read_uff_frfs_with(path: &Path, map: &[ChannelMap], rules: &[MaskRule]) -> Result<UffFrfs, FrfError> {
+    read_uff_frfs_in(path, map, rules, Dimension::Planar)
+}
+
+/// As [`read_uff_frfs_with`], for a model of dimension `dim` (whose test
+/// directions map by default as [`map_test_dof_in`] says).
+pub fn read_uff_frfs_in(
+    path: &Path,
+    map: &[ChannelMap],
+    rules: &[MaskRule],
+    dim: Dimension,
+) -> Result<UffFrfs, FrfError> {
     let bytes = super::read_bytes(path)?;
     let file = super::read::parse_with(path, &bytes, &mut |index, line, h| {
         check_function_type(h).map_err(|m| {
@@ -108,7 +120,7 @@ pub fn read_uff_frfs_with(path: &Path, map: &[ChannelMap], rules: &[MaskRule]) -
             })
         })
     })?;
-    frfs_from_uff_with(path, &file, map, rules)
+    frfs_from_uff_mapped(path, &file, rules, &|dof| map_test_dof_in(dof, map, dim))
 }
 
 fn check_function_type(h: &Header58) -> Result<(), String> {

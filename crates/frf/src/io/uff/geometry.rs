@@ -18,7 +18,10 @@
 //! within 2.6 degrees of the model's x or y axis is `ux` or `uy`, a
 //! rotation about the normal of the plane is `rz`, with the sign of the
 //! cosine. The coordinate along the normal is not compared: sensors sit on
-//! a surface, off the model's reference line.
+//! a surface, off the model's reference line. A 3D model's z axis is the
+//! normal (`x cross y`): positions are compared in space, and every test
+//! direction within 2.6 degrees of a model axis maps to the translation
+//! along or the rotation about it.
 //!
 //! Nothing is guessed silently: a file without dataset 164 is taken in
 //! metres, a coordinate system the file does not define as the global
@@ -31,7 +34,7 @@
 use std::collections::HashMap;
 
 use fe_model::case::ChannelMap;
-use fe_model::{Dof, DofRef};
+use fe_model::{Dimension, Dof, DofRef};
 
 use super::map::map_test_dof;
 use super::read::numbers;
@@ -376,6 +379,9 @@ pub struct PairingOptions {
     /// The test directions (global `+X`, `-Z`, ...) along the model's x and
     /// y axes.
     pub axes: [Direction; 2],
+    /// Planar (the coordinate along the plane's normal is not compared) or
+    /// in space.
+    pub dimension: Dimension,
 }
 
 /// A test node paired with a model node, as written into the results.
@@ -404,6 +410,7 @@ pub struct Pairing {
     /// Model x, y and the plane's normal in the test frame.
     frame: [[f64; 3]; 3],
     axes: [Direction; 2],
+    dimension: Dimension,
 }
 
 fn axis_vector(d: Direction) -> [f64; 3] {
@@ -444,6 +451,17 @@ impl Pairing {
             dof.node,
             dof.direction.axis()
         );
+        if self.dimension == Dimension::Spatial {
+            // the model axis the test direction lies along, translation or rotation
+            let along = [ex, ey, ez].iter().map(|&e| dot(u, e)).enumerate().find(|(_, c)| c.abs() >= PARALLEL);
+            let Some((axis, c)) = along else {
+                return Err(format!(
+                    "test DOF {dof} is oblique to the model's axes ({plane}, z their cross product); {hint}"
+                ));
+            };
+            let dofs = if code <= 3 { [Dof::Ux, Dof::Uy, Dof::Uz] } else { [Dof::Rx, Dof::Ry, Dof::Rz] };
+            return Ok((DofRef::new(model, dofs[axis]), dof.direction.sign() * c.signum()));
+        }
         let (dof_model, c) = if code <= 3 {
             let (cx, cy) = (dot(u, ex), dot(u, ey));
             if cx.abs() >= PARALLEL {
@@ -473,7 +491,7 @@ impl Pairing {
 }
 
 /// Pairs the test nodes `used` (those the FRF records name) with the model
-/// nodes `model` (`(id, x, y)`) by position (see the module docs). Returns
+/// nodes `model` (`(id, [x, y, z])`) by position (see the module docs). Returns
 /// the pairing (whose [`Pairing::map`] maps test directions), what it did
 /// per node, and notes. A used node without coordinates, or farther than
 /// the tolerance from every model node, is not an error here: mapping one
@@ -481,14 +499,20 @@ impl Pairing {
 pub fn pair_by_coordinates(
     geometry: &Geometry,
     used: &[i64],
-    model: &[(u32, f64, f64)],
+    model: &[(u32, [f64; 3])],
     opts: &PairingOptions,
     explicit: &[ChannelMap],
 ) -> (Pairing, Vec<PairedNode>, Vec<String>) {
     let ex = axis_vector(opts.axes[0]);
     let ey = axis_vector(opts.axes[1]);
     let frame = [ex, ey, cross(ex, ey)];
-    let mut pairing = Pairing { explicit: explicit.to_vec(), nodes: HashMap::new(), frame, axes: opts.axes };
+    let mut pairing = Pairing {
+        explicit: explicit.to_vec(),
+        nodes: HashMap::new(),
+        frame,
+        axes: opts.axes,
+        dimension: opts.dimension,
+    };
     let mut paired = Vec::new();
     let mut notes = Vec::new();
     let by_id: HashMap<i64, &TestNode> = geometry.nodes.iter().map(|n| (n.id, n)).collect();
@@ -504,8 +528,12 @@ pub fn pair_by_coordinates(
             continue;
         };
         let (x, y) = (dot(node.position, ex), dot(node.position, ey));
-        let mut near: Vec<(f64, u32)> =
-            model.iter().map(|&(m, mx, my)| (((mx - x).powi(2) + (my - y).powi(2)).sqrt(), m)).collect();
+        // the coordinate along a planar model's normal is not compared
+        let z = if opts.dimension == Dimension::Spatial { dot(node.position, frame[2]) } else { 0.0 };
+        let mut near: Vec<(f64, u32)> = model
+            .iter()
+            .map(|&(m, [mx, my, mz])| (((mx - x).powi(2) + (my - y).powi(2) + (mz - z).powi(2)).sqrt(), m))
+            .collect();
         near.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         let Some(&(d, m)) = near.first() else {
             pairing.nodes.insert(id, Err("the model has no nodes".into()));
@@ -535,7 +563,7 @@ pub fn pair_by_coordinates(
         }
         let axes = geometry.axes(node.displacement_cs).unwrap_or(IDENTITY);
         pairing.nodes.insert(id, Ok((m, axes)));
-        let directions = [Direction::X, Direction::Y, Direction::Z, Direction::RZ]
+        let directions = [Direction::X, Direction::Y, Direction::Z, Direction::RX, Direction::RY, Direction::RZ]
             .into_iter()
             .filter_map(|dir| {
                 let (dof, s) = pairing.map(TestDof::new(id, dir)).ok()?;
@@ -591,10 +619,11 @@ mod tests {
             metres_per_unit: 1.0,
             notes: Vec::new(),
         };
-        let model = [(1, 0.0, 0.0), (3, 0.25, 0.0), (5, 0.5, 0.0)];
+        let model = [(1, [0.0; 3]), (3, [0.25, 0.0, 0.0]), (5, [0.5, 0.0, 0.0])];
         // a beam along X bending in the test's XZ plane: model y along test +Z; the sensor sits 4 mm off
         // the plane (along Y), which is not compared
-        let opts = PairingOptions { tolerance_m: 0.002, axes: [Direction::X, Direction::Z] };
+        let opts =
+            PairingOptions { tolerance_m: 0.002, axes: [Direction::X, Direction::Z], dimension: Dimension::Planar };
         let (p, paired, notes) = pair_by_coordinates(&g, &[101, 102], &model, &opts, &[]);
         assert!(notes.is_empty(), "{notes:?}");
         assert_eq!((paired[0].model_node, paired[1].model_node), (5, 3));
@@ -612,7 +641,8 @@ mod tests {
         let e = m("101:+RX").unwrap_err();
         assert!(e.contains("rotation about an axis in the model's plane"), "{e}");
         // far from every model node
-        let opts = PairingOptions { tolerance_m: 0.002, axes: [Direction::X, Direction::Y] };
+        let opts =
+            PairingOptions { tolerance_m: 0.002, axes: [Direction::X, Direction::Y], dimension: Dimension::Planar };
         let far = Geometry {
             nodes: vec![TestNode { id: 9, position: [0.1, 0.0, 0.0], displacement_cs: 0, dataset: 2411, line: 5 }],
             ..g.clone()
@@ -634,10 +664,37 @@ mod tests {
             metres_per_unit: 1.0,
             ..Geometry::default()
         };
-        let model = [(41, 0.5, 0.0), (6, 0.5, 0.0)];
-        let opts = PairingOptions { tolerance_m: 0.001, axes: [Direction::X, Direction::Y] };
+        let model = [(41, [0.5, 0.0, 0.0]), (6, [0.5, 0.0, 0.0])];
+        let opts =
+            PairingOptions { tolerance_m: 0.001, axes: [Direction::X, Direction::Y], dimension: Dimension::Planar };
         let (p, _, notes) = pair_by_coordinates(&g, &[4], &model, &opts, &[]);
         assert_eq!(p.map("4:+Y".parse().unwrap()), Ok((DofRef::new(6, Dof::Uy), 1.0)));
         assert!(notes[0].contains("coincident model nodes 6, 41; paired with 6"), "{notes:?}");
+    }
+
+    #[test]
+    fn a_3d_model_pairs_in_space_and_maps_every_axis() {
+        let node = |id, position| TestNode { id, position, displacement_cs: 0, dataset: 15, line: 3 };
+        let g = Geometry {
+            nodes: vec![node(7, [0.5, 0.0, 0.3]), node(8, [0.5, 0.0, 0.0]), node(9, [0.5, 0.1, 0.0])],
+            metres_per_unit: 1.0,
+            ..Geometry::default()
+        };
+        // model x along test +X, model y along test +Z, so model z = X x Z = -Y
+        let model = [(1, [0.5, 0.0, 0.0]), (2, [0.5, 0.3, 0.0])];
+        let opts =
+            PairingOptions { tolerance_m: 0.002, axes: [Direction::X, Direction::Z], dimension: Dimension::Spatial };
+        let (p, paired, _) = pair_by_coordinates(&g, &[7, 8, 9], &model, &opts, &[]);
+        assert_eq!(paired.iter().map(|n| (n.test_node, n.model_node)).collect::<Vec<_>>(), [(7, 2), (8, 1)]);
+        let m = |s: &str| p.map(s.parse().unwrap());
+        assert_eq!(m("7:+Y"), Ok((DofRef::new(2, Dof::Uz), -1.0)));
+        assert_eq!(m("7:+Z"), Ok((DofRef::new(2, Dof::Uy), 1.0)));
+        assert_eq!(m("8:-X"), Ok((DofRef::new(1, Dof::Ux), -1.0)));
+        assert_eq!(m("8:+RX"), Ok((DofRef::new(1, Dof::Rx), 1.0)));
+        assert_eq!(m("8:+RZ"), Ok((DofRef::new(1, Dof::Ry), 1.0)));
+        assert_eq!(m("8:+RY"), Ok((DofRef::new(1, Dof::Rz), -1.0)));
+        // 100 mm off the model along its z: compared in space, so not paired
+        let e = m("9:+X").unwrap_err();
+        assert!(e.contains("test node 9") && e.contains("100.0 mm"), "{e}");
     }
 }

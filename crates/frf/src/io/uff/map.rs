@@ -9,18 +9,27 @@
 //!   direction) sign`. `test = "101:-Z"` thus says "the test's -Z axis at 101
 //!   is the model DOF"; a file direction `+Z` at node 101 then counts -1.
 //! - Without an entry, `X`, `Y` and `RZ` map to `ux`, `uy` and `rz` of the
-//!   node with the same number, with the sign of the file's direction.
-//! - `Z`, `RX`, `RY` and scalar channels leave the model's x-y plane and need
-//!   an entry; the error says which line to add.
+//!   node with the same number, with the sign of the file's direction, and
+//!   in a 3D model `Z`, `RX`, `RY` to `uz`, `rx`, `ry`.
+//! - In a planar model `Z`, `RX`, `RY` leave the model's x-y plane, and
+//!   scalar channels have no direction: they need an entry; the error says
+//!   which line to add.
 
 use fe_model::case::ChannelMap;
-use fe_model::{Dof, DofRef};
+use fe_model::{Dimension, Dof, DofRef};
 
 use super::{Direction, TestDof};
 
-/// The model DOF a test DOF measures, and the sign: `test = sign * model`.
-/// The error message names the test DOF and suggests the map entry to add.
+/// The model DOF a test DOF measures in a planar model, and the sign:
+/// `test = sign * model` (see [`map_test_dof_in`]).
 pub fn map_test_dof(dof: TestDof, map: &[ChannelMap]) -> Result<(DofRef, f64), String> {
+    map_test_dof_in(dof, map, Dimension::Planar)
+}
+
+/// The model DOF a test DOF measures in a model of dimension `dim`, and the
+/// sign: `test = sign * model`. The error message names the test DOF and
+/// suggests the map entry to add.
+pub fn map_test_dof_in(dof: TestDof, map: &[ChannelMap], dim: Dimension) -> Result<(DofRef, f64), String> {
     for entry in map {
         let (node, code) = entry.test_point().map_err(|e| format!("map entry `{}`: {e}", entry.test))?;
         if node == dof.node && code.abs() == dof.direction.code().abs() {
@@ -31,9 +40,13 @@ pub fn map_test_dof(dof: TestDof, map: &[ChannelMap]) -> Result<(DofRef, f64), S
     let model_dof = match dof.direction.axis() {
         Direction::X => Some(Dof::Ux),
         Direction::Y => Some(Dof::Uy),
+        Direction::Z => Some(Dof::Uz),
+        Direction::RX => Some(Dof::Rx),
+        Direction::RY => Some(Dof::Ry),
         Direction::RZ => Some(Dof::Rz),
         _ => None,
-    };
+    }
+    .filter(|&d| dim.local(d).is_some());
     let suggestion = |model: &str| {
         format!(
             "add to the case file's [measurement] section:\n    [[measurement.map]]\n    test = \"{}:{}\"\n    \
@@ -65,12 +78,16 @@ pub fn map_test_dof(dof: TestDof, map: &[ChannelMap]) -> Result<(DofRef, f64), S
     Ok((DofRef::new(node, model_dof), dof.direction.sign()))
 }
 
-/// The test DOF a writer uses for a model DOF: `ux`, `uy`, `rz` as `+X`,
-/// `+Y`, `+RZ` of the same node (the inverse of the default mapping).
+/// The test DOF a writer uses for a model DOF: `ux`, `uy`, `uz`, `rx`,
+/// `ry`, `rz` as `+X`, `+Y`, `+Z`, `+RX`, `+RY`, `+RZ` of the same node (the
+/// inverse of the default mapping).
 pub fn model_to_test_dof(dof: DofRef) -> TestDof {
     let direction = match dof.dof {
         Dof::Ux => Direction::X,
         Dof::Uy => Direction::Y,
+        Dof::Uz => Direction::Z,
+        Dof::Rx => Direction::RX,
+        Dof::Ry => Direction::RY,
         Dof::Rz => Direction::RZ,
     };
     TestDof::new(i64::from(dof.node.0), direction)
@@ -96,6 +113,15 @@ mod tests {
         for dof in [DofRef::new(3, Dof::Ux), DofRef::new(3, Dof::Uy), DofRef::new(3, Dof::Rz)] {
             assert_eq!(map_test_dof(model_to_test_dof(dof), &[]), Ok((dof, 1.0)));
         }
+    }
+
+    #[test]
+    fn a_3d_model_maps_every_direction_by_default() {
+        for dof in Dof::SPATIAL.map(|d| DofRef::new(4, d)) {
+            assert_eq!(map_test_dof_in(model_to_test_dof(dof), &[], Dimension::Spatial), Ok((dof, 1.0)));
+        }
+        assert_eq!(map_test_dof_in(t("4:-Z"), &[], Dimension::Spatial), Ok((DofRef::new(4, Dof::Uz), -1.0)));
+        assert!(map_test_dof_in(t("0:S"), &[], Dimension::Spatial).unwrap_err().contains("scalar"));
     }
 
     #[test]

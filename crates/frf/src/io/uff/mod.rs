@@ -59,10 +59,10 @@ use crate::error::{FileError, FrfError};
 
 pub use frfs::{
     ChannelSource, TestDofMapper, UffFrfs, frfs_from_uff, frfs_from_uff_mapped, frfs_from_uff_with, read_uff_frfs,
-    read_uff_frfs_with,
+    read_uff_frfs_in, read_uff_frfs_with,
 };
 pub use geometry::{CoordinateSystem, Geometry, PairedNode, Pairing, PairingOptions, TestNode, pair_by_coordinates};
-pub use map::{map_test_dof, model_to_test_dof};
+pub use map::{map_test_dof, map_test_dof_in, model_to_test_dof};
 pub use read::{parse_uff, read_uff};
 pub use units::{FrfUnits, frf_units};
 pub use write::{Spacing, UffWriteOptions, encode, frf_set_to_functions, to_uff_bytes, write_uff};

@@ -4,11 +4,14 @@
 //! undeformed.
 //!
 //! Drawing is in pixels on an equal-scale view of the model's x-y plane
-//! ([`View`]), so that a frame looks like the frame.
+//! ([`View`]), so that a frame looks like the frame. A 3D model is drawn in
+//! a cabinet projection ([`project`]): the x-y plane true to scale, as a
+//! planar model, and z receding up and to the right at half scale, so that
+//! a planar frame built in space looks as it does in the plane.
 
 use std::collections::HashMap;
 
-use fe_model::{Dof, DofRef, Model, NodeId};
+use fe_model::{Dimension, Dof, DofRef, Model, NodeId, PerDof};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
@@ -67,10 +70,11 @@ impl View {
 fn bbox(model: &Model) -> (f64, f64, f64, f64) {
     let (mut xmin, mut ymin, mut xmax, mut ymax) = (f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY);
     for n in model.nodes() {
-        xmin = xmin.min(n.x);
-        xmax = xmax.max(n.x);
-        ymin = ymin.min(n.y);
-        ymax = ymax.max(n.y);
+        let (x, y) = project(model, n.position());
+        xmin = xmin.min(x);
+        xmax = xmax.max(x);
+        ymin = ymin.min(y);
+        ymax = ymax.max(y);
     }
     if !xmin.is_finite() {
         return (0.0, 0.0, 1.0, 1.0);
@@ -91,8 +95,21 @@ fn aspect(model: &Model) -> f64 {
     ((ymax - ymin) / (xmax - xmin)).clamp(0.1, 3.0)
 }
 
+/// The drawing's direction of the model's z axis: half scale, 30 degrees
+/// above the x axis.
+const RECEDING: (f64, f64) = (0.433_012_701_892_219_3, 0.25);
+
+/// A point of the model on the drawing's plane (model units): `(x, y)` of
+/// a planar model, the cabinet projection `(x, y) + z RECEDING` in space.
+fn project(model: &Model, [x, y, z]: [f64; 3]) -> (f64, f64) {
+    match model.dimension() {
+        Dimension::Planar => (x, y),
+        Dimension::Spatial => (x + RECEDING.0 * z, y + RECEDING.1 * z),
+    }
+}
+
 fn node_xy(model: &Model, id: NodeId) -> Option<(f64, f64)> {
-    model.node(id).map(|n| (n.x, n.y))
+    model.node(id).map(|n| project(model, n.position()))
 }
 
 /// Unit direction (model axes) from a node along its first beam, or up.
@@ -177,7 +194,11 @@ fn dof_dir(d: Dof) -> Option<(f64, f64)> {
     match d {
         Dof::Ux => Some((1.0, 0.0)),
         Dof::Uy => Some((0.0, -1.0)),
-        Dof::Rz => None,
+        Dof::Uz => {
+            let l = RECEDING.0.hypot(RECEDING.1);
+            Some((RECEDING.0 / l, -RECEDING.1 / l))
+        }
+        Dof::Rx | Dof::Ry | Dof::Rz => None,
     }
 }
 
@@ -229,7 +250,7 @@ fn draw_model(area: &Area<'_>, model: &Model, view: &View, colour: RGBColor, wid
         let Some(p) = at(s.node) else { continue };
         let away = pixel_dir(beam_direction(model, s.node));
         let away = (-away.0, -away.1);
-        if s.dofs.len() == 3 {
+        if s.dofs.len() == model.node_dofs().len() {
             // clamped: a wall across the beam
             draw_ground(area, p, away, 14.0)?;
         } else {
@@ -322,7 +343,8 @@ pub(crate) fn structure(
         draw_model(&body, model, &view, BEAM, 3, true)?;
         for n in model.nodes() {
             if model.nodes().len() <= 200 {
-                body.draw(&Circle::new(view.px(n.x, n.y), 2, BEAM.filled()))?;
+                let (x, y) = project(model, n.position());
+                body.draw(&Circle::new(view.px(x, y), 2, BEAM.filled()))?;
             }
         }
         // excitations point into the node, responses out of it
@@ -394,8 +416,8 @@ pub(crate) struct ShapePanel {
     pub(crate) title: String,
     /// A line under the title.
     pub(crate) subtitle: String,
-    /// The model's `(ux, uy, rz)` per node id (absent nodes do not move).
-    pub(crate) model: HashMap<u32, [f64; 3]>,
+    /// The model's displacement per DOF per node id (absent nodes do not move).
+    pub(crate) model: HashMap<u32, PerDof>,
     /// The measured displacement at each measured DOF.
     pub(crate) measured: Vec<(DofRef, f64)>,
 }
@@ -427,14 +449,43 @@ fn deformed_beam(p: (f64, f64), q: (f64, f64), up: [f64; 3], uq: [f64; 3], amp: 
         .collect()
 }
 
+/// Points along a 3D beam from `p` to `q` with local axes `axes`, deformed
+/// by end displacements `up`, `uq` times `amp`: axial displacement linear,
+/// each transverse one cubic (Hermite) with its plane's end rotations, as
+/// the element's own shape functions ([`fe_model::element::frame3d`]).
+fn deformed_beam_3d(p: [f64; 3], q: [f64; 3], axes: &[[f64; 3]; 3], up: PerDof, uq: PerDof, amp: f64) -> Vec<[f64; 3]> {
+    let l = ((q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2) + (q[2] - p[2]).powi(2)).sqrt();
+    // local components of a global vector
+    let local = |v: [f64; 3]| axes.map(|e| e[0] * v[0] + e[1] * v[1] + e[2] * v[2]);
+    let (t1, t2) = (local([up[Dof::Ux], up[Dof::Uy], up[Dof::Uz]]), local([uq[Dof::Ux], uq[Dof::Uy], uq[Dof::Uz]]));
+    let (r1, r2) = (local([up[Dof::Rx], up[Dof::Ry], up[Dof::Rz]]), local([uq[Dof::Rx], uq[Dof::Ry], uq[Dof::Rz]]));
+    (0..=16)
+        .map(|k| {
+            let t = f64::from(k) / 16.0;
+            let (h1, h2, h3, h4) = (
+                1.0 - 3.0 * t * t + 2.0 * t.powi(3),
+                (t - 2.0 * t * t + t.powi(3)) * l,
+                3.0 * t * t - 2.0 * t.powi(3),
+                (t.powi(3) - t * t) * l,
+            );
+            let u = t1[0] * (1.0 - t) + t2[0] * t;
+            // v with tz = dv/dx, w with ty = -dw/dx
+            let v = h1 * t1[1] + h2 * r1[2] + h3 * t2[1] + h4 * r2[2];
+            let w = h1 * t1[2] - h2 * r1[1] + h3 * t2[2] - h4 * r2[1];
+            [0, 1, 2].map(|c| p[c] + t * (q[c] - p[c]) + amp * (u * axes[0][c] + v * axes[1][c] + w * axes[2][c]))
+        })
+        .collect()
+}
+
 /// The amplitude factor that makes the largest translation of any panel a
 /// sixth of the structure's size.
 fn amplitude(model: &Model, panels: &[ShapePanel]) -> f64 {
     let (xmin, ymin, xmax, ymax) = bbox(model);
     let size = (xmax - xmin).max(ymax - ymin);
+    let translation = |u: &PerDof| u[Dof::Ux].hypot(u[Dof::Uy]).hypot(u[Dof::Uz]);
     let largest = panels
         .iter()
-        .flat_map(|p| p.model.values().map(|u| u[0].hypot(u[1])).chain(p.measured.iter().map(|(_, v)| v.abs())))
+        .flat_map(|p| p.model.values().map(translation).chain(p.measured.iter().map(|(_, v)| v.abs())))
         .filter(|v| v.is_finite())
         .fold(0.0f64, f64::max);
     if largest > 0.0 { size / 6.0 / largest } else { 0.0 }
@@ -479,27 +530,45 @@ pub(crate) fn mode_shapes(title: &str, model: &Model, panels: &[ShapePanel]) -> 
             let (w, h) = area.dim_in_pixel();
             let view = View::fit(bbox, f64::from(w), f64::from(h), 10.0);
             draw_model(&area, model, &view, UNDEFORMED, 2, false)?;
-            let disp = |id: NodeId| panel.model.get(&id.0).copied().unwrap_or([0.0; 3]);
-            for b in model.beams() {
-                let (Some(p), Some(q)) = (node_xy(model, b.nodes[0]), node_xy(model, b.nodes[1])) else { continue };
-                let pts: Vec<(i32, i32)> = deformed_beam(p, q, disp(b.nodes[0]), disp(b.nodes[1]), amp)
-                    .into_iter()
-                    .map(|(x, y)| view.px(x, y))
-                    .collect();
+            let disp = |id: NodeId| panel.model.get(&id.0).copied().unwrap_or_default();
+            for (i, b) in model.beams().iter().enumerate() {
+                let pts: Vec<(i32, i32)> = match model.dimension() {
+                    Dimension::Planar => {
+                        let (Some(p), Some(q)) = (node_xy(model, b.nodes[0]), node_xy(model, b.nodes[1])) else {
+                            continue;
+                        };
+                        let planar = |u: PerDof| [u[Dof::Ux], u[Dof::Uy], u[Dof::Rz]];
+                        deformed_beam(p, q, planar(disp(b.nodes[0])), planar(disp(b.nodes[1])), amp)
+                            .into_iter()
+                            .map(|(x, y)| view.px(x, y))
+                            .collect()
+                    }
+                    Dimension::Spatial => {
+                        let [p, q] = b.nodes.map(|n| model.node(n).map(|n| n.position()).unwrap_or_default());
+                        deformed_beam_3d(p, q, &model.beam_axes(i), disp(b.nodes[0]), disp(b.nodes[1]), amp)
+                            .into_iter()
+                            .map(|at| {
+                                let (x, y) = project(model, at);
+                                view.px(x, y)
+                            })
+                            .collect()
+                    }
+                };
                 area.draw(&PathElement::new(pts, UPDATED.stroke_width(2)))?;
             }
             // a measured value moves its node in the measured direction, the
             // model's displacement in the others: where the shapes agree, the
             // dot sits on the blue line
             for (d, v) in &panel.measured {
-                let Some((x, y)) = node_xy(model, d.node) else { continue };
+                let Some(node) = model.node(d.node) else { continue };
                 if !d.dof.is_translation() {
                     continue;
                 }
                 let mut u = disp(d.node);
-                u[d.dof.index()] = *v;
-                let to = view.px(x + amp * u[0], y + amp * u[1]);
-                area.draw(&Circle::new(to, 4, MEASURED.filled()))?;
+                u[d.dof] = *v;
+                let [x, y, z] = node.position();
+                let (x, y) = project(model, [x + amp * u[Dof::Ux], y + amp * u[Dof::Uy], z + amp * u[Dof::Uz]]);
+                area.draw(&Circle::new(view.px(x, y), 4, MEASURED.filled()))?;
             }
         }
         Ok(())
@@ -520,7 +589,7 @@ mod tests {
         m.add_node(3, 0.5, 0.6).unwrap();
         m.add_beam(1, [1, 2], steel, sec, g).unwrap();
         m.add_beam(2, [2, 3], steel, sec, g).unwrap();
-        m.add_support(1, &Dof::ALL).unwrap();
+        m.add_support(1, &Dof::PLANAR).unwrap();
         m
     }
 
@@ -608,7 +677,9 @@ mod tests {
             .map(|k| ShapePanel {
                 title: format!("mode {k}"),
                 subtitle: String::new(),
-                model: [(2, [0.01 * f64::from(k), 0.0, 0.0]), (3, [0.01, 0.02, 0.0])].into_iter().collect(),
+                model: [(2, [0.01 * f64::from(k), 0.0, 0.0].into()), (3, [0.01, 0.02, 0.0].into())]
+                    .into_iter()
+                    .collect(),
                 measured: vec![(DofRef::new(3, Dof::Uy), 0.018)],
             })
             .collect();

@@ -1,6 +1,6 @@
 //! The change a candidate makes, applied to a model and written into a case file.
 
-use fe_model::{CaseEditor, CaseError, Dof, ElementId, Group, Model, ModelError};
+use fe_model::{CaseEditor, CaseError, Dimension, Dof, ElementId, Group, Model, ModelError, PerDof};
 
 use super::EffectKind;
 
@@ -9,16 +9,17 @@ use super::EffectKind;
 /// file by [`Edit::write`]. Names are chosen free in the whole nominal model.
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) enum Edit {
-    /// A lumped mass `m` (and rotary inertia `j`, when fitted) at a node, in
-    /// an undamped group of its own.
-    Mass { node: u32, name: String, group: String, m: f64, j: f64 },
+    /// A lumped mass `m` (and rotary inertia `j`, when fitted: about z in a
+    /// planar model, the same about every axis in space) at a node, in an
+    /// undamped group of its own.
+    Mass { node: u32, name: String, group: String, m: f64, j: f64, dim: Dimension },
     /// The rigid support of a node (the DOFs `fixed`) replaced, in the
     /// `released` DOFs, by ground springs `k` in a damping group of their
     /// own; the other fixed DOFs stay fixed.
-    Support { node: u32, fixed: Vec<Dof>, released: Vec<Dof>, name: String, group: Group, k: [f64; 3] },
+    Support { node: u32, fixed: Vec<Dof>, released: Vec<Dof>, name: String, group: Group, k: PerDof, dim: Dimension },
     /// Members detached from a node onto a new coincident node, joined to it
-    /// by springs `k` in the `sprung` DOFs (always the rotation), tied in the
-    /// others, in a damping group of their own.
+    /// by springs `k` in the `sprung` DOFs (always the rotations), tied in
+    /// the others, in a damping group of their own.
     Joint {
         node: u32,
         elements: Vec<u32>,
@@ -26,17 +27,14 @@ pub(crate) enum Edit {
         in_line: bool,
         name: String,
         group: Group,
-        k: [f64; 3],
+        k: PerDof,
         sprung: Vec<Dof>,
+        dim: Dimension,
     },
     /// Nothing added: the parameters exist in the nominal model.
     Set,
     /// Elements `first..=last` moved to a new group.
     Region { first: u32, last: u32, group: Group },
-}
-
-fn dof_key(d: Dof) -> &'static str {
-    ["kx", "ky", "kr"][d.index()]
 }
 
 fn range_name(first: u32, last: u32) -> String {
@@ -48,12 +46,16 @@ impl Edit {
     /// that holds the nodes and elements the change touches.
     pub(crate) fn apply(&self, m: &mut Model) -> Result<(), ModelError> {
         match self {
-            Edit::Mass { node, name, group, m: mass, j } => {
+            Edit::Mass { node, name, group, m: mass, j, dim } => {
                 let g = match m.group_index(group) {
                     Some(g) => g,
                     None => m.add_group(Group::new(group))?,
                 };
-                m.add_mass(name, *node, *mass, *j, g)?;
+                let j = match dim {
+                    Dimension::Planar => [0.0, 0.0, *j],
+                    Dimension::Spatial => [*j; 3],
+                };
+                m.add_mass(name, *node, *mass, j, g)?;
             }
             Edit::Support { node, released, name, group, k, .. } => {
                 let fixed = m.remove_support(*node);
@@ -64,10 +66,10 @@ impl Edit {
                 let g = m.add_group(group.clone())?;
                 m.add_spring(name, *node, None, *k, g)?;
             }
-            Edit::Joint { node, elements, new_node, name, group, k, sprung, .. } => {
+            Edit::Joint { node, elements, new_node, name, group, k, sprung, dim, .. } => {
                 let g = m.add_group(group.clone())?;
                 m.split_node(*node, elements, *new_node)?;
-                let tied: Vec<Dof> = [Dof::Ux, Dof::Uy].into_iter().filter(|d| !sprung.contains(d)).collect();
+                let tied: Vec<Dof> = dim.dofs().iter().copied().filter(|d| !sprung.contains(d)).collect();
                 if !tied.is_empty() {
                     m.add_tie(*node, *new_node, &tied)?;
                 }
@@ -99,8 +101,8 @@ impl Edit {
     /// Plain-language description with the location and the variant.
     pub(crate) fn describe(&self, kind: EffectKind) -> String {
         let damping = |g: &Group| if g.mu.is_some() { "non-viscous" } else { "viscous" };
-        let springs = |dofs: &[Dof]| {
-            let mut v: Vec<&str> = dofs.iter().map(|&d| dof_key(d)).collect();
+        let springs = |dofs: &[Dof], dim: &Dimension| {
+            let mut v: Vec<&str> = dofs.iter().map(|&d| dim.spring_key(d)).collect();
             v.sort_unstable();
             v.join(", ")
         };
@@ -112,17 +114,17 @@ impl Edit {
                     format!("lumped mass at node {node}")
                 }
             }
-            Edit::Support { node, released, group, .. } => {
-                format!("flexible, lossy support at node {node} ({}; {})", springs(released), damping(group))
+            Edit::Support { node, released, group, dim, .. } => {
+                format!("flexible, lossy support at node {node} ({}; {})", springs(released, dim), damping(group))
             }
-            Edit::Joint { node, elements, in_line, group, sprung, .. } => {
+            Edit::Joint { node, elements, in_line, group, sprung, dim, .. } => {
                 let ids: Vec<u32> = elements.clone();
                 let which = match ids.as_slice() {
                     [one] => format!("element {one}"),
                     _ => format!("elements {ids:?}"),
                 };
                 let what = if *in_line { "flexible, lossy in-line joint" } else { "flexible, lossy joint" };
-                format!("{what} at node {node} ({which}; {}; {})", springs(sprung), damping(group))
+                format!("{what} at node {node} ({which}; {}; {})", springs(sprung, dim), damping(group))
             }
             Edit::Region { first, last, .. } => format!("{} in {}", kind.label(), range_name(*first, *last)),
             Edit::Set => kind.label().to_string(),
@@ -178,26 +180,31 @@ impl Edit {
             }
             s
         };
-        let spring_lines = |k: &[f64; 3], dofs: &[Dof]| {
+        let spring_lines = |k: &PerDof, dofs: &[Dof], dim: &Dimension| {
             dofs.iter()
                 .map(|&d| {
-                    format!("{} = {:e}\n", dof_key(d), fitted(&format!(".{}", dof_key(d))).unwrap_or(k[d.index()]))
+                    let key = dim.spring_key(d);
+                    format!("{key} = {:e}\n", fitted(&format!(".{key}")).unwrap_or(k[d]))
                 })
                 .collect::<String>()
         };
         let text = match self {
-            Edit::Mass { node, name, group, m, j } => {
+            Edit::Mass { node, name, group, m, j, dim } => {
                 let mut s = format!(
                     "[groups.{group}]                # an undamped group for added masses\n\n[[masses]]\nname = \"{name}\"\nnode = {node}\nm = {:e}\n",
                     fitted(".m").unwrap_or(*m)
                 );
                 if *j > 0.0 {
-                    s.push_str(&format!("j = {:e}\n", fitted(".j").unwrap_or(*j)));
+                    let j = fitted(".j").unwrap_or(*j);
+                    match dim {
+                        Dimension::Planar => s.push_str(&format!("j = {j:e}\n")),
+                        Dimension::Spatial => s.push_str(&format!("jx = {j:e}\njy = {j:e}\njz = {j:e}\n")),
+                    }
                 }
                 s.push_str(&format!("group = \"{group}\"\n"));
                 s
             }
-            Edit::Support { node, fixed, released, name, group, k } => {
+            Edit::Support { node, fixed, released, name, group, k, dim } => {
                 let mut s = group_table(group);
                 s.push('\n');
                 let kept: Vec<&str> = fixed.iter().filter(|d| !released.contains(d)).map(|d| d.name()).collect();
@@ -211,16 +218,16 @@ impl Edit {
                 s.push_str(&format!(
                     "[[springs]]\nname = \"{name}\"\nnode = {node}                      # to ground\n"
                 ));
-                s.push_str(&spring_lines(k, released));
+                s.push_str(&spring_lines(k, released, dim));
                 s.push_str(&format!("group = \"{}\"\n", group.name));
                 s
             }
-            Edit::Joint { node, elements, new_node, name, group, k, sprung, .. } => {
+            Edit::Joint { node, elements, new_node, name, group, k, sprung, dim, .. } => {
                 let mut s = group_table(group);
                 s.push_str(&format!(
                     "\n[[joints]]\nname = \"{name}\"\nnode = {node}\nelements = {elements:?}\nnew_node = {new_node}\n"
                 ));
-                s.push_str(&spring_lines(k, sprung));
+                s.push_str(&spring_lines(k, sprung, dim));
                 s.push_str(&format!("group = \"{}\"\n", group.name));
                 s
             }

@@ -9,10 +9,16 @@
 //! to that element. On every model the refinement adds the fuller variants
 //! of the leaders: translational springs for a joint, a rotary inertia for
 //! a mass.
+//!
+//! A 3D model gets the same families in its own DOFs: supports release every
+//! fixed DOF, a joint springs the three rotations (and in its fuller variant
+//! the translations too), a mass acts on the three translations (its rotary
+//! inertia is the same about every axis), and members are told apart by
+//! their directions in space.
 
 use std::collections::{HashMap, HashSet};
 
-use fe_model::{Dof, Group, Model, NodeId};
+use fe_model::{Dimension, Dof, Group, Model, NodeId, PerDof};
 use rayon::prelude::*;
 
 use super::edit::Edit;
@@ -55,6 +61,7 @@ type Spec = (Head, Edit, Vec<Fitted>);
 /// starting values, bounds and plausible ranges.
 struct Ctx<'a> {
     model: &'a Model,
+    dim: Dimension,
     /// Beams (indices) at each node id.
     beams_at: HashMap<u32, Vec<usize>>,
     /// Runs of consecutive elements (beam indices in id order) of one group.
@@ -86,14 +93,15 @@ impl<'a> Ctx<'a> {
                 run_of[b] = (r, p);
             }
         }
-        let (xs, ys): (Vec<f64>, Vec<f64>) = model.nodes().iter().map(|n| (n.x, n.y)).unzip();
-        let extent = |v: &[f64]| {
-            v.iter().copied().fold(f64::NEG_INFINITY, f64::max) - v.iter().copied().fold(f64::INFINITY, f64::min)
+        let extent = |c: usize| {
+            let v = model.nodes().iter().map(|n| n.position()[c]);
+            v.clone().fold(f64::NEG_INFINITY, f64::max) - v.fold(f64::INFINITY, f64::min)
         };
-        let size = extent(&xs).max(extent(&ys)).max(1e-3);
+        let size = extent(0).max(extent(1)).max(extent(2)).max(1e-3);
         let two_pi = 2.0 * std::f64::consts::PI;
         Ctx {
             model,
+            dim: model.dimension(),
             beams_at,
             runs,
             run_of,
@@ -160,38 +168,47 @@ impl<'a> Ctx<'a> {
 
     /// Diagonal stiffness (for `E` and factors as modelled) of the beams at a
     /// node, per global DOF: the scale a spring at that node competes with.
-    fn local_stiffness(&self, node: u32) -> [f64; 3] {
+    fn local_stiffness(&self, node: u32) -> PerDof {
         let m = self.model;
-        let mut k = [0.0; 3];
+        let dofs = self.dim.dofs();
+        let mut k = PerDof::default();
         for &i in self.at(node) {
             let b = &m.beams()[i];
-            let (l, c, s) = m.beam_geometry(i);
-            let sec = &m.sections()[b.section];
             let e = m.materials()[b.material].e * b.stiffness_factor * m.groups()[b.group].stiffness;
-            let ke = fe_model::element::frame_stiffness(sec.area, sec.inertia, l, c, s) * e;
-            let o = if b.nodes[0] == NodeId(node) { 0 } else { 3 };
-            for d in 0..3 {
-                k[d] += ke[(o + d, o + d)];
+            let [ke, ..] = fe_model::element::beam_units(m, i);
+            let o = if b.nodes[0] == NodeId(node) { 0 } else { dofs.len() };
+            for (p, &d) in dofs.iter().enumerate() {
+                k[d] += ke[(o + p, o + p)] * e;
+            }
+        }
+        // and the imported stiffness matrices' diagonal there
+        for b in m.imported().iter().filter(|b| b.kind == fe_model::imported::ImportedKind::Stiffness) {
+            let n = b.dofs.len();
+            for (p, r) in b.dofs.iter().enumerate().filter(|(_, r)| r.node == NodeId(node)) {
+                k[r.dof] += b.values[p * n + p] * m.groups()[b.group].stiffness;
             }
         }
         k
     }
 
     /// The direction of beam `i` pointing away from `node`.
-    fn direction(&self, i: usize, node: u32) -> (f64, f64) {
-        let (_, c, s) = self.model.beam_geometry(i);
-        if self.model.beams()[i].nodes[0] == NodeId(node) { (c, s) } else { (-c, -s) }
+    fn direction(&self, i: usize, node: u32) -> [f64; 3] {
+        let (_, d) = self.model.beam_axis(i);
+        if self.model.beams()[i].nodes[0] == NodeId(node) { d } else { d.map(|v| -v) }
+    }
+
+    /// The cosine of the angle between the directions of beams `a` and `b`
+    /// away from `node`.
+    fn cosine(&self, a: usize, b: usize, node: u32) -> f64 {
+        let (p, q) = (self.direction(a, node), self.direction(b, node));
+        p[0] * q[0] + p[1] * q[1] + p[2] * q[2]
     }
 
     /// The beams at `node` grouped by direction: collinear beams form one member.
     fn members_at(&self, node: u32) -> Vec<Vec<usize>> {
         let mut members: Vec<Vec<usize>> = Vec::new();
         for &i in self.at(node) {
-            let (c, s) = self.direction(i, node);
-            match members.iter_mut().find(|m| {
-                let (c2, s2) = self.direction(m[0], node);
-                (c * c2 + s * s2).abs() > COLLINEAR
-            }) {
+            match members.iter_mut().find(|m| self.cosine(i, m[0], node).abs() > COLLINEAR) {
                 Some(m) => m.push(i),
                 None => members.push(vec![i]),
             }
@@ -205,9 +222,8 @@ impl<'a> Ctx<'a> {
     fn in_line(&self, node: u32) -> Option<usize> {
         let at = self.at(node);
         let [a, b] = at[..] else { return None };
-        let ((c1, s1), (c2, s2)) = (self.direction(a, node), self.direction(b, node));
         // opposite directions away from the node
-        (c1 * c2 + s1 * s2 < -COLLINEAR)
+        (self.cosine(a, b, node) < -COLLINEAR)
             .then(|| if self.model.beams()[a].id > self.model.beams()[b].id { a } else { b })
     }
 }
@@ -375,22 +391,22 @@ fn supports(ctx: &Ctx<'_>, node: u32) -> Vec<Spec> {
     fixed.sort();
     fixed.dedup();
     let kref = ctx.local_stiffness(node);
-    if fixed.is_empty() || fixed.iter().any(|d| kref[d.index()] <= 0.0) {
+    if fixed.is_empty() || fixed.iter().any(|&d| kref[d] <= 0.0) {
         return Vec::new();
     }
     let mut out = Vec::new();
     for non_viscous in [false, true] {
         let name = unique_name(model, &format!("support_{node}"));
-        let mut k = [0.0; 3];
-        for d in &fixed {
-            k[d.index()] = 100.0 * kref[d.index()];
+        let mut k = PerDof::default();
+        for &d in &fixed {
+            k[d] = 100.0 * kref[d];
         }
         let mut fitted: Vec<Fitted> = fixed
             .iter()
             .map(|&d| {
-                let r = kref[d.index()];
+                let r = kref[d];
                 Fitted {
-                    name: format!("spring.{name}.{}", ["kx", "ky", "kr"][d.index()]),
+                    name: format!("spring.{name}.{}", ctx.dim.spring_key(d)),
                     role: Role::Spring(d),
                     bounds: Some((1e-6 * r, 1e4 * r)),
                     // a spring far stiffer than the member is as good as rigid, not implausible
@@ -409,6 +425,7 @@ fn supports(ctx: &Ctx<'_>, node: u32) -> Vec<Spec> {
             name: name.clone(),
             group: ctx.damping_group(&name, non_viscous),
             k,
+            dim: ctx.dim,
         };
         let head = Head {
             kind: EffectKind::FlexibleSupport,
@@ -424,21 +441,21 @@ fn supports(ctx: &Ctx<'_>, node: u32) -> Vec<Spec> {
     out
 }
 
-/// A flexible, lossy joint detaching `beams` from `node`: a rotational
-/// spring (and translational springs when `translational`), viscous or not.
+/// A flexible, lossy joint detaching `beams` from `node`: rotational
+/// springs (and translational springs when `translational`), viscous or not.
 fn joint(ctx: &Ctx<'_>, node: u32, beams: &[usize], in_line: bool, translational: bool, non_viscous: bool) -> Spec {
     let model = ctx.model;
     let elements = ids(model, beams);
     let name = unique_name(model, &format!("joint_{node}_{}", elements[0]));
     let kref = ctx.local_stiffness(node);
-    let sprung: Vec<Dof> = if translational { Dof::ALL.to_vec() } else { vec![Dof::Rz] };
-    let mut k = [0.0; 3];
+    let sprung: Vec<Dof> = if translational { ctx.dim.dofs().to_vec() } else { ctx.dim.rotations().to_vec() };
+    let mut k = PerDof::default();
     let mut fitted = Vec::new();
     for &d in &sprung {
-        let r = kref[d.index()].max(f64::MIN_POSITIVE);
-        k[d.index()] = 100.0 * r;
+        let r = kref[d].max(f64::MIN_POSITIVE);
+        k[d] = 100.0 * r;
         fitted.push(Fitted {
-            name: format!("spring.{name}.{}", ["kx", "ky", "kr"][d.index()]),
+            name: format!("spring.{name}.{}", ctx.dim.spring_key(d)),
             role: Role::Spring(d),
             bounds: Some((1e-6 * r, 1e4 * r)),
             plausible: (0.0, f64::INFINITY, ""),
@@ -457,6 +474,7 @@ fn joint(ctx: &Ctx<'_>, node: u32, beams: &[usize], in_line: bool, translational
         group: ctx.damping_group(&name, non_viscous),
         k,
         sprung: sprung.clone(),
+        dim: ctx.dim,
     };
     let head = Head {
         kind: EffectKind::FlexibleJoint,
@@ -484,7 +502,7 @@ fn mass(ctx: &Ctx<'_>, node: u32, inertia: bool) -> Spec {
         bounds: Some((1e-7 * ctx.total_mass, 10.0 * ctx.total_mass)),
         plausible: (0.0, 0.25 * ctx.total_mass, "more than a quarter of the structure's mass"),
     }];
-    let mut dofs = vec![Dof::Ux, Dof::Uy];
+    let mut dofs = ctx.dim.translations().to_vec();
     if inertia {
         let j_scale = ctx.total_mass * ctx.size * ctx.size;
         fitted.push(Fitted {
@@ -497,9 +515,9 @@ fn mass(ctx: &Ctx<'_>, node: u32, inertia: bool) -> Spec {
                 "a quarter of the structure's mass at a tenth of its size",
             ),
         });
-        dofs.push(Dof::Rz);
+        dofs.extend(ctx.dim.rotations());
     }
-    let edit = Edit::Mass { node, name, group, m: m0, j: j0 };
+    let edit = Edit::Mass { node, name, group, m: m0, j: j0, dim: ctx.dim };
     let head = Head {
         kind: EffectKind::LumpedMass,
         description: edit.describe(EffectKind::LumpedMass),
@@ -518,19 +536,19 @@ fn existing_joints(ctx: &Ctx<'_>) -> Vec<Spec> {
     for sp in model.springs() {
         let Some(b) = sp.b else { continue };
         let kref = ctx.local_stiffness(sp.a.0);
-        let mut fitted: Vec<Fitted> = Dof::ALL
-            .iter()
-            .filter(|d| sp.k[d.index()] > 0.0)
-            .map(|&d| {
-                let r = kref[d.index()].max(sp.k[d.index()]);
-                Fitted {
-                    name: format!("spring.{}.{}", sp.name, ["kx", "ky", "kr"][d.index()]),
-                    role: Role::Spring(d),
-                    bounds: Some((1e-6 * r, 1e4 * r)),
-                    plausible: (0.0, f64::INFINITY, ""),
-                }
-            })
-            .collect();
+        let mut fitted: Vec<Fitted> =
+            sp.k.non_zero(ctx.dim.dofs())
+                .into_iter()
+                .map(|d| {
+                    let r = kref[d].max(sp.k[d]);
+                    Fitted {
+                        name: format!("spring.{}.{}", sp.name, ctx.dim.spring_key(d)),
+                        role: Role::Spring(d),
+                        bounds: Some((1e-6 * r, 1e4 * r)),
+                        plausible: (0.0, f64::INFINITY, ""),
+                    }
+                })
+                .collect();
         let g = &model.groups()[sp.group];
         let group_only_this = model.springs().iter().filter(|o| o.group == sp.group).count() == 1
             && model.beams().iter().all(|o| o.group != sp.group)
@@ -546,7 +564,7 @@ fn existing_joints(ctx: &Ctx<'_>) -> Vec<Spec> {
             description: format!("joint `{}` between nodes {} and {} (as modelled)", sp.name, sp.a, b),
             nodes: vec![sp.a.0, b.0],
             elements: Vec::new(),
-            dofs: Dof::ALL.iter().copied().filter(|d| sp.k[d.index()] > 0.0).collect(),
+            dofs: sp.k.non_zero(ctx.dim.dofs()),
             part_nodes: vec![sp.a.0, b.0],
         };
         out.push((head, Edit::Set, fitted));
@@ -561,11 +579,21 @@ fn mass_nodes(ctx: &Ctx<'_>) -> Vec<u32> {
     for s in model.supports() {
         *fixed.entry(s.node.0).or_default() += s.dofs.iter().filter(|d| d.is_translation()).count();
     }
+    let translations = ctx.dim.translations().len();
+    // nodes of imported mass matrices carry structure as a beam's do
+    let imported: HashSet<u32> = model
+        .imported()
+        .iter()
+        .filter(|b| b.kind == fe_model::imported::ImportedKind::Mass)
+        .flat_map(|b| b.dofs.iter().filter(|r| r.dof.is_translation()).map(|r| r.node.0))
+        .collect();
     model
         .nodes()
         .iter()
         .map(|n| n.id.0)
-        .filter(|n| fixed.get(n).copied().unwrap_or(0) < 2 && !ctx.at(*n).is_empty())
+        .filter(|n| {
+            fixed.get(n).copied().unwrap_or(0) < translations && (!ctx.at(*n).is_empty() || imported.contains(n))
+        })
         .collect()
 }
 
@@ -623,6 +651,9 @@ pub fn generate(model: &Model, opts: &CandidateOptions) -> Vec<Candidate> {
 
     for node in mass_nodes(&ctx) {
         specs.push(mass(&ctx, node, false));
+    }
+    for (group, nodes) in super::imported::imported_groups(model) {
+        specs.extend(super::imported::group_changes(model, group, &nodes, |n| ctx.alpha(n), |n| ctx.mu(n)));
     }
 
     // windows: on small models single elements at every offset and longer
@@ -686,7 +717,9 @@ pub(crate) fn refine(
     let mut specs: Vec<Spec> = Vec::new();
     for c in leaders {
         match &c.edit {
-            Edit::Joint { node, elements, in_line, group, sprung, .. } if sprung.len() < 3 => {
+            Edit::Joint { node, elements, in_line, group, sprung, .. }
+                if !sprung.iter().any(|d| d.is_translation()) =>
+            {
                 let beams: Vec<usize> =
                     elements.iter().filter_map(|&e| model.beam_index(fe_model::ElementId(e))).collect();
                 specs.push(joint(&ctx, *node, &beams, *in_line, true, group.mu.is_some()));

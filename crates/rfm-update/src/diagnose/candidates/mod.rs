@@ -9,6 +9,7 @@
 //! | mass change | the same windows | mass factor |
 //! | viscous damping | the same windows | alpha of the window |
 //! | non-viscous damping | the same windows | alpha and mu of the window |
+//! | stiffness, mass or damping change of an imported group | each group with imported matrices | its factor, or its alpha (and mu) |
 //!
 //! Each candidate is a change of the nominal model, the effect inserted at a
 //! starting value that changes little (a very stiff spring, a tiny mass, a
@@ -30,6 +31,7 @@
 
 mod edit;
 mod generate;
+mod imported;
 
 use fe_model::{Dof, ElementId, Model, ModelError, NodeId, Parameter};
 use serde::Serialize;
@@ -256,12 +258,12 @@ impl Candidate {
             let ok = match (&mut edit, self.roles[i]) {
                 (Edit::Support { released, k, .. }, Role::Spring(d)) => {
                     released.retain(|&x| x != d);
-                    k[d.index()] = 0.0;
+                    k[d] = 0.0;
                     true
                 }
                 (Edit::Joint { sprung, k, .. }, Role::Spring(d)) if d.is_translation() => {
                     sprung.retain(|&x| x != d);
-                    k[d.index()] = 0.0;
+                    k[d] = 0.0;
                     true
                 }
                 (Edit::Mass { j, .. }, Role::Inertia) => {

@@ -13,7 +13,7 @@ fn l_frame() -> Model {
     for (id, a, b) in [(1, 1, 2), (2, 2, 3), (3, 3, 4), (4, 4, 5)] {
         m.add_beam(id, [a, b], steel, sec, g).unwrap();
     }
-    m.add_support(1, &Dof::ALL).unwrap();
+    m.add_support(1, &Dof::PLANAR).unwrap();
     m
 }
 
