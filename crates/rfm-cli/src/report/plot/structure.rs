@@ -235,12 +235,32 @@ pub(crate) struct Highlight {
     pub(crate) elements: Vec<u32>,
 }
 
+/// The pairs of distinct nodes that imported stiffness matrices couple.
+fn imported_edges(model: &Model) -> Vec<[NodeId; 2]> {
+    let mut edges: Vec<[NodeId; 2]> = model
+        .imported()
+        .iter()
+        .filter(|b| b.kind == fe_model::imported::ImportedKind::Stiffness && b.nodes[0] != b.nodes[1])
+        .map(|b| b.nodes)
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    edges
+}
+
 /// Draws the beams, supports, springs and masses of `model` in `view`.
 fn draw_model(area: &Area<'_>, model: &Model, view: &View, colour: RGBColor, width: u32, symbols: bool) -> DrawResult {
     let at = |id: NodeId| node_xy(model, id).map(|(x, y)| view.px(x, y));
     for b in model.beams() {
         if let (Some(p), Some(q)) = (at(b.nodes[0]), at(b.nodes[1])) {
             area.draw(&PathElement::new(vec![p, q], colour.stroke_width(width)))?;
+        }
+    }
+    // an imported model has no elements to draw: a thin line joins each
+    // pair of nodes its stiffness couples
+    for [a, b] in imported_edges(model) {
+        if let (Some(p), Some(q)) = (at(a), at(b)) {
+            area.draw(&PathElement::new(vec![p, q], colour.stroke_width(1)))?;
         }
     }
     if !symbols {
@@ -555,6 +575,18 @@ pub(crate) fn mode_shapes(title: &str, model: &Model, panels: &[ShapePanel]) -> 
                     }
                 };
                 area.draw(&PathElement::new(pts, UPDATED.stroke_width(2)))?;
+            }
+            // an imported model's node pairs, straight between the displaced nodes
+            for [p, q] in imported_edges(model) {
+                let moved = |id: NodeId| {
+                    let (n, u) = (model.node(id)?, disp(id));
+                    let [x, y, z] = n.position();
+                    let (x, y) = project(model, [x + amp * u[Dof::Ux], y + amp * u[Dof::Uy], z + amp * u[Dof::Uz]]);
+                    Some(view.px(x, y))
+                };
+                if let (Some(a), Some(b)) = (moved(p), moved(q)) {
+                    area.draw(&PathElement::new(vec![a, b], UPDATED.stroke_width(1)))?;
+                }
             }
             // a measured value moves its node in the measured direction, the
             // model's displacement in the others: where the shapes agree, the
