@@ -24,6 +24,7 @@ use plotters::prelude::*;
 pub(crate) mod axes;
 pub(crate) mod frf;
 pub(crate) mod modes;
+mod projection;
 mod steps;
 pub(crate) mod structure;
 pub(crate) use steps::misfit_steps;
