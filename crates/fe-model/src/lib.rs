@@ -1,10 +1,15 @@
-//! Planar frame finite element models for FRF-based model updating.
+//! Frame finite element models, planar or in space, for FRF-based model
+//! updating.
 //!
 //! This crate is the bottom layer of the workspace. It describes a structure
-//! in the x-y plane — nodes with three DOFs each (`ux`, `uy`, `rz`),
-//! Euler-Bernoulli frame elements, springs between nodes (joints and flexible
-//! supports modelled with coincident nodes), lumped masses, supports and ties
-//! — and assembles it into sparse matrices that keep each group's share:
+//! in the x-y plane — nodes with three DOFs each (`ux`, `uy`, `rz`) — or in
+//! space (`[model] dimension = 3`: six DOFs, `ux` .. `rz`), with
+//! Euler-Bernoulli frame elements (in space with torsion and two bending
+//! planes), springs between nodes (joints and flexible supports modelled
+//! with coincident nodes), lumped masses, supports and ties, and the user's
+//! own stiffness and mass matrices imported from another code
+//! ([`imported`]) — and assembles it into sparse matrices that keep each
+//! group's share:
 //!
 //! ```text
 //! K = sum_g K_g,   M = sum_g M_g,   C_g = alpha_g K_g + beta_g M_g

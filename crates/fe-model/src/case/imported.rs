@@ -48,10 +48,24 @@ struct RawImportedGroup {
     mass: Option<Spanned<String>>,
 }
 
-/// A path the case names, relative to its folder.
+/// A path the case names, relative to its folder, with `..` taken out
+/// lexically: a case written into a folder that does not exist yet (an
+/// output being staged) names its files through it.
 fn resolve(ctx: &Ctx<'_>, name: &str) -> PathBuf {
     let p = Path::new(name);
-    if p.is_absolute() { p.to_path_buf() } else { ctx.path.parent().unwrap_or(Path::new(".")).join(p) }
+    let joined = if p.is_absolute() { p.to_path_buf() } else { ctx.path.parent().unwrap_or(Path::new(".")).join(p) };
+    let absolute = std::path::absolute(&joined).unwrap_or(joined);
+    let mut clean = PathBuf::new();
+    for c in absolute.components() {
+        match c {
+            std::path::Component::CurDir => {}
+            std::path::Component::ParentDir => {
+                clean.pop();
+            }
+            other => clean.push(other),
+        }
+    }
+    clean
 }
 
 /// The files `[imported]` names, resolved (inputs that no output may replace).

@@ -27,6 +27,7 @@ mod frame;
 pub(crate) mod frf;
 mod history;
 pub(crate) mod modes;
+mod projection;
 mod steps;
 pub(crate) mod structure;
 mod style;

@@ -37,6 +37,19 @@ fn compare_and_update_run_on_an_imported_model_and_recover_its_truth() {
         assert!(z < 3.0, "{name}: {p} vs the truth's {want}");
     }
     assert!(dir.path().join("updated.toml").exists() && dir.path().join("report.html").exists());
+    // named by a path relative to the working folder, written into a new one
+    // elsewhere: the updated case reaches the matrices through `..` while its
+    // folder is still being staged
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let elsewhere = tempfile::tempdir().unwrap();
+    let out = elsewhere.path().join("new/up");
+    let run = Command::new(env!("CARGO_BIN_EXE_rfm"))
+        .current_dir(&root)
+        .args(["update", "cases/imported/table.toml", "--out", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    CaseFile::load(out.join("updated.toml")).unwrap();
 }
 
 /// The example's files in `dir`, with `edit` applied to the file `name`.

@@ -15,6 +15,7 @@ use fe_model::{Dimension, Dof, DofRef, Model, NodeId, PerDof};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
+use super::projection::{RECEDING, deformed_beam_3d, imported_edges, project};
 use super::{AXIS, Area, DrawResult, FONT, LegendEntry, MEASURED, Mark, PlotError, UPDATED, WIDTH, frame, svg};
 
 /// Colour of the beams.
@@ -93,19 +94,6 @@ fn bbox(model: &Model) -> (f64, f64, f64, f64) {
 fn aspect(model: &Model) -> f64 {
     let (xmin, ymin, xmax, ymax) = bbox(model);
     ((ymax - ymin) / (xmax - xmin)).clamp(0.1, 3.0)
-}
-
-/// The drawing's direction of the model's z axis: half scale, 30 degrees
-/// above the x axis.
-const RECEDING: (f64, f64) = (0.433_012_701_892_219_3, 0.25);
-
-/// A point of the model on the drawing's plane (model units): `(x, y)` of
-/// a planar model, the cabinet projection `(x, y) + z RECEDING` in space.
-fn project(model: &Model, [x, y, z]: [f64; 3]) -> (f64, f64) {
-    match model.dimension() {
-        Dimension::Planar => (x, y),
-        Dimension::Spatial => (x + RECEDING.0 * z, y + RECEDING.1 * z),
-    }
 }
 
 fn node_xy(model: &Model, id: NodeId) -> Option<(f64, f64)> {
@@ -241,6 +229,13 @@ fn draw_model(area: &Area<'_>, model: &Model, view: &View, colour: RGBColor, wid
     for b in model.beams() {
         if let (Some(p), Some(q)) = (at(b.nodes[0]), at(b.nodes[1])) {
             area.draw(&PathElement::new(vec![p, q], colour.stroke_width(width)))?;
+        }
+    }
+    // an imported model has no elements to draw: a thin line joins each
+    // pair of nodes its stiffness couples
+    for [a, b] in imported_edges(model) {
+        if let (Some(p), Some(q)) = (at(a), at(b)) {
+            area.draw(&PathElement::new(vec![p, q], colour.stroke_width(1)))?;
         }
     }
     if !symbols {
@@ -449,34 +444,6 @@ fn deformed_beam(p: (f64, f64), q: (f64, f64), up: [f64; 3], uq: [f64; 3], amp: 
         .collect()
 }
 
-/// Points along a 3D beam from `p` to `q` with local axes `axes`, deformed
-/// by end displacements `up`, `uq` times `amp`: axial displacement linear,
-/// each transverse one cubic (Hermite) with its plane's end rotations, as
-/// the element's own shape functions ([`fe_model::element::frame3d`]).
-fn deformed_beam_3d(p: [f64; 3], q: [f64; 3], axes: &[[f64; 3]; 3], up: PerDof, uq: PerDof, amp: f64) -> Vec<[f64; 3]> {
-    let l = ((q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2) + (q[2] - p[2]).powi(2)).sqrt();
-    // local components of a global vector
-    let local = |v: [f64; 3]| axes.map(|e| e[0] * v[0] + e[1] * v[1] + e[2] * v[2]);
-    let (t1, t2) = (local([up[Dof::Ux], up[Dof::Uy], up[Dof::Uz]]), local([uq[Dof::Ux], uq[Dof::Uy], uq[Dof::Uz]]));
-    let (r1, r2) = (local([up[Dof::Rx], up[Dof::Ry], up[Dof::Rz]]), local([uq[Dof::Rx], uq[Dof::Ry], uq[Dof::Rz]]));
-    (0..=16)
-        .map(|k| {
-            let t = f64::from(k) / 16.0;
-            let (h1, h2, h3, h4) = (
-                1.0 - 3.0 * t * t + 2.0 * t.powi(3),
-                (t - 2.0 * t * t + t.powi(3)) * l,
-                3.0 * t * t - 2.0 * t.powi(3),
-                (t.powi(3) - t * t) * l,
-            );
-            let u = t1[0] * (1.0 - t) + t2[0] * t;
-            // v with tz = dv/dx, w with ty = -dw/dx
-            let v = h1 * t1[1] + h2 * r1[2] + h3 * t2[1] + h4 * r2[2];
-            let w = h1 * t1[2] - h2 * r1[1] + h3 * t2[2] - h4 * r2[1];
-            [0, 1, 2].map(|c| p[c] + t * (q[c] - p[c]) + amp * (u * axes[0][c] + v * axes[1][c] + w * axes[2][c]))
-        })
-        .collect()
-}
-
 /// The amplitude factor that makes the largest translation of any panel a
 /// sixth of the structure's size.
 fn amplitude(model: &Model, panels: &[ShapePanel]) -> f64 {
@@ -555,6 +522,18 @@ pub(crate) fn mode_shapes(title: &str, model: &Model, panels: &[ShapePanel]) -> 
                     }
                 };
                 area.draw(&PathElement::new(pts, UPDATED.stroke_width(2)))?;
+            }
+            // an imported model's node pairs, straight between the displaced nodes
+            for [p, q] in imported_edges(model) {
+                let moved = |id: NodeId| {
+                    let (n, u) = (model.node(id)?, disp(id));
+                    let [x, y, z] = n.position();
+                    let (x, y) = project(model, [x + amp * u[Dof::Ux], y + amp * u[Dof::Uy], z + amp * u[Dof::Uz]]);
+                    Some(view.px(x, y))
+                };
+                if let (Some(a), Some(b)) = (moved(p), moved(q)) {
+                    area.draw(&PathElement::new(vec![a, b], UPDATED.stroke_width(1)))?;
+                }
             }
             // a measured value moves its node in the measured direction, the
             // model's displacement in the others: where the shapes agree, the
