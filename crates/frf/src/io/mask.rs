@@ -107,6 +107,14 @@ fn unmodelled(dofs: &DofMap, dof: DofRef) -> Option<String> {
     match dofs.slot(dof) {
         Some(Slot::Free(_)) => None,
         Some(Slot::Fixed) => Some(format!("{dof} is held fixed by a support of the model")),
+        None if fe_model::Dof::SPATIAL.iter().any(|&d| dofs.slot(DofRef { node: dof.node, dof: d }).is_some()) => {
+            // the node exists, its DOF does not: a planar model's `uz`, `rx` or `ry`
+            Some(format!(
+                "the model's node {} has no `{}` (a planar model's nodes have ux, uy and rz; a frame in space needs \
+                 `[model] dimension = 3`)",
+                dof.node, dof.dof
+            ))
+        }
         None => Some(format!("the model has no node {}", dof.node)),
     }
 }
@@ -204,4 +212,26 @@ pub(crate) fn duplicate_lines(
         keep.push(k);
     }
     Ok((keep, masked))
+}
+
+#[cfg(test)]
+mod tests {
+    use fe_model::{Assembly, Dof, samples};
+
+    use super::*;
+
+    /// A channel at a DOF the model's dimension lacks says so, not that the
+    /// node is missing.
+    #[test]
+    fn a_channel_at_a_dof_a_planar_model_lacks_is_named_as_such() {
+        let a = Assembly::new(&samples::cantilever(2)).unwrap();
+        let why = unmodelled(&a.dofs, DofRef::new(2, Dof::Uz)).unwrap();
+        assert!(why.contains("node 2 has no `uz`") && why.contains("dimension = 3"), "{why}");
+        assert_eq!(unmodelled(&a.dofs, DofRef::new(9, Dof::Uy)).unwrap(), "the model has no node 9");
+        assert_eq!(
+            unmodelled(&a.dofs, DofRef::new(1, Dof::Uy)).unwrap(),
+            "1:uy is held fixed by a support of the model"
+        );
+        assert_eq!(unmodelled(&a.dofs, DofRef::new(2, Dof::Rz)), None);
+    }
 }
