@@ -239,6 +239,7 @@ struct Added {
 /// Adds ranked effect `rank` of `d` to `current` and updates every parameter
 /// of the case's `[update]` by output error on the diagnosis's lines; the
 /// updated values and the misfit go into the case's history as step `step`.
+/// The update restarts only for the loop's last model (see [`update_case`]).
 fn add_and_update(
     current: &CaseFile,
     d: &Diagnosis,
@@ -248,14 +249,16 @@ fn add_and_update(
     step: usize,
 ) -> Result<Added, UpdateError> {
     let editor = d.apply_with_data(current, rank, opts.data.as_deref())?;
-    let (editor, case, misfit_updated, outcome) = update_case(current, editor, d, measured, opts, step)?;
+    let last = step >= opts.max_steps;
+    let (editor, case, misfit_updated, outcome) = update_case(current, editor, d, measured, opts, step, last)?;
     Ok(Added { effect: d.ranking[rank - 1].clone(), rank, editor, case, misfit_updated, outcome })
 }
 
 /// Updates every parameter of the `[update]` of the case `editor` holds by
 /// output error on the diagnosis's lines; returns the editor with the
 /// updated values and the misfit in the case's history (as step `step`),
-/// the case it now holds, the misfit and the outcome.
+/// the case it now holds, the misfit and the outcome. `last`: the model is
+/// the loop's answer, and its fit restarts when it leaves more than the noise.
 fn update_case(
     current: &CaseFile,
     mut editor: CaseEditor,
@@ -263,6 +266,7 @@ fn update_case(
     measured: &FrfSet,
     opts: &FixOptions,
     step: usize,
+    last: bool,
 ) -> Result<(CaseEditor, CaseFile, f64, crate::study::UpdateOutcome), UpdateError> {
     let lines = opts.diagnose.lines;
     let added = CaseFile::parse(&current.path, &editor.text_at(&current.path)?)?;
@@ -278,17 +282,12 @@ fn update_case(
     // last step's model is the answer: when its fit leaves more than the
     // noise, restarts tell an optimiser stuck in a local minimum (they find
     // a lower one) from a model that lacks something (they do not).
-    if step < opts.max_steps {
+    if !last {
         oe_opts.restarts = 0;
     }
     let outcome = study.run_output_error(&oe_opts, |_| {})?;
     let misfit_updated = diagnose::log_misfit_with(&outcome.system, measured, lines, d.gains)?;
-    let model = outcome.system.model();
-    let values: Vec<(String, f64)> = study
-        .parameters
-        .iter()
-        .flat_map(|p| p.quantities.iter().map(|&q| (model.quantity_name(q).to_string(), model.get(q))))
-        .collect();
+    let values = crate::params::quantity_values(&study.parameters, outcome.system.model());
     editor.set_values(&values, &format!("updated by rfm fix, step {step}"))?;
     editor.push_history(&HistoryEntry {
         step: format!("updated after step {step}"),
@@ -327,7 +326,8 @@ fn swap(
                 editor = Some((e, j));
             }
             let (e, j) = editor.expect("at least one effect kept");
-            let (_, updated, ..) = update_case(&case, e, &applied[j].0, measured, opts, step)?;
+            // the model without the effect is knowingly incomplete: no restarts
+            let (_, updated, ..) = update_case(&case, e, &applied[j].0, measured, opts, step, false)?;
             let d = diagnose::diagnose(&updated.model, measured, &opts.diagnose)?;
             let rank = d.recommended.ok_or_else(|| UpdateError::Method("nothing to add".into()))?;
             add_and_update(&updated, &d, rank, measured, opts, step)
