@@ -216,14 +216,15 @@ fn raw_blocks(model: &Model) -> Vec<RawBlock> {
     for (i, b) in model.beams.iter().enumerate() {
         let dofs: Vec<DofRef> = node_dofs(b.nodes[0]).chain(node_dofs(b.nodes[1])).collect();
         let g = b.group;
-        // unit stiffness, unit consistent mass, unit added (lumped transverse) mass
-        let [k, m, added] = element::beam_units(model, i).map(|u| LocalMatrix::from_dense(&u));
+        // unit stiffness (axial with torsion, and bending, apart so that the
+        // bending alone can change), unit consistent mass, unit added
+        // (lumped transverse) mass
+        let [_, m, added] = element::beam_units(model, i).map(|u| LocalMatrix::from_dense(&u));
+        let [axial, bending] = element::beam_stiffness_parts(model, i).map(|u| LocalMatrix::from_dense(&u));
+        let stiffness = [Quantity::MaterialE(b.material), Quantity::ElementStiffness(i), Quantity::GroupStiffness(g)];
         let terms = vec![
-            (
-                MatrixKind::Stiffness,
-                vec![Quantity::MaterialE(b.material), Quantity::ElementStiffness(i), Quantity::GroupStiffness(g)],
-                k,
-            ),
+            (MatrixKind::Stiffness, stiffness.to_vec(), axial),
+            (MatrixKind::Stiffness, [stiffness.as_slice(), &[Quantity::ElementBending(i)]].concat(), bending),
             (
                 MatrixKind::Mass,
                 vec![Quantity::MaterialRho(b.material), Quantity::ElementMass(i), Quantity::GroupMass(g)],

@@ -151,6 +151,36 @@ pub fn beam_units(model: &Model, beam: usize) -> [DMatrix<f64>; 3] {
     }
 }
 
+/// The unit stiffness of beam `beam` of `model` (as in [`beam_units`])
+/// split into its axial part (in 3D with the torsion) and its bending part;
+/// their sum is the unit stiffness. The element matrices are linear in the
+/// area, the second moments and the torsion constant, so each part is the
+/// element's matrix with the other's section properties set to zero.
+pub fn beam_stiffness_parts(model: &Model, beam: usize) -> [DMatrix<f64>; 2] {
+    let b = &model.beams()[beam];
+    let sec = &model.sections()[b.section];
+    match model.dimension() {
+        Dimension::Planar => {
+            let (l, c, s) = model.beam_geometry(beam);
+            [frame_stiffness(sec.area, 0.0, l, c, s), frame_stiffness(0.0, sec.inertia, l, c, s)]
+                .map(|m| DMatrix::from_iterator(6, 6, m.iter().copied()))
+        }
+        Dimension::Spatial => {
+            let (l, _) = model.beam_axis(beam);
+            let axes = model.beam_axes(beam);
+            let g = model.materials()[b.material].shear_ratio();
+            [
+                frame3d::stiffness_local(sec.area, 0.0, 0.0, sec.torsion, g, l),
+                frame3d::stiffness_local(0.0, sec.iy, sec.inertia, 0.0, g, l),
+            ]
+            .map(|local| {
+                let m = frame3d::to_global(&local, &axes);
+                DMatrix::from_iterator(12, 12, m.iter().copied())
+            })
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

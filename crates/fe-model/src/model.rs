@@ -348,6 +348,7 @@ impl Model {
             group,
             added_mass: 0.0,
             stiffness_factor: 1.0,
+            bending_factor: 1.0,
             mass_factor: 1.0,
             reference: None,
             angle: 0.0,

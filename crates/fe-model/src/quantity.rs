@@ -8,6 +8,7 @@
 //! | `group.<g>.stiffness` / `.mass` | factors on `K_g` and `M_g` (nominal 1) |
 //! | `material.<m>.E` / `.rho` | Young's modulus, density |
 //! | `element.<id>.stiffness` / `.mass` | factors on one element (nominal 1) |
+//! | `element.<id>.bending` | factor on one element's bending stiffness alone (nominal 1) |
 //! | `element.<id>.added_mass` | non-structural transverse mass per length (kg/m) |
 //! | `spring.<name>.kx` / `.ky` / `.kr` | spring stiffnesses (planar) |
 //! | `spring.<name>.kx` / `.ky` / `.kz` / `.krx` / `.kry` / `.krz` | spring stiffnesses (3D) |
@@ -45,6 +46,9 @@ pub enum Quantity {
     MaterialRho(usize),
     /// Stiffness factor of one beam.
     ElementStiffness(usize),
+    /// Factor on the bending stiffness of one beam (its axial and
+    /// torsional stiffness unchanged).
+    ElementBending(usize),
     /// Mass factor of one beam.
     ElementMass(usize),
     /// Added transverse mass per length of one beam.
@@ -94,6 +98,7 @@ impl fmt::Display for QuantityName<'_> {
             Quantity::MaterialE(i) => write!(f, "material.{}.E", m.materials[i].name),
             Quantity::MaterialRho(i) => write!(f, "material.{}.rho", m.materials[i].name),
             Quantity::ElementStiffness(i) => write!(f, "element.{}.stiffness", m.beams[i].id),
+            Quantity::ElementBending(i) => write!(f, "element.{}.bending", m.beams[i].id),
             Quantity::ElementMass(i) => write!(f, "element.{}.mass", m.beams[i].id),
             Quantity::ElementAddedMass(i) => write!(f, "element.{}.added_mass", m.beams[i].id),
             Quantity::SpringK(i, d) => write!(f, "spring.{}.{}", m.springs[i].name, m.dimension.spring_key(d)),
@@ -123,10 +128,10 @@ impl Parameter {
 }
 
 const FORMS: &str = "group.<name>.{alpha,beta,mu,stiffness,mass}, material.<name>.{E,rho}, \
-                     element.<id>.{stiffness,mass,added_mass}, spring.<name>.{kx,ky,kr}, mass.<name>.{m,j}";
+                     element.<id>.{stiffness,bending,mass,added_mass}, spring.<name>.{kx,ky,kr}, mass.<name>.{m,j}";
 
 const FORMS_3D: &str = "group.<name>.{alpha,beta,mu,stiffness,mass}, material.<name>.{E,rho}, \
-                        element.<id>.{stiffness,mass,added_mass}, spring.<name>.{kx,ky,kz,krx,kry,krz}, \
+                        element.<id>.{stiffness,bending,mass,added_mass}, spring.<name>.{kx,ky,kz,krx,kry,krz}, \
                         mass.<name>.{m,jx,jy,jz}";
 
 impl Model {
@@ -167,9 +172,10 @@ impl Model {
                 let i = self.beam_index(ElementId(id)).ok_or_else(|| err(format!("no element {id}")))?;
                 Ok(match field {
                     "stiffness" => Quantity::ElementStiffness(i),
+                    "bending" => Quantity::ElementBending(i),
                     "mass" => Quantity::ElementMass(i),
                     "added_mass" => Quantity::ElementAddedMass(i),
-                    _ => return Err(bad_field("stiffness, mass, added_mass")),
+                    _ => return Err(bad_field("stiffness, bending, mass, added_mass")),
                 })
             }
             "spring" => {
@@ -244,6 +250,7 @@ impl Model {
             Quantity::MaterialE(i) => self.materials[i].e,
             Quantity::MaterialRho(i) => self.materials[i].rho,
             Quantity::ElementStiffness(i) => self.beams[i].stiffness_factor,
+            Quantity::ElementBending(i) => self.beams[i].bending_factor,
             Quantity::ElementMass(i) => self.beams[i].mass_factor,
             Quantity::ElementAddedMass(i) => self.beams[i].added_mass,
             Quantity::SpringK(i, d) => self.springs[i].k[d],
@@ -285,6 +292,7 @@ impl Model {
             Quantity::MaterialE(i) => self.materials[i].e = value,
             Quantity::MaterialRho(i) => self.materials[i].rho = value,
             Quantity::ElementStiffness(i) => self.beams[i].stiffness_factor = value,
+            Quantity::ElementBending(i) => self.beams[i].bending_factor = value,
             Quantity::ElementMass(i) => self.beams[i].mass_factor = value,
             Quantity::ElementAddedMass(i) => self.beams[i].added_mass = value,
             Quantity::SpringK(i, d) => self.springs[i].k[d] = value,

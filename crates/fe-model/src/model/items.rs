@@ -164,6 +164,10 @@ pub struct Beam {
     pub added_mass: f64,
     /// Stiffness factor of this element (1 = nominal).
     pub stiffness_factor: f64,
+    /// Factor on this element's bending stiffness alone (1 = nominal): a
+    /// smaller second moment of area (a notch, a crack, a thinner wall),
+    /// where the axial and torsional stiffness keep their values.
+    pub bending_factor: f64,
     /// Mass factor of this element (1 = nominal).
     pub mass_factor: f64,
     /// 3D models: the approximate direction of the section's local z axis

@@ -1,5 +1,6 @@
 //! Integration tests of fe-model.
 
+mod bending;
 mod elements;
 mod frame3d;
 mod properties;

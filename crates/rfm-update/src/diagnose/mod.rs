@@ -39,7 +39,10 @@
 //! with the fuller variants of the leaders (a joint's translational
 //! springs, a mass's rotary inertia); the best are screened and fitted
 //! fully, so that one weakened element is named as such and not as its
-//! region or a mass at its node.
+//! region or a mass at its node. The leading stiffness changes then get
+//! their twins, fitted from where they ended: the same change of the
+//! bending stiffness alone (a smaller second moment of area); the better of
+//! each pair ranks first.
 //!
 //! A fitted parameter whose relative standard deviation exceeds one (its
 //! value could as well be e times larger), or a spring that ran to its

@@ -1,6 +1,7 @@
 //! The stages of the diagnosis over a pool of candidates: pre-screening,
-//! screening, full fits, refinement around the leaders, and holding what the
-//! data cannot determine. [`super::diagnose`] runs them in that order.
+//! screening, full fits, refinement around the leaders, the twins of the
+//! leading stiffness changes, and holding what the data cannot
+//! determine. [`super::diagnose`] runs them in that order.
 
 use std::collections::HashSet;
 
@@ -377,6 +378,28 @@ impl<'a> Pool<'a> {
         self.add(new)
     }
 
+    /// The twins ([`candidates::twins`]) of the best `leaders` stiffness
+    /// changes by full fit, added to the pool, with their starting values:
+    /// where their originals ended.
+    pub(crate) fn twins(&mut self, opts: &CandidateOptions, leaders: usize) -> (Vec<usize>, Vec<Option<Vec<f64>>>) {
+        let tried = self.descriptions();
+        let order = self.by_full_fit();
+        let (mut twins, mut starts) = (Vec::new(), Vec::new());
+        for kind in [EffectKind::StiffnessChange] {
+            for &i in order.iter().filter(|&&i| self.candidates[i].kind == kind).take(leaders) {
+                for t in candidates::twins(self.model, opts, &self.candidates[i]) {
+                    if !tried.contains(&t.description)
+                        && !twins.iter().any(|o: &Candidate| o.description == t.description)
+                    {
+                        starts.push(self.full[i].as_ref().map(|f| f.values.clone()));
+                        twins.push(t);
+                    }
+                }
+            }
+        }
+        (self.add(twins), starts)
+    }
+
     /// For every full fit with parameters the data do not determine, the
     /// variant that holds them (see [`Candidate::holding`]) is fitted fully
     /// from the determined values and supersedes the fuller one.
@@ -460,11 +483,19 @@ pub(crate) fn search(
         pool.full_fit(full, &coarse, (opts.iterations, opts.screen_iterations), &best, None)?;
         trace(&format!("refined around the leaders: {} candidates, {} fitted", refined.len(), best.len()));
     }
+    // the twins of the leading stiffness changes, started where those ended
+    let (twins, starts) = pool.twins(copts, TWINNED_LEADERS);
+    if !twins.is_empty() {
+        pool.full_fit(full, &coarse, (opts.iterations, opts.screen_iterations), &twins, Some(starts))?;
+        trace(&format!("fitted {} twins of the leaders", twins.len()));
+    }
     pool.hold_undetermined(full, &coarse, (opts.iterations, opts.screen_iterations))?;
     trace("held what the data do not determine");
     Ok(())
 }
 
+/// Leading stiffness changes (by full-fit `dBIC`) whose twins are fitted.
+const TWINNED_LEADERS: usize = 3;
 /// Leaders (by full-fit `dBIC`) around which candidates are refined.
 const REFINED_LEADERS: usize = 3;
 /// Refined candidates fitted fully after screening.

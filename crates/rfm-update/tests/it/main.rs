@@ -1,6 +1,7 @@
 //! Integration tests of rfm-update.
 
 mod apply_every;
+mod bending_loss;
 mod calibration;
 mod fast_vs_naive;
 mod held_out;

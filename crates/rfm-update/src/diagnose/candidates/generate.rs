@@ -21,6 +21,8 @@ use std::collections::{HashMap, HashSet};
 use fe_model::{Dimension, Dof, Group, Model, NodeId, PerDof};
 use rayon::prelude::*;
 
+pub(crate) mod twins;
+
 use super::edit::Edit;
 use super::{Candidate, CandidateOptions, EffectKind, Fitted, Head, Role};
 

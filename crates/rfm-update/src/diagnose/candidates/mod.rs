@@ -39,6 +39,7 @@ use serde::Serialize;
 pub(crate) use edit::Edit;
 pub use generate::generate;
 pub(crate) use generate::refine;
+pub(crate) use generate::twins::twins;
 
 /// The kind of a candidate effect.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
