@@ -59,7 +59,7 @@ const CLASSIC: [Bug; 5] = [
     Bug {
         what: "sign of the Woodbury (low-rank) update of a candidate's receptance",
         package: "rfm-update",
-        file: "crates/rfm-update/src/diagnose/local.rs",
+        file: "crates/rfm-update/src/diagnose/local/response.rs",
         from: "h[c] -= (0..d).map(|i| x[i * k + r] * w.col[i]).sum::<C64>();",
         to: "h[c] += (0..d).map(|i| x[i * k + r] * w.col[i]).sum::<C64>();",
     },
@@ -73,7 +73,7 @@ const CLASSIC: [Bug; 5] = [
     Bug {
         what: "covariance doubled",
         package: "rfm-update",
-        file: "crates/rfm-update/src/oe.rs",
+        file: "crates/rfm-update/src/oe/mod.rs",
         from: "sigma2 * sol.scaled_inverse_normal[(i, j)]",
         to: "2.0 * sigma2 * sol.scaled_inverse_normal[(i, j)]",
     },

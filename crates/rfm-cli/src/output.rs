@@ -39,14 +39,24 @@
 //!   folder. The next run into the same target (holding the lock, so no
 //!   other run can own it) removes it and says so on standard error. Ctrl-C,
 //!   SIGTERM and SIGHUP remove it at once ([`abandon_all`]).
+//!
+//! The lock is in `lock.rs`, the swap of a folder in `swap.rs`, the
+//! clean-up after killed runs in `leftovers.rs`.
+
+mod leftovers;
+mod lock;
+mod swap;
 
 use std::ffi::OsString;
 use std::fs::{self, File};
-use std::io::{Read as _, Write as _};
+use std::io::Write as _;
 use std::path::{Component, Path, PathBuf};
 use std::sync::{Mutex, PoisonError};
 
 use frf::io::FileId;
+
+use self::leftovers::clean_leftovers;
+use self::lock::Lock;
 
 /// The file in a folder target that lists the names the last run wrote,
 /// so that the next run can replace them without touching other files.
@@ -125,59 +135,6 @@ pub(crate) fn abandon_all() {
     for (staging, lock) in ACTIVE.lock().unwrap_or_else(PoisonError::into_inner).drain(..) {
         let _ = fs::remove_dir_all(&staging);
         let _ = fs::remove_file(&lock);
-    }
-}
-
-/// An exclusive lock on `.NAME.rfm-lock` beside a target, held while the
-/// value lives; the file is removed when it is dropped.
-struct Lock {
-    path: PathBuf,
-    _file: File,
-}
-
-impl Lock {
-    fn take(path: &Path, target: &Path) -> Result<Lock, OutputError> {
-        // A run that removes the lock file at its end may do so between our
-        // opening and locking it; we would then hold a lock on a file no
-        // one else can find. Locking, then checking that the path still
-        // names the locked file, closes that gap.
-        for _ in 0..100 {
-            let mut file = File::options()
-                .read(true)
-                .write(true)
-                .create(true)
-                .truncate(false)
-                .open(path)
-                .map_err(io(path, "create the lock file"))?;
-            match file.try_lock() {
-                Ok(()) => {}
-                Err(fs::TryLockError::WouldBlock) => {
-                    let mut holder = String::new();
-                    let _ = file.read_to_string(&mut holder);
-                    let holder = match holder.trim() {
-                        "" => "lock file ".to_string() + &path.display().to_string(),
-                        pid => format!("process {pid}"),
-                    };
-                    return Err(OutputError::Busy { target: target.to_path_buf(), holder });
-                }
-                Err(fs::TryLockError::Error(e)) => return Err(io(path, "lock")(e)),
-            }
-            if FileId::of(path) != FileId::of_file(&file, path) {
-                continue;
-            }
-            // who holds it, for the message of a second run
-            file.set_len(0).map_err(io(path, "write the lock file"))?;
-            file.write_all(std::process::id().to_string().as_bytes()).map_err(io(path, "write the lock file"))?;
-            return Ok(Lock { path: path.to_path_buf(), _file: file });
-        }
-        Err(OutputError::Target { target: target.to_path_buf(), message: "its lock file keeps changing".into() })
-    }
-}
-
-impl Drop for Lock {
-    fn drop(&mut self) {
-        // removed while still locked (the file closes after this), see `take`
-        let _ = fs::remove_file(&self.path);
     }
 }
 
@@ -325,73 +282,6 @@ impl Outputs {
         self.committed = true;
         Ok(self.written())
     }
-
-    fn swap_folder(&self) -> Result<(), OutputError> {
-        let top: Vec<OsString> = self
-            .written
-            .iter()
-            .filter_map(|n| Path::new(n).components().next().map(|c| c.as_os_str().to_os_string()))
-            .collect();
-        let exists = self.target.is_dir();
-        if exists {
-            let previous: Vec<OsString> = fs::read_to_string(self.target.join(MANIFEST))
-                .map(|t| t.lines().map(OsString::from).collect())
-                .unwrap_or_default();
-            let entries = fs::read_dir(&self.target).map_err(io(&self.target, "list"))?;
-            for entry in entries {
-                let entry = entry.map_err(io(&self.target, "list"))?;
-                let name = entry.file_name();
-                let path = entry.path();
-                if name == MANIFEST || is_legacy_temporary(&name) {
-                    continue;
-                }
-                let replaced = top.contains(&name);
-                let stale = previous.contains(&name);
-                let input = find_input(&path, &self.inputs);
-                match (replaced, stale, input) {
-                    (true, _, Some(p)) => return Err(OutputError::Input { path: p }),
-                    (true, _, None) | (false, true, None) => {}
-                    (false, _, _) => carry(&path, &self.staging.join(&name))?,
-                }
-            }
-            if let Ok(meta) = fs::metadata(&self.target) {
-                let _ = fs::set_permissions(&self.staging, meta.permissions());
-            }
-        }
-        let mut manifest: Vec<String> = top.iter().map(|n| n.to_string_lossy().into_owned()).collect();
-        manifest.sort();
-        manifest.dedup();
-        let listing = self.staging.join(MANIFEST);
-        fs::write(&listing, manifest.join("\n") + "\n").map_err(io(&self.path(MANIFEST), "write"))?;
-        File::open(&listing).and_then(|f| f.sync_all()).map_err(io(&self.path(MANIFEST), "write"))?;
-        sync_dir(&self.staging);
-        if !exists {
-            return fs::rename(&self.staging, &self.target).map_err(io(&self.target, "move into place"));
-        }
-        match exchange(&self.staging, &self.target) {
-            Ok(()) => {
-                // the staging path now holds the old folder
-                let _ = fs::remove_dir_all(&self.staging);
-                Ok(())
-            }
-            Err(_) => self.swap_by_two_renames(),
-        }
-    }
-
-    /// The swap where the file system cannot exchange two folders: the old
-    /// folder goes aside first, so a crash between the two renames leaves
-    /// it complete under `.NAME.rfm-old-PID`, which the next run restores.
-    fn swap_by_two_renames(&self) -> Result<(), OutputError> {
-        let (parent, name) = split(&self.target)?;
-        let old = parent.join(format!(".{}.rfm-old-{}", name.to_string_lossy(), std::process::id()));
-        fs::rename(&self.target, &old).map_err(io(&self.target, "move the old outputs aside"))?;
-        if let Err(e) = fs::rename(&self.staging, &self.target) {
-            let _ = fs::rename(&old, &self.target);
-            return Err(io(&self.target, "move into place")(e));
-        }
-        let _ = fs::remove_dir_all(&old);
-        Ok(())
-    }
 }
 
 impl Drop for Outputs {
@@ -439,62 +329,6 @@ fn split(path: &Path) -> Result<(PathBuf, OsString), OutputError> {
     }
 }
 
-/// Removes what runs into this target left behind when they were killed:
-/// staging folders and (from older versions of rfm) temporary files; puts
-/// back an old folder that a killed two-rename swap left aside. Called with
-/// the lock held, so none of it belongs to a running process.
-fn clean_leftovers(parent: &Path, name: &OsString, target: &Path, kind: Kind) -> Result<(), OutputError> {
-    let name = name.to_string_lossy();
-    let staging = format!(".{name}.rfm-staging-");
-    let old = format!(".{name}.rfm-old-");
-    let legacy = format!(".{name}.tmp-");
-    let entries = fs::read_dir(parent).map_err(io(parent, "list"))?;
-    for entry in entries.flatten() {
-        let file = entry.file_name().to_string_lossy().into_owned();
-        let path = entry.path();
-        if file.starts_with(&staging) || file.starts_with(&legacy) {
-            remove_all(&path).map_err(io(&path, "remove the unfinished outputs of an earlier run"))?;
-            eprintln!(
-                "note: removed {}, the unfinished outputs of an earlier run that was stopped before it ended",
-                path.display()
-            );
-        } else if file.starts_with(&old) {
-            if fs::symlink_metadata(target).is_err() {
-                fs::rename(&path, target).map_err(io(&path, "restore the earlier outputs"))?;
-                eprintln!(
-                    "note: restored {} from {}, where a run stopped while replacing it had left it",
-                    target.display(),
-                    path.display()
-                );
-            } else {
-                remove_all(&path).map_err(io(&path, "remove the old outputs of an earlier run"))?;
-            }
-        }
-    }
-    if kind == Kind::Folder && target.is_dir() {
-        for entry in fs::read_dir(target).map_err(io(target, "list"))?.flatten() {
-            if is_legacy_temporary(&entry.file_name()) {
-                let path = entry.path();
-                fs::remove_file(&path).map_err(io(&path, "remove a temporary file of an earlier run"))?;
-                eprintln!("note: removed {}, a temporary file of an earlier run that was stopped", path.display());
-            }
-        }
-    }
-    Ok(())
-}
-
-/// `.NAME.tmp-PID`, the temporary file of an atomic write by earlier
-/// versions of rfm.
-fn is_legacy_temporary(name: &std::ffi::OsStr) -> bool {
-    let name = name.to_string_lossy();
-    name.starts_with('.')
-        && name.rsplit_once(".tmp-").is_some_and(|(_, pid)| !pid.is_empty() && pid.bytes().all(|b| b.is_ascii_digit()))
-}
-
-fn remove_all(path: &Path) -> std::io::Result<()> {
-    if fs::symlink_metadata(path)?.is_dir() { fs::remove_dir_all(path) } else { fs::remove_file(path) }
-}
-
 /// The first input at `path` or under it (a folder), if any.
 fn find_input(path: &Path, inputs: &[FileId]) -> Option<PathBuf> {
     let meta = fs::symlink_metadata(path).ok()?;
@@ -505,33 +339,6 @@ fn find_input(path: &Path, inputs: &[FileId]) -> Option<PathBuf> {
     FileId::of(path).filter(|id| inputs.contains(id)).map(|_| path.to_path_buf())
 }
 
-/// Puts `from` (a file, a folder or a symlink of the old folder) at `to` in
-/// the new one without copying data: a hard link shares the file, so an
-/// input stays the same file; a copy where links are not possible.
-fn carry(from: &Path, to: &Path) -> Result<(), OutputError> {
-    let meta = fs::symlink_metadata(from).map_err(io(from, "read"))?;
-    if meta.file_type().is_symlink() {
-        let link = fs::read_link(from).map_err(io(from, "read the symlink"))?;
-        #[cfg(unix)]
-        return std::os::unix::fs::symlink(link, to).map_err(io(to, "carry over the symlink"));
-        #[cfg(not(unix))]
-        return fs::copy(from, to).map(drop).map_err(io(to, format!("carry over (symlink to {})", link.display())));
-    }
-    if meta.is_dir() {
-        fs::create_dir(to).map_err(io(to, "carry over the folder"))?;
-        for entry in fs::read_dir(from).map_err(io(from, "list"))? {
-            let entry = entry.map_err(io(from, "list"))?;
-            carry(&entry.path(), &to.join(entry.file_name()))?;
-        }
-        let _ = fs::set_permissions(to, meta.permissions());
-        return Ok(());
-    }
-    if fs::hard_link(from, to).is_ok() {
-        return Ok(());
-    }
-    fs::copy(from, to).map(drop).map_err(io(from, "carry over into the new outputs"))
-}
-
 /// Makes a folder's entries durable (renames in it survive a power cut).
 fn sync_dir(dir: &Path) {
     // Not every platform can open a folder for syncing; the data files are
@@ -539,20 +346,6 @@ fn sync_dir(dir: &Path) {
     if let Ok(f) = File::open(dir) {
         let _ = f.sync_all();
     }
-}
-
-/// Swaps two folders in one step.
-#[cfg(any(target_os = "linux", target_os = "macos"))]
-fn exchange(a: &Path, b: &Path) -> std::io::Result<()> {
-    use rustix::fs::{CWD, RenameFlags, renameat_with};
-    renameat_with(CWD, a, CWD, b, RenameFlags::EXCHANGE).map_err(std::io::Error::from)
-}
-
-/// Swaps two folders in one step: not available here, see
-/// [`Outputs::swap_by_two_renames`].
-#[cfg(not(any(target_os = "linux", target_os = "macos")))]
-fn exchange(_a: &Path, _b: &Path) -> std::io::Result<()> {
-    Err(std::io::ErrorKind::Unsupported.into())
 }
 
 #[cfg(test)]

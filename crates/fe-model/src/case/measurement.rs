@@ -2,6 +2,15 @@
 //! where the data come from, and how to read them (the map of test points,
 //! masks, the band and excluded lines, gains, calibrations, pairing by
 //! coordinates). See `docs/case-files.md` and `docs/measured-data.md`.
+//!
+//! The value types with their syntaxes have a file each: `gains.rs`,
+//! `calibration.rs` (with the units of a sensitivity), `mask.rs` and
+//! `channel_map.rs`.
+
+mod calibration;
+mod channel_map;
+mod gains;
+mod mask;
 
 use std::collections::BTreeMap;
 use std::ops::Range;
@@ -14,6 +23,13 @@ use super::{Ctx, hint, parse_dof_refs, parse_frequencies};
 use crate::dof::DofRef;
 use crate::error::CaseError;
 use crate::model::Model;
+
+pub use calibration::{Calibration, CalibrationTarget};
+pub use channel_map::ChannelMap;
+pub use gains::{FittedGain, GainKey, Gains};
+pub use mask::MaskRule;
+
+use calibration::{calibration_target, sensitivity};
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -100,81 +116,6 @@ pub struct MeasurementSpec {
 /// Coherence below which a line counts as poor, unless the case says.
 pub const DEFAULT_COHERENCE_THRESHOLD: f64 = 0.8;
 
-/// Which unknown complex gains the model's FRFs are multiplied by before
-/// they are compared with the data (`[measurement] gains`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Gains {
-    /// `none`: the data are per newton, compared as they are.
-    None,
-    /// `per-reference`: one gain per reference (an amplifier's or a force
-    /// gauge's unknown sensitivity).
-    PerReference,
-    /// `per-channel`: one gain per channel (each accelerometer's too).
-    PerChannel,
-}
-
-impl Gains {
-    /// Every setting, in the order of the documentation.
-    pub const ALL: [Gains; 3] = [Gains::None, Gains::PerReference, Gains::PerChannel];
-
-    /// The name used in case files.
-    pub fn name(self) -> &'static str {
-        match self {
-            Gains::None => "none",
-            Gains::PerReference => "per-reference",
-            Gains::PerChannel => "per-channel",
-        }
-    }
-
-    /// The setting of a case-file name.
-    pub fn parse(name: &str) -> Option<Gains> {
-        Gains::ALL.into_iter().find(|g| g.name() == name.trim())
-    }
-}
-
-impl std::fmt::Display for Gains {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-/// The reference a calibration applies to.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum CalibrationTarget {
-    /// A model DOF (`"1:uy"`): the reference of channels after mapping.
-    Model(DofRef),
-    /// A test point as a universal file names it (`"1:+Z"`): node and axis
-    /// code (1 to 6, without sign).
-    Test(i64, i8),
-}
-
-impl std::fmt::Display for CalibrationTarget {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            CalibrationTarget::Model(d) => write!(f, "{d}"),
-            CalibrationTarget::Test(n, c) => {
-                let axis = ["S", "X", "Y", "Z", "RX", "RY", "RZ"].get(usize::from(c.unsigned_abs())).unwrap_or(&"?");
-                write!(f, "{n}:{axis}")
-            }
-        }
-    }
-}
-
-/// The sensitivity of the transducer behind a per-volt reference:
-/// `calibration = { "1:+Z" = "10.2 mV/N" }`. Per-volt values are
-/// multiplied by it to become per newton (`H_N = H_V s` with `s` in V/N).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Calibration {
-    /// The reference it applies to.
-    pub target: CalibrationTarget,
-    /// The sensitivity in volts per newton.
-    pub volts_per_newton: f64,
-    /// As written (`10.2 mV/N`), for notes.
-    pub text: String,
-    /// Where it is written, for messages about it ([`CaseError::with_message`]).
-    pub place: CaseError,
-}
-
 /// Pairing of test nodes with model nodes by position (`pair = "coordinates"`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PairingSpec {
@@ -183,157 +124,6 @@ pub struct PairingSpec {
     /// The signed test axes (1 X, 2 Y, 3 Z; negative for -) along the
     /// model's x and y (`axes = ["+X", "+Y"]`, the default).
     pub axes: [i8; 2],
-}
-
-/// What a fitted gain belongs to.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum GainKey {
-    /// A reference (`"1:uy"`).
-    Reference(DofRef),
-    /// A channel (`"H(31:uy,1:uy)"`): response, reference.
-    Channel(DofRef, DofRef),
-}
-
-impl std::fmt::Display for GainKey {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            GainKey::Reference(r) => write!(f, "{r}"),
-            GainKey::Channel(a, b) => write!(f, "H({a},{b})"),
-        }
-    }
-}
-
-impl std::str::FromStr for GainKey {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Self, String> {
-        let s = s.trim();
-        if let Some(inner) = s.strip_prefix("H(").and_then(|r| r.strip_suffix(')')) {
-            let (a, b) = inner.split_once(',').ok_or_else(|| format!("`{s}` is not a channel like H(31:uy,1:uy)"))?;
-            return Ok(GainKey::Channel(a.trim().parse()?, b.trim().parse()?));
-        }
-        Ok(GainKey::Reference(s.parse()?))
-    }
-}
-
-/// A gain fitted by an earlier update, kept in the case it wrote
-/// (`fitted_gains = { "1:uy" = [magnitude, phase_deg] }`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct FittedGain {
-    /// Its reference or channel.
-    pub key: GainKey,
-    /// Magnitude.
-    pub magnitude: f64,
-    /// Phase (degrees).
-    pub phase_deg: f64,
-}
-
-/// A kind of defect in measured data that a case accepts by leaving the
-/// affected values out (`[measurement] mask = [...]`), instead of refusing
-/// the file. What is left out is reported.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum MaskRule {
-    /// `non-finite`: a frequency line where any channel's value is NaN or
-    /// infinite is left out, for every channel.
-    NonFinite,
-    /// `duplicate-lines`: a line that repeats the frequency of the line
-    /// before it is left out (the first is kept). Lines that go backwards
-    /// are still refused.
-    DuplicateLines,
-    /// `unmodelled-channels`: a channel whose response or reference is at a
-    /// node the model lacks, or at a DOF it holds fixed, is left out.
-    UnmodelledChannels,
-    /// `bad-coherence`: a coherence record with a value outside 0..1 (or
-    /// not a number) is left out; its channel is weighted as if its
-    /// coherence were 1.
-    BadCoherence,
-}
-
-impl MaskRule {
-    /// Every rule, in the order of the documentation.
-    pub const ALL: [MaskRule; 4] =
-        [MaskRule::NonFinite, MaskRule::DuplicateLines, MaskRule::UnmodelledChannels, MaskRule::BadCoherence];
-
-    /// The name used in case files.
-    pub fn name(self) -> &'static str {
-        match self {
-            MaskRule::NonFinite => "non-finite",
-            MaskRule::DuplicateLines => "duplicate-lines",
-            MaskRule::UnmodelledChannels => "unmodelled-channels",
-            MaskRule::BadCoherence => "bad-coherence",
-        }
-    }
-
-    /// The rule of a case-file name.
-    pub fn parse(name: &str) -> Option<MaskRule> {
-        MaskRule::ALL.into_iter().find(|r| r.name() == name.trim())
-    }
-}
-
-impl std::fmt::Display for MaskRule {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-/// Mapping of a test point and direction to a model DOF: the unit vector of
-/// the test direction `test` equals `sign` times the model DOF `model`.
-///
-/// A measured FRF whose response or reference is at `test` is multiplied by
-/// the direction's sign (`-Z` counts -1) and by `sign`, once for the response
-/// and once for the reference. Without an entry, measurement readers map
-/// `X`, `Y`, `RZ` to `ux`, `uy`, `rz` of the same node (see
-/// `docs/measured-data.md`).
-#[derive(Clone, Debug, PartialEq)]
-pub struct ChannelMap {
-    /// Test point and direction as written in the measurement file, e.g. `101:+Y`.
-    pub test: String,
-    /// Model DOF.
-    pub model: DofRef,
-    /// +1 or -1.
-    pub sign: f64,
-}
-
-impl ChannelMap {
-    /// Parses a test point `node:direction` into the node and a signed
-    /// direction code: `X`, `Y`, `Z`, `RX`, `RY`, `RZ` are 1 to 6 (the codes
-    /// of UFF dataset 58), negative with a leading `-`; `S` (scalar) is 0.
-    /// Letters are case-insensitive, `+` is optional, and the numeric codes
-    /// themselves (`101:-3`) are accepted.
-    pub fn parse_test_point(s: &str) -> Result<(i64, i8), String> {
-        let bad = || {
-            format!(
-                "`{s}` is not a test point; write node:direction, e.g. `101:+Z` \
-                 (directions X, Y, Z, RX, RY, RZ with an optional sign, or S for scalar)"
-            )
-        };
-        let (node, dir) = s.trim().split_once(':').ok_or_else(bad)?;
-        let node: i64 = node.trim().parse().map_err(|_| bad())?;
-        let dir = dir.trim().to_ascii_uppercase();
-        let (sign, axis) = match dir.strip_prefix('-') {
-            Some(rest) => (-1, rest),
-            None => (1, dir.strip_prefix('+').unwrap_or(&dir)),
-        };
-        let code: i8 = match axis {
-            "X" => 1,
-            "Y" => 2,
-            "Z" => 3,
-            "RX" => 4,
-            "RY" => 5,
-            "RZ" => 6,
-            "S" | "SCALAR" => 0,
-            digits => match digits.parse::<i8>() {
-                Ok(c) if (0..=6).contains(&c) => c,
-                _ => return Err(bad()),
-            },
-        };
-        Ok((node, sign * code))
-    }
-
-    /// The node and signed direction code of `test` (see [`ChannelMap::parse_test_point`]).
-    pub fn test_point(&self) -> Result<(i64, i8), String> {
-        Self::parse_test_point(&self.test)
-    }
 }
 
 pub(super) fn parse_measurement(
@@ -523,56 +313,6 @@ fn parse_band(ctx: &Ctx<'_>, b: &Spanned<Vec<f64>>) -> Result<(f64, f64), CaseEr
         [lo, hi] if lo >= 0.0 && hi > lo && hi.is_finite() => Ok((lo, hi)),
         [lo, hi] => Err(ctx.err(b.span(), format!("a band needs 0 <= from < to (Hz), finite; got [{lo}, {hi}]"))),
         _ => Err(ctx.err(b.span(), format!("a band is [from, to] in Hz, got {} numbers", b.get_ref().len()))),
-    }
-}
-
-/// A calibration key: a model DOF (`1:uy`) or a test point (`1:+Z`, `1:Z`).
-fn calibration_target(key: &str) -> Result<CalibrationTarget, String> {
-    if let Ok(d) = key.parse::<DofRef>() {
-        return Ok(CalibrationTarget::Model(d));
-    }
-    let (node, code) = ChannelMap::parse_test_point(key)
-        .map_err(|_| format!("calibration key `{key}` is neither a model DOF (`1:uy`) nor a test point (`1:+Z`)"))?;
-    if code == 0 {
-        return Err(format!("calibration key `{key}` names a scalar channel, which has no force"));
-    }
-    Ok(CalibrationTarget::Test(node, code.abs()))
-}
-
-/// A force gauge's sensitivity with its units, in V/N: `10.2 mV/N`,
-/// `0.0102 V/N`, `98 N/V`, `45 mV/lbf`. A number without units is refused:
-/// V/N and N/V differ by a factor of ten thousand for a common gauge.
-fn sensitivity(text: &str) -> Result<f64, String> {
-    let bad = |why: &str| {
-        format!(
-            "calibration `{text}`: {why}; write the sensitivity with its units, e.g. \"10.2 mV/N\", \"0.0102 V/N\" or \
-             \"98 N/V\""
-        )
-    };
-    let t = text.trim();
-    let split = t.find(|c: char| c.is_alphabetic() || c == 'µ').ok_or_else(|| bad("no units"))?;
-    let value: f64 = t[..split].trim().parse().map_err(|_| bad("no number before the units"))?;
-    if !(value > 0.0 && value.is_finite()) {
-        return Err(bad("the sensitivity must be positive and finite"));
-    }
-    let units: String = t[split..].chars().filter(|c| !c.is_whitespace()).collect();
-    let (num, den) = units.split_once('/').ok_or_else(|| bad("units must be a quotient such as mV/N"))?;
-    let volts = |u: &str| match u {
-        "V" => Some(1.0),
-        "mV" => Some(1e-3),
-        "uV" | "µV" | "μV" => Some(1e-6),
-        _ => None,
-    };
-    let newtons = |u: &str| match u {
-        "N" => Some(1.0),
-        "kN" => Some(1e3),
-        "lbf" => Some(4.448_221_615_260_5),
-        _ => None,
-    };
-    match (volts(num), newtons(den), newtons(num), volts(den)) {
-        (Some(v), Some(n), _, _) => Ok(value * v / n),
-        (_, _, Some(n), Some(v)) => Ok(v / (value * n)),
-        _ => Err(bad(&format!("`{units}` is not volts per force or force per volt (V, mV, uV; N, kN, lbf)"))),
     }
 }
 

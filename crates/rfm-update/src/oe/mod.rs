@@ -55,6 +55,9 @@
 //! At the solution the covariance of `theta` is `s^2 (J^T J)^+` with `s^2` the
 //! residual variance estimated from the fit; see [`crate::uncertainty`].
 
+mod residual;
+mod response;
+
 use damping::DampedSystem;
 use faer::Mat;
 use fe_model::DofRef;
@@ -62,11 +65,15 @@ use frf::{FrfSet, ZSolver};
 use num_complex::Complex64 as C64;
 use serde::Serialize;
 
+pub(crate) use response::{Evaluated, Response};
+
+use self::residual::{Evaluator, Point, adjacent_correlation};
+use self::response::FullModel;
 use crate::error::UpdateError;
 use crate::lstsq;
 use crate::params::ParameterSet;
 use crate::rfm::{IterationRecord, Status};
-use crate::sensitivity::{self, ChannelPlan, Hybrid};
+use crate::sensitivity::ChannelPlan;
 
 /// Form of the residual; see the module docs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -219,205 +226,6 @@ pub struct OeData<'a> {
     pub measured: &'a FrfSet,
     /// Weights, channel-major like the data (`None`: all 1).
     pub weights: Option<&'a [f64]>,
-}
-
-/// Model receptances at the fitted lines and channels and their
-/// sensitivities, as a function of the parameters: what the iteration fits.
-/// The full model ([`FullModel`]) is the normal source; the diagnosis screens
-/// candidates that change `Z` only locally with an exact low-rank update of
-/// the nominal model instead (`crate::diagnose::local`).
-pub(crate) trait Response {
-    /// Sets the physical parameter values.
-    fn set(&mut self, values: &[f64]) -> Result<(), UpdateError>;
-
-    /// Model receptances `[line][channel]` at the current values and, with
-    /// `jacobian`, per line the channels x parameters block `-(dH/dp) p`;
-    /// `None` when the model cannot be evaluated.
-    fn evaluate(&mut self, lines: &[f64], jacobian: bool) -> Option<Evaluated>;
-
-    /// True when the sensitivities cost little beside the receptances: each
-    /// trial step is then evaluated with them, and an accepted step needs
-    /// no second evaluation.
-    fn cheap_jacobian(&self) -> bool {
-        false
-    }
-}
-
-/// The principal complex logarithm, with `ln |z|` from `|z|^2` where that
-/// neither overflows nor underflows: `Complex::ln` takes `|z|` by `hypot`,
-/// which dominated the misfit of the diagnosis's many small fits.
-#[inline]
-fn ln(z: C64) -> C64 {
-    let r2 = z.norm_sqr();
-    if r2.is_normal() { C64::new(0.5 * r2.ln(), z.im.atan2(z.re)) } else { z.ln() }
-}
-
-/// Model receptances `[line][channel]` and optional sensitivity blocks.
-pub(crate) type Evaluated = (Vec<Vec<C64>>, Option<Vec<Mat<C64>>>);
-
-/// [`Response`] of a whole damped system: one sparse factorisation per line
-/// and the shared sensitivity assembly.
-struct FullModel<'a> {
-    sys: &'a mut DampedSystem,
-    params: &'a ParameterSet,
-    solver: ZSolver,
-    plan: ChannelPlan,
-}
-
-impl Response for FullModel<'_> {
-    fn set(&mut self, values: &[f64]) -> Result<(), UpdateError> {
-        self.params.set_values(self.sys, values)
-    }
-
-    fn evaluate(&mut self, lines: &[f64], jacobian: bool) -> Option<Evaluated> {
-        if jacobian {
-            let blocks = sensitivity::assemble(
-                self.sys,
-                &self.solver,
-                &self.plan,
-                self.params.quantities(),
-                lines,
-                Hybrid::Model,
-            )
-            .ok()?;
-            let sens = blocks.iter().map(|b| self.params.combine(b)).collect();
-            Some((blocks.into_iter().map(|b| b.model).collect(), Some(sens)))
-        } else {
-            let set = frf::synthesize_with(self.sys, &self.solver, &self.plan.channels, lines).ok()?;
-            let nc = self.plan.channels.len();
-            Some(((0..lines.len()).map(|k| (0..nc).map(|c| set.get(c, k)).collect()).collect(), None))
-        }
-    }
-}
-
-struct Evaluator<'a> {
-    data: &'a OeData<'a>,
-    opts: &'a OeOptions,
-    /// Reference index of each channel.
-    ref_of: Vec<usize>,
-    refs: Vec<DofRef>,
-    p0: Vec<f64>,
-}
-
-struct Point {
-    residual: Vec<f64>,
-    cost_data: f64,
-    cost: f64,
-    jacobian: Option<Mat<f64>>,
-}
-
-impl Evaluator<'_> {
-    fn n_params(&self) -> usize {
-        self.p0.len()
-    }
-
-    fn n_gain(&self) -> usize {
-        if self.opts.gains { 2 * self.refs.len() } else { 0 }
-    }
-
-    fn weight(&self, c: usize, k: usize) -> f64 {
-        let nf = self.data.measured.n_freq();
-        let w = self.data.weights.map_or(1.0, |w| w[c * nf + k]);
-        let m = self.data.measured.get(c, k);
-        if m.norm() > 0.0 && m.norm().is_finite() { w } else { 0.0 }
-    }
-
-    fn n_data(&self) -> usize {
-        let nf = self.data.measured.n_freq();
-        let nc = self.data.measured.channels().len();
-        2 * (0..nc).flat_map(|c| (0..nf).map(move |k| (c, k))).filter(|&(c, k)| self.weight(c, k) > 0.0).count()
-    }
-
-    /// Sets the model to `theta` (structural part of `x`).
-    fn apply(&self, src: &mut impl Response, x: &[f64]) -> Result<(), UpdateError> {
-        let values: Vec<f64> = self.p0.iter().zip(x).map(|(p, t)| p * t.exp()).collect();
-        src.set(&values)
-    }
-
-    fn gain(&self, x: &[f64], v: usize) -> C64 {
-        if self.opts.gains {
-            let n = self.n_params();
-            C64::new(x[n + 2 * v], x[n + 2 * v + 1]).exp()
-        } else {
-            C64::new(1.0, 0.0)
-        }
-    }
-
-    /// Residuals (and optionally the Jacobian) at `x`; `None` when the model
-    /// cannot be evaluated there.
-    fn eval(&self, src: &mut impl Response, x: &[f64], jacobian: bool) -> Option<Point> {
-        self.apply(src, x).ok()?;
-        let m = self.data.measured;
-        let lines = m.frequencies_hz();
-        let (nf, nc, n) = (lines.len(), m.channels().len(), self.n_params());
-        let ncol = n + self.n_gain();
-        // model FRFs [line][channel] and per-parameter sensitivities
-        let (model, sens) = src.evaluate(lines, jacobian)?;
-        if model.len() != nf || model.iter().any(|h| h.len() != nc) {
-            return None;
-        }
-        let n_reg = if self.opts.regularization > 0.0 { n } else { 0 };
-        let rows = nf * nc;
-        let mut residual = vec![0.0; 2 * rows + n_reg];
-        let mut jac = jacobian.then(|| Mat::<f64>::zeros(2 * rows + n_reg, ncol));
-        let mut cost_data = 0.0;
-        for k in 0..nf {
-            for c in 0..nc {
-                let w = self.weight(c, k);
-                if w == 0.0 {
-                    continue;
-                }
-                let r = k * nc + c;
-                let v = self.ref_of[c];
-                let g = self.gain(x, v);
-                let h = model[k][c];
-                let meas = m.get(c, k);
-                let rho = match self.opts.misfit {
-                    Misfit::Relative => w * (g * h - meas) / meas.norm(),
-                    Misfit::Log => w * ln(g * h / meas),
-                };
-                if !(rho.re.is_finite() && rho.im.is_finite()) {
-                    return None;
-                }
-                residual[r] = rho.re;
-                residual[rows + r] = rho.im;
-                cost_data += rho.norm_sqr();
-                if let (Some(j), Some(s)) = (jac.as_mut(), sens.as_ref()) {
-                    for i in 0..n {
-                        let d = match self.opts.misfit {
-                            Misfit::Relative => -w * g * s[k][(c, i)] / meas.norm(),
-                            Misfit::Log => -w * s[k][(c, i)] / h,
-                        };
-                        j[(r, i)] = d.re;
-                        j[(rows + r, i)] = d.im;
-                    }
-                    if self.opts.gains {
-                        let da = match self.opts.misfit {
-                            Misfit::Relative => w * g * h / meas.norm(),
-                            Misfit::Log => C64::new(w, 0.0),
-                        };
-                        let db = da * C64::new(0.0, 1.0);
-                        j[(r, n + 2 * v)] = da.re;
-                        j[(rows + r, n + 2 * v)] = da.im;
-                        j[(r, n + 2 * v + 1)] = db.re;
-                        j[(rows + r, n + 2 * v + 1)] = db.im;
-                    }
-                }
-            }
-        }
-        let mut cost = cost_data;
-        if n_reg > 0 {
-            let s = self.opts.regularization.sqrt();
-            for i in 0..n {
-                residual[2 * rows + i] = s * x[i];
-                cost += (s * x[i]).powi(2);
-                if let Some(j) = jac.as_mut() {
-                    j[(2 * rows + i, i)] = s;
-                }
-            }
-        }
-        Some(Point { residual, cost_data, cost, jacobian: jac })
-    }
 }
 
 fn project(x: &mut [f64], lo: &[f64], hi: &[f64]) {
@@ -664,26 +472,6 @@ pub(crate) fn run_with(
     })
 }
 
-/// Lag-one correlation along the lines of residuals laid out as the
-/// evaluator writes them (real parts `[line * nc + channel]`, then the
-/// imaginary parts); see [`OeResult::residual_correlation`].
-fn adjacent_correlation(residual: &[f64], nf: usize, nc: usize) -> f64 {
-    let rows = nf * nc;
-    let (mut num, mut den) = (0.0, 0.0);
-    for part in [0, rows] {
-        for c in 0..nc {
-            for k in 0..nf {
-                let r = residual[part + k * nc + c];
-                den += r * r;
-                if k + 1 < nf {
-                    num += r * residual[part + (k + 1) * nc + c];
-                }
-            }
-        }
-    }
-    if den > 0.0 { num / den } else { 0.0 }
-}
-
 /// `sigma2 (J^T J)^+` from the column-scaled SVD of the Jacobian `J`, with
 /// unbounded variance in the directions the data cannot resolve (the
 /// pseudo-inverse would report zero there).
@@ -723,39 +511,5 @@ mod tests {
             }
         }
         assert!(set.channel(2).iter().all(|v| *v == C64::new(1.0, 0.0)));
-    }
-
-    /// The fast logarithm agrees with `Complex::ln` over every magnitude a
-    /// ratio of receptances can take, including where `|z|^2` would
-    /// overflow or underflow, and on both sides of the branch cut.
-    #[test]
-    fn adjacent_correlation_is_one_for_a_smooth_misfit_and_small_for_noise() {
-        let (nf, nc) = (200, 2);
-        let smooth: Vec<f64> = (0..2 * nf * nc).map(|i| 1.0 + 1e-3 * (i / nc) as f64).collect();
-        assert!(adjacent_correlation(&smooth, nf, nc) > 0.99);
-        // alternating signs along the lines: anti-correlated
-        let alternating: Vec<f64> = (0..2 * nf * nc).map(|i| if (i / nc) % 2 == 0 { 1.0 } else { -1.0 }).collect();
-        assert!(adjacent_correlation(&alternating, nf, nc) < -0.99);
-        let mut state = 12345u64;
-        let noise: Vec<f64> = (0..2 * nf * nc)
-            .map(|_| {
-                state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-                (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-            })
-            .collect();
-        assert!(adjacent_correlation(&noise, nf, nc).abs() < 0.1);
-    }
-
-    #[test]
-    fn fast_log_equals_the_complex_log() {
-        for mag in [1e-300, 1e-160, 1e-20, 1e-3, 0.5, 1.0, 3.0, 1e40, 1e160, 1e300] {
-            for angle in [-3.1, -2.0, -0.3, 0.0, 0.7, 1.6, 3.0, std::f64::consts::PI] {
-                let z = C64::from_polar(mag, angle);
-                let (got, want) = (ln(z), z.ln());
-                assert!((got - want).norm() <= 1e-14 * want.norm().max(1.0), "ln({z}) = {got}, want {want}");
-            }
-        }
-        let below_cut = C64::new(-2.0, -0.0);
-        assert_eq!(ln(below_cut).im, below_cut.ln().im);
     }
 }

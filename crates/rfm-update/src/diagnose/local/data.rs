@@ -1,0 +1,155 @@
+//! What every local candidate needs from the nominal model: per line, from
+//! one factorisation of the nominal `Z`, `H_0` at the channels and at the
+//! measured equations `W`, and `S = H_0[D, D]` on every distinct `D`.
+
+use std::collections::HashMap;
+
+use damping::DampedSystem;
+use frf::{Channel, SelectedInverse, ZSolver};
+use num_complex::Complex64 as C64;
+use rayon::prelude::*;
+
+use super::{LocalForm, ZERO};
+use crate::error::UpdateError;
+
+/// Unit right-hand sides solved together when gathering `H_0[D, D]`.
+const CHUNK: usize = 32;
+
+/// What every local candidate needs from the nominal model at a set of
+/// lines: `H_0` at the channels, at `W` and on each distinct `D`.
+pub(crate) struct LocalData {
+    pub(super) lines: Vec<f64>,
+    /// Distinct response and reference equations.
+    pub(super) w_eqs: Vec<usize>,
+    /// Per channel: (index of its response, index of its reference) in `w_eqs`.
+    pub(super) picks: Vec<(usize, usize)>,
+    /// The distinct `D`s.
+    pub(super) slots: Vec<Vec<usize>>,
+    /// Row of each equation in [`Line::w_rows`] (`usize::MAX`: none).
+    pub(super) row_of: Vec<usize>,
+    /// Per line: the nominal receptances needed.
+    pub(super) per_line: Vec<Line>,
+}
+
+/// The nominal receptances at one line.
+pub(super) struct Line {
+    /// `H_0` at the channels.
+    pub(super) h0: Vec<C64>,
+    /// `H_0[:, W]` on the rows that some `D` needs (see
+    /// [`LocalData::row_of`]), `rows x |W|` row-interleaved.
+    pub(super) w_rows: Vec<C64>,
+    /// Per slot: `S = H_0[D, D]`, row-major.
+    pub(super) s: Vec<Vec<C64>>,
+}
+
+/// Every `S = H_0[D, D]` by unit solves, `CHUNK` equations at a time: the
+/// fallback when the factorisation has no selected inverse (the LU fallback).
+pub(super) fn unit_solves(
+    solver: &ZSolver,
+    ws: &mut frf::Workspace,
+    slots: &[Vec<usize>],
+    x: &mut Vec<C64>,
+    f: f64,
+    s: &mut [Vec<C64>],
+) -> Result<(), frf::FrfError> {
+    // for each equation of some D: the (slot, local column) it fills
+    let mut users: HashMap<usize, Vec<(usize, usize)>> = HashMap::new();
+    for (slot, eqs) in slots.iter().enumerate() {
+        for (j, &e) in eqs.iter().enumerate() {
+            users.entry(e).or_default().push((slot, j));
+        }
+    }
+    let mut columns: Vec<usize> = users.keys().copied().collect();
+    columns.sort_unstable();
+    for chunk in columns.chunks(CHUNK) {
+        let k = chunk.len();
+        solver.solve_units_ordered(ws, chunk, x, f)?;
+        for (j, eq) in chunk.iter().enumerate() {
+            for &(slot, col) in &users[eq] {
+                let d = slots[slot].len();
+                for (row, &e) in slots[slot].iter().enumerate() {
+                    s[slot][row * d + col] = x[solver.position(e) * k + j];
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+impl LocalData {
+    /// Gathers the data for the given forms (deduplicated by `D`) at `lines`
+    /// (Hz): per line, in parallel, one factorisation of the nominal `Z`.
+    pub(crate) fn new(
+        nominal: &DampedSystem,
+        channels: &[Channel],
+        lines: &[f64],
+        forms: &[&LocalForm],
+    ) -> Result<Self, UpdateError> {
+        let mut w_eqs: Vec<usize> = Vec::new();
+        let mut index = |eq: usize| match w_eqs.iter().position(|&e| e == eq) {
+            Some(i) => i,
+            None => {
+                w_eqs.push(eq);
+                w_eqs.len() - 1
+            }
+        };
+        let mut picks = Vec::new();
+        for c in channels {
+            let r = frf::equation_of(nominal, c.response)?;
+            let f = frf::equation_of(nominal, c.reference)?;
+            picks.push((index(r), index(f)));
+        }
+        let mut slots: Vec<Vec<usize>> = Vec::new();
+        for f in forms {
+            if !slots.contains(&f.eqs) {
+                slots.push(f.eqs.clone());
+            }
+        }
+        // the rows of H_0[:, W] that some D needs, compactly
+        let n = nominal.n();
+        let mut row_of = vec![usize::MAX; n];
+        let mut rows = 0;
+        for &e in slots.iter().flatten() {
+            if row_of[e] == usize::MAX {
+                row_of[e] = rows;
+                rows += 1;
+            }
+        }
+        // The symbolic analysis makes each D a clique of the factor, so that
+        // the selected inverse holds every S = H_0[D, D] (about the cost of
+        // the factorisation, where a solve per equation would cost N solves).
+        let solver = ZSolver::with_cliques(&nominal.assembly().pattern, &slots)?;
+        let per_line: Vec<Line> = lines
+            .par_iter()
+            .map_init(
+                || (solver.workspace(), Vec::new(), Vec::new(), SelectedInverse::new()),
+                |(ws, z, x, inv), &f| {
+                    let omega = 2.0 * std::f64::consts::PI * f;
+                    z.resize(nominal.assembly().pattern.nnz(), ZERO);
+                    nominal.z_values_into(omega, z);
+                    solver.factorize(ws, z, f)?;
+                    let k = w_eqs.len();
+                    solver.solve_units_ordered(ws, &w_eqs, x, f)?;
+                    let h0 = picks.iter().map(|&(r, c)| x[solver.position(w_eqs[r]) * k + c]).collect();
+                    let mut w_rows = vec![ZERO; rows * k];
+                    for (eq, &row) in row_of.iter().enumerate().filter(|(_, r)| **r != usize::MAX) {
+                        let p = solver.position(eq);
+                        w_rows[row * k..row * k + k].copy_from_slice(&x[p * k..p * k + k]);
+                    }
+                    let mut s: Vec<Vec<C64>> = slots.iter().map(|e| vec![ZERO; e.len() * e.len()]).collect();
+                    let selected = match solver.selected_inverse(ws, inv) {
+                        Ok(()) => slots.iter().zip(&mut s).all(|(eqs, s)| solver.inverse_block(inv, eqs, s)),
+                        // the LU fallback has no selected inverse
+                        Err(frf::FrfError::NoLdltFactors { .. }) => false,
+                        Err(e) => return Err(e),
+                    };
+                    if !selected {
+                        unit_solves(&solver, ws, &slots, x, f, &mut s)?;
+                    }
+                    Ok(Line { h0, w_rows, s })
+                },
+            )
+            .collect::<Result<_, frf::FrfError>>()?;
+        Ok(LocalData { lines: lines.to_vec(), w_eqs, picks, slots, row_of, per_line })
+    }
+}

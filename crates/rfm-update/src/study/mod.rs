@@ -1,0 +1,375 @@
+//! A study: a case file turned into a model, measured data and an updating
+//! set-up, ready for a solver.
+//!
+//! This file makes the study (loading, the initial model's check, gains);
+//! beside it, one concern per file: `lines.rs` the updating lines,
+//! `weights.rs` the residual weights, `response_function_method.rs` and
+//! `output_error.rs` the two runs, `outcome.rs` what they return and
+//! `natural_frequencies.rs` the table of natural frequencies in it.
+
+mod lines;
+mod natural_frequencies;
+mod outcome;
+mod output_error;
+mod response_function_method;
+mod weights;
+
+use damping::DampedSystem;
+use fe_model::case::{FrequencyChoice, Gains, MeasurementSpec};
+use fe_model::{CaseFile, DofRef, Parameter};
+use frf::{Channel, FrfKind, FrfSet, NoiseModel};
+use serde::Serialize;
+
+pub use crate::measured::read_measured_for;
+pub use natural_frequencies::{FrequencyTable, MAX_UNDAMPED_DOFS, natural_frequencies};
+pub use outcome::{ParameterReport, Restart, UpdateOutcome, describe_masked};
+pub use weights::line_weights_for;
+
+use crate::error::UpdateError;
+use crate::gain;
+use crate::params::ParameterSet;
+
+/// An updating method.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Method {
+    /// The response function method (the paper's).
+    Rfm,
+    /// Output-error Levenberg-Marquardt with uncertainty.
+    OutputError,
+}
+
+impl Method {
+    /// Parses `rfm` or `output-error`.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "rfm" => Some(Method::Rfm),
+            "output-error" | "oe" => Some(Method::OutputError),
+            _ => None,
+        }
+    }
+
+    /// The name used in case files and outputs.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Rfm => "rfm",
+            Method::OutputError => "output-error",
+        }
+    }
+}
+
+/// A case made ready for updating.
+#[derive(Clone, Debug)]
+pub struct Study {
+    /// The case file.
+    pub case: CaseFile,
+    /// The initial model.
+    pub system: DampedSystem,
+    /// The truth model of a simulated study.
+    pub truth: Option<DampedSystem>,
+    /// Measured receptances on the measurement lines.
+    pub measured: FrfSet,
+    /// Parameters to update (empty when the case has no `[update]`).
+    pub parameters: Vec<Parameter>,
+    /// Lines used for updating (Hz).
+    pub update_frequencies_hz: Vec<f64>,
+    /// What the case's `[measurement] mask` left out of the measured file.
+    pub masked: Vec<frf::io::Masked>,
+    /// What reading the measured file changed or passed over (lines at
+    /// 0 Hz dropped, units scaled, kinds converted, datasets skipped), one
+    /// line each, to be shown and stored with the results.
+    pub notes: Vec<String>,
+    /// The kind of the measured data as read (`measured` itself is
+    /// receptance, for the updating methods); comparisons are made in it,
+    /// whichever way the data arrive.
+    pub measured_kind: FrfKind,
+    /// The unknown gains every comparison and fit of this study applies to
+    /// the model's FRFs ([`crate::gain`]): `Gains::None` for per-newton data
+    /// unless the case asks for gains.
+    pub gains: Gains,
+    /// Why those gains, in words (for the notes and reports).
+    pub gains_reason: String,
+    /// The references whose data are per volt (uncalibrated).
+    pub per_volt: Vec<DofRef>,
+    /// How the test nodes were paired with the model's by coordinates
+    /// (empty unless the case asks for it).
+    pub pairing: Vec<PairingReport>,
+}
+
+/// A test node paired with a model node by coordinates, as stored with the
+/// results (`[measurement] pair = "coordinates"`).
+#[derive(Clone, Debug, Serialize)]
+pub struct PairingReport {
+    /// Test node label.
+    pub test_node: i64,
+    /// Model node.
+    pub model_node: u32,
+    /// Distance in the model's plane (m).
+    pub distance_m: f64,
+    /// Its test directions as model DOFs (`+Z -> uy`).
+    pub directions: Vec<String>,
+}
+
+impl PairingReport {
+    /// The reports of a reader's pairing.
+    pub fn of(paired: &[frf::io::uff::PairedNode]) -> Vec<PairingReport> {
+        paired
+            .iter()
+            .map(|p| PairingReport {
+                test_node: p.test_node,
+                model_node: p.model_node,
+                distance_m: p.distance_m,
+                directions: p.directions.clone(),
+            })
+            .collect()
+    }
+}
+
+fn channels_of(m: &MeasurementSpec) -> Vec<Channel> {
+    m.references.iter().flat_map(|&r| m.responses.iter().map(move |&resp| Channel::new(resp, r))).collect()
+}
+
+impl Study {
+    /// Loads a case file and prepares the study.
+    pub fn load(path: &std::path::Path) -> Result<Self, UpdateError> {
+        Self::from_case(CaseFile::load(path)?)
+    }
+
+    /// Prepares a study from a loaded case: synthesises measured data from the
+    /// truth (with noise) or reads it from the data file, and resolves the
+    /// updating lines.
+    pub fn from_case(case: CaseFile) -> Result<Self, UpdateError> {
+        let system = DampedSystem::new(case.model.clone())?;
+        let spec = case
+            .measurement
+            .as_ref()
+            .ok_or_else(|| UpdateError::Case(case.error(None, "the case has no [measurement] section")))?;
+        let truth = case.truth.as_ref().map(|t| DampedSystem::new(t.model.clone())).transpose()?;
+        let channels = channels_of(spec);
+        let mut grid = spec.frequencies_hz.clone();
+        if let (Some(update), None) = (&case.update, &spec.data) {
+            // synthesised data: make sure the chosen points are lines of it
+            if let Some(FrequencyChoice::List(points)) = &update.frequencies {
+                grid.extend(points.iter().copied());
+                grid.sort_by(f64::total_cmp);
+                grid.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * b.abs());
+            }
+        }
+        let mut masked = Vec::new();
+        let mut notes = Vec::new();
+        let mut measured_kind = FrfKind::Receptance;
+        let mut per_volt = Vec::new();
+        let mut pairing = Vec::new();
+        let measured = match (&spec.data, &case.truth, &truth) {
+            (Some(path), _, _) => {
+                let read = read_measured_for(&system, path, Some(spec))?;
+                masked = read.masked.clone();
+                notes = read.notes.iter().map(|n| format!("{}: {n}", path.display())).collect();
+                measured_kind = read.set.kind();
+                per_volt = read.per_volt_references();
+                pairing = PairingReport::of(&read.pairing);
+                let set = read.set.to_receptance();
+                let index = set.channel_indices();
+                let idx = channels
+                    .iter()
+                    .map(|c| {
+                        index.get(c).copied().ok_or_else(|| {
+                            UpdateError::Data(format!(
+                                "{}: the data has no channel {c} that the case lists",
+                                path.display()
+                            ))
+                        })
+                    })
+                    .collect::<Result<Vec<usize>, _>>()?;
+                set.select_channels(&idx)
+            }
+            (None, Some(spec_t), Some(truth)) => {
+                let mut set = frf::synthesize(truth, &channels, &grid)?;
+                NoiseModel { relative: spec_t.noise, floor: spec_t.floor, seed: spec_t.seed }.apply(&mut set);
+                set
+            }
+            _ => unreachable!("the case loader requires data or a truth"),
+        };
+        let parameters = case.update.as_ref().map(|u| u.parameters.clone()).unwrap_or_default();
+        let (gains, gains_reason) = gain::decide(Some(spec), case.update.as_ref(), &per_volt)?;
+        if gains != Gains::None {
+            notes.push(format!("model FRFs are multiplied by fitted gains ({gains}): {gains_reason}"));
+        }
+        let mut study = Study {
+            case,
+            system,
+            truth,
+            measured,
+            parameters,
+            update_frequencies_hz: Vec::new(),
+            masked,
+            notes,
+            measured_kind,
+            gains,
+            gains_reason,
+            per_volt,
+            pairing,
+        };
+        if study.case.update.is_some() {
+            study.update_frequencies_hz = study.lines_for(study.method())?;
+        }
+        Ok(study)
+    }
+
+    /// Prepares a study from a loaded case and measured receptances that the
+    /// caller holds (the loop of [`crate::fix`] keeps one data set while the
+    /// model grows). The channels must be those of the case's measurement.
+    /// The case's truth, if any, is not built: the data are given.
+    pub fn with_measured(case: CaseFile, measured: FrfSet) -> Result<Self, UpdateError> {
+        let system = DampedSystem::new(case.model.clone())?;
+        let parameters = case.update.as_ref().map(|u| u.parameters.clone()).unwrap_or_default();
+        // the data's per-volt references are not known here: the caller that
+        // read them sets `gains` (see `gain::decide`) when they differ
+        let (gains, gains_reason) = gain::decide(case.measurement.as_ref(), case.update.as_ref(), &[])?;
+        let mut study = Study {
+            case,
+            system,
+            truth: None,
+            measured,
+            parameters,
+            update_frequencies_hz: Vec::new(),
+            masked: Vec::new(),
+            notes: Vec::new(),
+            measured_kind: FrfKind::Receptance,
+            gains,
+            gains_reason,
+            per_volt: Vec::new(),
+            pairing: Vec::new(),
+        };
+        if study.case.update.is_some() {
+            study.update_frequencies_hz = study.lines_for(study.method())?;
+        }
+        Ok(study)
+    }
+
+    /// The updating method the case asks for (`rfm` when it does not say).
+    pub fn method(&self) -> Method {
+        match self.case.update.as_ref().and_then(|u| u.method.as_ref()).map(|m| m.0.as_str()) {
+            Some("output-error") => Method::OutputError,
+            _ => Method::Rfm,
+        }
+    }
+
+    /// Checks the case's method name; returns it parsed.
+    pub fn checked_method(&self) -> Result<Method, UpdateError> {
+        match self.case.update.as_ref().and_then(|u| u.method.as_ref()) {
+            None => Ok(Method::Rfm),
+            Some((m, span)) => Method::parse(m).ok_or_else(|| {
+                UpdateError::Case(
+                    self.case.error(Some(span.clone()), format!("unknown method `{m}` (available: rfm, output-error)")),
+                )
+            }),
+        }
+    }
+
+    /// Parameter names.
+    pub fn parameter_names(&self) -> Vec<String> {
+        self.parameters.iter().map(|p| p.name.clone()).collect()
+    }
+
+    /// The parameters as a set for the solvers.
+    pub fn parameter_set(&self) -> ParameterSet {
+        ParameterSet::new(self.parameters.clone())
+    }
+
+    /// The measured data at the updating lines.
+    pub fn measured_at_update_lines(&self) -> Result<FrfSet, UpdateError> {
+        Ok(self.measured.at_frequencies(&self.update_frequencies_hz)?)
+    }
+
+    /// Evaluates the initial model at the lines of `measured`, so that a
+    /// model that cannot be evaluated is refused with the reason and the
+    /// line before any iteration (the solvers would only see that the
+    /// misfit is not a number).
+    pub fn check_initial(&self, measured: &FrfSet) -> Result<(), UpdateError> {
+        let model = frf::synthesize(&self.system, measured.channels(), measured.frequencies_hz())?;
+        for (c, channel) in model.channels().iter().enumerate() {
+            if let Some(k) = model.channel(c).iter().position(|v| !(v.re.is_finite() && v.im.is_finite())) {
+                return Err(UpdateError::Numerics(format!(
+                    "the initial model's receptance {channel} at {} Hz is {}: a value of the model is out of the \
+                     range double precision holds (a modulus, density, stiffness or damping coefficient many \
+                     orders of magnitude off?)",
+                    model.frequencies_hz()[k],
+                    model.get(c, k)
+                )));
+            }
+        }
+        if model.values().iter().all(|v| v.norm_sqr() == 0.0) {
+            return Err(UpdateError::Numerics(format!(
+                "the initial model's receptances are zero at every updating line ({} to {} Hz): a value of the \
+                 model is out of the range double precision holds (a modulus or stiffness many orders of \
+                 magnitude too large?)",
+                model.frequencies_hz()[0],
+                model.frequencies_hz()[model.n_freq() - 1]
+            )));
+        }
+        let synthesised = self.case.measurement.as_ref().is_some_and(|m| m.data.is_none());
+        for (c, channel) in measured.channels().iter().enumerate() {
+            if synthesised && measured.channel(c).iter().all(|v| v.norm_sqr() == 0.0) {
+                return Err(UpdateError::Numerics(format!(
+                    "the FRF {channel} synthesised from the case's truth model is zero at every updating line: a \
+                     value of the truth model is out of the range double precision holds"
+                )));
+            }
+            if measured.channel(c).iter().all(|v| v.norm_sqr() == 0.0) {
+                return Err(UpdateError::Data(format!(
+                    "the measured FRF {channel} is zero at every updating line: a relative misfit cannot be formed"
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Decides the gains again for measured data read from another file
+    /// (`--measured`): from the case and that file's per-volt references,
+    /// as [`Study::from_case`] does for the case's own data.
+    pub fn set_gains_for(&mut self, read: &frf::io::Measured) -> Result<(), UpdateError> {
+        self.per_volt = read.per_volt_references();
+        (self.gains, self.gains_reason) =
+            gain::decide(self.case.measurement.as_ref(), self.case.update.as_ref(), &self.per_volt)?;
+        Ok(())
+    }
+
+    /// The diagnosis options of this study: the defaults, with a gain per
+    /// reference fitted with every candidate when the study has gains. A
+    /// gain per channel is refused: the diagnosis fits them per reference.
+    pub fn diagnose_options(&self) -> Result<crate::diagnose::DiagnoseOptions, UpdateError> {
+        let gains = match self.gains {
+            Gains::None => false,
+            Gains::PerReference => true,
+            Gains::PerChannel => {
+                return Err(UpdateError::Method(
+                    "`gains = \"per-channel\"`: the diagnosis and the output-error update fit one gain per \
+                     reference (compare fits them per channel); diagnose with `gains = \"per-reference\"`"
+                        .into(),
+                ));
+            }
+        };
+        Ok(crate::diagnose::DiagnoseOptions { gains, ..Default::default() })
+    }
+
+    /// The measured FRFs in the kind they were measured in (`measured` is
+    /// receptance): what comparisons show.
+    pub fn measured_as_read(&self) -> FrfSet {
+        self.measured.converted(self.measured_kind)
+    }
+
+    /// Fits this study's gains ([`Study::gains`]) to `model` (the model's
+    /// FRFs on the channels and lines of `measured`, in any kind) against
+    /// `measured`, weighted by [`Study::line_weights`].
+    pub fn fit_gains(&self, model: &FrfSet, measured: &FrfSet) -> Result<gain::FittedGains, UpdateError> {
+        let model = if model.kind() == measured.kind() { model.clone() } else { model.converted(measured.kind()) };
+        let weights = self.line_weights(measured)?;
+        gain::fit_gains(&model, measured, weights.as_deref(), self.gains)
+    }
+
+    /// The initial values of the updating parameters.
+    pub fn system_values(&self) -> Vec<f64> {
+        self.parameter_set().values(&self.system)
+    }
+}

@@ -1,0 +1,161 @@
+//! The output-error estimator on a study: its options from the case and a
+//! run that restarts from spread starts when the fit ends above the noise.
+
+use fe_model::case::Gains;
+
+use super::{Method, Restart, Study, UpdateOutcome, describe_masked};
+use crate::error::UpdateError;
+use crate::oe::{self, Misfit, OeData, OeOptions};
+use crate::rfm::{IterationRecord, Status};
+use crate::uncertainty;
+use crate::verdict;
+
+/// Restart fits of a few steps each; the best are then run to the end.
+const RESTART_STEPS: usize = 15;
+/// How many of the short restarts are run to the end.
+const RESTARTS_REFINED: usize = 2;
+/// Restart starts spread by up to this factor either way from the initial values.
+const RESTART_SPREAD: f64 = 10.0;
+
+impl Study {
+    /// Output-error options from the case's `[update]` section, with the
+    /// study's gains ([`Study::gains`]; the estimator fits them per reference).
+    pub fn output_error_options(&self) -> Result<OeOptions, UpdateError> {
+        let gains = match self.gains {
+            Gains::None => false,
+            Gains::PerReference => true,
+            Gains::PerChannel => {
+                return Err(UpdateError::Method(
+                    "`gains = \"per-channel\"`: the output-error update fits one gain per reference (compare fits \
+                     them per channel); update with `gains = \"per-reference\"`"
+                        .into(),
+                ));
+            }
+        };
+        let mut opts = OeOptions { gains, ..OeOptions::default() };
+        if let Some(spec) = self.case.update.as_ref() {
+            if let Some(n) = spec.max_iterations {
+                opts.max_iterations = n as usize;
+            }
+            if let Some(t) = spec.tolerance {
+                opts.tolerance = t;
+            }
+            opts.regularization = spec.regularization.unwrap_or(0.0);
+            opts.bounds = spec.bounds.clone();
+            if let Some((m, span)) = &spec.misfit {
+                opts.misfit = Misfit::parse(m).ok_or_else(|| {
+                    UpdateError::Case(
+                        self.case.error(Some(span.clone()), format!("unknown misfit `{m}` (relative or log)")),
+                    )
+                })?;
+            }
+        }
+        Ok(opts)
+    }
+
+    /// Runs the output-error estimator from the initial model, with the
+    /// case's options (bounds, regularisation, gains, weights, misfit form).
+    pub fn run_output_error(
+        &self,
+        opts: &OeOptions,
+        on_iteration: impl FnMut(&IterationRecord),
+    ) -> Result<UpdateOutcome, UpdateError> {
+        if self.parameters.is_empty() {
+            return Err(UpdateError::NoParameters);
+        }
+        let lines = self.lines_for(Method::OutputError)?;
+        let measured = self.measured.at_frequencies(&lines)?;
+        self.check_initial(&measured)?;
+        let weights = self.weights(&measured)?;
+        let params = self.parameter_set();
+        let mut sys = self.system.clone();
+        let data = OeData { measured: &measured, weights: weights.as_deref() };
+        let noise = crate::diagnose::estimate_noise(&self.measured);
+        let ratio = |r: &oe::OeResult| noise.filter(|&s| s > 0.0).map(|s| (2.0 * r.sigma2).sqrt() / s);
+        let first = oe::run(&mut sys, &params, &data, opts, on_iteration)?;
+        let settled =
+            |r: &oe::OeResult| r.status == Status::Converged && ratio(r).is_none_or(|x| x <= verdict::RESTART_ABOVE);
+        let mut restarts = Vec::new();
+        let mut agree = None;
+        let mut history = first.history.clone();
+        let mut result = first;
+        if !settled(&result) && opts.restarts > 0 && !matches!(result.status, Status::Failed(_)) {
+            // restarts spread in log space around the initial values, a few
+            // steps each; the best are run to the end and the lowest kept
+            let p_init = params.values(&self.system);
+            let bounds: Vec<(f64, f64)> = p_init
+                .iter()
+                .enumerate()
+                .map(|(i, &p)| opts.bounds.get(i).copied().flatten().unwrap_or((p / 1e6, p * 1e6)))
+                .collect();
+            let fit = |start: &[f64], o: &OeOptions| -> Option<oe::OeResult> {
+                let mut s = self.system.clone();
+                params.set_values(&mut s, start).ok()?;
+                oe::run(&mut s, &params, &data, o, |_| {}).ok().filter(|r| r.cost.is_finite())
+            };
+            let short = OeOptions { max_iterations: RESTART_STEPS, ..opts.clone() };
+            let mut tried: Vec<oe::OeResult> = (1..=opts.restarts)
+                .filter_map(|i| fit(&verdict::spread_start(&p_init, &bounds, i, RESTART_SPREAD), &short))
+                .collect();
+            tried.sort_by(|a, b| a.cost.total_cmp(&b.cost));
+            for t in &tried[RESTARTS_REFINED.min(tried.len())..] {
+                restarts.push(Restart {
+                    start_residual: t.history[0].residual,
+                    residual: t.history.last().map_or(f64::NAN, |r| r.residual),
+                    refined: false,
+                });
+            }
+            let mut ends = vec![result.cost];
+            for t in tried.into_iter().take(RESTARTS_REFINED) {
+                let Some(r) = fit(&t.values, opts) else { continue };
+                restarts.push(Restart {
+                    start_residual: t.history[0].residual,
+                    residual: r.history.last().map_or(f64::NAN, |x| x.residual),
+                    refined: true,
+                });
+                ends.push(r.cost);
+                if r.cost < result.cost {
+                    let offset = history.len();
+                    history.extend(r.history.iter().cloned().map(|mut rec| {
+                        rec.iteration += offset;
+                        rec
+                    }));
+                    result = r;
+                }
+            }
+            let best = result.cost;
+            let same = ends.iter().filter(|&&c| (c - best) <= verdict::SAME_MINIMUM * best).count();
+            agree = Some(same >= 2);
+            params.set_values(&mut sys, &result.values)?;
+        }
+        let noise_ratio = ratio(&result);
+        let status = verdict::classify(&result.status, noise_ratio, agree);
+        let band = (lines[0], lines[lines.len() - 1]);
+        let report = uncertainty::analyse(&params, &result, band, noise);
+        let natural_frequencies_hz = self.frequency_table(&sys);
+        let first_residual = history.first().map_or(f64::NAN, |r| r.residual);
+        let residual = result.history.last().map_or(f64::NAN, |r| r.residual);
+        Ok(UpdateOutcome {
+            method: "output-error".into(),
+            status,
+            parameters: self.reports(&result.values),
+            residual,
+            history,
+            frequencies_hz: lines,
+            natural_frequencies_hz,
+            uncertainty: Some(report),
+            gains: result.gains,
+            noise_estimate: noise,
+            masked: describe_masked(&self.masked),
+            notes: self.notes.clone(),
+            warnings: Vec::new(),
+            noise_ratio,
+            restarts,
+            worse_than_start: residual > first_residual,
+            gain_setting: format!("{} ({})", self.gains, self.gains_reason),
+            coherence_weighted: weights.is_some() && self.weighs_coherence(),
+            pairing: self.pairing.clone(),
+            system: sys,
+        })
+    }
+}
