@@ -41,8 +41,10 @@
 //! fully, so that one weakened element is named as such and not as its
 //! region or a mass at its node. The leading stiffness changes then get
 //! their twins, fitted from where they ended: the same change of the
-//! bending stiffness alone (a smaller second moment of area); the better of
-//! each pair ranks first.
+//! bending stiffness alone (a smaller second moment of area). A twin stays
+//! in the ranking only when it beats its original by very strong evidence
+//! (`dBIC` lower by 10); where the data cannot tell the two apart the plain
+//! change stands.
 //!
 //! A fitted parameter whose relative standard deviation exceeds one (its
 //! value could as well be e times larger), or a spring that ran to its

@@ -379,12 +379,13 @@ impl<'a> Pool<'a> {
     }
 
     /// The twins ([`candidates::twins`]) of the best `leaders` stiffness
-    /// changes by full fit, added to the pool, with their starting values:
-    /// where their originals ended.
-    pub(crate) fn twins(&mut self, opts: &CandidateOptions, leaders: usize) -> (Vec<usize>, Vec<Option<Vec<f64>>>) {
+    /// changes by full fit, added to the pool: their indices, the indices
+    /// of their originals, and their starting values (where their originals
+    /// ended).
+    pub(crate) fn twins(&mut self, opts: &CandidateOptions, leaders: usize) -> Twins {
         let tried = self.descriptions();
         let order = self.by_full_fit();
-        let (mut twins, mut starts) = (Vec::new(), Vec::new());
+        let (mut twins, mut originals, mut starts) = (Vec::new(), Vec::new(), Vec::new());
         for kind in [EffectKind::StiffnessChange] {
             for &i in order.iter().filter(|&&i| self.candidates[i].kind == kind).take(leaders) {
                 for t in candidates::twins(self.model, opts, &self.candidates[i]) {
@@ -392,12 +393,28 @@ impl<'a> Pool<'a> {
                         && !twins.iter().any(|o: &Candidate| o.description == t.description)
                     {
                         starts.push(self.full[i].as_ref().map(|f| f.values.clone()));
+                        originals.push(i);
                         twins.push(t);
                     }
                 }
             }
         }
-        (self.add(twins), starts)
+        Twins { twins: self.add(twins), originals, starts }
+    }
+
+    /// Drops each fitted twin that does not beat its original by
+    /// [`TWIN_EVIDENCE`]: where the data cannot tell the two apart (a
+    /// cantilever measured across its axis never stretches), the change
+    /// stays the plain one the user would write first.
+    pub(crate) fn keep_better_twins(&mut self, t: &Twins) {
+        for (&twin, &original) in t.twins.iter().zip(&t.originals) {
+            let score = |i: usize| self.full[i].as_ref().map(|f| self.bic(f, self.candidates[i].parameters.len()));
+            if let (Some(a), Some(b)) = (score(twin), score(original))
+                && a > b - TWIN_EVIDENCE
+            {
+                self.superseded[twin] = true;
+            }
+        }
     }
 
     /// For every full fit with parameters the data do not determine, the
@@ -484,15 +501,28 @@ pub(crate) fn search(
         trace(&format!("refined around the leaders: {} candidates, {} fitted", refined.len(), best.len()));
     }
     // the twins of the leading stiffness changes, started where those ended
-    let (twins, starts) = pool.twins(copts, TWINNED_LEADERS);
-    if !twins.is_empty() {
-        pool.full_fit(full, &coarse, (opts.iterations, opts.screen_iterations), &twins, Some(starts))?;
-        trace(&format!("fitted {} twins of the leaders", twins.len()));
+    let twins = pool.twins(copts, TWINNED_LEADERS);
+    if !twins.twins.is_empty() {
+        let starts = Some(twins.starts.clone());
+        pool.full_fit(full, &coarse, (opts.iterations, opts.screen_iterations), &twins.twins, starts)?;
+        pool.keep_better_twins(&twins);
+        trace(&format!("fitted {} twins of the leaders", twins.twins.len()));
     }
     pool.hold_undetermined(full, &coarse, (opts.iterations, opts.screen_iterations))?;
     trace("held what the data do not determine");
     Ok(())
 }
+
+/// Twins of candidates added by [`Pool::twins`].
+pub(crate) struct Twins {
+    twins: Vec<usize>,
+    originals: Vec<usize>,
+    starts: Vec<Option<Vec<f64>>>,
+}
+
+/// How much lower a twin's `dBIC` must be than its original's for the twin
+/// to stay in the ranking: the threshold of very strong evidence.
+const TWIN_EVIDENCE: f64 = 10.0;
 
 /// Leading stiffness changes (by full-fit `dBIC`) whose twins are fitted.
 const TWINNED_LEADERS: usize = 3;

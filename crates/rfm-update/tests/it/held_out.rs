@@ -19,9 +19,11 @@
 //! - in pair trials both effects are found in at least 80 %;
 //! - in null trials (2 % noise) nothing is significant in at least 95 %.
 //!
-//! On CI the test runs 4 trials per family, 6 pairs and 10 null trials (a
-//! few minutes); `cargo xtask heldout` runs the full study (12 per family,
-//! 16 pairs, 20 null trials) with the same criteria. `HELD_OUT_SINGLE` (per
+//! The reduced set is 4 trials per family, 6 pairs and 10 null trials (a
+//! few minutes); CI runs its null trials, while the trials with effects are
+//! ignored on CI until they meet every criterion (the ignore note gives the
+//! counts). `cargo xtask heldout` runs the full study (12 per family, 16
+//! pairs, 20 null trials) with the same criteria. `HELD_OUT_SINGLE` (per
 //! family), `HELD_OUT_PAIRS` and `HELD_OUT_NULL` set the numbers of trials;
 //! `HELD_OUT_ONLY=i,j,...` runs those trials alone and `HELD_OUT_DUMP=DIR` writes
 //! each trial as a case with its data.
@@ -181,7 +183,7 @@ fn kind_name(r: &Option<Ranked>) -> String {
 }
 
 #[test]
-#[ignore = "misses two of its criteria on the reduced CI set (27/30 first, 26/30 fixed, values 19/23 < 85 %, pairs 3/6 < 80 %); run by cargo xtask heldout"]
+#[ignore = "misses one of its criteria on the reduced set (27/30 first, 26/30 fixed, values 20/23, pairs 4/6 < 80 %); run by cargo xtask heldout"]
 fn the_loop_finds_and_fixes_held_out_effects() {
     let singles = count("HELD_OUT_SINGLE", 4);
     let pairs = count("HELD_OUT_PAIRS", 6);

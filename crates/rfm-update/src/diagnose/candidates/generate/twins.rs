@@ -1,7 +1,8 @@
 //! Twins of leading candidates: the same effect at the same place, modelled
 //! the other way a user's model may hold it, fitted from where the original
-//! ended (see `search`). Each twin has as many parameters as its original,
-//! so the better fit ranks first.
+//! ended (see `search`). Each twin has as many parameters as its original;
+//! it stays in the ranking only when it fits better by very strong evidence,
+//! so that where the data cannot tell the two apart the plain change stands.
 //!
 //! - **The bending-only twin of a stiffness change**: a factor on the
 //!   elements' bending stiffness alone (`element.<id>.bending`), their axial
