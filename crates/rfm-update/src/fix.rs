@@ -16,10 +16,12 @@
 //! with the data), when the significant ones are all implausible (the
 //! missing effect is not among the candidates), when an update does not
 //! lower the misfit, or after the given number of steps. When it then
-//! leaves more than 1.5 times the noise, each effect but the last is left
-//! out in turn and the data diagnosed again without it: an effect added
-//! early may only have mimicked the missing one, and the replacement is
-//! kept when it lowers the misfit (a last step that names what it replaced).
+//! leaves more than 1.5 times the noise, each effect but the last, and each
+//! pair of effects, is left out in turn and the data diagnosed again
+//! without them, adding as many effects as were left out: an effect added
+//! early may only have mimicked the missing one, and another added later
+//! may only have made up for it ([`swap`]). The best replacement is kept
+//! when it lowers the misfit (last steps that name what they replaced).
 //! A last diagnosis of the final model says what, if anything, still stands
 //! out.
 
@@ -32,6 +34,8 @@ use crate::error::UpdateError;
 use crate::rfm::Status;
 use crate::study::{ParameterReport, Study};
 use crate::uncertainty::UncertaintyReport;
+
+mod swap;
 
 /// Options of the loop.
 #[derive(Clone, Debug)]
@@ -74,8 +78,9 @@ pub struct FixStep {
     /// single effect left more than three times the noise), with the misfit
     /// each left after its best follower; empty when there was no need.
     pub alternatives: Vec<LookAhead>,
-    /// The effect of an earlier step this one replaced (left out, the others
-    /// kept, and this one added instead; see [`fix`]), when it did.
+    /// The effects of earlier steps this one replaced, with any that follow
+    /// it (left out, the others kept, and these added instead; see [`fix`]),
+    /// when it did: their descriptions joined by " and ".
     pub replaced: Option<String>,
     /// The case after this step (write it with [`CaseEditor::text_at`]).
     #[serde(skip)]
@@ -248,8 +253,21 @@ fn add_and_update(
     opts: &FixOptions,
     step: usize,
 ) -> Result<Added, UpdateError> {
+    add_and_update_as(current, d, rank, measured, opts, step, step >= opts.max_steps)
+}
+
+/// [`add_and_update`] with the model's place in the loop given: `last`, it
+/// is the loop's answer and its update restarts (see [`update_case`]).
+fn add_and_update_as(
+    current: &CaseFile,
+    d: &Diagnosis,
+    rank: usize,
+    measured: &FrfSet,
+    opts: &FixOptions,
+    step: usize,
+    last: bool,
+) -> Result<Added, UpdateError> {
     let editor = d.apply_with_data(current, rank, opts.data.as_deref())?;
-    let last = step >= opts.max_steps;
     let (editor, case, misfit_updated, outcome) = update_case(current, editor, d, measured, opts, step, last)?;
     Ok(Added { effect: d.ranking[rank - 1].clone(), rank, editor, case, misfit_updated, outcome })
 }
@@ -297,58 +315,6 @@ fn update_case(
     let case = CaseFile::parse(&current.path, &editor.text_at(&current.path)?)?;
     Ok((editor, case, misfit_updated, outcome))
 }
-
-/// When the loop leaves more than [`SWAP_ABOVE`] times the noise, an effect
-/// added early may be one that only mimicked the missing one (a stiffness
-/// change beside a loose joint, a mass change for a lumped mass), and the
-/// loop, which only adds, cannot undo it. Each effect but the last is
-/// therefore left out in turn: the others are added to the nominal case as
-/// they were diagnosed, everything is updated, the data are diagnosed again
-/// and the recommended effect added and updated. Returns the effect left
-/// out and the best such replacement, when it lowers the final misfit by
-/// more than [`SWAP_GAIN`].
-fn swap(
-    nominal: &CaseFile,
-    applied: &[(Diagnosis, usize)],
-    measured: &FrfSet,
-    opts: &FixOptions,
-    misfit: f64,
-) -> Option<(usize, Added)> {
-    let step = opts.max_steps.max(applied.len() + 1);
-    let mut best: Option<(usize, Added)> = None;
-    for out in 0..applied.len().saturating_sub(1) {
-        let tried = (|| -> Result<Added, UpdateError> {
-            let mut case = nominal.clone();
-            let mut editor = None;
-            for (j, (d, r)) in applied.iter().enumerate().filter(|(j, _)| *j != out) {
-                let e = d.apply_with_data(&case, *r, opts.data.as_deref())?;
-                case = CaseFile::parse(&nominal.path, &e.text_at(&nominal.path)?)?;
-                editor = Some((e, j));
-            }
-            let (e, j) = editor.expect("at least one effect kept");
-            // the model without the effect is knowingly incomplete: no restarts
-            let (_, updated, ..) = update_case(&case, e, &applied[j].0, measured, opts, step, false)?;
-            let d = diagnose::diagnose(&updated.model, measured, &opts.diagnose)?;
-            let rank = d.recommended.ok_or_else(|| UpdateError::Method("nothing to add".into()))?;
-            add_and_update(&updated, &d, rank, measured, opts, step)
-        })();
-        if let Ok(a) = tried
-            && a.misfit_updated < SWAP_GAIN * misfit
-            && best.as_ref().is_none_or(|(_, b)| a.misfit_updated < b.misfit_updated)
-        {
-            best = Some((out, a));
-        }
-    }
-    best
-}
-
-/// Above this multiple of the noise after the loop, the effects added early
-/// are tried left out and replaced ([`swap`]).
-const SWAP_ABOVE: f64 = 1.5;
-
-/// A replacement is kept when it leaves less than this fraction of the
-/// loop's final misfit.
-const SWAP_GAIN: f64 = 0.9;
 
 /// The ranks of up to `width` recommendable effects (significant and
 /// plausible, fully fitted or screened) that differ from each other in kind
@@ -490,19 +456,30 @@ pub fn fix(
     let mut effects: Vec<Ranked> = steps.iter().map(|s| s.effect.clone()).collect();
     let misfit = steps.last().map_or(nominal_misfit, |s| s.misfit_updated);
     if steps.len() >= 2
-        && misfit > SWAP_ABOVE * noise
-        && let Some((out, a)) = swap(case, &applied, measured, opts, misfit)
+        && misfit > swap::SWAP_ABOVE * noise
+        && let Some((outs, added)) = swap::swap(case, &applied, measured, opts, misfit)
     {
-        let removed = effects.remove(out);
-        effects.push(a.effect.clone());
-        progress(FixProgress::Updated {
-            step: steps.len(),
-            effect: &format!("{} instead of {}", a.effect.description, removed.description),
-            misfit: a.misfit_updated,
-            status: &a.outcome.status,
-        });
-        current = a.case.clone();
-        steps.push(FixStep::of(a, Vec::new(), Some(removed.description)));
+        let removed: Vec<String> = outs.iter().map(|&i| effects[i].description.clone()).collect();
+        for &i in outs.iter().rev() {
+            effects.remove(i);
+        }
+        let replaced = removed.join(" and ");
+        for (k, a) in added.into_iter().enumerate() {
+            let effect = if k == 0 {
+                format!("{} instead of {replaced}", a.effect.description)
+            } else {
+                a.effect.description.clone()
+            };
+            progress(FixProgress::Updated {
+                step: steps.len(),
+                effect: &effect,
+                misfit: a.misfit_updated,
+                status: &a.outcome.status,
+            });
+            effects.push(a.effect.clone());
+            current = a.case.clone();
+            steps.push(FixStep::of(a, Vec::new(), (k == 0).then(|| replaced.clone())));
+        }
         last = None;
     }
     let last = match last {
