@@ -182,14 +182,9 @@ fn kind_name(r: &Option<Ranked>) -> String {
     r.as_ref().map_or("none".into(), |r| format!("{:?}", r.kind))
 }
 
-#[test]
-#[ignore = "misses one of its criteria on the reduced set (27/30 first, 26/30 fixed, values 20/23, pairs 4/6 < 80 %); run by cargo xtask heldout"]
-fn the_loop_finds_and_fixes_held_out_effects() {
-    let singles = count("HELD_OUT_SINGLE", 4);
-    let pairs = count("HELD_OUT_PAIRS", 6);
-    let opts = FixOptions { max_steps: 3, ..FixOptions::default() };
+/// The trials: `singles` per family, then `pairs` with two effects.
+fn draws(singles: usize, pairs: usize) -> Vec<Truth> {
     let mut rng = ChaCha8Rng::seed_from_u64(2611);
-    let mut trials: Vec<Trial> = Vec::new();
     let mut draws: Vec<Truth> = Vec::new();
     for family in Family::ALL {
         for _ in 0..singles {
@@ -199,6 +194,35 @@ fn the_loop_finds_and_fixes_held_out_effects() {
     for _ in 0..pairs {
         draws.push(truths::draw(&mut rng, None, true));
     }
+    draws
+}
+
+/// Trial 25 of the reduced set: a mass with rotary inertia and a lossy
+/// corner joint. The first diagnosis, misled by both at once, adds a
+/// stiffness change beside the joint, and the effects added after it make
+/// up for it: the loop ends 2.7 times the noise. Leaving that stiffness
+/// change out together with the effect that compensated it, and diagnosing
+/// again, brings it to 1.6 times.
+#[test]
+fn the_swap_undoes_an_early_effect_and_what_made_up_for_it() {
+    let truth = &draws(4, 6)[25];
+    let opts = FixOptions { max_steps: 3, ..FixOptions::default() };
+    let trial = run(truth, 7025, &opts);
+    let o = &trial.outcome;
+    let swapped = o.steps.iter().find(|s| s.replaced.is_some()).expect("a step that replaced earlier ones");
+    println!("{}: {} instead of {:?}", trial.label, swapped.effect.description, swapped.replaced);
+    assert!(o.final_misfit() < 2.0 * NOISE, "the loop ends {:.2} times the noise", o.final_misfit() / NOISE);
+    assert!(trial.found.iter().all(|&f| f), "both effects found: {:?}", trial.found);
+}
+
+#[test]
+#[ignore = "misses one of its criteria on the reduced set (27/30 first, 26/30 fixed, values 20/23, pairs 4/6 < 80 %); run by cargo xtask heldout"]
+fn the_loop_finds_and_fixes_held_out_effects() {
+    let singles = count("HELD_OUT_SINGLE", 4);
+    let pairs = count("HELD_OUT_PAIRS", 6);
+    let opts = FixOptions { max_steps: 3, ..FixOptions::default() };
+    let mut trials: Vec<Trial> = Vec::new();
+    let draws = draws(singles, pairs);
     // HELD_OUT_ONLY=i,j,... runs those trials alone (to look into them)
     let only: Option<Vec<usize>> =
         std::env::var("HELD_OUT_ONLY").ok().map(|v| v.split(',').filter_map(|k| k.trim().parse().ok()).collect());
