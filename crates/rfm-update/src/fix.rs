@@ -244,21 +244,9 @@ struct Added {
 /// Adds ranked effect `rank` of `d` to `current` and updates every parameter
 /// of the case's `[update]` by output error on the diagnosis's lines; the
 /// updated values and the misfit go into the case's history as step `step`.
-/// The update restarts only for the loop's last model (see [`update_case`]).
+/// `last`: the model is the loop's answer, and its update restarts (see
+/// [`update_case`]).
 fn add_and_update(
-    current: &CaseFile,
-    d: &Diagnosis,
-    rank: usize,
-    measured: &FrfSet,
-    opts: &FixOptions,
-    step: usize,
-) -> Result<Added, UpdateError> {
-    add_and_update_as(current, d, rank, measured, opts, step, step >= opts.max_steps)
-}
-
-/// [`add_and_update`] with the model's place in the loop given: `last`, it
-/// is the loop's answer and its update restarts (see [`update_case`]).
-fn add_and_update_as(
     current: &CaseFile,
     d: &Diagnosis,
     rank: usize,
@@ -392,10 +380,11 @@ pub fn fix(
             for r in distinct_leaders(&d, &current.model, LOOK_AHEAD_WIDTH) {
                 // one alternative that cannot be added (its update left a
                 // mechanism, say) must not end the loop: the others can
-                let tried = add_and_update(&current, &d, r, measured, opts, step).and_then(|a| {
-                    let ahead = diagnose::diagnose(&a.case.model, measured, &opts.diagnose)?;
-                    Ok((a, ahead))
-                });
+                let tried =
+                    add_and_update(&current, &d, r, measured, opts, step, step >= opts.max_steps).and_then(|a| {
+                        let ahead = diagnose::diagnose(&a.case.model, measured, &opts.diagnose)?;
+                        Ok((a, ahead))
+                    });
                 let (a, ahead) = match tried {
                     Ok(x) => x,
                     Err(e) => {
@@ -429,7 +418,7 @@ pub fn fix(
             // when adding and updating one fails
             let added = std::iter::once(rank)
                 .chain(distinct_leaders(&d, &current.model, LOOK_AHEAD_WIDTH))
-                .find_map(|r| add_and_update(&current, &d, r, measured, opts, step).ok());
+                .find_map(|r| add_and_update(&current, &d, r, measured, opts, step, step >= opts.max_steps).ok());
             let Some(a) = added else {
                 break (FixStop::CannotAdd, Some(d));
             };

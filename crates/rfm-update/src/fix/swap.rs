@@ -12,7 +12,7 @@
 use fe_model::CaseFile;
 use frf::FrfSet;
 
-use super::{Added, FixOptions, add_and_update_as, update_case};
+use super::{Added, FixOptions, add_and_update, update_case};
 use crate::diagnose::{self, Diagnosis};
 use crate::error::UpdateError;
 
@@ -73,7 +73,7 @@ pub(super) fn swap(
                 let Some(rank) = d.recommended else { break };
                 // the last replacement's model is the answer: its fit restarts
                 let last = round + 1 == outs.len();
-                let a = add_and_update_as(&current, &d, rank, measured, opts, step + round, last)?;
+                let a = add_and_update(&current, &d, rank, measured, opts, step + round, last)?;
                 current = a.case.clone();
                 added.push(a);
             }
