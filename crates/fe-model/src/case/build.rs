@@ -189,9 +189,7 @@ pub(super) fn build_model(ctx: &Ctx<'_>, raw: &RawCase, model: &mut Model) -> Re
     // joints before masses, supports and ties: a joint makes a node (its
     // `new_node`, or the next free id) that those may name, as a case
     // written by `rfm diagnose --apply` does for a mass at a joint
-    for j in &raw.joints {
-        add_joint(ctx, model, j)?;
-    }
+    add_joints(ctx, model, &raw.joints)?;
     for m in &raw.masses {
         add_mass(ctx, model, m)?;
     }
@@ -322,24 +320,90 @@ pub(super) fn add_spring(ctx: &Ctx<'_>, model: &mut Model, s: &Spanned<RawSpring
     model.add_spring(&r.name, a, b, k, g).map_err(|e| ctx.model_err(s.span(), e))
 }
 
-/// A joint: the node is split, the listed elements move to a new coincident
-/// node, a spring joins the pair in the DOFs given a stiffness (in a planar
-/// model always kr, and kx, ky when given) and the other DOFs are tied.
-pub(super) fn add_joint(ctx: &Ctx<'_>, model: &mut Model, j: &Spanned<RawJoint>) -> Result<(), CaseError> {
-    let r = j.get_ref();
+/// The joints of a case: each node is split, the listed elements move to a
+/// new coincident node, a spring joins the pair in the DOFs given a
+/// stiffness (in a planar model always kr, and kx, ky when given) and the
+/// other DOFs are tied. Entries with the same `node` and `new_node` are one
+/// joint whose springs are in groups of their own (a joint with a different
+/// loss in each direction): the node is split once, each entry adds its
+/// spring, and the DOFs none of them springs are tied.
+pub(super) fn add_joints(ctx: &Ctx<'_>, model: &mut Model, joints: &[Spanned<RawJoint>]) -> Result<(), CaseError> {
+    let mut done = vec![false; joints.len()];
+    for i in 0..joints.len() {
+        if done[i] {
+            continue;
+        }
+        let r = joints[i].get_ref();
+        let same: Vec<usize> = (i..joints.len())
+            .filter(|&k| {
+                let o = joints[k].get_ref();
+                k == i || (r.new_node.is_some() && o.node == r.node && o.new_node == r.new_node)
+            })
+            .collect();
+        for &k in &same {
+            done[k] = true;
+        }
+        add_joint(ctx, model, &same.iter().map(|&k| &joints[k]).collect::<Vec<_>>())?;
+    }
+    Ok(())
+}
+
+/// One joint, written as one entry or as several on the same node pair
+/// (see [`add_joints`]).
+fn add_joint(ctx: &Ctx<'_>, model: &mut Model, entries: &[&Spanned<RawJoint>]) -> Result<(), CaseError> {
+    let (j, r) = (entries[0], entries[0].get_ref());
     let dim = model.dimension();
-    let what = format!("joint `{}`", r.name);
-    let sprung = stiffnesses(ctx, dim, &what, r.stiffnesses())?;
-    if dim == Dimension::Planar && r.kr.is_none() {
-        return Err(ctx.err(j.span(), format!("{what} needs `kr`, the rotational stiffness of the joint")));
+    let what = |o: &RawJoint| format!("joint `{}`", o.name);
+    let mut given = Vec::new();
+    for &e in entries {
+        given.push(stiffnesses(ctx, dim, &what(e.get_ref()), e.get_ref().stiffnesses())?);
     }
-    if sprung.is_empty() {
-        return Err(ctx.err(
-            j.span(),
-            format!("{what} needs a stiffness in at least one DOF (krx, kry, krz for a rotational joint)"),
-        ));
+    if dim == Dimension::Planar && !given.iter().flatten().any(|&(d, _)| d == Dof::Rz) {
+        let whose = if entries.len() == 1 { what(r) } else { format!("the joint at node {}", r.node) };
+        return Err(ctx.err(j.span(), format!("{whose} needs `kr`, the rotational stiffness of the joint")));
     }
-    let g = group_ref(ctx, model, &r.group)?;
+    let mut springs: Vec<(&Spanned<RawJoint>, PerDof, usize)> = Vec::new();
+    let mut sprung: Vec<Dof> = Vec::new();
+    for (&e, given) in entries.iter().zip(given) {
+        let o = e.get_ref();
+        if given.is_empty() {
+            return Err(ctx.err(
+                e.span(),
+                format!("{} needs a stiffness in at least one DOF (krx, kry, krz for a rotational joint)", what(o)),
+            ));
+        }
+        if o.elements != r.elements {
+            return Err(ctx.err(
+                e.span(),
+                format!(
+                    "{} is on the node pair {} and {} of joint `{}`, which detaches elements {:?}: an entry on the \
+                     same pair lists the same elements",
+                    what(o),
+                    r.node,
+                    r.new_node.unwrap_or_default(),
+                    r.name,
+                    r.elements
+                ),
+            ));
+        }
+        let mut k = PerDof::default();
+        for (d, v) in given {
+            if sprung.contains(&d) {
+                return Err(ctx.err(
+                    e.span(),
+                    format!(
+                        "{}: `{}` of the joint at node {} is given by an earlier entry on the same node pair",
+                        what(o),
+                        dim.spring_key(d),
+                        r.node
+                    ),
+                ));
+            }
+            sprung.push(d);
+            k[d] = v;
+        }
+        springs.push((e, k, group_ref(ctx, model, &o.group)?));
+    }
     let new_id = match r.new_node {
         Some(id) => id,
         None => model
@@ -348,15 +412,13 @@ pub(super) fn add_joint(ctx: &Ctx<'_>, model: &mut Model, j: &Spanned<RawJoint>)
             .ok_or_else(|| ctx.err(j.span(), format!("joint `{}`: no node id left above {}", r.name, u32::MAX)))?,
     };
     model.split_node(r.node, &r.elements, new_id).map_err(|e| ctx.model_err(j.span(), e))?;
-    let tied: Vec<Dof> = dim.dofs().iter().copied().filter(|d| !sprung.iter().any(|(s, _)| s == d)).collect();
+    let tied: Vec<Dof> = dim.dofs().iter().copied().filter(|d| !sprung.contains(d)).collect();
     if !tied.is_empty() {
         model.add_tie(r.node, new_id, &tied).map_err(|e| ctx.model_err(j.span(), e))?;
     }
-    let mut k = PerDof::default();
-    for (d, v) in sprung {
-        k[d] = v;
+    for (e, k, g) in springs {
+        model.add_spring(&e.get_ref().name, r.node, Some(new_id), k, g).map_err(|err| ctx.model_err(e.span(), err))?;
     }
-    model.add_spring(&r.name, r.node, Some(new_id), k, g).map_err(|e| ctx.model_err(j.span(), e))?;
     Ok(())
 }
 

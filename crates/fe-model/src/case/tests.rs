@@ -4,7 +4,7 @@ use std::path::Path;
 
 use super::dof_list::parse_dof_list;
 use super::*;
-use crate::dof::{Dof, DofRef};
+use crate::dof::{Dof, DofRef, PerDof};
 use crate::model::NodeId;
 
 fn parse(text: &str) -> Result<CaseFile, CaseError> {
@@ -69,6 +69,43 @@ fn a_joint_splits_a_node_ties_translations_and_adds_a_rotational_spring() {
     assert_eq!(c.model.ties()[0].dofs, vec![Dof::Ux, Dof::Uy]);
     let bad = text.replace("elements = [3]", "elements = [1]");
     assert!(parse(&bad).unwrap_err().message.contains("does not end at node 3"));
+}
+
+/// Entries on the same node pair are one joint with a spring per entry, each
+/// in its own group (as `rfm diagnose --apply` writes a joint with a loss
+/// per direction): the node is split once and only the DOFs none of them
+/// springs are tied. Such entries must detach the same elements and not
+/// spring a DOF twice.
+#[test]
+fn joint_entries_on_one_node_pair_are_one_joint_with_a_group_per_spring() {
+    let entry = |name: &str, key: &str, elements: &str| {
+        format!(
+            "[groups.{name}]\nalpha = 1e-3\n[[joints]]\nname = \"{name}\"\nnode = 3\nelements = {elements}\nnew_node = \
+             9\n{key} = 5e3\ngroup = \"{name}\"\n"
+        )
+    };
+    let text = format!("{BEAM}\n{}{}", entry("j_r", "kr", "[3]"), entry("j_x", "kx", "[3]"));
+    let c = parse(&text).unwrap();
+    assert_eq!(c.model.nodes().len(), 6);
+    let e3 = &c.model.beams()[c.model.beam_index(crate::model::ElementId(3)).unwrap()];
+    assert_eq!(e3.nodes[0], NodeId(9));
+    let springs: Vec<(&str, PerDof, &str)> =
+        c.model.springs().iter().map(|s| (s.name.as_str(), s.k, c.model.groups()[s.group].name.as_str())).collect();
+    assert_eq!(springs, vec![("j_r", [0.0, 0.0, 5e3].into(), "j_r"), ("j_x", [5e3, 0.0, 0.0].into(), "j_x")]);
+    assert!(c.model.springs().iter().all(|s| (s.a, s.b) == (NodeId(3), Some(NodeId(9)))));
+    assert_eq!(c.model.ties().len(), 1);
+    assert_eq!(c.model.ties()[0].dofs, vec![Dof::Uy]);
+    // a translational entry alone on its pair is a joint without kr
+    let alone = format!("{BEAM}\n{}", entry("j_x", "kx", "[3]"));
+    assert!(parse(&alone).unwrap_err().message.contains("`j_x` needs `kr`"));
+    let other = format!("{BEAM}\n{}{}", entry("j_r", "kr", "[3]"), entry("j_x", "kx", "[2]"));
+    let e = parse(&other).unwrap_err();
+    assert!(e.message.contains("lists the same elements"), "{e}");
+    // at the second entry
+    let second = other[..other.rfind("[[joints]]").unwrap()].lines().count() + 1;
+    assert!(e.location.unwrap().line >= second, "{e}");
+    let twice = format!("{BEAM}\n{}{}", entry("j_r", "kr", "[3]"), entry("j_x", "kr", "[3]"));
+    assert!(parse(&twice).unwrap_err().message.contains("`kr` of the joint at node 3 is given by an earlier entry"));
 }
 
 /// A mass may sit at the node a joint makes (as `rfm diagnose --apply`

@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use toml::Spanned;
 
 use super::Ctx;
-use super::build::{add_joint, add_mass, add_spring, raw_group};
+use super::build::{add_joints, add_mass, add_spring, raw_group};
 use super::raw::RawTruth;
 use super::spec::TruthSpec;
 use crate::error::CaseError;
@@ -48,9 +48,7 @@ pub(super) fn parse_truth(ctx: &Ctx<'_>, t: &Spanned<RawTruth>, base: &Model) ->
     for m in &r.masses {
         add_mass(ctx, &mut model, m)?;
     }
-    for j in &r.joints {
-        add_joint(ctx, &mut model, j)?;
-    }
+    add_joints(ctx, &mut model, &r.joints)?;
     // Values may name items the truth adds, so resolve them on the truth model.
     for (name, v) in &r.set {
         let q = model.quantity(name).map_err(|e| ctx.model_err(v.span(), e))?;

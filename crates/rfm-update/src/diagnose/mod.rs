@@ -39,19 +39,24 @@
 //! with the fuller variants of the leaders (a joint's translational
 //! springs, a mass's rotary inertia); the best are screened and fitted
 //! fully, so that one weakened element is named as such and not as its
-//! region or a mass at its node. The leading stiffness changes then get
-//! their twins, fitted from where they ended: the same change of the
-//! bending stiffness alone (a smaller second moment of area). A twin stays
-//! in the ranking only when it beats its original by very strong evidence
-//! (`dBIC` lower by 10); where the data cannot tell the two apart the plain
-//! change stands.
+//! region or a mass at its node. Then a support or joint among the leaders
+//! with springs in two or more DOFs gets a damping group per direction,
+//! fitted fully from its own fit, so that a clamp that loses more in
+//! rotation than in shear is not given one loss for both at the price of
+//! biased stiffnesses. The leading stiffness changes get their twins,
+//! fitted from where they ended: the same change of the bending stiffness
+//! alone (a smaller second moment of area). A twin stays in the ranking
+//! only when it beats its original by very strong evidence (`dBIC` lower
+//! by 10); where the data cannot tell the two apart the plain change
+//! stands.
 //!
 //! A fitted parameter whose relative standard deviation exceeds one (its
 //! value could as well be e times larger), or a spring that ran to its
 //! upper bound, is *not determined* by the data. A spring of a support or
 //! joint that is not determined is held rigid, and the candidate fitted
 //! again without it: the axial spring of a clamp measured in bending says
-//! nothing about the clamp. Plausibility is judged only on determined
+//! nothing about the clamp; a spring with a group of its own (per
+//! direction) takes its group's alpha and mu along. Plausibility is judged only on determined
 //! values. The *recommended* effect is the first significant, plausible one
 //! of the ranking.
 //!

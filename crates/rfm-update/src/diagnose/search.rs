@@ -1,7 +1,8 @@
 //! The stages of the diagnosis over a pool of candidates: pre-screening,
-//! screening, full fits, refinement around the leaders, the twins of the
-//! leading stiffness changes, and holding what the data cannot
-//! determine. [`super::diagnose`] runs them in that order.
+//! screening, full fits, refinement around the leaders, a damping group per
+//! direction for leading supports and joints, the twins of the leading
+//! stiffness changes, and holding what the data cannot determine.
+//! [`super::diagnose`] runs them in that order.
 
 use std::collections::HashSet;
 
@@ -417,6 +418,24 @@ impl<'a> Pool<'a> {
         }
     }
 
+    /// The per-direction variants (see [`candidates::per_direction_variant`])
+    /// of those of the best `leaders` fully fitted candidates that are
+    /// supports or joints, started from their fits, added to the pool;
+    /// returns their indices.
+    pub(crate) fn per_direction(&mut self, leaders: usize) -> Vec<usize> {
+        let mut tried = self.descriptions();
+        let mut new = Vec::new();
+        for i in self.by_full_fit().into_iter().take(leaders) {
+            let fit = self.full[i].as_ref().expect("fully fitted");
+            if let Some(v) = candidates::per_direction_variant(self.model, &self.candidates[i], &fit.values)
+                && tried.insert(v.description.clone())
+            {
+                new.push(v);
+            }
+        }
+        self.add(new)
+    }
+
     /// For every full fit with parameters the data do not determine, the
     /// variant that holds them (see [`Candidate::holding`]) is fitted fully
     /// from the determined values and supersedes the fuller one.
@@ -435,12 +454,12 @@ impl<'a> Pool<'a> {
                 continue;
             }
             let Some(h) = self.candidates[i].holding(self.model, &held) else { continue };
+            // the held variant fits the parameters it does not hold, in
+            // order (a variant per direction left with one spring renames them)
             let original = &self.candidates[i].parameters;
-            let start: Vec<f64> = h
-                .parameters
-                .iter()
-                .map(|n| f.values[original.iter().position(|p| p == n).expect("the held variant fits a subset")])
-                .collect();
+            let start: Vec<f64> =
+                (0..original.len()).filter(|&p| !h.held.contains(&original[p])).map(|p| f.values[p]).collect();
+            assert_eq!(start.len(), h.parameters.len(), "the held variant fits a subset");
             // the held variant may be a candidate of its own already (a plain mass)
             match self.candidates.iter().position(|c| c.description == h.description) {
                 Some(j) if self.full[j].is_none() && !fits.iter().any(|(k, _)| *k == j) => fits.push((j, start)),
@@ -499,6 +518,15 @@ pub(crate) fn search(
         let best: Vec<usize> = pool.by_screening(&refined).into_iter().take(REFINED_FITS).collect();
         pool.full_fit(full, &coarse, (opts.iterations, opts.screen_iterations), &best, None)?;
         trace(&format!("refined around the leaders: {} candidates, {} fitted", refined.len(), best.len()));
+    }
+    // a support or joint among the leaders with one damping group per
+    // direction: fitted fully from its leader's fit, beside the refined
+    // candidates rather than competing with them for a full fit (it
+    // screens as well as its leader and would crowd out the windows)
+    let variants = pool.per_direction(REFINED_LEADERS);
+    if !variants.is_empty() {
+        pool.full_fit(full, &coarse, (opts.iterations, opts.screen_iterations), &variants, None)?;
+        trace(&format!("fitted {} variants with a damping group per direction", variants.len()));
     }
     // the twins of the leading stiffness changes, started where those ended
     let twins = pool.twins(copts, TWINNED_LEADERS);

@@ -3,6 +3,8 @@
 //! effect is written into a new case file in another folder; the written
 //! case loads, reads its measured data through a path relative to itself,
 //! and its misfit with the fitted values equals the diagnosis's to 1e-6.
+//! The per-direction variants of supports and joints (a spring and a group
+//! per direction) are among them.
 
 use damping::DampedSystem;
 use std::collections::BTreeSet;
@@ -163,6 +165,9 @@ fn apply_every(case: CaseFile, dir: &Path) -> BTreeSet<String> {
         let history: Vec<f64> = applied.case.history.iter().map(|h| h.misfit).collect();
         assert_eq!(history, vec![d.nominal_misfit, r.misfit], "{title}, rank {rank}");
         kinds.insert(format!("{:?}", r.kind));
+        if r.description.contains("one group per direction") {
+            kinds.insert(format!("{:?} per direction", r.kind));
+        }
     }
     println!("{title}: {} effects applied ({:?})", d.ranking.len(), kinds);
     kinds
@@ -189,6 +194,13 @@ fn every_ranked_effect_applies_to_the_tutorial_the_papers_cases_and_samples() {
         std::fs::create_dir_all(path.parent().unwrap()).unwrap();
         std::fs::write(&path, text).unwrap();
         kinds.extend(apply_every(CaseFile::load(&path).unwrap(), &tmp.path().join(format!("sample-{k}"))));
+    }
+    // a support with a loss per direction, whose per-direction variant is written
+    let dir = tmp.path().join("per-direction");
+    kinds.extend(apply_every(crate::per_direction::nominal_case(&crate::per_direction::lossy_rotation(), &dir), &dir));
+    println!("applied: {kinds:?}");
+    for kind in ["FlexibleSupport per direction", "FlexibleJoint per direction"] {
+        assert!(kinds.contains(kind), "no {kind} was applied");
     }
     for kind in [
         EffectKind::FlexibleSupport,

@@ -9,6 +9,7 @@ mod hidden_effects;
 mod numerics;
 mod output_error;
 mod paper_cases;
+mod per_direction;
 mod sensitivity;
 mod trust;
 mod truths;

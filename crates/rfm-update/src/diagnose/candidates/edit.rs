@@ -15,11 +15,23 @@ pub(crate) enum Edit {
     Mass { node: u32, name: String, group: String, m: f64, j: f64, dim: Dimension },
     /// The rigid support of a node (the DOFs `fixed`) replaced, in the
     /// `released` DOFs, by ground springs `k` in a damping group of their
-    /// own; the other fixed DOFs stay fixed.
-    Support { node: u32, fixed: Vec<Dof>, released: Vec<Dof>, name: String, group: Group, k: PerDof, dim: Dimension },
+    /// own; the other fixed DOFs stay fixed. With `per_direction`, one
+    /// spring per released DOF, each in a group of its own (see
+    /// [`direction_name`]), all starting as `group`.
+    Support {
+        node: u32,
+        fixed: Vec<Dof>,
+        released: Vec<Dof>,
+        name: String,
+        group: Group,
+        k: PerDof,
+        dim: Dimension,
+        per_direction: bool,
+    },
     /// Members detached from a node onto a new coincident node, joined to it
     /// by springs `k` in the `sprung` DOFs (always the rotations), tied in
-    /// the others, in a damping group of their own.
+    /// the others, in a damping group of their own; with `per_direction`,
+    /// one spring per sprung DOF in a group of its own, as for supports.
     Joint {
         node: u32,
         elements: Vec<u32>,
@@ -30,11 +42,45 @@ pub(crate) enum Edit {
         k: PerDof,
         sprung: Vec<Dof>,
         dim: Dimension,
+        per_direction: bool,
     },
     /// Nothing added: the parameters exist in the nominal model.
     Set,
     /// Elements `first..=last` moved to a new group.
     Region { first: u32, last: u32, group: Group },
+}
+
+/// The name of the spring, and of its group, in DOF `d` of a support or
+/// joint `base` with one group per direction: `support_1_r` for its `kr`,
+/// `joint_5_4_x` for its `kx`, `support_1_rx` for a `krx` in space.
+pub(crate) fn direction_name(base: &str, dim: Dimension, d: Dof) -> String {
+    format!("{base}_{}", &dim.spring_key(d)[1..])
+}
+
+/// The springs of a support or joint: one `(name, stiffness, group)` with
+/// every DOF of `dofs`, or with `per_direction` one per DOF, its group a
+/// copy of `group` named as the spring.
+fn springs(
+    name: &str,
+    group: &Group,
+    k: &PerDof,
+    dofs: &[Dof],
+    dim: Dimension,
+    per_direction: bool,
+) -> Vec<(String, PerDof, Group)> {
+    if !per_direction {
+        return vec![(name.to_string(), *k, group.clone())];
+    }
+    dofs.iter()
+        .map(|&d| {
+            let n = direction_name(name, dim, d);
+            let mut kd = PerDof::default();
+            kd[d] = k[d];
+            let mut g = group.clone();
+            g.name = direction_name(&group.name, dim, d);
+            (n, kd, g)
+        })
+        .collect()
 }
 
 fn range_name(first: u32, last: u32) -> String {
@@ -57,23 +103,31 @@ impl Edit {
                 };
                 m.add_mass(name, *node, *mass, j, g)?;
             }
-            Edit::Support { node, released, name, group, k, .. } => {
+            Edit::Support { node, released, name, group, k, dim, per_direction, .. } => {
                 let fixed = m.remove_support(*node);
                 let kept: Vec<Dof> = fixed.iter().copied().filter(|d| !released.contains(d)).collect();
                 if !kept.is_empty() {
                     m.add_support(*node, &kept)?;
                 }
-                let g = m.add_group(group.clone())?;
-                m.add_spring(name, *node, None, *k, g)?;
+                for (name, k, group) in springs(name, group, k, released, *dim, *per_direction) {
+                    let g = m.add_group(group)?;
+                    m.add_spring(&name, *node, None, k, g)?;
+                }
             }
-            Edit::Joint { node, elements, new_node, name, group, k, sprung, dim, .. } => {
-                let g = m.add_group(group.clone())?;
+            Edit::Joint { node, elements, new_node, name, group, k, sprung, dim, per_direction, .. } => {
+                let springs = springs(name, group, k, sprung, *dim, *per_direction);
+                let mut groups = Vec::new();
+                for (_, _, group) in &springs {
+                    groups.push(m.add_group(group.clone())?);
+                }
                 m.split_node(*node, elements, *new_node)?;
                 let tied: Vec<Dof> = dim.dofs().iter().copied().filter(|d| !sprung.contains(d)).collect();
                 if !tied.is_empty() {
                     m.add_tie(*node, *new_node, &tied)?;
                 }
-                m.add_spring(name, *node, Some(*new_node), *k, g)?;
+                for ((name, k, _), g) in springs.into_iter().zip(groups) {
+                    m.add_spring(&name, *node, Some(*new_node), k, g)?;
+                }
             }
             Edit::Set => {}
             Edit::Region { first, last, group } => {
@@ -100,7 +154,10 @@ impl Edit {
 
     /// Plain-language description with the location and the variant.
     pub(crate) fn describe(&self, kind: EffectKind) -> String {
-        let damping = |g: &Group| if g.mu.is_some() { "non-viscous" } else { "viscous" };
+        let damping = |g: &Group, per_direction: bool| {
+            let form = if g.mu.is_some() { "non-viscous" } else { "viscous" };
+            if per_direction { format!("{form}, one group per direction") } else { form.to_string() }
+        };
         let springs = |dofs: &[Dof], dim: &Dimension| {
             let mut v: Vec<&str> = dofs.iter().map(|&d| dim.spring_key(d)).collect();
             v.sort_unstable();
@@ -114,17 +171,21 @@ impl Edit {
                     format!("lumped mass at node {node}")
                 }
             }
-            Edit::Support { node, released, group, dim, .. } => {
-                format!("flexible, lossy support at node {node} ({}; {})", springs(released, dim), damping(group))
+            Edit::Support { node, released, group, dim, per_direction, .. } => {
+                format!(
+                    "flexible, lossy support at node {node} ({}; {})",
+                    springs(released, dim),
+                    damping(group, *per_direction)
+                )
             }
-            Edit::Joint { node, elements, in_line, group, sprung, dim, .. } => {
+            Edit::Joint { node, elements, in_line, group, sprung, dim, per_direction, .. } => {
                 let ids: Vec<u32> = elements.clone();
                 let which = match ids.as_slice() {
                     [one] => format!("element {one}"),
                     _ => format!("elements {ids:?}"),
                 };
                 let what = if *in_line { "flexible, lossy in-line joint" } else { "flexible, lossy joint" };
-                format!("{what} at node {node} ({which}; {}; {})", springs(sprung, dim), damping(group))
+                format!("{what} at node {node} ({which}; {}; {})", springs(sprung, dim), damping(group, *per_direction))
             }
             Edit::Region { first, last, .. } => format!("{} in {}", kind.label(), range_name(*first, *last)),
             Edit::Set => kind.label().to_string(),
@@ -158,11 +219,11 @@ impl Edit {
     /// `values` (see [`Edit::write`]); `None` for [`Edit::Set`]. A support
     /// replaces the node's `[[supports]]` entries, which the user deletes.
     pub(crate) fn snippet(&self, names: &[String], values: &[f64]) -> Option<String> {
-        // the fitted value of a parameter by its last name component
-        let fitted = |field: &str| names.iter().zip(values).find(|(n, _)| n.ends_with(field)).map(|(_, &v)| v);
+        // the fitted value of a parameter by its name
+        let fitted = |name: String| names.iter().zip(values).find(|(n, _)| **n == name).map(|(_, &v)| v);
         let group_table = |g: &Group| {
             let mut s = format!("[groups.{}]\n", g.name);
-            let alpha = fitted(".alpha").unwrap_or(g.alpha);
+            let alpha = fitted(format!("group.{}.alpha", g.name)).unwrap_or(g.alpha);
             if alpha != 0.0 {
                 s.push_str(&format!("alpha = {alpha:e}\n"));
             }
@@ -170,7 +231,8 @@ impl Edit {
                 s.push_str(&format!("beta = {:e}\n", g.beta));
             }
             if g.mu.is_some() {
-                s.push_str(&format!("mu = {:e}\n", fitted(".mu").or(g.mu).expect("non-viscous")));
+                let mu = fitted(format!("group.{}.mu", g.name)).or(g.mu).expect("non-viscous");
+                s.push_str(&format!("mu = {mu:e}\n"));
             }
             if g.stiffness != 1.0 {
                 s.push_str(&format!("stiffness = {:e}\n", g.stiffness));
@@ -180,22 +242,27 @@ impl Edit {
             }
             s
         };
-        let spring_lines = |k: &PerDof, dofs: &[Dof], dim: &Dimension| {
-            dofs.iter()
-                .map(|&d| {
+        // the stiffness lines of spring `name`, and its group's
+        let spring_lines = |name: &str, k: &PerDof, g: &Group, dim: &Dimension| {
+            let mut s: String = k
+                .non_zero(dim.dofs())
+                .into_iter()
+                .map(|d| {
                     let key = dim.spring_key(d);
-                    format!("{key} = {:e}\n", fitted(&format!(".{key}")).unwrap_or(k[d]))
+                    format!("{key} = {:e}\n", fitted(format!("spring.{name}.{key}")).unwrap_or(k[d]))
                 })
-                .collect::<String>()
+                .collect();
+            s.push_str(&format!("group = \"{}\"\n", g.name));
+            s
         };
         let text = match self {
             Edit::Mass { node, name, group, m, j, dim } => {
                 let mut s = format!(
                     "[groups.{group}]                # an undamped group for added masses\n\n[[masses]]\nname = \"{name}\"\nnode = {node}\nm = {:e}\n",
-                    fitted(".m").unwrap_or(*m)
+                    fitted(format!("mass.{name}.m")).unwrap_or(*m)
                 );
                 if *j > 0.0 {
-                    let j = fitted(".j").unwrap_or(*j);
+                    let j = fitted(format!("mass.{name}.j")).unwrap_or(*j);
                     match dim {
                         Dimension::Planar => s.push_str(&format!("j = {j:e}\n")),
                         Dimension::Spatial => s.push_str(&format!("jx = {j:e}\njy = {j:e}\njz = {j:e}\n")),
@@ -204,9 +271,9 @@ impl Edit {
                 s.push_str(&format!("group = \"{group}\"\n"));
                 s
             }
-            Edit::Support { node, fixed, released, name, group, k, dim } => {
-                let mut s = group_table(group);
-                s.push('\n');
+            Edit::Support { node, fixed, released, name, group, k, dim, per_direction } => {
+                let springs = springs(name, group, k, released, *dim, *per_direction);
+                let mut s: String = springs.iter().map(|(_, _, g)| group_table(g) + "\n").collect();
                 let kept: Vec<&str> = fixed.iter().filter(|d| !released.contains(d)).map(|d| d.name()).collect();
                 if !kept.is_empty() {
                     let list: Vec<String> = kept.iter().map(|d| format!("\"{d}\"")).collect();
@@ -215,20 +282,32 @@ impl Edit {
                         list.join(", ")
                     ));
                 }
-                s.push_str(&format!(
-                    "[[springs]]\nname = \"{name}\"\nnode = {node}                      # to ground\n"
-                ));
-                s.push_str(&spring_lines(k, released, dim));
-                s.push_str(&format!("group = \"{}\"\n", group.name));
+                let entries: Vec<String> = springs
+                    .iter()
+                    .map(|(name, k, g)| {
+                        format!(
+                            "[[springs]]\nname = \"{name}\"\nnode = {node}                      # to ground\n{}",
+                            spring_lines(name, k, g, dim)
+                        )
+                    })
+                    .collect();
+                s.push_str(&entries.join("\n"));
                 s
             }
-            Edit::Joint { node, elements, new_node, name, group, k, sprung, dim, .. } => {
-                let mut s = group_table(group);
-                s.push_str(&format!(
-                    "\n[[joints]]\nname = \"{name}\"\nnode = {node}\nelements = {elements:?}\nnew_node = {new_node}\n"
-                ));
-                s.push_str(&spring_lines(k, sprung, dim));
-                s.push_str(&format!("group = \"{}\"\n", group.name));
+            Edit::Joint { node, elements, new_node, name, group, k, sprung, dim, per_direction, .. } => {
+                // one entry per spring; entries on the same node pair are one joint
+                let springs = springs(name, group, k, sprung, *dim, *per_direction);
+                let mut s: String = springs.iter().map(|(_, _, g)| group_table(g) + "\n").collect();
+                let entries: Vec<String> = springs
+                    .iter()
+                    .map(|(name, k, g)| {
+                        format!(
+                            "[[joints]]\nname = \"{name}\"\nnode = {node}\nelements = {elements:?}\nnew_node = {new_node}\n{}",
+                            spring_lines(name, k, g, dim)
+                        )
+                    })
+                    .collect();
+                s.push_str(&entries.join("\n"));
                 s
             }
             Edit::Region { first, last, group } => {

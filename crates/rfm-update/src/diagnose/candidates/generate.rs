@@ -428,6 +428,7 @@ fn supports(ctx: &Ctx<'_>, node: u32) -> Vec<Spec> {
             group: ctx.damping_group(&name, non_viscous),
             k,
             dim: ctx.dim,
+            per_direction: false,
         };
         let head = Head {
             kind: EffectKind::FlexibleSupport,
@@ -477,6 +478,7 @@ fn joint(ctx: &Ctx<'_>, node: u32, beams: &[usize], in_line: bool, translational
         k,
         sprung: sprung.clone(),
         dim: ctx.dim,
+        per_direction: false,
     };
     let head = Head {
         kind: EffectKind::FlexibleJoint,

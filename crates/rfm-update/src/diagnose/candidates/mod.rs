@@ -2,8 +2,8 @@
 //!
 //! | kind | where | parameters |
 //! |---|---|---|
-//! | flexible, lossy support | each supported node | a ground spring per fixed DOF; its own damping group: alpha (viscous) or alpha and mu (non-viscous) |
-//! | flexible, lossy joint | where members meet at an angle, at interior nodes of members (in line: a splice, a lap joint), and existing joint springs | rotational spring (and translational springs, refined), its own damping group as for supports |
+//! | flexible, lossy support | each supported node | a ground spring per fixed DOF; its own damping group: alpha (viscous) or alpha and mu (non-viscous); refined, a group per direction |
+//! | flexible, lossy joint | where members meet at an angle, at interior nodes of members (in line: a splice, a lap joint), and existing joint springs | rotational spring (and translational springs, refined), its own damping group as for supports (refined, a group per direction when it springs two or more DOFs) |
 //! | lumped mass | each node | mass (and rotary inertia, refined) |
 //! | stiffness change | windows of 1, 2, 3, 4, 6 or 8 elements at every offset along a member (on large models coarse windows, refined around the leaders) | stiffness factor |
 //! | mass change | the same windows | mass factor |
@@ -21,7 +21,8 @@
 //! What the data cannot determine is held rather than fitted to a bound
 //! ([`Candidate::holding`]): a support or joint spring the measured
 //! directions do not see (the axial spring of a clamp measured in bending)
-//! is made rigid again, and the candidate is fitted without it.
+//! is made rigid again, and the candidate is fitted without it (with one
+//! group per direction, without that spring's group either).
 //!
 //! A candidate does not carry a copy of the whole model: a large model has
 //! thousands of candidates. It carries the recipe of its change ([`Edit`]),
@@ -32,6 +33,7 @@
 mod edit;
 mod generate;
 mod imported;
+mod per_direction;
 
 use fe_model::{Dof, ElementId, Model, ModelError, NodeId, Parameter};
 use serde::Serialize;
@@ -40,6 +42,7 @@ pub(crate) use edit::Edit;
 pub use generate::generate;
 pub(crate) use generate::refine;
 pub(crate) use generate::twins::twins;
+pub(crate) use per_direction::per_direction_variant;
 
 /// The kind of a candidate effect.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
@@ -249,7 +252,9 @@ impl Candidate {
     /// The candidate without the parameters at `held` (indices), held at
     /// their rigid or nominal value: a support spring becomes the rigid
     /// support again in its DOF, a joint's translational spring a tie, a
-    /// rotary inertia zero. `None` when none of them can be held (a
+    /// rotary inertia zero; a spring with a damping group of its own (one
+    /// group per direction) takes the group's alpha and mu along, so that
+    /// nothing undetermined is left free. `None` when none of them can be held (a
     /// damping parameter, a joint's rotational spring) or nothing would be
     /// left to fit; the caller then reports them as not determined.
     pub(crate) fn holding(&self, model: &Model, held: &[usize]) -> Option<Candidate> {
@@ -277,6 +282,20 @@ impl Candidate {
                 dropped.push(i);
             }
         }
+        // a spring with a group of its own takes its damping along: nothing
+        // is left for the data to determine of them
+        if let Edit::Support { name, dim, per_direction: true, .. }
+        | Edit::Joint { name, dim, per_direction: true, .. } = &edit
+        {
+            let springs: Vec<usize> = dropped.clone();
+            for i in springs {
+                let Role::Spring(d) = self.roles[i] else { continue };
+                let group = format!("group.{}.", edit::direction_name(name, *dim, d));
+                dropped.extend((0..self.parameters.len()).filter(|&p| self.parameters[p].starts_with(&group)));
+            }
+            dropped.sort_unstable();
+            dropped.dedup();
+        }
         if dropped.is_empty() || dropped.len() == self.parameters.len() {
             return None;
         }
@@ -285,10 +304,22 @@ impl Candidate {
         {
             return None;
         }
+        // one group per direction with one direction left is the plain
+        // candidate (under its name), not a variant of its own
+        let mut renamed: Option<(String, String)> = None;
+        if let Edit::Support { name, dim, released: dofs, per_direction, .. }
+        | Edit::Joint { name, dim, sprung: dofs, per_direction, .. } = &mut edit
+            && *per_direction
+            && dofs.len() == 1
+        {
+            *per_direction = false;
+            renamed = Some((format!(".{}.", edit::direction_name(name, *dim, dofs[0])), format!(".{name}.")));
+        }
+        let rename = |n: &String| renamed.as_ref().map_or_else(|| n.clone(), |(a, b)| n.replacen(a, b, 1));
         let fitted: Vec<Fitted> = (0..self.parameters.len())
             .filter(|i| !dropped.contains(i))
             .map(|i| Fitted {
-                name: self.parameters[i].clone(),
+                name: rename(&self.parameters[i]),
                 role: self.roles[i],
                 bounds: self.bounds[i],
                 plausible: self.plausible[i],
@@ -315,10 +346,12 @@ impl Candidate {
     /// depends on alpha and mu together: `alpha w mu^2 / (mu^2 + w^2)`, at
     /// most `alpha mu / 2`, reached at `w = mu`.
     pub fn implausible(&self, values: &[f64], determined: &[bool]) -> Option<String> {
-        let mu = self.roles.iter().position(|&r| r == Role::Mu).map(|i| values[i]);
         (0..self.parameters.len()).filter(|&i| determined[i]).find_map(|i| {
             let v = values[i];
             if self.roles[i] == Role::Alpha {
+                // the relaxation parameter of the same group
+                let mu_name = self.parameters[i].strip_suffix(".alpha").map(|g| format!("{g}.mu"));
+                let mu = self.parameters.iter().position(|p| Some(p) == mu_name.as_ref()).map(|m| values[m]);
                 let eta = max_loss_factor(v, mu, self.band_rad);
                 return (eta > 1.0).then(|| {
                     format!(

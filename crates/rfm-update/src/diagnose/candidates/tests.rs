@@ -42,8 +42,32 @@ fn every_candidate_applies_to_the_whole_model() {
             .count();
         assert!(new_joints >= corners, "{new_joints} new joints for {corners} corners in {}", model.title);
         let mut held = 0;
+        let mut per_direction = 0;
         for c in &all {
             check(&model, c);
+            // its variant with a group per direction, from its starting values
+            if let Some(v) = per_direction_variant(&model, c, &c.start_values()) {
+                per_direction += 1;
+                check(&model, &v);
+                assert!(v.description.ends_with("one group per direction)"), "{}", v.description);
+                assert_eq!(v.start_values().len(), v.parameters.len());
+                // a held spring takes its own group's damping along
+                let springs: Vec<usize> = (0..v.roles.len())
+                    .filter(|&i| matches!(v.roles[i], Role::Spring(d) if d.is_translation()))
+                    .collect();
+                if let Some(h) = v.holding(&model, &springs[..1]) {
+                    let Role::Spring(d) = v.roles[springs[0]] else { unreachable!() };
+                    let (Edit::Support { name, dim, .. } | Edit::Joint { name, dim, .. }) = &v.edit else {
+                        unreachable!()
+                    };
+                    let group = format!("group.{}.", edit::direction_name(name, *dim, d));
+                    assert!(h.parameters.iter().all(|p| !p.starts_with(&group)), "{:?}", h.parameters);
+                    assert!(h.held.iter().any(|p| p.starts_with(&group)), "{:?}", h.held);
+                    let n_springs = |c: &Candidate| c.roles.iter().filter(|r| matches!(r, Role::Spring(_))).count();
+                    assert_eq!(n_springs(&h) + 1, n_springs(&v));
+                    check(&model, &h);
+                }
+            }
             // hold every spring that can be held
             let springs: Vec<usize> =
                 (0..c.roles.len()).filter(|&i| matches!(c.roles[i], Role::Spring(d) if d.is_translation())).collect();
@@ -54,6 +78,7 @@ fn every_candidate_applies_to_the_whole_model() {
             }
         }
         assert!(held > 0, "no candidate of {} held a spring", model.title);
+        assert!(per_direction > 0, "no candidate of {} has a variant per direction", model.title);
     }
 }
 
@@ -133,5 +158,27 @@ fn the_largest_loss_factor_is_found_over_the_band() {
             .fold(0.0, f64::max);
         let got = max_loss_factor(alpha, mu, band);
         assert!((got / brute - 1.0).abs() < 1e-6, "mu {mu:?}: {got} vs {brute}");
+    }
+}
+
+/// A support with a group per direction whose translational springs are
+/// held (the data see only its rotation) is the plain support with kr
+/// alone, under the plain one's names and description: the diagnosis then
+/// finds it among its candidates instead of offering it twice.
+#[test]
+fn a_support_per_direction_left_with_one_spring_is_the_plain_support() {
+    let model = samples::cantilever(6);
+    let all = generate(&model, &CandidateOptions::default());
+    for c in all.iter().filter(|c| c.kind == EffectKind::FlexibleSupport) {
+        let v = per_direction_variant(&model, c, &c.start_values()).unwrap();
+        assert_eq!(v.parameters.len(), 3 * (c.parameters.len() - 2), "{:?}", v.parameters);
+        let translations: Vec<usize> =
+            (0..v.roles.len()).filter(|&i| matches!(v.roles[i], Role::Spring(d) if d.is_translation())).collect();
+        let h = v.holding(&model, &translations).unwrap();
+        let plain = c.holding(&model, &[0, 1]).unwrap();
+        assert_eq!(h.description, plain.description);
+        assert_eq!(h.parameters, plain.parameters);
+        assert_eq!(h.edit, plain.edit);
+        assert_eq!(h.held.len(), v.parameters.len() - h.parameters.len(), "{:?}", h.held);
     }
 }
