@@ -157,7 +157,9 @@ fn print_outcome(o: &FixOutcome) -> Result<()> {
         }
         outln!("{}", t.render());
     }
-    if o.significant_remains
+    if let Some(e) = &o.diagnosis_error {
+        outln!("\nthe diagnosis of the final model failed, so what remains is not known: {e}");
+    } else if o.significant_remains
         && let Some(r) = o.remaining.first()
     {
         outln!("\nstill significant in the last diagnosis: {} (dBIC {:.1})", r.description, r.delta_bic);

@@ -212,7 +212,9 @@ pub(crate) fn write(study: &Study, outcome: &FixOutcome, opts: &ReportOptions, o
     }
 
     let mut rest = Section::new("What the last diagnosis finds");
-    rest.push(Block::Text(if outcome.significant_remains {
+    rest.push(Block::Text(if let Some(e) = &outcome.diagnosis_error {
+        format!("The diagnosis of the final model failed, so what remains is not known: {e}.")
+    } else if outcome.significant_remains {
         "Some candidates are still significant in the diagnosis of the final model:".to_string()
     } else {
         "No candidate is significant in the diagnosis of the final model.".to_string()

@@ -215,6 +215,25 @@ fn the_swap_undoes_an_early_effect_and_what_made_up_for_it() {
     assert!(trial.found.iter().all(|&f| f), "both effects found: {:?}", trial.found);
 }
 
+/// Trial 34 of the full study: a splice found and fixed at the first step;
+/// the third step's update drives the joint's ky (which the data hardly
+/// see) to 4e14 N/m, and the diagnosis of that model calls a line singular.
+/// The loop must keep its steps and say that what remains is unknown,
+/// not fail as a whole.
+#[test]
+fn the_loop_keeps_its_steps_when_the_last_diagnosis_fails() {
+    let truth = &draws(12, 16)[34];
+    let opts = FixOptions { max_steps: 3, ..FixOptions::default() };
+    let trial = run(truth, 7034, &opts);
+    let o = &trial.outcome;
+    println!("{}: {} steps, diagnosis error {:?}", trial.label, o.steps.len(), o.diagnosis_error);
+    assert!(trial.found.iter().all(|&f| f), "the splice is found: {:?}", trial.found);
+    assert!(o.final_misfit() < 1.5 * NOISE, "the loop ends {:.2} times the noise", o.final_misfit() / NOISE);
+    if o.diagnosis_error.is_some() {
+        assert!(o.significant_remains && o.remaining.is_empty(), "an unknown remainder is not called consistent");
+    }
+}
+
 #[test]
 #[ignore = "misses one of its criteria on the reduced set (27/30 first, 26/30 fixed, values 20/23, pairs 4/6 < 80 %); run by cargo xtask heldout"]
 fn the_loop_finds_and_fixes_held_out_effects() {
