@@ -1,0 +1,235 @@
+//! The candidates at a node: a flexible, lossy support in place of a rigid
+//! one, a flexible, lossy joint (at a corner or in line), a lumped mass, and
+//! the joints the model already has, as modelled.
+
+use std::collections::{HashMap, HashSet};
+
+use fe_model::{Dof, PerDof};
+
+use super::{Ctx, Spec, ids, unique_name};
+use crate::diagnose::candidates::edit::Edit;
+use crate::diagnose::candidates::{EffectKind, Fitted, Head, Role};
+
+/// The flexible, lossy support candidates of a supported node: every fixed
+/// DOF released onto a ground spring, viscous and non-viscous.
+pub(super) fn supports(ctx: &Ctx<'_>, node: u32) -> Vec<Spec> {
+    let model = ctx.model;
+    let mut fixed: Vec<Dof> =
+        model.supports().iter().filter(|s| s.node.0 == node).flat_map(|s| s.dofs.iter().copied()).collect();
+    fixed.sort();
+    fixed.dedup();
+    let kref = ctx.local_stiffness(node);
+    if fixed.is_empty() || fixed.iter().any(|&d| kref[d] <= 0.0) {
+        return Vec::new();
+    }
+    let mut out = Vec::new();
+    for non_viscous in [false, true] {
+        let name = unique_name(model, &format!("support_{node}"));
+        let mut k = PerDof::default();
+        for &d in &fixed {
+            k[d] = 100.0 * kref[d];
+        }
+        let mut fitted: Vec<Fitted> = fixed
+            .iter()
+            .map(|&d| {
+                let r = kref[d];
+                Fitted {
+                    name: format!("spring.{name}.{}", ctx.dim.spring_key(d)),
+                    role: Role::Spring(d),
+                    bounds: Some((1e-6 * r, 1e4 * r)),
+                    // a spring far stiffer than the member is as good as rigid, not implausible
+                    plausible: (0.0, f64::INFINITY, ""),
+                }
+            })
+            .collect();
+        fitted.push(ctx.alpha(format!("group.{name}.alpha")));
+        if non_viscous {
+            fitted.push(ctx.mu(format!("group.{name}.mu")));
+        }
+        let edit = Edit::Support {
+            node,
+            fixed: fixed.clone(),
+            released: fixed.clone(),
+            name: name.clone(),
+            group: ctx.damping_group(&name, non_viscous),
+            k,
+            dim: ctx.dim,
+            per_direction: false,
+        };
+        let head = Head {
+            kind: EffectKind::FlexibleSupport,
+            description: edit.describe(EffectKind::FlexibleSupport),
+            nodes: vec![node],
+            elements: Vec::new(),
+            dofs: fixed.clone(),
+            // the released DOFs enter every element at the node
+            part_nodes: ctx.ring(node),
+        };
+        out.push((head, edit, fitted));
+    }
+    out
+}
+
+/// A flexible, lossy joint detaching `beams` from `node`: rotational
+/// springs (and translational springs when `translational`), viscous or not.
+pub(super) fn joint(
+    ctx: &Ctx<'_>,
+    node: u32,
+    beams: &[usize],
+    in_line: bool,
+    translational: bool,
+    non_viscous: bool,
+) -> Spec {
+    let model = ctx.model;
+    let elements = ids(model, beams);
+    let name = unique_name(model, &format!("joint_{node}_{}", elements[0]));
+    let kref = ctx.local_stiffness(node);
+    let sprung: Vec<Dof> = if translational { ctx.dim.dofs().to_vec() } else { ctx.dim.rotations().to_vec() };
+    let mut k = PerDof::default();
+    let mut fitted = Vec::new();
+    for &d in &sprung {
+        let r = kref[d].max(f64::MIN_POSITIVE);
+        k[d] = 100.0 * r;
+        fitted.push(Fitted {
+            name: format!("spring.{name}.{}", ctx.dim.spring_key(d)),
+            role: Role::Spring(d),
+            bounds: Some((1e-6 * r, 1e4 * r)),
+            plausible: (0.0, f64::INFINITY, ""),
+        });
+    }
+    fitted.push(ctx.alpha(format!("group.{name}.alpha")));
+    if non_viscous {
+        fitted.push(ctx.mu(format!("group.{name}.mu")));
+    }
+    let edit = Edit::Joint {
+        node,
+        elements: elements.clone(),
+        new_node: ctx.new_node,
+        in_line,
+        name: name.clone(),
+        group: ctx.damping_group(&name, non_viscous),
+        k,
+        sprung: sprung.clone(),
+        dim: ctx.dim,
+        per_direction: false,
+    };
+    let head = Head {
+        kind: EffectKind::FlexibleJoint,
+        description: edit.describe(EffectKind::FlexibleJoint),
+        nodes: vec![node],
+        elements,
+        dofs: sprung,
+        // every element at the node: splitting it checks that one stays
+        part_nodes: ctx.ring(node),
+    };
+    (head, edit, fitted)
+}
+
+/// A lumped mass at a node, with a rotary inertia when `inertia`.
+pub(super) fn mass(ctx: &Ctx<'_>, node: u32, inertia: bool) -> Spec {
+    let model = ctx.model;
+    let name = unique_name(model, &format!("mass_{node}"));
+    let group = unique_name(model, "added_masses");
+    let m0 = 1e-3 * ctx.total_mass;
+    // a radius of gyration of a hundredth of the structure to start
+    let j0 = if inertia { m0 * (0.01 * ctx.size).powi(2) } else { 0.0 };
+    let mut fitted = vec![Fitted {
+        name: format!("mass.{name}.m"),
+        role: Role::Mass,
+        bounds: Some((1e-7 * ctx.total_mass, 10.0 * ctx.total_mass)),
+        plausible: (0.0, 0.25 * ctx.total_mass, "more than a quarter of the structure's mass"),
+    }];
+    let mut dofs = ctx.dim.translations().to_vec();
+    if inertia {
+        let j_scale = ctx.total_mass * ctx.size * ctx.size;
+        fitted.push(Fitted {
+            name: format!("mass.{name}.j"),
+            role: Role::Inertia,
+            bounds: Some((1e-12 * j_scale, 10.0 * j_scale)),
+            plausible: (
+                0.0,
+                0.25 * ctx.total_mass * (0.1 * ctx.size).powi(2),
+                "a quarter of the structure's mass at a tenth of its size",
+            ),
+        });
+        dofs.extend(ctx.dim.rotations());
+    }
+    let edit = Edit::Mass { node, name, group, m: m0, j: j0, dim: ctx.dim };
+    let head = Head {
+        kind: EffectKind::LumpedMass,
+        description: edit.describe(EffectKind::LumpedMass),
+        nodes: vec![node],
+        elements: Vec::new(),
+        dofs,
+        part_nodes: vec![node],
+    };
+    (head, edit, fitted)
+}
+
+/// The existing joint springs, with their stiffness and damping as modelled.
+pub(super) fn existing_joints(ctx: &Ctx<'_>) -> Vec<Spec> {
+    let model = ctx.model;
+    let mut out = Vec::new();
+    for sp in model.springs() {
+        let Some(b) = sp.b else { continue };
+        let kref = ctx.local_stiffness(sp.a.0);
+        let mut fitted: Vec<Fitted> =
+            sp.k.non_zero(ctx.dim.dofs())
+                .into_iter()
+                .map(|d| {
+                    let r = kref[d].max(sp.k[d]);
+                    Fitted {
+                        name: format!("spring.{}.{}", sp.name, ctx.dim.spring_key(d)),
+                        role: Role::Spring(d),
+                        bounds: Some((1e-6 * r, 1e4 * r)),
+                        plausible: (0.0, f64::INFINITY, ""),
+                    }
+                })
+                .collect();
+        let g = &model.groups()[sp.group];
+        let group_only_this = model.springs().iter().filter(|o| o.group == sp.group).count() == 1
+            && model.beams().iter().all(|o| o.group != sp.group)
+            && model.masses().iter().all(|o| o.group != sp.group);
+        if group_only_this && g.alpha > 0.0 {
+            fitted.push(ctx.alpha(format!("group.{}.alpha", g.name)));
+            if g.mu.is_some() {
+                fitted.push(ctx.mu(format!("group.{}.mu", g.name)));
+            }
+        }
+        let head = Head {
+            kind: EffectKind::FlexibleJoint,
+            description: format!("joint `{}` between nodes {} and {} (as modelled)", sp.name, sp.a, b),
+            nodes: vec![sp.a.0, b.0],
+            elements: Vec::new(),
+            dofs: sp.k.non_zero(ctx.dim.dofs()),
+            part_nodes: vec![sp.a.0, b.0],
+        };
+        out.push((head, Edit::Set, fitted));
+    }
+    out
+}
+
+/// Nodes where a lumped mass is a candidate: free in some translation, on a beam.
+pub(super) fn mass_nodes(ctx: &Ctx<'_>) -> Vec<u32> {
+    let model = ctx.model;
+    let mut fixed: HashMap<u32, usize> = HashMap::new();
+    for s in model.supports() {
+        *fixed.entry(s.node.0).or_default() += s.dofs.iter().filter(|d| d.is_translation()).count();
+    }
+    let translations = ctx.dim.translations().len();
+    // nodes of imported mass matrices carry structure as a beam's do
+    let imported: HashSet<u32> = model
+        .imported()
+        .iter()
+        .filter(|b| b.kind == fe_model::imported::ImportedKind::Mass)
+        .flat_map(|b| b.dofs.iter().filter(|r| r.dof.is_translation()).map(|r| r.node.0))
+        .collect();
+    model
+        .nodes()
+        .iter()
+        .map(|n| n.id.0)
+        .filter(|n| {
+            fixed.get(n).copied().unwrap_or(0) < translations && (!ctx.at(*n).is_empty() || imported.contains(n))
+        })
+        .collect()
+}
