@@ -315,6 +315,19 @@ fn update_case(
     Ok((editor, case, misfit_updated, outcome))
 }
 
+/// The diagnosis of `current`'s model, reported as that of step `step`.
+fn diagnosed(
+    current: &CaseFile,
+    measured: &FrfSet,
+    opts: &FixOptions,
+    step: usize,
+    progress: &mut impl FnMut(FixProgress<'_>),
+) -> Result<Diagnosis, UpdateError> {
+    let d = diagnose::diagnose(&current.model, measured, &opts.diagnose)?;
+    progress(FixProgress::Diagnosed { step, diagnosis: &d });
+    Ok(d)
+}
+
 /// The ranks of up to `width` recommendable effects (significant and
 /// plausible, fully fitted or screened) that differ from each other in kind
 /// or place, best first: the full fits cover only the best of each kind, and
@@ -364,21 +377,16 @@ pub fn fix(
     let mut next: Option<Diagnosis> = None;
     // the diagnosis and rank of each effect added, to rebuild without one
     let mut applied: Vec<(Diagnosis, usize)> = Vec::new();
-    let mut diagnosis_error: Option<String> = None;
+    // the loop ends with the last diagnosis when it has one (`None`: the
+    // final model is still to be diagnosed), or with why it failed
     let stop = loop {
         let d = match next.take() {
             Some(d) => d,
-            None => match diagnose::diagnose(&current.model, measured, &opts.diagnose) {
-                Ok(d) => {
-                    progress(FixProgress::Diagnosed { step: steps.len(), diagnosis: &d });
-                    d
-                }
+            None => match diagnosed(&current, measured, opts, steps.len(), &mut progress) {
+                Ok(d) => d,
                 // the nominal model's failure is the user's to see; a later
                 // one must not discard the steps done
-                Err(e) if !steps.is_empty() => {
-                    diagnosis_error = Some(e.to_string());
-                    break (FixStop::DiagnosisFailed, None);
-                }
+                Err(e) if !steps.is_empty() => break (FixStop::DiagnosisFailed, Some(Err(e.to_string()))),
                 Err(e) => return Err(e),
             },
         };
@@ -387,10 +395,10 @@ pub fn fix(
         }
         let Some(rank) = d.recommended else {
             let stop = if d.consistent() { FixStop::NothingSignificant } else { FixStop::NoPlausibleCandidate };
-            break (stop, Some(d));
+            break (stop, Some(Ok(d)));
         };
         if steps.len() == opts.max_steps {
-            break (FixStop::StepsDone, Some(d));
+            break (FixStop::StepsDone, Some(Ok(d)));
         }
         let step = steps.len() + 1;
         let leader_misfit = d.ranking[rank - 1].misfit;
@@ -429,7 +437,7 @@ pub fn fix(
                 }
             }
             let Some((_, a, ahead)) = best else {
-                break (FixStop::CannotAdd, Some(d));
+                break (FixStop::CannotAdd, Some(Ok(d)));
             };
             next = Some(ahead);
             a
@@ -440,7 +448,7 @@ pub fn fix(
                 .chain(distinct_leaders(&d, &current.model, LOOK_AHEAD_WIDTH))
                 .find_map(|r| add_and_update(&current, &d, r, measured, opts, step, step >= opts.max_steps).ok());
             let Some(a) = added else {
-                break (FixStop::CannotAdd, Some(d));
+                break (FixStop::CannotAdd, Some(Ok(d)));
             };
             a
         };
@@ -458,7 +466,7 @@ pub fn fix(
         applied.push((d, added.rank));
         steps.push(FixStep::of(added, alternatives, None));
         if !improved {
-            break (FixStop::NoImprovement, next.take());
+            break (FixStop::NoImprovement, next.take().map(Ok));
         }
     };
     let (stop, mut last) = stop;
@@ -491,18 +499,11 @@ pub fn fix(
         }
         last = None;
     }
-    let last = match last {
-        Some(d) => Some(d),
-        None => match diagnose::diagnose(&current.model, measured, &opts.diagnose) {
-            Ok(d) => {
-                progress(FixProgress::Diagnosed { step: steps.len(), diagnosis: &d });
-                Some(d)
-            }
-            Err(e) => {
-                diagnosis_error = Some(e.to_string());
-                None
-            }
-        },
+    let last = last
+        .unwrap_or_else(|| diagnosed(&current, measured, opts, steps.len(), &mut progress).map_err(|e| e.to_string()));
+    let (last, diagnosis_error) = match last {
+        Ok(d) => (Some(d), None),
+        Err(e) => (None, Some(e)),
     };
     Ok(FixOutcome {
         noise,

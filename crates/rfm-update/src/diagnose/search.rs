@@ -385,19 +385,20 @@ impl<'a> Pool<'a> {
     /// ended).
     pub(crate) fn twins(&mut self, opts: &CandidateOptions, leaders: usize) -> Twins {
         let tried = self.descriptions();
-        let order = self.by_full_fit();
+        let leading: Vec<usize> = self
+            .by_full_fit()
+            .into_iter()
+            .filter(|&i| self.candidates[i].kind == EffectKind::StiffnessChange)
+            .take(leaders)
+            .collect();
+        let of: Vec<&Candidate> = leading.iter().map(|&i| &self.candidates[i]).collect();
         let (mut twins, mut originals, mut starts) = (Vec::new(), Vec::new(), Vec::new());
-        for kind in [EffectKind::StiffnessChange] {
-            for &i in order.iter().filter(|&&i| self.candidates[i].kind == kind).take(leaders) {
-                for t in candidates::twins(self.model, opts, &self.candidates[i]) {
-                    if !tried.contains(&t.description)
-                        && !twins.iter().any(|o: &Candidate| o.description == t.description)
-                    {
-                        starts.push(self.full[i].as_ref().map(|f| f.values.clone()));
-                        originals.push(i);
-                        twins.push(t);
-                    }
-                }
+        for (k, t) in candidates::twins(self.model, opts, &of) {
+            if !tried.contains(&t.description) && !twins.iter().any(|o: &Candidate| o.description == t.description) {
+                let i = leading[k];
+                starts.push(self.full[i].as_ref().map(|f| f.values.clone()));
+                originals.push(i);
+                twins.push(t);
             }
         }
         Twins { twins: self.add(twins), originals, starts }
@@ -407,8 +408,8 @@ impl<'a> Pool<'a> {
     /// [`TWIN_EVIDENCE`]: where the data cannot tell the two apart (a
     /// cantilever measured across its axis never stretches), the change
     /// stays the plain one the user would write first.
-    pub(crate) fn keep_better_twins(&mut self, t: &Twins) {
-        for (&twin, &original) in t.twins.iter().zip(&t.originals) {
+    pub(crate) fn keep_better_twins(&mut self, twins: &[usize], originals: &[usize]) {
+        for (&twin, &original) in twins.iter().zip(originals) {
             let score = |i: usize| self.full[i].as_ref().map(|f| self.bic(f, self.candidates[i].parameters.len()));
             if let (Some(a), Some(b)) = (score(twin), score(original))
                 && a > b - TWIN_EVIDENCE
@@ -529,12 +530,11 @@ pub(crate) fn search(
         trace(&format!("fitted {} variants with a damping group per direction", variants.len()));
     }
     // the twins of the leading stiffness changes, started where those ended
-    let twins = pool.twins(copts, TWINNED_LEADERS);
-    if !twins.twins.is_empty() {
-        let starts = Some(twins.starts.clone());
-        pool.full_fit(full, &coarse, (opts.iterations, opts.screen_iterations), &twins.twins, starts)?;
-        pool.keep_better_twins(&twins);
-        trace(&format!("fitted {} twins of the leaders", twins.twins.len()));
+    let Twins { twins, originals, starts } = pool.twins(copts, TWINNED_LEADERS);
+    if !twins.is_empty() {
+        pool.full_fit(full, &coarse, (opts.iterations, opts.screen_iterations), &twins, Some(starts))?;
+        pool.keep_better_twins(&twins, &originals);
+        trace(&format!("fitted {} twins of the leaders", twins.len()));
     }
     pool.hold_undetermined(full, &coarse, (opts.iterations, opts.screen_iterations))?;
     trace("held what the data do not determine");

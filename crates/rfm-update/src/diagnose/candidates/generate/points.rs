@@ -10,6 +10,18 @@ use super::{Ctx, Spec, ids, unique_name};
 use crate::diagnose::candidates::edit::Edit;
 use crate::diagnose::candidates::{EffectKind, Fitted, Head, Role};
 
+/// The stiffness in DOF `d` of spring `name` as a fitted parameter, searched
+/// from 1e-6 to 1e4 times `reference` (the stiffness of the members there).
+fn spring(ctx: &Ctx<'_>, name: &str, d: Dof, reference: f64) -> Fitted {
+    Fitted {
+        name: format!("spring.{name}.{}", ctx.dim.spring_key(d)),
+        role: Role::Spring(d),
+        bounds: Some((1e-6 * reference, 1e4 * reference)),
+        // a spring far stiffer than the member is as good as rigid, not implausible
+        plausible: (0.0, f64::INFINITY, ""),
+    }
+}
+
 /// The flexible, lossy support candidates of a supported node: every fixed
 /// DOF released onto a ground spring, viscous and non-viscous.
 pub(super) fn supports(ctx: &Ctx<'_>, node: u32) -> Vec<Spec> {
@@ -29,19 +41,7 @@ pub(super) fn supports(ctx: &Ctx<'_>, node: u32) -> Vec<Spec> {
         for &d in &fixed {
             k[d] = 100.0 * kref[d];
         }
-        let mut fitted: Vec<Fitted> = fixed
-            .iter()
-            .map(|&d| {
-                let r = kref[d];
-                Fitted {
-                    name: format!("spring.{name}.{}", ctx.dim.spring_key(d)),
-                    role: Role::Spring(d),
-                    bounds: Some((1e-6 * r, 1e4 * r)),
-                    // a spring far stiffer than the member is as good as rigid, not implausible
-                    plausible: (0.0, f64::INFINITY, ""),
-                }
-            })
-            .collect();
+        let mut fitted: Vec<Fitted> = fixed.iter().map(|&d| spring(ctx, &name, d, kref[d])).collect();
         fitted.push(ctx.alpha(format!("group.{name}.alpha")));
         if non_viscous {
             fitted.push(ctx.mu(format!("group.{name}.mu")));
@@ -90,12 +90,7 @@ pub(super) fn joint(
     for &d in &sprung {
         let r = kref[d].max(f64::MIN_POSITIVE);
         k[d] = 100.0 * r;
-        fitted.push(Fitted {
-            name: format!("spring.{name}.{}", ctx.dim.spring_key(d)),
-            role: Role::Spring(d),
-            bounds: Some((1e-6 * r, 1e4 * r)),
-            plausible: (0.0, f64::INFINITY, ""),
-        });
+        fitted.push(spring(ctx, &name, d, r));
     }
     fitted.push(ctx.alpha(format!("group.{name}.alpha")));
     if non_viscous {
@@ -174,18 +169,7 @@ pub(super) fn existing_joints(ctx: &Ctx<'_>) -> Vec<Spec> {
         let Some(b) = sp.b else { continue };
         let kref = ctx.local_stiffness(sp.a.0);
         let mut fitted: Vec<Fitted> =
-            sp.k.non_zero(ctx.dim.dofs())
-                .into_iter()
-                .map(|d| {
-                    let r = kref[d].max(sp.k[d]);
-                    Fitted {
-                        name: format!("spring.{}.{}", sp.name, ctx.dim.spring_key(d)),
-                        role: Role::Spring(d),
-                        bounds: Some((1e-6 * r, 1e4 * r)),
-                        plausible: (0.0, f64::INFINITY, ""),
-                    }
-                })
-                .collect();
+            sp.k.non_zero(ctx.dim.dofs()).into_iter().map(|d| spring(ctx, &sp.name, d, kref[d].max(sp.k[d]))).collect();
         let g = &model.groups()[sp.group];
         let group_only_this = model.springs().iter().filter(|o| o.group == sp.group).count() == 1
             && model.beams().iter().all(|o| o.group != sp.group)

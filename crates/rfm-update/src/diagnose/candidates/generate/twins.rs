@@ -25,25 +25,33 @@ use fe_model::{ElementId, Model};
 use super::{Ctx, build, window};
 use crate::diagnose::candidates::{Candidate, CandidateOptions, Edit, EffectKind};
 
-/// The twins of a candidate (none for most kinds).
-pub(crate) fn twins(model: &Model, opts: &CandidateOptions, c: &Candidate) -> Vec<Candidate> {
-    let whole_stiffness = c.kind == EffectKind::StiffnessChange
-        && c.edit == Edit::Set
-        && c.parameters.len() == 1
-        && c.parameters[0].starts_with("element.")
-        && c.parameters[0].ends_with(".stiffness");
-    if !whole_stiffness {
-        return Vec::new();
-    }
+/// The twins of the given candidates, each with the index (in `of`) of its
+/// original; most kinds have none.
+pub(crate) fn twins(model: &Model, opts: &CandidateOptions, of: &[&Candidate]) -> Vec<(usize, Candidate)> {
     let ctx = Ctx::new(model, opts);
-    let beams: Option<Vec<usize>> = c.elements.iter().map(|&e| model.beam_index(ElementId(e))).collect();
-    let Some((mut head, edit, mut fitted)) = beams.and_then(|b| window(&ctx, &b, &[EffectKind::StiffnessChange]).pop())
-    else {
-        return Vec::new();
-    };
-    head.description = format!("bending {}", head.description);
-    let f = &mut fitted[0];
-    f.name = format!("{}.bending", f.name.strip_suffix(".stiffness").expect("a stiffness factor"));
-    f.plausible.2 = "a change beyond -95 % .. +50 % of the nominal bending stiffness";
-    build(&ctx, vec![(head, edit, fitted)])
+    let mut specs = Vec::new();
+    let mut originals = Vec::new();
+    for (k, c) in of.iter().enumerate() {
+        let whole_stiffness = c.kind == EffectKind::StiffnessChange
+            && c.edit == Edit::Set
+            && c.parameters.len() == 1
+            && c.parameters[0].starts_with("element.")
+            && c.parameters[0].ends_with(".stiffness");
+        if !whole_stiffness {
+            continue;
+        }
+        let beams: Option<Vec<usize>> = c.elements.iter().map(|&e| model.beam_index(ElementId(e))).collect();
+        let Some((mut head, edit, mut fitted)) =
+            beams.and_then(|b| window(&ctx, &b, &[EffectKind::StiffnessChange]).pop())
+        else {
+            continue;
+        };
+        head.description = format!("bending {}", head.description);
+        let f = &mut fitted[0];
+        f.name = format!("{}.bending", f.name.strip_suffix(".stiffness").expect("a stiffness factor"));
+        f.plausible.2 = "a change beyond -95 % .. +50 % of the nominal bending stiffness";
+        specs.push((head, edit, fitted));
+        originals.push(k);
+    }
+    originals.into_iter().zip(specs).filter_map(|(k, spec)| build(&ctx, vec![spec]).pop().map(|c| (k, c))).collect()
 }
