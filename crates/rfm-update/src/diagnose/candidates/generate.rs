@@ -142,6 +142,16 @@ impl<'a> Ctx<'a> {
         }
     }
 
+    /// The damping parameters of group `group`: alpha, and mu when
+    /// non-viscous.
+    fn group_damping(&self, group: &str, non_viscous: bool) -> Vec<Fitted> {
+        let mut fitted = vec![self.alpha(format!("group.{group}.alpha"))];
+        if non_viscous {
+            fitted.push(self.mu(format!("group.{group}.mu")));
+        }
+        fitted
+    }
+
     fn mu(&self, name: String) -> Fitted {
         Fitted {
             name,
@@ -351,10 +361,7 @@ fn window(ctx: &Ctx<'_>, w: &[usize], kinds: &[EffectKind]) -> Vec<Spec> {
         if !kinds.contains(&kind) {
             continue;
         }
-        let mut fitted = vec![ctx.alpha(format!("group.{name}.alpha"))];
-        if non_viscous {
-            fitted.push(ctx.mu(format!("group.{name}.mu")));
-        }
+        let fitted = ctx.group_damping(&name, non_viscous);
         let mut h = head(kind);
         h.description = format!("{} in {}", kind.label(), range_name(&ids));
         out.push((h, Edit::Region { first, last, group: g }, fitted));

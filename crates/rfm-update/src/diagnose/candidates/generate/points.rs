@@ -42,10 +42,7 @@ pub(super) fn supports(ctx: &Ctx<'_>, node: u32) -> Vec<Spec> {
             k[d] = 100.0 * kref[d];
         }
         let mut fitted: Vec<Fitted> = fixed.iter().map(|&d| spring(ctx, &name, d, kref[d])).collect();
-        fitted.push(ctx.alpha(format!("group.{name}.alpha")));
-        if non_viscous {
-            fitted.push(ctx.mu(format!("group.{name}.mu")));
-        }
+        fitted.extend(ctx.group_damping(&name, non_viscous));
         let edit = Edit::Support {
             node,
             fixed: fixed.clone(),
@@ -92,10 +89,7 @@ pub(super) fn joint(
         k[d] = 100.0 * r;
         fitted.push(spring(ctx, &name, d, r));
     }
-    fitted.push(ctx.alpha(format!("group.{name}.alpha")));
-    if non_viscous {
-        fitted.push(ctx.mu(format!("group.{name}.mu")));
-    }
+    fitted.extend(ctx.group_damping(&name, non_viscous));
     let edit = Edit::Joint {
         node,
         elements: elements.clone(),
@@ -175,10 +169,7 @@ pub(super) fn existing_joints(ctx: &Ctx<'_>) -> Vec<Spec> {
             && model.beams().iter().all(|o| o.group != sp.group)
             && model.masses().iter().all(|o| o.group != sp.group);
         if group_only_this && g.alpha > 0.0 {
-            fitted.push(ctx.alpha(format!("group.{}.alpha", g.name)));
-            if g.mu.is_some() {
-                fitted.push(ctx.mu(format!("group.{}.mu", g.name)));
-            }
+            fitted.extend(ctx.group_damping(&g.name, g.mu.is_some()));
         }
         let head = Head {
             kind: EffectKind::FlexibleJoint,
