@@ -73,7 +73,7 @@ const CLASSIC: [Bug; 5] = [
     Bug {
         what: "covariance doubled",
         package: "rfm-update",
-        file: "crates/rfm-update/src/oe/mod.rs",
+        file: "crates/rfm-update/src/output_error/mod.rs",
         from: "sigma2 * sol.scaled_inverse_normal[(i, j)]",
         to: "2.0 * sigma2 * sol.scaled_inverse_normal[(i, j)]",
     },

@@ -12,7 +12,7 @@ use std::fmt;
 use fe_model::{CaseError, ModelError};
 use frf::{FileError, FrfError};
 use rfm_update::UpdateError;
-use rfm_update::rfm::Status;
+use rfm_update::status::Status;
 
 use crate::output::OutputError;
 

@@ -31,7 +31,7 @@ use serde::Serialize;
 
 use crate::diagnose::{self, DiagnoseOptions, Diagnosis, Ranked};
 use crate::error::UpdateError;
-use crate::rfm::Status;
+use crate::status::Status;
 use crate::study::{ParameterReport, Study};
 use crate::uncertainty::UncertaintyReport;
 

@@ -10,7 +10,7 @@
 //! ```
 //!
 //! stacked over frequency points, real and imaginary parts, solved by least
-//! squares, iterated ([`rfm`]). The sensitivity columns come from
+//! squares, iterated ([`response_function`]). The sensitivity columns come from
 //! [`sensitivity`]: one sparse factorisation of `Z(w)` and one solve per
 //! measured DOF and reference per frequency, then a short local product per
 //! parameter, frequencies in parallel.
@@ -27,7 +27,7 @@
 //! use fe_model::{Dof, DofRef, samples};
 //! use frf::{Channel, synthesize};
 //! use rfm_update::params::ParameterSet;
-//! use rfm_update::rfm::{self, RfmOptions};
+//! use rfm_update::response_function::{self, RfmOptions};
 //!
 //! // truth: the paper's two-material beam; model: steel group's mu and alpha off
 //! let truth = DampedSystem::new(samples::two_material_cantilever()).unwrap();
@@ -43,7 +43,7 @@
 //! let measured = synthesize(&truth, &channels, &lines).unwrap();
 //!
 //! let params = ParameterSet::of_quantities(&model, &[mu, alpha]);
-//! let result = rfm::run(&mut model, &params, &measured, &RfmOptions::default(), |_| {}).unwrap();
+//! let result = response_function::run(&mut model, &params, &measured, &RfmOptions::default(), |_| {}).unwrap();
 //! assert!((result.values[0] / 631.12 - 1.0).abs() < 1e-8);
 //! assert!((result.values[1] / 1e-5 - 1.0).abs() < 1e-8);
 //! ```
@@ -60,7 +60,7 @@
 //! use frf::correlation::{BandSpec, correlate};
 //! use rfm_update::diagnose::{self, DiagnoseOptions};
 //! use rfm_update::Study;
-//! use rfm_update::rfm::Status;
+//! use rfm_update::status::Status;
 //!
 //! let path = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../cases/tutorial/l-frame.toml"));
 //! let study = Study::load(path).unwrap();
@@ -97,10 +97,11 @@ pub mod history;
 pub mod jackknife;
 pub mod lstsq;
 pub mod measured;
-pub mod oe;
+pub mod output_error;
 pub mod params;
-pub mod rfm;
+pub mod response_function;
 pub mod sensitivity;
+pub mod status;
 pub mod study;
 pub mod uncertainty;
 pub mod verdict;

@@ -1,7 +1,7 @@
 //! Parameter uncertainty and identifiability at an output-error solution.
 //!
 //! With log-parameters `theta_i = ln(p_i / p_i0)` and covariance `C` of theta
-//! (see [`crate::oe`]), parameter `i` has relative standard deviation
+//! (see [`crate::output_error`]), parameter `i` has relative standard deviation
 //! `s_i = sqrt(C_ii)`, standard deviation about `p_i s_i`, and the 95 %
 //! interval `p_i exp(-1.96 s_i) .. p_i exp(1.96 s_i)` (asymmetric, as a
 //! positive parameter's should be). Correlations are `C_ij / sqrt(C_ii C_jj)`.
@@ -46,7 +46,7 @@ use fe_model::Quantity;
 use serde::Serialize;
 
 use crate::lstsq;
-use crate::oe::OeResult;
+use crate::output_error::OeResult;
 use crate::params::ParameterSet;
 
 /// Uncertainty of one parameter.

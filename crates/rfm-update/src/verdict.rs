@@ -6,7 +6,7 @@
 //! alone says nothing about whether the model explains the data. For
 //! multiplicative noise of relative level `s`, the RMS residual per complex
 //! value of a model that explains the data is about `s` (both misfit forms,
-//! see [`crate::oe`], and the RFM's relative misfit). So a run is called
+//! see [`crate::output_error`], and the RFM's relative misfit). So a run is called
 //! [`Status::Converged`] only when its residual is within [`NOISE_FACTOR`]
 //! times the noise estimated from the data
 //! ([`crate::diagnose::estimate_noise`]). Above it, the fit either sits in a
@@ -14,7 +14,7 @@
 //! or the model cannot represent the data (restarts end at the same
 //! minimum: [`Status::ModelInadequate`]).
 
-use crate::rfm::Status;
+use crate::status::Status;
 
 /// A residual up to this many times the noise is consistent with it.
 pub const NOISE_FACTOR: f64 = 1.5;

@@ -103,7 +103,7 @@ pub struct HistoryEntry {
 }
 
 /// How an updating run may end, as its results name it (the statuses of
-/// `rfm_update::rfm::Status`, whose tests keep the two lists equal).
+/// `rfm_update::status::Status`, whose tests keep the two lists equal).
 pub const RUN_STATUSES: [&str; 6] =
     ["converged", "model_inadequate", "local_minimum", "stalled", "max_iterations", "failed"];
 

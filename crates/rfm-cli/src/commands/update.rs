@@ -3,8 +3,11 @@
 use std::path::Path;
 
 use indicatif::{ProgressBar, ProgressStyle};
-use rfm_update::rfm::{IterationRecord, RfmOptions, Status};
 use rfm_update::{Method, Study, UpdateOutcome};
+use rfm_update::{
+    response_function::RfmOptions,
+    status::{IterationRecord, Status},
+};
 
 use super::{Result, print_masked, print_notes};
 use crate::exit::{Exit, Failure};

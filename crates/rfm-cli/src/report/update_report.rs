@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 
 use frf::correlation::{BandSpec, correlate};
 use frf::synthesize_regular;
-use rfm_update::oe::Gain;
-use rfm_update::rfm::Status;
+use rfm_update::output_error::Gain;
+use rfm_update::status::Status;
 use rfm_update::study::FrequencyTable;
 use rfm_update::{Study, UpdateOutcome};
 

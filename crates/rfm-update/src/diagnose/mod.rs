@@ -185,7 +185,7 @@ pub struct Ranked {
     pub kind: EffectKind,
     /// The unknown gains fitted with it, per reference (empty unless the
     /// diagnosis fits gains: [`DiagnoseOptions::gains`]).
-    pub gains: Vec<crate::oe::Gain>,
+    pub gains: Vec<crate::output_error::Gain>,
     /// Plain-language description with location.
     pub description: String,
     /// Nodes where it acts.

@@ -14,7 +14,7 @@ use super::candidates::{self, Candidate, CandidateOptions, EffectKind, Role};
 use super::local::{LocalCandidate, LocalData};
 use super::{DiagnoseOptions, informative_lines};
 use crate::error::UpdateError;
-use crate::oe::{self, Misfit, OeData, OeOptions};
+use crate::output_error::{self, Misfit, OeData, OeOptions};
 use crate::params::ParameterSet;
 use fe_model::case::Gains;
 
@@ -38,7 +38,7 @@ pub(crate) struct Fit {
     /// Per parameter: the data determine it (see [`determined`]).
     pub(crate) determined: Vec<bool>,
     /// The gains fitted with it (empty unless the line set fits gains).
-    pub(crate) gains: Vec<oe::Gain>,
+    pub(crate) gains: Vec<output_error::Gain>,
 }
 
 /// A line set with the nominal model's cost on it.
@@ -84,7 +84,7 @@ impl LineSet {
 /// Per parameter, whether the data determine it: a finite relative standard
 /// deviation below [`UNDETERMINED_STD`], and for a spring not at its upper
 /// bound (where it is as good as rigid and its sensitivity vanishes).
-fn determined(c: &Candidate, r: &oe::OeResult, relative_std: &[f64]) -> Vec<bool> {
+fn determined(c: &Candidate, r: &output_error::OeResult, relative_std: &[f64]) -> Vec<bool> {
     (0..c.parameters.len())
         .map(|i| {
             let rigid = matches!(c.roles[i], Role::Spring(_))
@@ -137,9 +137,9 @@ fn fit(
     let r = match local {
         Some((ld, lc)) => {
             let mut response = ld.response(lc, sys);
-            oe::run_with(&mut response, now, &data, &opts, |_| {})
+            output_error::run_with(&mut response, now, &data, &opts, |_| {})
         }
-        None => oe::run(&mut sys, &params, &data, &opts, |_| {}),
+        None => output_error::run(&mut sys, &params, &data, &opts, |_| {}),
     }
     .map_err(|e| e.to_string())?;
     if !r.cost.is_finite() {

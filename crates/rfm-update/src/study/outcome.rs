@@ -4,8 +4,8 @@ use damping::DampedSystem;
 use serde::Serialize;
 
 use super::{FrequencyTable, PairingReport, Study};
-use crate::oe::Gain;
-use crate::rfm::{IterationRecord, Status};
+use crate::output_error::Gain;
+use crate::status::{IterationRecord, Status};
 use crate::uncertainty::UncertaintyReport;
 
 /// One parameter's values for reporting.

@@ -5,8 +5,8 @@ use fe_model::case::Gains;
 
 use super::{Method, Restart, Study, UpdateOutcome, describe_masked};
 use crate::error::UpdateError;
-use crate::oe::{self, Misfit, OeData, OeOptions};
-use crate::rfm::{IterationRecord, Status};
+use crate::output_error::{self, Misfit, OeData, OeOptions};
+use crate::status::{IterationRecord, Status};
 use crate::uncertainty;
 use crate::verdict;
 
@@ -71,10 +71,11 @@ impl Study {
         let mut sys = self.system.clone();
         let data = OeData { measured: &measured, weights: weights.as_deref() };
         let noise = crate::diagnose::estimate_noise(&self.measured);
-        let ratio = |r: &oe::OeResult| noise.filter(|&s| s > 0.0).map(|s| (2.0 * r.sigma2).sqrt() / s);
-        let first = oe::run(&mut sys, &params, &data, opts, on_iteration)?;
-        let settled =
-            |r: &oe::OeResult| r.status == Status::Converged && ratio(r).is_none_or(|x| x <= verdict::RESTART_ABOVE);
+        let ratio = |r: &output_error::OeResult| noise.filter(|&s| s > 0.0).map(|s| (2.0 * r.sigma2).sqrt() / s);
+        let first = output_error::run(&mut sys, &params, &data, opts, on_iteration)?;
+        let settled = |r: &output_error::OeResult| {
+            r.status == Status::Converged && ratio(r).is_none_or(|x| x <= verdict::RESTART_ABOVE)
+        };
         let mut restarts = Vec::new();
         let mut agree = None;
         let mut history = first.history.clone();
@@ -88,13 +89,13 @@ impl Study {
                 .enumerate()
                 .map(|(i, &p)| opts.bounds.get(i).copied().flatten().unwrap_or((p / 1e6, p * 1e6)))
                 .collect();
-            let fit = |start: &[f64], o: &OeOptions| -> Option<oe::OeResult> {
+            let fit = |start: &[f64], o: &OeOptions| -> Option<output_error::OeResult> {
                 let mut s = self.system.clone();
                 params.set_values(&mut s, start).ok()?;
-                oe::run(&mut s, &params, &data, o, |_| {}).ok().filter(|r| r.cost.is_finite())
+                output_error::run(&mut s, &params, &data, o, |_| {}).ok().filter(|r| r.cost.is_finite())
             };
             let short = OeOptions { max_iterations: RESTART_STEPS, ..opts.clone() };
-            let mut tried: Vec<oe::OeResult> = (1..=opts.restarts)
+            let mut tried: Vec<output_error::OeResult> = (1..=opts.restarts)
                 .filter_map(|i| fit(&verdict::spread_start(&p_init, &bounds, i, RESTART_SPREAD), &short))
                 .collect();
             tried.sort_by(|a, b| a.cost.total_cmp(&b.cost));

@@ -5,8 +5,11 @@ use fe_model::case::Gains;
 
 use super::{Method, Study, UpdateOutcome, describe_masked};
 use crate::error::UpdateError;
-use crate::rfm::{self, IterationRecord, RfmOptions};
 use crate::verdict;
+use crate::{
+    response_function::{self, RfmOptions},
+    status::IterationRecord,
+};
 
 impl Study {
     /// RFM options from the case's `[update]` section (iteration limit,
@@ -48,7 +51,7 @@ impl Study {
         if let Some(spec) = &self.case.update {
             opts.bounds = spec.bounds.clone();
         }
-        let result = rfm::run(&mut sys, &self.parameter_set(), &measured, &opts, on_iteration)?;
+        let result = response_function::run(&mut sys, &self.parameter_set(), &measured, &opts, on_iteration)?;
         let mut warnings: Vec<String> = self
             .parameters
             .iter()
@@ -62,7 +65,7 @@ impl Study {
                     format!(
                         "{} ended a factor of {:e} from its initial value, the most the RFM allows without bounds of its own: the data do not determine it",
                         p.name,
-                        rfm::DEFAULT_RANGE
+                        response_function::DEFAULT_RANGE
                     )
                 }
             })

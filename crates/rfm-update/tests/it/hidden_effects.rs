@@ -18,7 +18,7 @@ use frf::{Channel, FrfSet, NoiseModel, synthesize};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rfm_update::diagnose::{DiagnoseOptions, Diagnosis, EffectKind, diagnose};
-use rfm_update::oe::{self, OeData, OeOptions};
+use rfm_update::output_error::{self, OeData, OeOptions};
 use rfm_update::params::ParameterSet;
 
 const N_EL: u32 = 20;
@@ -151,8 +151,14 @@ fn run_trial(h: &Hidden, measured: &FrfSet, opts: &DiagnoseOptions) -> Outcome {
     let fit_lines: Vec<f64> = lines().into_iter().step_by(4).collect();
     let data_lines = measured.at_frequencies(&fit_lines).unwrap();
     let before = misfit(&DampedSystem::new(model).unwrap(), &data_lines);
-    let r = oe::run(&mut sys, &params, &OeData { measured: &data_lines, weights: None }, &OeOptions::default(), |_| {})
-        .unwrap();
+    let r = output_error::run(
+        &mut sys,
+        &params,
+        &OeData { measured: &data_lines, weights: None },
+        &OeOptions::default(),
+        |_| {},
+    )
+    .unwrap();
     let after = misfit(&sys, &data_lines);
     let mut within = right_kind;
     let mut detail = String::new();

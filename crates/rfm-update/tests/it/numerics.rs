@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use fe_model::CaseFile;
 use rfm_update::Study;
-use rfm_update::rfm::RfmOptions;
+use rfm_update::response_function::RfmOptions;
 
 /// The two-material beam of Table 1 with its `[update]` parameters replaced
 /// (steel's beta and all of aluminium's damping at their truth, so that

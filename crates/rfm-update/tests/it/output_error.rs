@@ -3,9 +3,9 @@
 use damping::DampedSystem;
 use fe_model::{Dof, DofRef, samples};
 use frf::{C64, Channel, FrfSet, NoiseModel, synthesize};
-use rfm_update::oe::{self, Misfit, OeData, OeOptions};
+use rfm_update::output_error::{self, Misfit, OeData, OeOptions};
 use rfm_update::params::ParameterSet;
-use rfm_update::rfm::Status;
+use rfm_update::status::Status;
 
 fn beam_data(truth: &DampedSystem, noise: f64) -> FrfSet {
     let tip = DofRef::new(31, Dof::Uy);
@@ -41,7 +41,7 @@ fn an_unknown_complex_gain_per_reference_is_estimated_with_the_parameters() {
     }
     let (mut model, params) = perturbed(&truth);
     let opts = OeOptions { gains: true, ..OeOptions::default() };
-    let r = oe::run(&mut model, &params, &OeData { measured: &data, weights: None }, &opts, |_| {}).unwrap();
+    let r = output_error::run(&mut model, &params, &OeData { measured: &data, weights: None }, &opts, |_| {}).unwrap();
     assert_eq!(r.status, Status::Converged);
     assert!((r.gains[0].magnitude / 0.37 - 1.0).abs() < 1e-8, "{:?}", r.gains);
     assert!((r.gains[0].phase_deg - 0.4f64.to_degrees()).abs() < 1e-6, "{:?}", r.gains);
@@ -51,8 +51,14 @@ fn an_unknown_complex_gain_per_reference_is_estimated_with_the_parameters() {
     }
     // without the gain the same data cannot be fitted
     let (mut model, params) = perturbed(&truth);
-    let r = oe::run(&mut model, &params, &OeData { measured: &data, weights: None }, &OeOptions::default(), |_| {})
-        .unwrap();
+    let r = output_error::run(
+        &mut model,
+        &params,
+        &OeData { measured: &data, weights: None },
+        &OeOptions::default(),
+        |_| {},
+    )
+    .unwrap();
     assert!(r.history.last().unwrap().residual > 0.3);
 }
 
@@ -64,7 +70,7 @@ fn an_active_bound_holds_and_is_reported() {
     // the steel mu is 631 in truth; keep it below 400
     let start = params.values(&model);
     let opts = OeOptions { bounds: vec![Some((1.0, 400.0)), None, None], ..OeOptions::default() };
-    let r = oe::run(&mut model, &params, &OeData { measured: &data, weights: None }, &opts, |_| {}).unwrap();
+    let r = output_error::run(&mut model, &params, &OeData { measured: &data, weights: None }, &opts, |_| {}).unwrap();
     assert!(start[0] <= 400.0);
     assert!((r.values[0] - 400.0).abs() < 1e-9, "{}", r.values[0]);
     assert_eq!(r.at_bound, vec![true, false, false]);
@@ -91,7 +97,8 @@ fn band_weights_of_zero_mask_corrupted_lines() {
     }
     let (mut model, params) = perturbed(&truth);
     let opts = OeOptions { misfit: Misfit::Log, ..OeOptions::default() };
-    let r = oe::run(&mut model, &params, &OeData { measured: &data, weights: Some(&weights) }, &opts, |_| {}).unwrap();
+    let r = output_error::run(&mut model, &params, &OeData { measured: &data, weights: Some(&weights) }, &opts, |_| {})
+        .unwrap();
     for (&v, q) in r.values.iter().zip(params.quantities()) {
         let t = truth.get(*q);
         assert!((v / t - 1.0).abs() < 1e-6, "{v} vs {t}");
@@ -132,7 +139,8 @@ fn covariance_is_the_gauss_newton_one_with_a_finite_difference_jacobian() {
     let data = beam_data(&truth, 0.01);
     let (mut model, params) = perturbed(&truth);
     let opts = OeOptions { misfit: Misfit::Log, ..OeOptions::default() };
-    let fit = oe::run(&mut model, &params, &OeData { measured: &data, weights: None }, &opts, |_| {}).unwrap();
+    let fit =
+        output_error::run(&mut model, &params, &OeData { measured: &data, weights: None }, &opts, |_| {}).unwrap();
     assert_eq!(fit.status, Status::Converged);
     assert!(fit.at_bound.iter().all(|b| !b));
     let residuals = |values: &[f64]| -> Vec<f64> {

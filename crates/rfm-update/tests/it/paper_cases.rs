@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use rfm_update::Study;
-use rfm_update::rfm::Status;
+use rfm_update::status::Status;
 
 fn case(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases").join(format!("{name}.toml"))
@@ -146,15 +146,15 @@ fn f_frame_output_error_stops_within_the_noise_near_the_optimum() {
     let lines = study.lines_for(rfm_update::Method::OutputError).unwrap();
     let measured = study.measured.at_frequencies(&lines).unwrap();
     let params = study.parameter_set();
-    let data = rfm_update::oe::OeData { measured: &measured, weights: None };
+    let data = rfm_update::output_error::OeData { measured: &measured, weights: None };
     let mut sys = study.system.clone();
-    let first = rfm_update::oe::run(&mut sys, &params, &data, &opts, |_| {}).unwrap();
+    let first = rfm_update::output_error::run(&mut sys, &params, &data, &opts, |_| {}).unwrap();
     assert_eq!(first.status, Status::Converged);
     assert!(first.flat_valley);
     assert!(first.history.len() < opts.max_iterations, "{} steps", first.history.len());
 
-    let exact = rfm_update::oe::OeOptions { stop_within_noise: false, max_iterations: 5000, ..opts.clone() };
-    let optimum = rfm_update::oe::run(&mut sys, &params, &data, &exact, |_| {}).unwrap();
+    let exact = rfm_update::output_error::OeOptions { stop_within_noise: false, max_iterations: 5000, ..opts.clone() };
+    let optimum = rfm_update::output_error::run(&mut sys, &params, &data, &exact, |_| {}).unwrap();
     assert_eq!(optimum.status, Status::Converged);
     assert!(!optimum.flat_valley);
     let chi2_gain = (first.cost - optimum.cost) / first.sigma2;

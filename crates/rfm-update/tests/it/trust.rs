@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use fe_model::CaseFile;
 use rfm_update::Study;
-use rfm_update::rfm::Status;
+use rfm_update::status::Status;
 
 fn beam(noise: f64) -> Study {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases/two-material-beam-noisy.toml");

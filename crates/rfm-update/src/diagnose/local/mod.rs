@@ -93,7 +93,7 @@ mod tests {
     use super::data::unit_solves;
     use super::*;
     use crate::diagnose::candidates::{self, CandidateOptions, EffectKind};
-    use crate::oe::Response;
+    use crate::output_error::Response;
     use crate::sensitivity::{self, ChannelPlan, Hybrid};
     use fe_model::{Dof, DofRef, samples};
 

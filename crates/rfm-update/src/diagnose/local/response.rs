@@ -10,7 +10,7 @@ use num_complex::Complex64 as C64;
 use super::kernels::{condense, lu_in_place, lu_solve, lu_solve_transposed};
 use super::{LocalCandidate, LocalData, LocalForm, ZERO};
 use crate::error::UpdateError;
-use crate::oe::{Evaluated, Response};
+use crate::output_error::{Evaluated, Response};
 use crate::params::ParameterSet;
 
 impl LocalData {

@@ -72,8 +72,8 @@ use self::response::FullModel;
 use crate::error::UpdateError;
 use crate::lstsq;
 use crate::params::ParameterSet;
-use crate::rfm::{IterationRecord, Status};
 use crate::sensitivity::ChannelPlan;
+use crate::status::{IterationRecord, Status};
 
 /// Form of the residual; see the module docs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
