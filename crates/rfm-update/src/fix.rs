@@ -11,7 +11,9 @@
 //!    added so far: an effect fitted while another was still missing is
 //!    biased, and the joint update removes that bias,
 //!
-//! and records the misfit after 2 and after 3 in the case's history. The
+//! and records the misfit after 2 and after 3 in the case's history. When
+//! the best single effect leaves far more than the noise, two effects fitted
+//! together may be added as two steps instead ([`fix`], `pairs.rs`). The
 //! loop stops when no candidate is significant (the model is consistent
 //! with the data), when the significant ones are all implausible (the
 //! missing effect is not among the candidates), when an update does not
@@ -35,6 +37,7 @@ use crate::status::Status;
 use crate::study::{ParameterReport, Study};
 use crate::uncertainty::UncertaintyReport;
 
+mod pairs;
 mod swap;
 
 /// Options of the loop.
@@ -74,9 +77,10 @@ pub struct FixStep {
     pub parameters: Vec<ParameterReport>,
     /// Their uncertainty.
     pub uncertainty: Option<UncertaintyReport>,
-    /// The first effects tried by looking one step ahead (when the best
-    /// single effect left more than three times the noise), with the misfit
-    /// each left after its best follower; empty when there was no need.
+    /// The best pair fitted together and the first effects tried by looking
+    /// one step ahead (when the best single effect left more than three
+    /// times the noise), with the misfit each left after its best follower
+    /// (both updated jointly); empty when there was no need.
     pub alternatives: Vec<LookAhead>,
     /// The effects of earlier steps this one replaced, with any that follow
     /// it (left out, the others kept, and these added instead; see [`fix`]),
@@ -114,6 +118,10 @@ pub struct LookAhead {
     /// Why adding and updating it failed (an update that drove a spring to
     /// zero and left a mechanism, say), when it did.
     pub failed: Option<String>,
+    /// The second effect, when this is a pair fitted together: `effect` and
+    /// it were added and updated jointly, and `misfit_ahead` is the misfit
+    /// they leave (no follower diagnosed).
+    pub with: Option<String>,
 }
 
 /// Why the loop stopped.
@@ -359,9 +367,13 @@ fn distinct_leaders(d: &Diagnosis, model: &fe_model::Model, width: usize) -> Vec
 ///
 /// When the best single effect would leave more than three times the noise
 /// (two effects may hide at once, and a single candidate that mimics both
-/// may lead), the first effect is chosen by looking one step ahead: each of
-/// a few distinct leaders is added and updated, the data diagnosed again,
-/// and the leader whose best follower leaves the smallest misfit is kept.
+/// may lead), every pair of a few distinct leaders is added and updated
+/// jointly ([`pairs`]); unless the best pair reaches the noise, the first
+/// effect is also sought by looking one step ahead: each of a few distinct
+/// leaders is added and updated, the data diagnosed again, and its best
+/// follower added and everything updated jointly. The best pair is added as
+/// two steps when it leaves less than every leader with its follower, else
+/// the best leader as one.
 pub fn fix(
     case: &CaseFile,
     measured: &FrfSet,
@@ -403,21 +415,48 @@ pub fn fix(
         let step = steps.len() + 1;
         let leader_misfit = d.ranking[rank - 1].misfit;
         let mut alternatives = Vec::new();
-        let added = if leader_misfit > LOOK_AHEAD_ABOVE * noise && steps.len() + 2 <= opts.max_steps {
+        let added: Vec<(Added, Diagnosis)> = if leader_misfit > LOOK_AHEAD_ABOVE * noise
+            && steps.len() + 2 <= opts.max_steps
+        {
+            // pairs of distinct leaders fitted together first: when the best
+            // reaches the noise, nothing is left to look ahead for
+            let leaders = distinct_leaders(&d, &current.model, pairs::PAIR_WIDTH);
+            let pair = pairs::best_pair(&current, &d, &leaders, measured, opts, step);
+            if let Some(p) = &pair {
+                alternatives.push(LookAhead {
+                    effect: d.ranking[p.ranks.0 - 1].description.clone(),
+                    misfit_ahead: p.misfit,
+                    failed: None,
+                    with: Some(d.ranking[p.ranks.1 - 1].description.clone()),
+                });
+                progress(FixProgress::LookedAhead { step: steps.len(), ahead: alternatives.last().expect("pushed") });
+            }
             let mut best: Option<(f64, Added, Diagnosis)> = None;
-            for r in distinct_leaders(&d, &current.model, LOOK_AHEAD_WIDTH) {
+            let look = pair.as_ref().is_none_or(|p| p.misfit > swap::SWAP_ABOVE * noise);
+            for r in distinct_leaders(&d, &current.model, LOOK_AHEAD_WIDTH).into_iter().filter(|_| look) {
                 // one alternative that cannot be added (its update left a
                 // mechanism, say) must not end the loop: the others can
                 let tried =
                     add_and_update(&current, &d, r, measured, opts, step, step >= opts.max_steps).and_then(|a| {
                         let ahead = diagnose::diagnose(&a.case.model, measured, &opts.diagnose)?;
-                        Ok((a, ahead))
+                        // the follower added and everything updated jointly,
+                        // as the pairs are: a first effect that absorbed part
+                        // of the other is corrected by the joint update
+                        let joint = ahead
+                            .recommended
+                            .and_then(|r| add_and_update(&a.case, &ahead, r, measured, opts, step + 1, false).ok());
+                        Ok((a, ahead, joint.map(|j| j.misfit_updated)))
                     });
-                let (a, ahead) = match tried {
+                let (a, ahead, joint) = match tried {
                     Ok(x) => x,
                     Err(e) => {
                         let effect = d.ranking[r - 1].description.clone();
-                        alternatives.push(LookAhead { effect, misfit_ahead: f64::NAN, failed: Some(e.to_string()) });
+                        alternatives.push(LookAhead {
+                            effect,
+                            misfit_ahead: f64::NAN,
+                            failed: Some(e.to_string()),
+                            with: None,
+                        });
                         progress(FixProgress::LookedAhead {
                             step: steps.len(),
                             ahead: alternatives.last().expect("pushed"),
@@ -425,22 +464,37 @@ pub fn fix(
                         continue;
                     }
                 };
-                let score = ahead.leader().map_or(a.misfit_updated, |l| l.misfit.min(a.misfit_updated));
+                let alone = ahead.leader().map_or(a.misfit_updated, |l| l.misfit.min(a.misfit_updated));
+                let score = joint.map_or(alone, |j| j.min(alone));
                 alternatives.push(LookAhead {
                     effect: a.effect.description.clone(),
                     misfit_ahead: score,
                     failed: None,
+                    with: None,
                 });
                 progress(FixProgress::LookedAhead { step: steps.len(), ahead: alternatives.last().expect("pushed") });
                 if best.as_ref().is_none_or(|(b, ..)| score < *b) {
                     best = Some((score, a, ahead));
                 }
             }
-            let Some((_, a, ahead)) = best else {
-                break (FixStop::CannotAdd, Some(Ok(d)));
-            };
-            next = Some(ahead);
-            a
+            // the pair, when it beats every single effect with its follower:
+            // its first effect is a step of its own, then the second is added
+            let pair = pair.filter(|p| best.as_ref().is_none_or(|(b, ..)| p.misfit < *b));
+            let both = pair.and_then(|p| {
+                let (a, b) = p.ranks;
+                let first = add_and_update(&current, &d, a, measured, opts, step, false).ok()?;
+                let last = step + 1 >= opts.max_steps;
+                let second = add_and_update(&first.case, &d, b, measured, opts, step + 1, last).ok()?;
+                Some([first, second])
+            });
+            match (both, best) {
+                (Some([first, second]), _) => vec![(first, d.clone()), (second, d)],
+                (None, Some((_, a, ahead))) => {
+                    next = Some(ahead);
+                    vec![(a, d)]
+                }
+                (None, None) => break (FixStop::CannotAdd, Some(Ok(d))),
+            }
         } else {
             // the recommended effect, else the next distinct leaders in turn
             // when adding and updating one fails
@@ -450,21 +504,25 @@ pub fn fix(
             let Some(a) = added else {
                 break (FixStop::CannotAdd, Some(Ok(d)));
             };
-            a
+            vec![(a, d)]
         };
-        progress(FixProgress::Updated {
-            step: steps.len(),
-            effect: &added.effect.description,
-            misfit: added.misfit_updated,
-            status: &added.outcome.status,
-        });
-        if let Some(ahead) = &next {
-            progress(FixProgress::Diagnosed { step: steps.len() + 1, diagnosis: ahead });
+        let mut improved = true;
+        for (k, (added, d)) in added.into_iter().enumerate() {
+            progress(FixProgress::Updated {
+                step: steps.len(),
+                effect: &added.effect.description,
+                misfit: added.misfit_updated,
+                status: &added.outcome.status,
+            });
+            current = added.case.clone();
+            improved = added.misfit_updated < steps.last().map_or(nominal_misfit, |s: &FixStep| s.misfit_updated);
+            applied.push((d, added.rank));
+            let tried = if k == 0 { std::mem::take(&mut alternatives) } else { Vec::new() };
+            steps.push(FixStep::of(added, tried, None));
         }
-        current = added.case.clone();
-        let improved = added.misfit_updated < steps.last().map_or(nominal_misfit, |s: &FixStep| s.misfit_updated);
-        applied.push((d, added.rank));
-        steps.push(FixStep::of(added, alternatives, None));
+        if let Some(ahead) = &next {
+            progress(FixProgress::Diagnosed { step: steps.len(), diagnosis: ahead });
+        }
         if !improved {
             break (FixStop::NoImprovement, next.take().map(Ok));
         }

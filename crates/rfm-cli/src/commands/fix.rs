@@ -76,9 +76,13 @@ pub(crate) fn fix(args: &FixArgs<'_>) -> Result<Exit> {
                 None if diagnosis.consistent() => format!("diagnosis {}: nothing significant", step + 1),
                 None => format!("diagnosis {}: significant effects, none at plausible values", step + 1),
             },
-            FixProgress::LookedAhead { ahead, .. } => match &ahead.failed {
-                Some(why) => format!("  looking one step ahead from {}: could not add it ({why})", ahead.effect),
-                None => format!(
+            FixProgress::LookedAhead { ahead, .. } => match (&ahead.failed, &ahead.with) {
+                (Some(why), _) => format!("  looking one step ahead from {}: could not add it ({why})", ahead.effect),
+                (None, Some(with)) => format!(
+                    "  the best pair fitted together: {} with {with}: misfit {:.4e}",
+                    ahead.effect, ahead.misfit_ahead
+                ),
+                (None, None) => format!(
                     "  looking one step ahead from {}: misfit {:.4e} after it and its best follower",
                     ahead.effect, ahead.misfit_ahead
                 ),

@@ -175,17 +175,20 @@ pub(crate) fn write(study: &Study, outcome: &FixOutcome, opts: &ReportOptions, o
             let mut t = Table::new(&["first effect tried", "misfit after it and its best follower", "x noise"])
                 .caption(
                     "The best single effect left more than three times the noise, so two effects may hide at once: \
-                 each of these was added and updated, the data diagnosed again, and the one whose best follower \
-                 left the smallest misfit was kept.",
+                 the pairs of the leading effects were added and updated together (the best pair is shown), and \
+                 unless it reached the noise each leader was added and updated, the data diagnosed again; the \
+                 pair, or the leader whose best follower, left the smallest misfit was kept.",
                 );
             for a in &s.alternatives {
+                let effect = match &a.with {
+                    Some(with) => format!("{} together with {with}", a.effect),
+                    None => a.effect.clone(),
+                };
                 match &a.failed {
-                    Some(why) => t.row(vec![a.effect.clone(), format!("could not be added: {why}"), "-".into()]),
-                    None => t.row(vec![
-                        a.effect.clone(),
-                        sig(a.misfit_ahead, 4),
-                        format!("{:.1}", a.misfit_ahead / outcome.noise),
-                    ]),
+                    Some(why) => t.row(vec![effect, format!("could not be added: {why}"), "-".into()]),
+                    None => {
+                        t.row(vec![effect, sig(a.misfit_ahead, 4), format!("{:.1}", a.misfit_ahead / outcome.noise)])
+                    }
                 }
             }
             sec.push(Block::Table(t));

@@ -197,17 +197,17 @@ fn draws(singles: usize, pairs: usize) -> Vec<Truth> {
     draws
 }
 
-/// Trial 25 of the reduced set: a mass with rotary inertia and a lossy
-/// corner joint. The first diagnosis, misled by both at once, adds a
-/// stiffness change beside the joint, and the effects added after it make
-/// up for it: the loop ends 2.7 times the noise. Leaving that stiffness
-/// change out together with the effect that compensated it, and diagnosing
-/// again, brings it to 1.6 times.
+/// Trial 74 of the full study: a soft splice near a cantilever's tip and a
+/// damping patch over elements 5..8. The splice is found first; then, with
+/// the patch still missing, a mass change of element 2 leads by a small
+/// margin and damping over elements 5..7 follows: the loop ends 2.6 times
+/// the noise. Leaving the mass change out and diagnosing again adds damping
+/// in element 8, which completes the patch: 1.0 times the noise.
 #[test]
 fn the_swap_undoes_an_early_effect_and_what_made_up_for_it() {
-    let truth = &draws(4, 6)[25];
+    let truth = &draws(12, 16)[74];
     let opts = FixOptions { max_steps: 3, ..FixOptions::default() };
-    let trial = run(truth, 7025, &opts);
+    let trial = run(truth, 7074, &opts);
     let o = &trial.outcome;
     let swapped = o.steps.iter().find(|s| s.replaced.is_some()).expect("a step that replaced earlier ones");
     println!("{}: {} instead of {:?}", trial.label, swapped.effect.description, swapped.replaced);
@@ -234,8 +234,32 @@ fn the_loop_keeps_its_steps_when_the_last_diagnosis_fails() {
     }
 }
 
+/// Trial 76 of the full study: a splice near the arm's end and a mass on
+/// the column. One at a time, a flexible support at the base explains most
+/// of both and neither right effect leads (the mass ranks eleventh, the
+/// splice twentieth); each leader added alone, updated and diagnosed again
+/// left more than 30 times the noise, and the loop ended 22 times above
+/// it. Pairs of leaders added together and updated jointly find a mass
+/// beside the right node with the splice.
 #[test]
-#[ignore = "misses one of its criteria on the reduced set (27/30 first, 26/30 fixed, values 20/23, pairs 4/6 < 80 %); run by cargo xtask heldout"]
+fn two_effects_that_mislead_one_at_a_time_are_fitted_together() {
+    let truth = &draws(12, 16)[76];
+    let opts = FixOptions { max_steps: 3, ..FixOptions::default() };
+    let trial = run(truth, 7076, &opts);
+    let o = &trial.outcome;
+    let pair = o.steps[0].alternatives.iter().find(|a| a.with.is_some()).expect("pairs tried at the first step");
+    println!("{}: {} with {:?}: {:.2} x noise", trial.label, pair.effect, pair.with, pair.misfit_ahead / NOISE);
+    let best_single = o.steps[0].alternatives.iter().filter(|a| a.with.is_none()).map(|a| a.misfit_ahead);
+    assert!(best_single.fold(f64::INFINITY, f64::min) > pair.misfit_ahead, "{:?}", o.steps[0].alternatives);
+    // the pair is what the loop added, as two steps
+    assert_eq!(o.steps[0].effect.description, pair.effect);
+    assert_eq!(Some(&o.steps[1].effect.description), pair.with.as_ref());
+    assert!(trial.found.iter().all(|&f| f), "both effects found: {:?}", trial.found);
+    assert!(o.final_misfit() < 4.0 * NOISE, "the loop ends {:.2} times the noise", o.final_misfit() / NOISE);
+}
+
+#[test]
+#[ignore = "misses three of its criteria on the reduced set (28/30 first, 25/30 fixed < 85 %, values 19/23 < 85 %, pairs 4/6 < 80 %); run by cargo xtask heldout"]
 fn the_loop_finds_and_fixes_held_out_effects() {
     let singles = count("HELD_OUT_SINGLE", 4);
     let pairs = count("HELD_OUT_PAIRS", 6);
