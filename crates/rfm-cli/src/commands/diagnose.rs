@@ -8,7 +8,7 @@ use rfm_update::Study;
 use rfm_update::diagnose::{Diagnosis, diagnose_with};
 use rfm_update::study::{describe_masked, read_measured_for};
 
-use super::{Result, print_masked, print_notes};
+use super::{Result, WithNotes, print_masked, print_notes};
 use crate::exit::Exit;
 use crate::output::Outputs;
 use crate::table::{Table, num, percent};
@@ -46,7 +46,7 @@ pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
         }
         _ => None,
     };
-    let measured = match args.measured {
+    let (measured, notes) = match args.measured {
         Some(path) => {
             let read = read_measured_for(&study.system, path, study.case.measurement.as_ref())?;
             study.set_gains_for(&read)?;
@@ -59,12 +59,12 @@ pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
             }
             print_notes(&notes, args.json)?;
             print_masked(&describe_masked(&read.masked), args.json)?;
-            read.set.to_receptance()
+            (read.set.to_receptance(), notes)
         }
         None => {
             print_notes(&study.notes, args.json)?;
             print_masked(&describe_masked(&study.masked), args.json)?;
-            study.measured.clone()
+            (study.measured.clone(), study.notes.clone())
         }
     };
     if !args.json {
@@ -91,7 +91,7 @@ pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
     })?;
     bar.finish_and_clear();
     if args.json {
-        outln!("{}", serde_json::to_string_pretty(&d)?);
+        outln!("{}", serde_json::to_string_pretty(&WithNotes { notes: &notes, result: &d })?);
     } else {
         print_diagnosis(&d, args.top)?;
     }

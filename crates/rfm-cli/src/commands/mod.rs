@@ -51,6 +51,17 @@ pub(crate) fn print_masked(masked: &[String], json: bool) -> Result<()> {
     Ok(())
 }
 
+/// A library result that does not carry them as JSON, with the notes on
+/// how its measured data were read (units, gains, the test nodes paired by
+/// coordinates, ...) under `notes`, as `results.json` and `compare --json`
+/// have them.
+#[derive(serde::Serialize)]
+pub(crate) struct WithNotes<'a, T: serde::Serialize> {
+    pub notes: &'a [String],
+    #[serde(flatten)]
+    pub result: &'a T,
+}
+
 /// Tells what reading the measured data changed or passed over (lines at
 /// 0 Hz dropped, units scaled, kinds converted, datasets skipped), where
 /// [`print_masked`] tells what the mask left out.

@@ -106,3 +106,38 @@ fn a_test_node_far_from_every_model_node_is_refused_with_its_line() {
     assert!(stderr.contains("test.uff:") && stderr.contains("test node 105"), "{stderr}");
     assert!(stderr.contains("20.0 mm from the nearest model node 5"), "{stderr}");
 }
+
+/// The map used is kept with the results: in `results.json` of `rfm update`
+/// and in the document of `rfm diagnose --json`, under `notes`.
+#[test]
+fn the_pairing_used_is_written_into_the_results() {
+    let dir = tempfile::tempdir().unwrap();
+    write_test_file(dir.path(), 0.0);
+    let case = dir.path().join("case.toml");
+    let text = BEAM
+        .replace(
+            "frequencies = { from = 5.0, to = 200.0, step = 5.0 }\n",
+            "data = \"test.uff\"\npair = \"coordinates\"\ntolerance = 0.005\n",
+        )
+        // a model 5 % too stiff, for the update to have something to do
+        .replace("[groups.beam]\nalpha = 1e-5\n", "[groups.beam]\nalpha = 1e-5\nstiffness = 1.05\n")
+        + "[update]\nparameters = [\"group.beam.stiffness\"]\n";
+    std::fs::write(&case, text).unwrap();
+    let map = "paired 2 test node(s) with model nodes by coordinates within 5 mm: 103 -> 3, 105 -> 5";
+    let has_map =
+        |doc: &serde_json::Value| doc["notes"].as_array().unwrap().iter().any(|n| n.as_str().unwrap().contains(map));
+
+    let out_dir = dir.path().join("updated");
+    let out = rfm(&["update", case.to_str().unwrap(), "--out", out_dir.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let results: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("results.json")).unwrap()).unwrap();
+    assert!(has_map(&results), "{}", results["notes"]);
+
+    let out = rfm(&["diagnose", case.to_str().unwrap(), "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(has_map(&doc), "{}", doc["notes"]);
+    // the diagnosis itself is there beside them
+    assert!(doc["ranking"].as_array().is_some_and(|r| !r.is_empty()), "{doc}");
+}
