@@ -18,9 +18,10 @@ use crate::error::ModelError;
 
 mod geometry;
 mod items;
+pub use crate::dof::NodeId;
 pub use items::{
-    Beam, ElementId, Group, LumpedMass, Material, Node, NodeId, RotaryInertia, Section, Spring, Support, Tie,
-    rectangle_torsion,
+    Beam, ElementId, Group, ImportedBlock, ImportedKind, LumpedMass, Material, Node, RotaryInertia, Section, Spring,
+    Support, Tie, rectangle_torsion,
 };
 
 /// A frame model, planar or in space.
@@ -43,7 +44,7 @@ pub struct Model {
     pub(crate) supports: Vec<Support>,
     pub(crate) ties: Vec<Tie>,
     pub(crate) groups: Vec<Group>,
-    pub(crate) imported: Vec<crate::imported::ImportedBlock>,
+    pub(crate) imported: Vec<ImportedBlock>,
 }
 
 fn positive(what: String, v: f64) -> Result<(), ModelError> {
