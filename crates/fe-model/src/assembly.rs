@@ -31,6 +31,7 @@ use crate::error::ModelError;
 use crate::imported::ImportedKind;
 use crate::model::{Model, NodeId};
 use crate::quantity::Quantity;
+use crate::union_find::UnionFind;
 
 /// Which global matrix a term belongs to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -137,31 +138,6 @@ pub struct Assembly {
     pub group_blocks: Vec<Vec<usize>>,
     /// For each factor quantity, the `(block, term)` pairs it multiplies.
     by_quantity: HashMap<Quantity, Vec<(usize, usize)>>,
-}
-
-/// Disjoint sets of `0..n` whose representative is the smallest member
-/// (here: equations follow node order; in [`crate::kinematics`], bodies).
-pub(crate) struct UnionFind(Vec<usize>);
-
-impl UnionFind {
-    pub(crate) fn new(n: usize) -> Self {
-        UnionFind((0..n).collect())
-    }
-    pub(crate) fn find(&mut self, mut i: usize) -> usize {
-        while self.0[i] != i {
-            self.0[i] = self.0[self.0[i]];
-            i = self.0[i];
-        }
-        i
-    }
-    pub(crate) fn union(&mut self, a: usize, b: usize) {
-        let (ra, rb) = (self.find(a), self.find(b));
-        if ra != rb {
-            // keep the smaller index as root: equations follow node order
-            let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
-            self.0[hi] = lo;
-        }
-    }
 }
 
 fn build_dof_map(model: &Model) -> DofMap {

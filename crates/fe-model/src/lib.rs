@@ -65,6 +65,7 @@ pub mod quantity;
 pub mod samples;
 pub mod suggest;
 pub mod text;
+mod union_find;
 
 pub use assembly::{Assembly, Block, BlockSource, MatrixKind, Pattern, Term};
 pub use case::{CaseEditor, CaseFile, HistoryEntry};
