@@ -233,6 +233,11 @@ pub enum FixProgress<'a> {
     },
 }
 
+/// A final misfit within this multiple of the noise is consistent with it:
+/// the model explains the data down to their noise (what `rfm fix` calls
+/// success, and the band its report shades).
+pub const CONSISTENT: f64 = 1.5;
+
 /// Above this multiple of the noise, the misfit the best single effect
 /// leaves suggests that more than one effect is missing, and the first is
 /// chosen by looking one step ahead.

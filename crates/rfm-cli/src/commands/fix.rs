@@ -5,18 +5,16 @@
 use std::path::Path;
 
 use rfm_update::Study;
-use rfm_update::fix::{FixOptions, FixOutcome, FixProgress, FixStop, fix as run_fix};
+use rfm_update::fix::{CONSISTENT, FixOptions, FixOutcome, FixProgress, FixStop, fix as run_fix};
 
 use super::{Result, print_masked, print_notes};
 use crate::exit::Exit;
 use crate::output::Outputs;
+use crate::report::fix_report::step_file;
 use crate::table::{Table, num};
 
 /// The data a case synthesised from its `[truth]`, written beside the steps.
 const DATA_FILE: &str = "measured.csv";
-
-/// A misfit within this many times the noise is consistent with it.
-pub(crate) const CONSISTENT: f64 = 1.5;
 
 /// Options of the fix command.
 pub(crate) struct FixArgs<'a> {
@@ -25,11 +23,6 @@ pub(crate) struct FixArgs<'a> {
     pub(crate) steps: usize,
     pub(crate) json: bool,
     pub(crate) report: crate::report::ReportOptions,
-}
-
-/// The name of the case file written after step `k` (1-based).
-pub(crate) fn step_file(k: usize) -> String {
-    format!("step-{k}.toml")
 }
 
 pub(crate) fn fix(args: &FixArgs<'_>) -> Result<Exit> {

@@ -10,14 +10,20 @@ use frf::correlation::{BandSpec, correlate};
 use frf::synthesize;
 use rfm_update::Study;
 use rfm_update::diagnose::{EffectKind, Ranked};
-use rfm_update::fix::FixOutcome;
+use rfm_update::fix::{CONSISTENT, FixOutcome};
 
 use super::html::{Block, Report, Section, Table, Tone};
 use super::plot::structure::{Highlight, HighlightKind};
 use super::{ModelFrfs, ReportOptions, Result, plot, sig};
-use crate::commands::fix::{CONSISTENT, step_file};
 use crate::output::Outputs;
 use crate::table::{num, percent};
+
+/// The name of the case file written after step `k` (1-based): the
+/// command writes it, the report names it beside the step (here, below the
+/// command, so that the two do not import each other).
+pub(crate) fn step_file(k: usize) -> String {
+    format!("step-{k}.toml")
+}
 
 /// How an effect is marked on the structure: at its nodes for a joint, a
 /// support or a mass, along its elements for a change over a region.
