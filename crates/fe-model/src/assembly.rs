@@ -56,59 +56,185 @@ pub enum BlockSource {
 }
 
 /// One unit matrix of a block, times a value.
+///
+/// Made only by [`Assembly`], from its model: the value is always the
+/// product of the factors' current values ([`Assembly::refresh`]), and the
+/// unit matrix is square over the block's free DOFs.
 #[derive(Clone, Debug)]
 pub struct Term {
+    kind: MatrixKind,
+    factors: Vec<Quantity>,
+    value: f64,
+    unit: Vec<f64>,
+}
+
+impl Term {
     /// Stiffness or mass.
-    pub kind: MatrixKind,
-    /// Model quantities whose product is `value`.
-    pub factors: Vec<Quantity>,
+    #[inline]
+    pub fn kind(&self) -> MatrixKind {
+        self.kind
+    }
+
+    /// Model quantities whose product is [`Self::value`].
+    #[inline]
+    pub fn factors(&self) -> &[Quantity] {
+        &self.factors
+    }
+
     /// Current product of the factors.
-    pub value: f64,
+    #[inline]
+    pub fn value(&self) -> f64 {
+        self.value
+    }
+
     /// Unit matrix over the block's free local DOFs, row-major `n x n`.
-    pub unit: Vec<f64>,
+    #[inline]
+    pub fn unit(&self) -> &[f64] {
+        &self.unit
+    }
 }
 
 /// The contribution of one element, spring or mass.
+///
+/// Made only by [`Assembly`]: its equations are the free ones of its DOFs,
+/// every term's unit matrix is `len() x len()`, and its positions are in
+/// the assembly's pattern.
 #[derive(Clone, Debug)]
 pub struct Block {
-    /// Where it comes from.
-    pub source: BlockSource,
-    /// Its group index.
-    pub group: usize,
-    /// Equation index of each free local DOF (may repeat when DOFs are tied).
-    pub eqs: Vec<usize>,
-    /// Its terms.
-    pub terms: Vec<Term>,
-    /// For each local pair `(r, c)` (row-major), the index in the pattern's values.
-    pub positions: Vec<usize>,
+    source: BlockSource,
+    group: usize,
+    eqs: Vec<usize>,
+    terms: Vec<Term>,
+    positions: Vec<usize>,
 }
 
 impl Block {
+    /// Where it comes from.
+    #[inline]
+    pub fn source(&self) -> BlockSource {
+        self.source
+    }
+
+    /// Its group index.
+    #[inline]
+    pub fn group(&self) -> usize {
+        self.group
+    }
+
+    /// Equation index of each free local DOF (may repeat when DOFs are tied).
+    #[inline]
+    pub fn eqs(&self) -> &[usize] {
+        &self.eqs
+    }
+
+    /// Its terms.
+    #[inline]
+    pub fn terms(&self) -> &[Term] {
+        &self.terms
+    }
+
+    /// For each local pair `(r, c)` (row-major), the index in the pattern's values.
+    #[inline]
+    pub fn positions(&self) -> &[usize] {
+        &self.positions
+    }
+
     /// Number of free local DOFs.
+    #[inline]
     pub fn len(&self) -> usize {
         self.eqs.len()
     }
 
     /// True when every local DOF is fixed.
+    #[inline]
     pub fn is_empty(&self) -> bool {
         self.eqs.is_empty()
     }
 }
 
 /// Symmetric sparsity pattern in compressed sparse column form (both
-/// triangles stored, rows sorted within each column).
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
+/// triangles stored, rows sorted within each column, every diagonal entry
+/// stored). [`Pattern::new`] checks all of it; an [`Assembly`]'s pattern
+/// also holds every block's entries.
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Pattern {
-    /// Matrix dimension.
-    pub n: usize,
-    /// Column pointers, length `n + 1`.
-    pub col_ptr: Vec<usize>,
-    /// Row indices, length `nnz`.
-    pub row_idx: Vec<usize>,
+    n: usize,
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
 }
 
 impl Pattern {
+    /// The pattern of an `n x n` matrix with the rows `row_idx[col_ptr[c]
+    /// .. col_ptr[c + 1]]` in column `c`. Refuses (`ModelError::Invalid`)
+    /// column pointers that are not `n + 1` from 0 to `row_idx.len()`
+    /// without decreasing, rows that are out of range or not strictly
+    /// ascending within a column, a missing diagonal entry, and an entry
+    /// whose mirror is not stored.
+    pub fn new(n: usize, col_ptr: Vec<usize>, row_idx: Vec<usize>) -> Result<Self, ModelError> {
+        let bad = |reason: String| ModelError::Invalid { what: "the sparsity pattern".into(), reason };
+        if col_ptr.len() != n + 1 {
+            return Err(bad(format!("has {} column pointers for {n} columns; expected {}", col_ptr.len(), n + 1)));
+        }
+        if col_ptr[0] != 0 || col_ptr[n] != row_idx.len() {
+            return Err(bad(format!(
+                "has column pointers from {} to {}; expected from 0 to {}, the number of rows stored",
+                col_ptr[0],
+                col_ptr[n],
+                row_idx.len()
+            )));
+        }
+        if let Some(c) = (0..n).find(|&c| col_ptr[c] > col_ptr[c + 1]) {
+            return Err(bad(format!("has column pointers that decrease at column {c}")));
+        }
+        for c in 0..n {
+            let rows = &row_idx[col_ptr[c]..col_ptr[c + 1]];
+            if let Some(&r) = rows.iter().find(|&&r| r >= n) {
+                return Err(bad(format!("has row {r} in column {c}, beyond its {n} rows")));
+            }
+            if let Some(w) = rows.windows(2).find(|w| w[0] >= w[1]) {
+                return Err(bad(format!("has rows {} then {} in column {c}: not strictly ascending", w[0], w[1])));
+            }
+            if rows.binary_search(&c).is_err() {
+                return Err(bad(format!("has no diagonal entry in column {c}")));
+            }
+        }
+        let pattern = Pattern { n, col_ptr, row_idx };
+        for c in 0..n {
+            for &r in pattern.rows(c) {
+                if pattern.position(c, r).is_none() {
+                    return Err(bad(format!("is not symmetric: ({r}, {c}) is stored and ({c}, {r}) is not")));
+                }
+            }
+        }
+        Ok(pattern)
+    }
+
+    /// Matrix dimension.
+    #[inline]
+    pub fn n(&self) -> usize {
+        self.n
+    }
+
+    /// Column pointers, length `n + 1`.
+    #[inline]
+    pub fn col_ptr(&self) -> &[usize] {
+        &self.col_ptr
+    }
+
+    /// Row indices, length `nnz`.
+    #[inline]
+    pub fn row_idx(&self) -> &[usize] {
+        &self.row_idx
+    }
+
+    /// The rows stored in column `col`, ascending.
+    #[inline]
+    pub fn rows(&self, col: usize) -> &[usize] {
+        &self.row_idx[self.col_ptr[col]..self.col_ptr[col + 1]]
+    }
+
     /// Number of stored entries.
+    #[inline]
     pub fn nnz(&self) -> usize {
         self.row_idx.len()
     }
@@ -126,16 +252,16 @@ impl Pattern {
 }
 
 /// A model assembled into equations; see the module docs.
+///
+/// Made only from a [`Model`] ([`Assembly::new`], [`Assembly::of_part`]),
+/// so that its blocks, pattern and DOF map agree; its term values follow
+/// the model through [`Assembly::refresh`] and [`Assembly::refresh_quantity`].
 #[derive(Clone, Debug)]
 pub struct Assembly {
-    /// DOF numbering.
-    pub dofs: DofMap,
-    /// Shared sparsity pattern.
-    pub pattern: Pattern,
-    /// One block per beam, spring and lumped mass.
-    pub blocks: Vec<Block>,
-    /// Blocks of each group.
-    pub group_blocks: Vec<Vec<usize>>,
+    dofs: DofMap,
+    pattern: Pattern,
+    blocks: Vec<Block>,
+    group_blocks: Vec<Vec<usize>>,
     /// For each factor quantity, the `(block, term)` pairs it multiplies.
     by_quantity: HashMap<Quantity, Vec<(usize, usize)>>,
 }
@@ -428,8 +554,34 @@ impl Assembly {
     }
 
     /// Number of equations.
+    #[inline]
     pub fn n(&self) -> usize {
         self.dofs.len()
+    }
+
+    /// DOF numbering.
+    #[inline]
+    pub fn dofs(&self) -> &DofMap {
+        &self.dofs
+    }
+
+    /// Shared sparsity pattern of K, M and every group matrix.
+    #[inline]
+    pub fn pattern(&self) -> &Pattern {
+        &self.pattern
+    }
+
+    /// One block per beam, spring, lumped mass and imported block with a
+    /// free DOF, in that order.
+    #[inline]
+    pub fn blocks(&self) -> &[Block] {
+        &self.blocks
+    }
+
+    /// The blocks of group `group` (indices into [`Self::blocks`]).
+    #[inline]
+    pub fn group_blocks(&self, group: usize) -> &[usize] {
+        &self.group_blocks[group]
     }
 
     /// Accumulates `sum over blocks and terms of coef(block, term) * value * unit`
@@ -595,5 +747,48 @@ mod tests {
         assert_eq!(e2, e3);
         assert_ne!(a.dofs.equation(DofRef::new(2, Dof::Rz)), a.dofs.equation(DofRef::new(3, Dof::Rz)));
         assert_eq!(a.dofs.slot(DofRef::new(1, Dof::Rz)), Some(Slot::Fixed));
+    }
+
+    #[test]
+    fn an_assemblys_pattern_passes_the_checks_of_a_pattern_from_outside() {
+        let a = Assembly::new(&samples::frame_with_joint()).unwrap();
+        let p = a.pattern();
+        assert_eq!(Pattern::new(p.n(), p.col_ptr().to_vec(), p.row_idx().to_vec()).unwrap(), *p);
+    }
+
+    #[test]
+    fn a_pattern_that_breaks_an_invariant_is_refused_with_the_reason() {
+        let refused = |n: usize, col_ptr: Vec<usize>, row_idx: Vec<usize>| match Pattern::new(n, col_ptr, row_idx) {
+            Err(ModelError::Invalid { what, reason }) => {
+                assert_eq!(what, "the sparsity pattern");
+                reason
+            }
+            other => panic!("expected ModelError::Invalid, got {other:?}"),
+        };
+        // [[x, x], [x, x]] is accepted
+        assert!(Pattern::new(2, vec![0, 2, 4], vec![0, 1, 0, 1]).is_ok());
+        assert_eq!(refused(2, vec![0, 2], vec![0, 1]), "has 2 column pointers for 2 columns; expected 3");
+        assert_eq!(
+            refused(2, vec![1, 2, 4], vec![0, 1, 0, 1]),
+            "has column pointers from 1 to 4; expected from 0 to 4, the number of rows stored"
+        );
+        assert_eq!(
+            refused(2, vec![0, 2, 3], vec![0, 1, 0, 1]),
+            "has column pointers from 0 to 3; expected from 0 to 4, the number of rows stored"
+        );
+        assert_eq!(refused(2, vec![0, 3, 2], vec![0, 1]), "has column pointers that decrease at column 1");
+        assert_eq!(refused(2, vec![0, 2, 4], vec![0, 2, 0, 1]), "has row 2 in column 0, beyond its 2 rows");
+        assert_eq!(
+            refused(2, vec![0, 2, 4], vec![1, 0, 0, 1]),
+            "has rows 1 then 0 in column 0: not strictly ascending"
+        );
+        assert_eq!(
+            refused(2, vec![0, 2, 4], vec![0, 0, 0, 1]),
+            "has rows 0 then 0 in column 0: not strictly ascending"
+        );
+        assert_eq!(refused(2, vec![0, 1, 3], vec![1, 0, 1]), "has no diagonal entry in column 0");
+        assert_eq!(refused(2, vec![0, 2, 3], vec![0, 1, 1]), "is not symmetric: (1, 0) is stored and (0, 1) is not");
+        let message = Pattern::new(1, vec![0, 0], vec![]).unwrap_err().to_string();
+        assert_eq!(message, "the sparsity pattern has no diagonal entry in column 0");
     }
 }

@@ -619,20 +619,20 @@ mod tests {
         let (a, w) = (Assembly::of_part(&part).unwrap(), Assembly::new(&whole).unwrap());
         assert_eq!(a.n(), 7, "ux, uy shared by nodes 2 and 3, three rotations, node 4's ux, uy");
         let beam = |asm: &Assembly, m: &Model| {
-            asm.blocks
+            asm.blocks()
                 .iter()
-                .find(|b| matches!(b.source, BlockSource::Beam(i) if m.beams()[i].id.0 == 2))
+                .find(|b| matches!(b.source(), BlockSource::Beam(i) if m.beams()[i].id.0 == 2))
                 .cloned()
                 .unwrap()
         };
         let (bp, bw) = (beam(&a, &part), beam(&w, &whole));
-        for (tp, tw) in bp.terms.iter().zip(&bw.terms) {
-            assert_eq!(tp.unit, tw.unit);
-            assert_eq!(tp.value, tw.value);
+        for (tp, tw) in bp.terms().iter().zip(bw.terms()) {
+            assert_eq!(tp.unit(), tw.unit());
+            assert_eq!(tp.value(), tw.value());
         }
         // the same DOFs in both numberings
-        for (&ep, &ew) in bp.eqs.iter().zip(&bw.eqs) {
-            assert_eq!(a.dofs.dof_of(ep), w.dofs.dof_of(ew));
+        for (&ep, &ew) in bp.eqs().iter().zip(bw.eqs()) {
+            assert_eq!(a.dofs().dof_of(ep), w.dofs().dof_of(ew));
         }
     }
 }
