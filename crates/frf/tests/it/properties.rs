@@ -22,8 +22,10 @@ fn damping() -> impl Strategy<Value = (f64, f64, Option<f64>)> {
 fn frame(members: &[TreeMember], groups: [(f64, f64, Option<f64>); 2]) -> Model {
     let mut m = tree_frame(members, &(0..members.len()).collect::<Vec<_>>(), true);
     for (g, (alpha, beta, mu)) in groups.into_iter().enumerate() {
-        let group = m.group_mut(g);
-        (group.alpha, group.beta, group.mu) = (alpha, beta, mu);
+        m.set(Quantity::GroupAlpha(g), alpha).unwrap();
+        m.set(Quantity::GroupBeta(g), beta).unwrap();
+        // an infinite mu is the viscous group (`None`)
+        m.set(Quantity::GroupMu(g), mu.unwrap_or(f64::INFINITY)).unwrap();
     }
     m
 }
