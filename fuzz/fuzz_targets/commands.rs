@@ -17,8 +17,8 @@ use frf::correlation::{BandSpec, correlate};
 use libfuzzer_sys::fuzz_target;
 use rfm_update::Study;
 use rfm_update::diagnose::DiagnoseOptions;
-use rfm_update::oe::OeOptions;
-use rfm_update::rfm::RfmOptions;
+use rfm_update::output_error::OeOptions;
+use rfm_update::response_function::RfmOptions;
 
 /// Larger models and data sets only cost time: the parsers and set-up are
 /// exercised on small ones just as well.
