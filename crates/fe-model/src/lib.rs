@@ -62,6 +62,7 @@ pub mod imported;
 pub mod kinematics;
 pub mod model;
 pub mod quantity;
+#[cfg(any(test, feature = "samples"))]
 pub mod samples;
 pub mod suggest;
 pub mod text;
