@@ -17,8 +17,8 @@ use frf::correlation::{BandSpec, correlate};
 use libfuzzer_sys::fuzz_target;
 use rfm_update::Study;
 use rfm_update::diagnose::DiagnoseOptions;
-use rfm_update::oe::OeOptions;
-use rfm_update::rfm::RfmOptions;
+use rfm_update::output_error::OeOptions;
+use rfm_update::response_function::RfmOptions;
 
 /// Larger models and data sets only cost time: the parsers and set-up are
 /// exercised on small ones just as well.
@@ -54,24 +54,24 @@ fuzz_target!(|bytes: &[u8]| {
         return;
     }
     let Ok(study) = Study::from_case(case) else { return };
-    let measured = &study.measured;
+    let measured = study.measured();
     if measured.n_freq() * measured.channels().len() > MAX_VALUES {
         return;
     }
     // compare
-    if let Ok(model) = frf::synthesize(&study.system, measured.channels(), measured.frequencies_hz()) {
+    if let Ok(model) = frf::synthesize(study.system(), measured.channels(), measured.frequencies_hz()) {
         let _ = correlate(measured, &model, &BandSpec::Auto);
     }
     if let (Some(&lo), Some(&hi)) = (measured.frequencies_hz().first(), measured.frequencies_hz().last()) {
         if let Ok(est) = frf::lscf(measured, &frf::LscfOptions::new(lo, hi)) {
             let modes = frf::measured_modes(&est);
-            if let Ok(model) = frf::model_modes(&study.system, &est.responses, hi) {
+            if let Ok(model) = frf::model_modes(study.system(), &est.responses, hi) {
                 let _ = frf::pair_modes(&model, &modes, 0.5);
             }
         }
     }
     // update, both methods
-    if !study.parameters.is_empty() {
+    if !study.parameters().is_empty() {
         let _ = study.run_rfm(&RfmOptions { max_iterations: 2, ..Default::default() }, |_| {});
         if let Ok(opts) = study.output_error_options() {
             let _ = study.run_output_error(&OeOptions { max_iterations: 2, ..opts }, |_| {});
@@ -88,5 +88,5 @@ fuzz_target!(|bytes: &[u8]| {
         iterations: 2,
         ..Default::default()
     };
-    let _ = rfm_update::diagnose::diagnose(&study.case.model, measured, &opts);
+    let _ = rfm_update::diagnose::diagnose(&study.case().model, measured, &opts);
 });

@@ -162,7 +162,7 @@ struct Operators<'a> {
 impl<'a> Operators<'a> {
     fn new(sys: &'a DampedSystem) -> Self {
         let a = sys.assembly();
-        let nnz = a.pattern.nnz();
+        let nnz = a.pattern().nnz();
         let mut c_viscous = vec![0.0; nnz];
         let mut relaxing = Vec::new();
         for (g, group) in sys.model().groups().iter().enumerate() {
@@ -226,11 +226,11 @@ impl<'a> Operators<'a> {
     }
 
     fn dense(&self, values: &[C64]) -> Mat<C64> {
-        let p = &self.sys.assembly().pattern;
-        let mut z = Mat::<C64>::zeros(p.n, p.n);
-        for c in 0..p.n {
-            for k in p.col_ptr[c]..p.col_ptr[c + 1] {
-                z[(p.row_idx[k], c)] = values[k];
+        let p = self.sys.assembly().pattern();
+        let mut z = Mat::<C64>::zeros(p.n(), p.n());
+        for c in 0..p.n() {
+            for k in p.col_ptr()[c]..p.col_ptr()[c + 1] {
+                z[(p.row_idx()[k], c)] = values[k];
             }
         }
         z
@@ -238,11 +238,11 @@ impl<'a> Operators<'a> {
 
     /// `values * x` for values on the pattern.
     fn apply(&self, values: &[C64], x: &[C64]) -> Vec<C64> {
-        let p = &self.sys.assembly().pattern;
-        let mut y = vec![C64::new(0.0, 0.0); p.n];
-        for c in 0..p.n {
-            for k in p.col_ptr[c]..p.col_ptr[c + 1] {
-                y[p.row_idx[k]] += values[k] * x[c];
+        let p = self.sys.assembly().pattern();
+        let mut y = vec![C64::new(0.0, 0.0); p.n()];
+        for c in 0..p.n() {
+            for k in p.col_ptr()[c]..p.col_ptr()[c + 1] {
+                y[p.row_idx()[k]] += values[k] * x[c];
             }
         }
         y
@@ -272,7 +272,7 @@ pub fn dynamic_stiffness_derivative(sys: &DampedSystem, s: C64) -> Mat<C64> {
 /// retained `(d_i, r_i)` with `r_i` over the full equations.
 fn internal_directions(ops: &Operators<'_>, group: usize, c: &[f64]) -> Result<Vec<(f64, Vec<f64>)>, ModalError> {
     let a = ops.sys.assembly();
-    let mut eqs: Vec<usize> = a.group_blocks[group].iter().flat_map(|&b| a.blocks[b].eqs.iter().copied()).collect();
+    let mut eqs: Vec<usize> = a.group_blocks(group).iter().flat_map(|&b| a.blocks()[b].eqs().iter().copied()).collect();
     eqs.sort_unstable();
     eqs.dedup();
     let d = eqs.len();
@@ -282,7 +282,7 @@ fn internal_directions(ops: &Operators<'_>, group: usize, c: &[f64]) -> Result<V
     let mut local = Mat::<f64>::zeros(d, d);
     for (i, &ei) in eqs.iter().enumerate() {
         for (j, &ej) in eqs.iter().enumerate() {
-            if let Some(p) = a.pattern.position(ei, ej) {
+            if let Some(p) = a.pattern().position(ei, ej) {
                 local[(i, j)] = c[p];
             }
         }
@@ -392,11 +392,11 @@ struct Spectrum {
 
 /// The model's `K`, `M` or `C_v` as a dense matrix.
 fn dense_real(ops: &Operators<'_>, values: &[f64]) -> Mat<f64> {
-    let p = &ops.sys.assembly().pattern;
-    let mut m = Mat::<f64>::zeros(p.n, p.n);
-    for c in 0..p.n {
-        for k in p.col_ptr[c]..p.col_ptr[c + 1] {
-            m[(p.row_idx[k], c)] = values[k];
+    let p = ops.sys.assembly().pattern();
+    let mut m = Mat::<f64>::zeros(p.n(), p.n());
+    for c in 0..p.n() {
+        for k in p.col_ptr()[c]..p.col_ptr()[c + 1] {
+            m[(p.row_idx()[k], c)] = values[k];
         }
     }
     m
@@ -479,14 +479,14 @@ fn solve_pencil(ops: &Operators<'_>, internal: &[(f64, f64, Vec<f64>)]) -> Resul
     let w0 = if w0.is_finite() && w0 > 0.0 { w0 } else { 1.0 };
     let mut a = Mat::<f64>::zeros(big, big);
     let mut b = Mat::<f64>::zeros(big, big);
-    let pat = &ops.sys.assembly().pattern;
+    let pat = ops.sys.assembly().pattern();
     for i in 0..n {
         a[(i, n + i)] = w0;
         b[(i, i)] = 1.0;
     }
     for c in 0..n {
-        for p in pat.col_ptr[c]..pat.col_ptr[c + 1] {
-            let r = pat.row_idx[p];
+        for p in pat.col_ptr()[c]..pat.col_ptr()[c + 1] {
+            let r = pat.row_idx()[p];
             a[(n + r, c)] = -ops.k[p] / w0;
             a[(n + r, n + c)] = -ops.c_viscous[p];
             b[(n + r, n + c)] = ops.m[p];
@@ -572,11 +572,11 @@ mod tests {
         for w in [5.0, 300.0, 4000.0] {
             let dense = dynamic_stiffness(&sys, C64::new(0.0, w));
             let sparse = sys.z_values(w);
-            let p = &sys.assembly().pattern;
+            let p = sys.assembly().pattern();
             let scale = sparse.iter().map(|v| v.norm()).fold(0.0, f64::max);
-            for c in 0..p.n {
-                for k in p.col_ptr[c]..p.col_ptr[c + 1] {
-                    assert!((dense[(p.row_idx[k], c)] - sparse[k]).norm() <= 1e-14 * scale);
+            for c in 0..p.n() {
+                for k in p.col_ptr()[c]..p.col_ptr()[c + 1] {
+                    assert!((dense[(p.row_idx()[k], c)] - sparse[k]).norm() <= 1e-14 * scale);
                 }
             }
         }

@@ -58,7 +58,7 @@
 //! let sys = DampedSystem::new(samples::two_material_cantilever()).unwrap();
 //! let omega = 2.0 * std::f64::consts::PI * 50.0;
 //! let z = sys.z_values(omega); // values on sys.assembly().pattern
-//! assert_eq!(z.len(), sys.assembly().pattern.nnz());
+//! assert_eq!(z.len(), sys.assembly().pattern().nnz());
 //!
 //! // the relative derivative with respect to the steel group's relaxation parameter
 //! let mu = sys.model().quantity("group.steel.mu").unwrap();

@@ -50,11 +50,11 @@ pub struct NormalModes {
 
 pub(crate) fn dense(assembly: &Assembly, kind: MatrixKind) -> Mat<f64> {
     let v = assembly.real_values(kind);
-    let p = &assembly.pattern;
-    let mut m = Mat::zeros(p.n, p.n);
-    for c in 0..p.n {
-        for k in p.col_ptr[c]..p.col_ptr[c + 1] {
-            m[(p.row_idx[k], c)] = v[k];
+    let p = assembly.pattern();
+    let mut m = Mat::zeros(p.n(), p.n());
+    for c in 0..p.n() {
+        for k in p.col_ptr()[c]..p.col_ptr()[c + 1] {
+            m[(p.row_idx()[k], c)] = v[k];
         }
     }
     m

@@ -17,7 +17,7 @@ pub struct DampedSystem {
 
 /// `(dZ/dq) q` for one quantity at one frequency, as a list of
 /// `(block, term, coefficient)`: the derivative is the sum of
-/// `coefficient * term.value * term.unit` over the listed terms.
+/// `coefficient * term.value() * term.unit()` over the listed terms.
 #[derive(Clone, Debug, Default)]
 pub struct Derivative {
     /// `(block index, term index, complex coefficient)`.
@@ -27,12 +27,12 @@ pub struct Derivative {
 impl Derivative {
     /// The derivative as values on the sparsity pattern.
     pub fn values(&self, assembly: &Assembly) -> Vec<C64> {
-        let mut out = vec![C64::new(0.0, 0.0); assembly.pattern.nnz()];
+        let mut out = vec![C64::new(0.0, 0.0); assembly.pattern().nnz()];
         for &(b, t, c) in &self.terms {
-            let block = &assembly.blocks[b];
-            let term = &block.terms[t];
-            for (k, &p) in block.positions.iter().enumerate() {
-                out[p] += c * (term.value * term.unit[k]);
+            let block = &assembly.blocks()[b];
+            let term = &block.terms()[t];
+            for (k, &p) in block.positions().iter().enumerate() {
+                out[p] += c * (term.value() * term.unit()[k]);
             }
         }
         out
@@ -42,20 +42,20 @@ impl Derivative {
     /// (an equation may appear more than once; entries add).
     pub fn apply(&self, assembly: &Assembly, x: &[C64], out: &mut Vec<(usize, C64)>) {
         for &(b, t, c) in &self.terms {
-            let block = &assembly.blocks[b];
-            let term = &block.terms[t];
-            let n = block.eqs.len();
-            let scale = c * term.value;
+            let block = &assembly.blocks()[b];
+            let term = &block.terms()[t];
+            let n = block.eqs().len();
+            let scale = c * term.value();
             for r in 0..n {
                 let mut acc = C64::new(0.0, 0.0);
                 for col in 0..n {
-                    let u = term.unit[r * n + col];
+                    let u = term.unit()[r * n + col];
                     if u != 0.0 {
-                        acc += x[block.eqs[col]] * u;
+                        acc += x[block.eqs()[col]] * u;
                     }
                 }
                 if acc != C64::new(0.0, 0.0) {
-                    out.push((block.eqs[r], scale * acc));
+                    out.push((block.eqs()[r], scale * acc));
                 }
             }
         }
@@ -119,12 +119,12 @@ impl DampedSystem {
     pub fn z_values_into(&self, omega: f64, out: &mut [C64]) {
         let coefs = self.coefficients(omega);
         out.fill(C64::new(0.0, 0.0));
-        self.assembly.accumulate(|b, t| Some(coefs[b.group].of(t.kind)), out);
+        self.assembly.accumulate(|b, t| Some(coefs[b.group()].of(t.kind())), out);
     }
 
     /// `Z(w)` on the pattern.
     pub fn z_values(&self, omega: f64) -> Vec<C64> {
-        let mut v = vec![C64::new(0.0, 0.0); self.assembly.pattern.nnz()];
+        let mut v = vec![C64::new(0.0, 0.0); self.assembly.pattern().nnz()];
         self.z_values_into(omega, &mut v);
         v
     }
@@ -132,12 +132,12 @@ impl DampedSystem {
     /// The kernel matrix `G(w) = sum_g h_g(w) C_g` on the pattern.
     pub fn g_values(&self, omega: f64) -> Vec<C64> {
         let groups = self.model.groups();
-        let mut v = vec![C64::new(0.0, 0.0); self.assembly.pattern.nnz()];
+        let mut v = vec![C64::new(0.0, 0.0); self.assembly.pattern().nnz()];
         self.assembly.accumulate(
             |b, t| {
-                let g = &groups[b.group];
+                let g = &groups[b.group()];
                 let h = kernel::relaxation_factor(g.mu, omega);
-                Some(match t.kind {
+                Some(match t.kind() {
                     MatrixKind::Stiffness => h * g.alpha,
                     MatrixKind::Mass => h * g.beta,
                 })
@@ -158,13 +158,13 @@ impl DampedSystem {
                     Quantity::GroupBeta(_) => kernel::d_beta(&groups[g], omega),
                     _ => kernel::d_mu(&groups[g], omega),
                 };
-                for &b in &self.assembly.group_blocks[g] {
-                    for (t, term) in self.assembly.blocks[b].terms.iter().enumerate() {
-                        let c = match term.kind {
+                for &b in self.assembly.group_blocks(g) {
+                    for (t, term) in self.assembly.blocks()[b].terms().iter().enumerate() {
+                        let c = match term.kind() {
                             MatrixKind::Stiffness => d.stiffness,
                             MatrixKind::Mass => d.mass,
                         };
-                        if c != C64::new(0.0, 0.0) && term.value != 0.0 {
+                        if c != C64::new(0.0, 0.0) && term.value() != 0.0 {
                             terms.push((b, t, c));
                         }
                     }
@@ -173,10 +173,10 @@ impl DampedSystem {
             _ => {
                 let coefs: Vec<GroupCoefficients> = groups.iter().map(|g| GroupCoefficients::new(g, omega)).collect();
                 for &(b, t) in self.assembly.terms_of(q) {
-                    let block = &self.assembly.blocks[b];
-                    let term = &block.terms[t];
-                    if term.value != 0.0 {
-                        terms.push((b, t, coefs[block.group].of(term.kind)));
+                    let block = &self.assembly.blocks()[b];
+                    let term = &block.terms()[t];
+                    if term.value() != 0.0 {
+                        terms.push((b, t, coefs[block.group()].of(term.kind())));
                     }
                 }
             }
@@ -300,10 +300,10 @@ mod tests {
             let d = sys.derivative(q, 400.0);
             let dense = d.values(sys.assembly());
             let mut expect = vec![C64::new(0.0, 0.0); n];
-            let pat = &sys.assembly().pattern;
+            let pat = sys.assembly().pattern();
             for c in 0..n {
-                for p in pat.col_ptr[c]..pat.col_ptr[c + 1] {
-                    expect[pat.row_idx[p]] += dense[p] * x[c];
+                for p in pat.col_ptr()[c]..pat.col_ptr()[c + 1] {
+                    expect[pat.row_idx()[p]] += dense[p] * x[c];
                 }
             }
             let mut sparse = Vec::new();

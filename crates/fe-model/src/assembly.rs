@@ -31,6 +31,10 @@ use crate::error::ModelError;
 use crate::imported::ImportedKind;
 use crate::model::{Model, NodeId};
 use crate::quantity::Quantity;
+use crate::union_find::UnionFind;
+
+mod pattern;
+pub use pattern::Pattern;
 
 /// Which global matrix a term belongs to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -55,113 +59,115 @@ pub enum BlockSource {
 }
 
 /// One unit matrix of a block, times a value.
+///
+/// Made only by [`Assembly`], from its model: the value is always the
+/// product of the factors' current values ([`Assembly::refresh`]), and the
+/// unit matrix is square over the block's free DOFs.
 #[derive(Clone, Debug)]
 pub struct Term {
+    kind: MatrixKind,
+    factors: Vec<Quantity>,
+    value: f64,
+    unit: Vec<f64>,
+}
+
+impl Term {
     /// Stiffness or mass.
-    pub kind: MatrixKind,
-    /// Model quantities whose product is `value`.
-    pub factors: Vec<Quantity>,
+    #[inline]
+    pub fn kind(&self) -> MatrixKind {
+        self.kind
+    }
+
+    /// Model quantities whose product is [`Self::value`].
+    #[inline]
+    pub fn factors(&self) -> &[Quantity] {
+        &self.factors
+    }
+
     /// Current product of the factors.
-    pub value: f64,
+    #[inline]
+    pub fn value(&self) -> f64 {
+        self.value
+    }
+
     /// Unit matrix over the block's free local DOFs, row-major `n x n`.
-    pub unit: Vec<f64>,
+    #[inline]
+    pub fn unit(&self) -> &[f64] {
+        &self.unit
+    }
 }
 
 /// The contribution of one element, spring or mass.
+///
+/// Made only by [`Assembly`]: its equations are the free ones of its DOFs,
+/// every term's unit matrix is `len() x len()`, and its positions are in
+/// the assembly's pattern.
 #[derive(Clone, Debug)]
 pub struct Block {
-    /// Where it comes from.
-    pub source: BlockSource,
-    /// Its group index.
-    pub group: usize,
-    /// Equation index of each free local DOF (may repeat when DOFs are tied).
-    pub eqs: Vec<usize>,
-    /// Its terms.
-    pub terms: Vec<Term>,
-    /// For each local pair `(r, c)` (row-major), the index in the pattern's values.
-    pub positions: Vec<usize>,
+    source: BlockSource,
+    group: usize,
+    eqs: Vec<usize>,
+    terms: Vec<Term>,
+    positions: Vec<usize>,
 }
 
 impl Block {
+    /// Where it comes from.
+    #[inline]
+    pub fn source(&self) -> BlockSource {
+        self.source
+    }
+
+    /// Its group index.
+    #[inline]
+    pub fn group(&self) -> usize {
+        self.group
+    }
+
+    /// Equation index of each free local DOF (may repeat when DOFs are tied).
+    #[inline]
+    pub fn eqs(&self) -> &[usize] {
+        &self.eqs
+    }
+
+    /// Its terms.
+    #[inline]
+    pub fn terms(&self) -> &[Term] {
+        &self.terms
+    }
+
+    /// For each local pair `(r, c)` (row-major), the index in the pattern's values.
+    #[inline]
+    pub fn positions(&self) -> &[usize] {
+        &self.positions
+    }
+
     /// Number of free local DOFs.
+    #[inline]
     pub fn len(&self) -> usize {
         self.eqs.len()
     }
 
     /// True when every local DOF is fixed.
+    #[inline]
     pub fn is_empty(&self) -> bool {
         self.eqs.is_empty()
     }
 }
 
-/// Symmetric sparsity pattern in compressed sparse column form (both
-/// triangles stored, rows sorted within each column).
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct Pattern {
-    /// Matrix dimension.
-    pub n: usize,
-    /// Column pointers, length `n + 1`.
-    pub col_ptr: Vec<usize>,
-    /// Row indices, length `nnz`.
-    pub row_idx: Vec<usize>,
-}
-
-impl Pattern {
-    /// Number of stored entries.
-    pub fn nnz(&self) -> usize {
-        self.row_idx.len()
-    }
-
-    /// Index of entry `(row, col)` in the values array.
-    pub fn position(&self, row: usize, col: usize) -> Option<usize> {
-        let (a, b) = (self.col_ptr[col], self.col_ptr[col + 1]);
-        self.row_idx[a..b].binary_search(&row).ok().map(|k| a + k)
-    }
-
-    /// Index of each diagonal entry.
-    pub fn diagonal_positions(&self) -> Vec<usize> {
-        (0..self.n).map(|i| self.position(i, i).expect("diagonal is always stored")).collect()
-    }
-}
-
 /// A model assembled into equations; see the module docs.
+///
+/// Made only from a [`Model`] ([`Assembly::new`], [`Assembly::of_part`]),
+/// so that its blocks, pattern and DOF map agree; its term values follow
+/// the model through [`Assembly::refresh`] and [`Assembly::refresh_quantity`].
 #[derive(Clone, Debug)]
 pub struct Assembly {
-    /// DOF numbering.
-    pub dofs: DofMap,
-    /// Shared sparsity pattern.
-    pub pattern: Pattern,
-    /// One block per beam, spring and lumped mass.
-    pub blocks: Vec<Block>,
-    /// Blocks of each group.
-    pub group_blocks: Vec<Vec<usize>>,
+    dofs: DofMap,
+    pattern: Pattern,
+    blocks: Vec<Block>,
+    group_blocks: Vec<Vec<usize>>,
     /// For each factor quantity, the `(block, term)` pairs it multiplies.
     by_quantity: HashMap<Quantity, Vec<(usize, usize)>>,
-}
-
-/// Disjoint sets of `0..n` whose representative is the smallest member
-/// (here: equations follow node order; in [`crate::kinematics`], bodies).
-pub(crate) struct UnionFind(Vec<usize>);
-
-impl UnionFind {
-    pub(crate) fn new(n: usize) -> Self {
-        UnionFind((0..n).collect())
-    }
-    pub(crate) fn find(&mut self, mut i: usize) -> usize {
-        while self.0[i] != i {
-            self.0[i] = self.0[self.0[i]];
-            i = self.0[i];
-        }
-        i
-    }
-    pub(crate) fn union(&mut self, a: usize, b: usize) {
-        let (ra, rb) = (self.find(a), self.find(b));
-        if ra != rb {
-            // keep the smaller index as root: equations follow node order
-            let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
-            self.0[hi] = lo;
-        }
-    }
 }
 
 fn build_dof_map(model: &Model) -> DofMap {
@@ -388,7 +394,7 @@ impl Assembly {
                 return Err(ModelError::DanglingNode { id: node.id.0 });
             }
         }
-        let pattern = build_pattern(dofs.len(), &blocks);
+        let pattern = Pattern::of_blocks(dofs.len(), blocks.iter().map(|b| b.eqs.as_slice()));
         for b in &mut blocks {
             let n = b.eqs.len();
             b.positions = (0..n * n)
@@ -452,8 +458,34 @@ impl Assembly {
     }
 
     /// Number of equations.
+    #[inline]
     pub fn n(&self) -> usize {
         self.dofs.len()
+    }
+
+    /// DOF numbering.
+    #[inline]
+    pub fn dofs(&self) -> &DofMap {
+        &self.dofs
+    }
+
+    /// Shared sparsity pattern of K, M and every group matrix.
+    #[inline]
+    pub fn pattern(&self) -> &Pattern {
+        &self.pattern
+    }
+
+    /// One block per beam, spring, lumped mass and imported block with a
+    /// free DOF, in that order.
+    #[inline]
+    pub fn blocks(&self) -> &[Block] {
+        &self.blocks
+    }
+
+    /// The blocks of group `group` (indices into [`Self::blocks`]).
+    #[inline]
+    pub fn group_blocks(&self, group: usize) -> &[usize] {
+        &self.group_blocks[group]
     }
 
     /// Accumulates `sum over blocks and terms of coef(block, term) * value * unit`
@@ -498,8 +530,8 @@ impl Assembly {
         let n = self.n();
         let mut m = DMatrix::zeros(n, n);
         for c in 0..n {
-            for p in self.pattern.col_ptr[c]..self.pattern.col_ptr[c + 1] {
-                m[(self.pattern.row_idx[p], c)] = values[p];
+            for p in self.pattern.col_ptr()[c]..self.pattern.col_ptr()[c + 1] {
+                m[(self.pattern.row_idx()[p], c)] = values[p];
             }
         }
         m
@@ -532,28 +564,6 @@ fn describe_source(model: &Model, source: BlockSource) -> String {
     }
 }
 
-fn build_pattern(n: usize, blocks: &[Block]) -> Pattern {
-    let mut cols: Vec<Vec<usize>> = vec![Vec::new(); n];
-    for i in 0..n {
-        cols[i].push(i);
-    }
-    for b in blocks {
-        for &c in &b.eqs {
-            cols[c].extend_from_slice(&b.eqs);
-        }
-    }
-    let mut col_ptr = Vec::with_capacity(n + 1);
-    let mut row_idx = Vec::new();
-    col_ptr.push(0);
-    for mut rows in cols {
-        rows.sort_unstable();
-        rows.dedup();
-        row_idx.extend(rows);
-        col_ptr.push(row_idx.len());
-    }
-    Pattern { n, col_ptr, row_idx }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -569,8 +579,8 @@ mod tests {
         assert_relative_eq!(k, k.transpose(), epsilon = 1e-6);
         assert_relative_eq!(m, m.transpose(), epsilon = 1e-12);
         for c in 0..a.n() {
-            for p in a.pattern.col_ptr[c]..a.pattern.col_ptr[c + 1] {
-                assert!(a.pattern.position(c, a.pattern.row_idx[p]).is_some());
+            for &r in a.pattern.rows(c) {
+                assert!(a.pattern.position(c, r).is_some());
             }
         }
     }

@@ -25,6 +25,7 @@ mod dof_list;
 mod edit;
 mod frequencies;
 mod imported;
+mod lookup;
 mod measurement;
 mod raw;
 mod spec;

@@ -1,12 +1,22 @@
 //! Degrees of freedom: the three of a planar node or the six of a node in
 //! space ([`Dimension`]), references to them, values per DOF ([`PerDof`]),
-//! and the map from (node, dof) to equation index.
+//! and the map from (node, dof) to equation index. Node ids ([`NodeId`])
+//! are here, below the model, because a DOF names its node as the model's
+//! items do; `model` re-exports them.
 
 use std::collections::HashMap;
 use std::fmt;
 use std::str::FromStr;
 
-use crate::model::NodeId;
+/// Identifier of a node as written by the user (not an index).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct NodeId(pub u32);
+
+impl fmt::Display for NodeId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.0)
+    }
+}
 
 /// A degree of freedom of a node: three translations and three rotations.
 /// A planar model's nodes have `ux`, `uy` and `rz` ([`Dimension::Planar`]),

@@ -19,45 +19,22 @@
 
 use std::collections::{BTreeMap, HashMap};
 
-use crate::dof::DofRef;
+use crate::dof::{DofRef, NodeId};
 use crate::error::ModelError;
-use crate::model::{Model, NodeId};
+use crate::model::Model;
 
 pub mod export;
 pub mod matrix_market;
 pub mod tables;
 
+// The blocks are items of the model (`model/items.rs`, so that the model
+// holds them without importing this module); named here too, where they
+// are made.
+pub use crate::model::{ImportedBlock, ImportedKind};
 pub use matrix_market::SymmetricCoo;
 
 /// An entry of a matrix: row, column, value.
 type Entry = (usize, usize, f64);
-
-/// Which matrix an imported block belongs to.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum ImportedKind {
-    /// A stiffness matrix, scaled by the group's stiffness factor.
-    Stiffness,
-    /// A mass matrix, scaled by the group's mass factor.
-    Mass,
-}
-
-/// The entries of an imported group matrix between the DOFs of one node,
-/// or between the DOFs of two nodes.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ImportedBlock {
-    /// Index into [`Model::groups`].
-    pub group: usize,
-    /// Stiffness or mass.
-    pub kind: ImportedKind,
-    /// The node, twice, or the two nodes (smaller id first).
-    pub nodes: [NodeId; 2],
-    /// Its DOFs: those of the first node, then of the second, that have an
-    /// entry in the block, in table order.
-    pub dofs: Vec<DofRef>,
-    /// The values, row-major `dofs.len()` squared, symmetric; the entries
-    /// among one node's own DOFs are zero in a block of two nodes.
-    pub values: Vec<f64>,
-}
 
 impl Model {
     /// The blocks of the imported matrices.

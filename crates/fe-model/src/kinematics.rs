@@ -26,10 +26,10 @@ use std::collections::HashMap;
 
 use nalgebra::DMatrix;
 
-use crate::assembly::UnionFind;
 use crate::dof::{Dimension, Dof, DofRef, PerDof};
 use crate::error::ModelError;
 use crate::model::{Model, NodeId};
+use crate::union_find::UnionFind;
 
 /// Most bodies (beam-connected parts and lone nodes) solved together.
 pub const MAX_BODIES: usize = 200;

@@ -62,9 +62,11 @@ pub mod imported;
 pub mod kinematics;
 pub mod model;
 pub mod quantity;
+#[cfg(any(test, feature = "samples"))]
 pub mod samples;
 pub mod suggest;
 pub mod text;
+mod union_find;
 
 pub use assembly::{Assembly, Block, BlockSource, MatrixKind, Pattern, Term};
 pub use case::{CaseEditor, CaseFile, HistoryEntry};

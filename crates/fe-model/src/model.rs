@@ -18,9 +18,10 @@ use crate::error::ModelError;
 
 mod geometry;
 mod items;
+pub use crate::dof::NodeId;
 pub use items::{
-    Beam, ElementId, Group, LumpedMass, Material, Node, NodeId, RotaryInertia, Section, Spring, Support, Tie,
-    rectangle_torsion,
+    Beam, ElementId, Group, ImportedBlock, ImportedKind, LumpedMass, Material, Node, RotaryInertia, Section, Spring,
+    Support, Tie, rectangle_torsion,
 };
 
 /// A frame model, planar or in space.
@@ -43,7 +44,7 @@ pub struct Model {
     pub(crate) supports: Vec<Support>,
     pub(crate) ties: Vec<Tie>,
     pub(crate) groups: Vec<Group>,
-    pub(crate) imported: Vec<crate::imported::ImportedBlock>,
+    pub(crate) imported: Vec<ImportedBlock>,
 }
 
 fn positive(what: String, v: f64) -> Result<(), ModelError> {
@@ -128,10 +129,6 @@ impl Model {
     /// Groups.
     pub fn groups(&self) -> &[Group] {
         &self.groups
-    }
-    /// Mutable group (damping values and factors are plain data).
-    pub fn group_mut(&mut self, index: usize) -> &mut Group {
-        &mut self.groups[index]
     }
 
     /// The node with this id.
@@ -266,7 +263,28 @@ impl Model {
 
     /// Adds a group and returns its index.
     pub fn add_group(&mut self, group: Group) -> Result<usize, ModelError> {
-        if self.group_index(&group.name).is_some() {
+        self.check_group(&group, None)?;
+        self.groups.push(group);
+        Ok(self.groups.len() - 1)
+    }
+
+    /// Replaces group `index` (its damping and factors, or its name) with
+    /// `group`, checked as [`Self::add_group`] checks a new one; the items
+    /// of the group stay in it. To change one value, [`Self::set`] its
+    /// quantity.
+    pub fn replace_group(&mut self, index: usize, group: Group) -> Result<(), ModelError> {
+        if index >= self.groups.len() {
+            return Err(ModelError::UnknownGroup { name: format!("#{index}"), context: "a replaced group".into() });
+        }
+        self.check_group(&group, Some(index))?;
+        self.groups[index] = group;
+        Ok(())
+    }
+
+    /// The checks of a group's values, and of its name against the other
+    /// groups (all but `replacing`).
+    fn check_group(&self, group: &Group, replacing: Option<usize>) -> Result<(), ModelError> {
+        if self.group_index(&group.name).is_some_and(|i| Some(i) != replacing) {
             return Err(ModelError::Duplicate { what: format!("group `{}`", group.name) });
         }
         let g = &group.name;
@@ -277,8 +295,7 @@ impl Model {
         }
         positive(format!("group `{g}`: stiffness"), group.stiffness)?;
         positive(format!("group `{g}`: mass"), group.mass)?;
-        self.groups.push(group);
-        Ok(self.groups.len() - 1)
+        Ok(())
     }
 
     /// Returns the index of the group named `name`, creating an undamped
@@ -618,20 +635,52 @@ mod tests {
         let (a, w) = (Assembly::of_part(&part).unwrap(), Assembly::new(&whole).unwrap());
         assert_eq!(a.n(), 7, "ux, uy shared by nodes 2 and 3, three rotations, node 4's ux, uy");
         let beam = |asm: &Assembly, m: &Model| {
-            asm.blocks
+            asm.blocks()
                 .iter()
-                .find(|b| matches!(b.source, BlockSource::Beam(i) if m.beams()[i].id.0 == 2))
+                .find(|b| matches!(b.source(), BlockSource::Beam(i) if m.beams()[i].id.0 == 2))
                 .cloned()
                 .unwrap()
         };
         let (bp, bw) = (beam(&a, &part), beam(&w, &whole));
-        for (tp, tw) in bp.terms.iter().zip(&bw.terms) {
-            assert_eq!(tp.unit, tw.unit);
-            assert_eq!(tp.value, tw.value);
+        for (tp, tw) in bp.terms().iter().zip(bw.terms()) {
+            assert_eq!(tp.unit(), tw.unit());
+            assert_eq!(tp.value(), tw.value());
         }
         // the same DOFs in both numberings
-        for (&ep, &ew) in bp.eqs.iter().zip(&bw.eqs) {
-            assert_eq!(a.dofs.dof_of(ep), w.dofs.dof_of(ew));
+        for (&ep, &ew) in bp.eqs().iter().zip(bw.eqs()) {
+            assert_eq!(a.dofs().dof_of(ep), w.dofs().dof_of(ew));
         }
+    }
+
+    #[test]
+    fn a_replaced_group_is_checked_as_an_added_one() {
+        let mut m = samples::frame_with_joint();
+        let joint = m.group_index("joint").unwrap();
+        assert_eq!(
+            m.replace_group(joint, Group::new("joint").rayleigh(-1.0, 0.0)).unwrap_err(),
+            ModelError::Invalid {
+                what: "group `joint`: alpha".into(),
+                reason: "must be zero or positive and finite, got -1".into()
+            }
+        );
+        assert_eq!(
+            m.replace_group(joint, Group::new("joint").relaxation(0.0)).unwrap_err(),
+            ModelError::Invalid {
+                what: "group `joint`: mu".into(),
+                reason: "must be positive and finite, got 0".into()
+            }
+        );
+        assert_eq!(
+            m.replace_group(joint, Group::new("frame")).unwrap_err(),
+            ModelError::Duplicate { what: "group `frame`".into() }
+        );
+        assert_eq!(
+            m.replace_group(9, Group::new("joint")).unwrap_err(),
+            ModelError::UnknownGroup { name: "#9".into(), context: "a replaced group".into() }
+        );
+        // nothing refused changed the group; a valid replacement does
+        assert_eq!(m.groups()[joint], samples::frame_with_joint().groups()[joint]);
+        m.replace_group(joint, Group::new("joint").rayleigh(2e-3, 0.0)).unwrap();
+        assert_eq!((m.groups()[joint].alpha, m.groups()[joint].mu), (2e-3, None));
     }
 }

@@ -1,4 +1,9 @@
 //! Tiny canonical models shared by tests, examples, benchmarks and docs.
+//!
+//! Behind the `samples` feature: they are fixtures, which unwrap what a
+//! user's model would return as an error, so they are not part of the
+//! default API. Enable it where they are used, as a dev-dependency:
+//! `fe-model = { workspace = true, features = ["samples"] }`.
 
 use crate::dof::{Dimension, Dof};
 use crate::model::{Group, Model, Section};

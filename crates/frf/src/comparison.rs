@@ -53,7 +53,7 @@ pub const MODEL_REACH: f64 = 2.0;
 
 /// Every free DOF of a system, node by node.
 pub fn free_dofs(system: &DampedSystem) -> Vec<DofRef> {
-    let dofs = &system.assembly().dofs;
+    let dofs = system.assembly().dofs();
     let model = system.model();
     model
         .nodes()

@@ -132,13 +132,14 @@ impl ZSolver {
     /// ([`Self::factor_nnz`]); pairs already in `pattern` (the equations of
     /// one element) change nothing. With no cliques this is [`Self::new`].
     pub fn with_cliques(pattern: &Pattern, cliques: &[Vec<usize>]) -> Result<Self, FrfError> {
-        let n = pattern.n;
+        let n = pattern.n();
         for (clique, eqs) in cliques.iter().enumerate() {
             if let Some(&eq) = eqs.iter().find(|&&eq| eq >= n) {
                 return Err(FrfError::CliqueOutOfRange { clique, eq, n });
             }
         }
-        let symbolic = SymbolicSparseColMat::new_checked(n, n, pattern.col_ptr.clone(), None, pattern.row_idx.clone());
+        let symbolic =
+            SymbolicSparseColMat::new_checked(n, n, pattern.col_ptr().to_vec(), None, pattern.row_idx().to_vec());
         let ldlt = SymbolicLdlt::new(pattern, cliques).map_err(FrfError::Factorization)?;
         Ok(ZSolver { pattern: symbolic, ldlt, lu: OnceLock::new() })
     }

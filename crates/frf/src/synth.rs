@@ -12,7 +12,7 @@ use crate::solver::ZSolver;
 
 /// Equation index of a DOF, or a located error.
 pub fn equation_of(sys: &DampedSystem, dof: DofRef) -> Result<usize, FrfError> {
-    match sys.assembly().dofs.slot(dof) {
+    match sys.assembly().dofs().slot(dof) {
         Some(Slot::Free(eq)) => Ok(eq),
         Some(Slot::Fixed) => Err(FrfError::FixedDof { dof }),
         None => Err(FrfError::UnknownDof { dof }),
@@ -30,7 +30,7 @@ pub fn receptance_columns(
     excitation: &[usize],
 ) -> Result<Mat<C64>, FrfError> {
     let omega = 2.0 * std::f64::consts::PI * freq_hz;
-    z.resize(sys.assembly().pattern.nnz(), C64::new(0.0, 0.0));
+    z.resize(sys.assembly().pattern().nnz(), C64::new(0.0, 0.0));
     sys.z_values_into(omega, z);
     solver.factorize(ws, z, freq_hz)?;
     let mut rhs = Mat::<C64>::zeros(sys.n(), excitation.len());
@@ -45,7 +45,7 @@ pub fn receptance_columns(
 /// frequency lines (Hz): one sparse factorisation per line and one solve per
 /// distinct reference, lines spread over rayon threads.
 pub fn synthesize(sys: &DampedSystem, channels: &[Channel], freqs_hz: &[f64]) -> Result<FrfSet, FrfError> {
-    let solver = ZSolver::new(&sys.assembly().pattern)?;
+    let solver = ZSolver::new(sys.assembly().pattern())?;
     synthesize_with(sys, &solver, channels, freqs_hz)
 }
 
@@ -69,7 +69,7 @@ pub fn synthesize_regular(
     channels: &[Channel],
     freqs_hz: &[f64],
 ) -> Result<(FrfSet, Vec<f64>), FrfError> {
-    let solver = ZSolver::new(&sys.assembly().pattern)?;
+    let solver = ZSolver::new(sys.assembly().pattern())?;
     synthesize_lines(sys, &solver, channels, freqs_hz, true)
 }
 

@@ -31,7 +31,7 @@ use frf::ZSolver;
 use rfm_update::sensitivity::{self, ChannelPlan, Hybrid};
 
 fn fast(c: &mut Criterion, group: &str, w: &Workload, samples: usize) {
-    let solver = ZSolver::new(&w.sys.assembly().pattern).unwrap();
+    let solver = ZSolver::new(w.sys.assembly().pattern()).unwrap();
     let plan = ChannelPlan::new(&w.sys, &w.channels).unwrap();
     let mut g = c.benchmark_group(group);
     g.sample_size(samples).throughput(Throughput::Elements(w.freqs.len() as u64));

@@ -44,7 +44,7 @@ fn main() {
 
     let t0 = Instant::now();
     let w = common::workload(family, params, measured, freqs);
-    let solver = frf::ZSolver::new(&w.sys.assembly().pattern).expect("pattern analyses");
+    let solver = frf::ZSolver::new(w.sys.assembly().pattern()).expect("pattern analyses");
     let plan = ChannelPlan::new(&w.sys, &w.channels).expect("channels resolve");
     let setup = t0.elapsed().as_secs_f64();
 

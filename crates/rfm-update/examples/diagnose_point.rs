@@ -40,7 +40,7 @@ fn main() {
     truth.set(q, 0.6).expect("factor is valid");
 
     // translational DOFs spread over the frame, driven at one of them
-    let dofs = &sys.assembly().dofs;
+    let dofs = sys.assembly().dofs();
     let uy: Vec<_> = (0..sys.n()).map(|eq| dofs.dof_of(eq)).filter(|d| d.dof == Dof::Uy).collect();
     let measured: Vec<_> = (0..n_measured).map(|i| uy[(2 * i + 1) * uy.len() / (2 * n_measured)]).collect();
     let reference = measured[measured.len() / 2];

@@ -241,6 +241,11 @@ pub enum FixProgress<'a> {
     },
 }
 
+/// A final misfit within this multiple of the noise is consistent with it:
+/// the model explains the data down to their noise (what `rfm fix` calls
+/// success, and the band its report shades).
+pub const CONSISTENT: f64 = 1.5;
+
 /// Above this multiple of the noise, the misfit the best single effect
 /// leaves suggests that more than one effect is missing, and the first is
 /// chosen by looking one step ahead.
@@ -296,9 +301,11 @@ fn update_case(
     let lines = opts.diagnose.lines;
     let added = CaseFile::parse(&current.path, &editor.text_at(&current.path)?)?;
     let mut study = Study::with_measured(added, measured.clone())?;
-    if let Some(u) = study.case.update.as_mut() {
+    if study.case().update.is_some() {
         // the lines the misfit is measured on (see `diagnose::log_misfit`)
-        u.frequencies = Some(fe_model::case::FrequencyChoice::List(diagnose::informative_lines(measured, lines)));
+        study.set_update_frequencies(fe_model::case::FrequencyChoice::List(diagnose::informative_lines(
+            measured, lines,
+        )))?;
     }
     let mut oe_opts = study.output_error_options()?;
     oe_opts.max_iterations = opts.update_iterations;
@@ -312,7 +319,7 @@ fn update_case(
     }
     let outcome = study.run_output_error(&oe_opts, |_| {})?;
     let misfit_updated = diagnose::log_misfit_with(&outcome.system, measured, lines, d.gains)?;
-    let values = crate::params::quantity_values(&study.parameters, outcome.system.model());
+    let values = crate::params::quantity_values(study.parameters(), outcome.system.model());
     editor.set_values(&values, &format!("updated by rfm fix, step {step}"))?;
     editor.push_history(&HistoryEntry {
         step: format!("updated after step {step}"),

@@ -40,7 +40,7 @@ pub fn rms_db_per_iteration(study: &Study, outcome: &UpdateOutcome, measured: &F
         v
     };
     let nf = measured.n_freq();
-    let stride = line_stride(study.system.n(), chosen.len(), nf);
+    let stride = line_stride(study.system().n(), chosen.len(), nf);
     let lines: Vec<usize> = (0..nf).step_by(stride).collect();
     let mut out = vec![f64::NAN; n];
     let Ok(measured) = measured.select_lines(&lines) else {
@@ -50,7 +50,7 @@ pub fn rms_db_per_iteration(study: &Study, outcome: &UpdateOutcome, measured: &F
     let whole = BandSpec::Edges(vec![f[0], f[f.len() - 1]]);
     let params = study.parameter_set();
     for k in chosen {
-        let mut sys = study.system.clone();
+        let mut sys = study.system().clone();
         if params.set_values(&mut sys, &outcome.history[k].values).is_err() {
             continue;
         }
@@ -76,13 +76,13 @@ mod tests {
         let path = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../cases/two-material-beam.toml"));
         let study = Study::load(path).unwrap();
         let outcome = study.run_output_error(&study.output_error_options().unwrap(), |_| {}).unwrap();
-        let measured = &study.measured;
+        let measured = study.measured();
         let (db, stride) = rms_db_per_iteration(&study, &outcome, measured);
         assert_eq!(stride, 1);
         assert_eq!(db.len(), outcome.history.len());
         let f = measured.frequencies_hz();
         let whole = BandSpec::Edges(vec![f[0], f[f.len() - 1]]);
-        for (sys, got) in [(&study.system, db[0]), (&outcome.system, db[db.len() - 1])] {
+        for (sys, got) in [(study.system(), db[0]), (&outcome.system, db[db.len() - 1])] {
             let frfs = frf::synthesize(sys, measured.channels(), f).unwrap();
             let want = correlate(measured, &frfs, &whole).unwrap().total.rms_db;
             assert!((got - want).abs() <= 1e-9 * want.abs(), "{got} vs {want}");

@@ -64,22 +64,22 @@
 //!
 //! let path = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../cases/tutorial/l-frame.toml"));
 //! let study = Study::load(path).unwrap();
-//! let measured = study.measured.to_receptance();
+//! let measured = study.measured().to_receptance();
 //!
 //! // compare: FRF errors per channel and band, and the modes paired by MAC
-//! let model = frf::synthesize(&study.system, measured.channels(), measured.frequencies_hz()).unwrap();
+//! let model = frf::synthesize(study.system(), measured.channels(), measured.frequencies_hz()).unwrap();
 //! let before = correlate(&measured, &model, &BandSpec::Auto).unwrap();
-//! let modes = frf::compare_modes(&study.system, &measured, 0.5).unwrap();
+//! let modes = frf::compare_modes(study.system(), &measured, 0.5).unwrap();
 //! assert!(!modes.pairing.pairs.is_empty());
 //!
 //! // diagnose: every candidate effect fitted and ranked against the noise
-//! let d = diagnose::diagnose(&study.case.model, &measured, &DiagnoseOptions::default()).unwrap();
+//! let d = diagnose::diagnose(&study.case().model, &measured, &DiagnoseOptions::default()).unwrap();
 //! let rank = d.recommended.expect("the tutorial's model lacks its bolted joint");
 //! assert!(d.ranking[rank - 1].description.contains("joint at node 13"));
 //!
 //! // add it and update every parameter of the new case
-//! let added = d.apply(&study.case, rank).unwrap().text_at(path).unwrap();
-//! let next = Study::with_measured(CaseFile::parse(path, &added).unwrap(), study.measured.clone()).unwrap();
+//! let added = d.apply(study.case(), rank).unwrap().text_at(path).unwrap();
+//! let next = Study::with_measured(CaseFile::parse(path, &added).unwrap(), study.measured().clone()).unwrap();
 //! let updated = next.run_output_error(&next.output_error_options().unwrap(), |_| {}).unwrap();
 //! assert_eq!(updated.status, Status::Converged);
 //!

@@ -38,7 +38,7 @@ pub fn read_measured_for(
             frf::io::load_measured_opts(path, &ReadOptions { map, mask, channel, dimension })?
         }
     };
-    let mut measured = measured.check_channels(path, &system.assembly().dofs, mask)?;
+    let mut measured = measured.check_channels(path, system.assembly().dofs(), mask)?;
     if let Some(s) = spec {
         calibrate(&mut measured, path, s)?;
         measured = restrict(measured, path, s)?;

@@ -231,7 +231,7 @@ pub fn run(
     opts: &RfmOptions,
     mut on_iteration: impl FnMut(&IterationRecord),
 ) -> Result<RfmResult, UpdateError> {
-    let solver = ZSolver::new(&sys.assembly().pattern)?;
+    let solver = ZSolver::new(sys.assembly().pattern())?;
     let plan = ChannelPlan::new(sys, measured.channels())?;
     let freqs = measured.frequencies_hz().to_vec();
     let weights = weights(measured);

@@ -6,7 +6,7 @@
 use damping::{DampedSystem, ModalError, complex_modes, normal_modes};
 use faer::Mat;
 use faer::linalg::solvers::DenseSolveCore;
-use fe_model::{Dof, Group, MatrixKind, Model, samples};
+use fe_model::{Dof, Group, MatrixKind, Model, Quantity, samples};
 use num_complex::Complex64 as C64;
 
 /// `Z(s) = K + s^2 M + s sum_g h_g(s) (alpha_g K_g + beta_g M_g)`, built here
@@ -291,9 +291,10 @@ fn a_large_viscous_mu_gives_the_viscous_modes() {
     let base = samples::frame_with_joint();
     let joint = base.group_index("joint").unwrap();
     let mut viscous = base.clone();
-    viscous.group_mut(joint).mu = None;
+    // an infinite mu is the viscous group
+    viscous.set(Quantity::GroupMu(joint), f64::INFINITY).unwrap();
     let mut nearly = base;
-    nearly.group_mut(joint).mu = Some(1e9);
+    nearly.set(Quantity::GroupMu(joint), 1e9).unwrap();
     let a = complex_modes(&DampedSystem::new(viscous).unwrap()).unwrap();
     let b = complex_modes(&DampedSystem::new(nearly).unwrap()).unwrap();
     assert_eq!(a.internal_variables, 0);
@@ -313,7 +314,7 @@ fn models_beyond_the_dense_limit_are_refused_with_their_size() {
     // 699 DOFs fit as a viscous model but not with an exponential kernel on
     // every element: the internal variables push the state past the limit
     let mut model = samples::cantilever(233);
-    model.group_mut(0).mu = Some(500.0);
+    model.set(Quantity::GroupMu(0), 500.0).unwrap();
     let sys = DampedSystem::new(model).unwrap();
     match complex_modes(&sys).unwrap_err() {
         ModalError::TooLarge { dofs, state_dimension, max: m } => {

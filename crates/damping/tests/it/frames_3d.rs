@@ -113,7 +113,7 @@ fn cantilever_bends_in_two_planes_with_its_two_second_moments() {
         for node in 2..=n + 1 {
             let u: Vec<f64> = [Dof::Ux, Dof::Uy, Dof::Uz]
                 .iter()
-                .map(|&d| col[a.dofs.equation(DofRef::new(node, d)).unwrap()])
+                .map(|&d| col[a.dofs().equation(DofRef::new(node, d)).unwrap()])
                 .collect();
             let p = u[0] * axis[0] + u[1] * axis[1] + u[2] * axis[2];
             sum += p * p;

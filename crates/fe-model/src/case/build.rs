@@ -7,40 +7,15 @@ use std::ops::Range;
 
 use toml::Spanned;
 
+use super::Ctx;
+use super::lookup::{group_ref, material_ref, section_ref};
 use super::raw::{RawCase, RawGroup, RawJoint, RawLine, RawMass, RawMaterial, RawSection, RawSpring};
-use super::{Ctx, hint};
 use crate::dof::{Dimension, Dof, PerDof};
 use crate::error::CaseError;
 use crate::model::{Group, Model, NodeId, Section};
 
 /// Most elements one `[[lines]]` entry may generate.
 pub const MAX_LINE_ELEMENTS: u32 = 100_000;
-
-/// The index of the material, section or group a case names, or an error at
-/// the name with the closest defined one suggested (or the list).
-fn find<'a>(
-    ctx: &Ctx<'_>,
-    kind: &str,
-    name: &Spanned<String>,
-    defined: impl Iterator<Item = &'a str> + Clone,
-) -> Result<usize, CaseError> {
-    defined.clone().position(|n| n == name.get_ref()).ok_or_else(|| {
-        let known: Vec<&str> = defined.collect();
-        ctx.err(name.span(), format!("unknown {kind} `{}`{}", name.get_ref(), hint(name.get_ref(), &known, "defined")))
-    })
-}
-
-pub(super) fn group_ref(ctx: &Ctx<'_>, model: &Model, name: &Spanned<String>) -> Result<usize, CaseError> {
-    find(ctx, "group", name, model.groups.iter().map(|g| g.name.as_str()))
-}
-
-fn material_ref(ctx: &Ctx<'_>, model: &Model, name: &Spanned<String>) -> Result<usize, CaseError> {
-    find(ctx, "material", name, model.materials.iter().map(|m| m.name.as_str()))
-}
-
-fn section_ref(ctx: &Ctx<'_>, model: &Model, name: &Spanned<String>) -> Result<usize, CaseError> {
-    find(ctx, "section", name, model.sections.iter().map(|s| s.name.as_str()))
-}
 
 pub(super) fn raw_group(ctx: &Ctx<'_>, name: &str, g: &Spanned<RawGroup>) -> Result<Group, CaseError> {
     let r = g.get_ref();

@@ -20,33 +20,16 @@
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
-use serde::Deserialize;
 use toml::Spanned;
 
 use super::Ctx;
-use super::build::group_ref;
+use super::lookup::group_ref;
+use super::raw::RawImported;
 use crate::dof::DofRef;
 use crate::error::{CaseError, Location};
 use crate::imported::matrix_market::{self, TextError};
 use crate::imported::{ImportedKind, tables};
 use crate::model::{Model, NodeId};
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(super) struct RawImported {
-    nodes: Option<Spanned<String>>,
-    #[serde(default)]
-    groups: Vec<Spanned<RawImportedGroup>>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawImportedGroup {
-    group: Spanned<String>,
-    dofs: Spanned<String>,
-    stiffness: Option<Spanned<String>>,
-    mass: Option<Spanned<String>>,
-}
 
 /// A path the case names, relative to its folder, with `..` taken out
 /// lexically: a case written into a folder that does not exist yet (an

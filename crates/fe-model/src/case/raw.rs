@@ -17,7 +17,7 @@ pub(super) struct RawCase {
     pub(super) title: Option<String>,
     pub(super) description: Option<String>,
     pub(super) model: Option<Spanned<RawModel>>,
-    pub(super) imported: Option<Spanned<super::imported::RawImported>>,
+    pub(super) imported: Option<Spanned<RawImported>>,
     #[serde(default)]
     pub(super) materials: BTreeMap<String, Spanned<RawMaterial>>,
     #[serde(default)]
@@ -51,6 +51,24 @@ pub(super) struct RawCase {
     #[serde(default)]
     pub(super) history: Vec<Spanned<RawHistory>>,
     pub(super) check: Option<Spanned<RawCheck>>,
+}
+
+/// `[imported]` (read in `imported.rs`).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawImported {
+    pub(super) nodes: Option<Spanned<String>>,
+    #[serde(default)]
+    pub(super) groups: Vec<Spanned<RawImportedGroup>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawImportedGroup {
+    pub(super) group: Spanned<String>,
+    pub(super) dofs: Spanned<String>,
+    pub(super) stiffness: Option<Spanned<String>>,
+    pub(super) mass: Option<Spanned<String>>,
 }
 
 #[derive(Deserialize)]

@@ -479,3 +479,20 @@ fn dofs_and_keys_of_the_other_dimension_are_refused_where_written() {
         assert_eq!(line_of(&text, &e), line, "{e}");
     }
 }
+
+#[test]
+fn a_truth_group_that_replaces_a_model_group_is_checked_as_the_model_group_is() {
+    let measurement = "[measurement]\nfrequencies = [10.0]\nreferences = [\"5:uy\"]\nresponses = [\"5:uy\"]\n";
+    let truth = format!("{BEAM}{measurement}[truth.groups.beam]\nalpha = -1e-5\n");
+    let e = parse(&truth).unwrap_err();
+    assert!(e.message.contains("group `beam`: alpha must be zero or positive and finite, got -1e-5"), "{e}");
+    assert_eq!(line_of(&truth, &e), "[truth.groups.beam]");
+    // the same value in the model's own group is refused with the same words
+    let model = format!("{}{measurement}", BEAM.replace("alpha = 1e-5", "alpha = -1e-5"));
+    let e = parse(&model).unwrap_err();
+    assert!(e.message.contains("group `beam`: alpha must be zero or positive and finite, got -1e-5"), "{e}");
+    // a valid one replaces the group's damping in the truth only
+    let c = parse(&format!("{BEAM}{measurement}[truth.groups.beam]\nalpha = 2e-5\n")).unwrap();
+    assert_eq!(c.model.groups()[0].alpha, 1e-5);
+    assert_eq!(c.truth.unwrap().model.groups()[0].alpha, 2e-5);
+}

@@ -36,11 +36,10 @@ pub(super) fn parse_truth(ctx: &Ctx<'_>, t: &Spanned<RawTruth>, base: &Model) ->
     for (name, g) in &r.groups {
         let group = raw_group(ctx, name, g)?;
         match model.group_index(name) {
-            Some(i) => *model.group_mut(i) = group,
-            None => {
-                model.add_group(group).map_err(|e| ctx.model_err(g.span(), e))?;
-            }
+            Some(i) => model.replace_group(i, group),
+            None => model.add_group(group).map(|_| ()),
         }
+        .map_err(|e| ctx.model_err(g.span(), e))?;
     }
     for s in &r.springs {
         add_spring(ctx, &mut model, s)?;

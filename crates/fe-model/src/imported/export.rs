@@ -22,18 +22,18 @@ pub struct Exported {
 
 /// Exports the group matrices of `model`, assembled as `assembly`.
 pub fn export(model: &Model, assembly: &Assembly) -> Exported {
-    let p = &assembly.pattern;
+    let p = assembly.pattern();
     let lower = |values: Vec<f64>| {
         let mut entries = Vec::new();
-        for c in 0..p.n {
-            for k in p.col_ptr[c]..p.col_ptr[c + 1] {
-                let r = p.row_idx[k];
+        for c in 0..p.n() {
+            for k in p.col_ptr()[c]..p.col_ptr()[c + 1] {
+                let r = p.row_idx()[k];
                 if r >= c && values[k] != 0.0 {
                     entries.push((r, c, values[k]));
                 }
             }
         }
-        SymmetricCoo { n: p.n, entries }
+        SymmetricCoo { n: p.n(), entries }
     };
     let groups = (0..model.groups().len())
         .map(|g| {
@@ -45,7 +45,7 @@ pub fn export(model: &Model, assembly: &Assembly) -> Exported {
         })
         .filter(|(_, k, m)| !(k.entries.is_empty() && m.entries.is_empty()))
         .collect();
-    Exported { dofs: (0..assembly.n()).map(|eq| assembly.dofs.dof_of(eq)).collect(), groups }
+    Exported { dofs: (0..assembly.n()).map(|eq| assembly.dofs().dof_of(eq)).collect(), groups }
 }
 
 impl Exported {

@@ -1,21 +1,11 @@
-//! The items a model is made of, as plain data: node and element ids,
-//! nodes, materials, sections (with the torsion constant of a rectangle),
-//! beams, springs, lumped masses, supports, ties and groups. [`super::Model`]
-//! checks them as they are added.
-
+//! The items a model is made of, as plain data: element ids (node ids,
+//! which DOFs name too, are in `dof.rs`), nodes, materials, sections (with
+//! the torsion constant of a rectangle), beams, springs, lumped masses,
+//! supports, ties, groups and the blocks of imported matrices (made by
+//! `crate::imported`). [`super::Model`] checks them as they are added.
 use std::fmt;
 
-use crate::dof::{Dof, PerDof};
-
-/// Identifier of a node as written by the user (not an index).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct NodeId(pub u32);
-
-impl fmt::Display for NodeId {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}", self.0)
-    }
-}
+use crate::dof::{Dof, DofRef, NodeId, PerDof};
 
 /// Identifier of a beam element as written by the user (not an index).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -287,4 +277,31 @@ impl From<[f64; 3]> for RotaryInertia {
     fn from(j: [f64; 3]) -> Self {
         RotaryInertia(j)
     }
+}
+
+/// Which matrix an imported block belongs to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ImportedKind {
+    /// A stiffness matrix, scaled by the group's stiffness factor.
+    Stiffness,
+    /// A mass matrix, scaled by the group's mass factor.
+    Mass,
+}
+
+/// The entries of an imported group matrix between the DOFs of one node,
+/// or between the DOFs of two nodes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImportedBlock {
+    /// Index into [`Model::groups`](super::Model::groups).
+    pub group: usize,
+    /// Stiffness or mass.
+    pub kind: ImportedKind,
+    /// The node, twice, or the two nodes (smaller id first).
+    pub nodes: [NodeId; 2],
+    /// Its DOFs: those of the first node, then of the second, that have an
+    /// entry in the block, in table order.
+    pub dofs: Vec<DofRef>,
+    /// The values, row-major `dofs.len()` squared, symmetric; the entries
+    /// among one node's own DOFs are zero in a block of two nodes.
+    pub values: Vec<f64>,
 }

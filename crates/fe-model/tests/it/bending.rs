@@ -11,10 +11,10 @@ fn deflect(model: &Model, loads: &[(u32, Dof, f64)]) -> impl Fn(u32, Dof) -> f64
     let a = Assembly::new(model).unwrap();
     let mut f = DVector::zeros(a.n());
     for &(node, dof, value) in loads {
-        f[a.dofs.equation(DofRef::new(node, dof)).unwrap()] += value;
+        f[a.dofs().equation(DofRef::new(node, dof)).unwrap()] += value;
     }
     let u = a.stiffness_dense().cholesky().expect("a supported structure").solve(&f);
-    move |node, dof| u[a.dofs.equation(DofRef::new(node, dof)).unwrap()]
+    move |node, dof| u[a.dofs().equation(DofRef::new(node, dof)).unwrap()]
 }
 
 fn scale_bending(model: &mut Model, range: &str, factor: f64) {

@@ -222,7 +222,7 @@ fn assembled_stiffness_and_mass_equal_an_independent_assembly_of_every_item_type
     let theta: f64 = 0.6;
     let model = beam_spring_mass(theta);
     let a = Assembly::new(&model).unwrap();
-    let eq = |node: u32, dof: Dof| a.dofs.equation(DofRef::new(node, dof));
+    let eq = |node: u32, dof: Dof| a.dofs().equation(DofRef::new(node, dof));
     let n = a.n();
     let (mut k, mut m) = (DMatrix::<f64>::zeros(n, n), DMatrix::<f64>::zeros(n, n));
     // the beam: quadrature matrices turned by the rotation written out here

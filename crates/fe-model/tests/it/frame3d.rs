@@ -292,7 +292,7 @@ fn assembled_3d_matrices_equal_an_independent_assembly_of_every_item_type() {
     let model = beam_spring_mass_3d();
     let a = Assembly::new(&model).unwrap();
     assert_eq!(a.n(), 12);
-    let eq = |node: u32, dof: Dof| a.dofs.equation(DofRef::new(node, dof));
+    let eq = |node: u32, dof: Dof| a.dofs().equation(DofRef::new(node, dof));
     let n = a.n();
     let (mut k, mut m) = (DMatrix::<f64>::zeros(n, n), DMatrix::<f64>::zeros(n, n));
     // the beam: quadrature matrices turned by the rotation built here from its axes

@@ -225,13 +225,13 @@ mod tests {
     #[test]
     fn a_channel_at_a_dof_a_planar_model_lacks_is_named_as_such() {
         let a = Assembly::new(&samples::cantilever(2)).unwrap();
-        let why = unmodelled(&a.dofs, DofRef::new(2, Dof::Uz)).unwrap();
+        let why = unmodelled(a.dofs(), DofRef::new(2, Dof::Uz)).unwrap();
         assert!(why.contains("node 2 has no `uz`") && why.contains("dimension = 3"), "{why}");
-        assert_eq!(unmodelled(&a.dofs, DofRef::new(9, Dof::Uy)).unwrap(), "the model has no node 9");
+        assert_eq!(unmodelled(a.dofs(), DofRef::new(9, Dof::Uy)).unwrap(), "the model has no node 9");
         assert_eq!(
-            unmodelled(&a.dofs, DofRef::new(1, Dof::Uy)).unwrap(),
+            unmodelled(a.dofs(), DofRef::new(1, Dof::Uy)).unwrap(),
             "1:uy is held fixed by a support of the model"
         );
-        assert_eq!(unmodelled(&a.dofs, DofRef::new(2, Dof::Rz)), None);
+        assert_eq!(unmodelled(a.dofs(), DofRef::new(2, Dof::Rz)), None);
     }
 }

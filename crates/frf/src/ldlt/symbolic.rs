@@ -24,7 +24,7 @@ impl SymbolicLdlt {
     /// read on the original pattern. With no cliques this is the plain
     /// analysis of `pattern`.
     pub(crate) fn new(pattern: &Pattern, cliques: &[Vec<usize>]) -> Result<Self, String> {
-        let n = pattern.n;
+        let n = pattern.n();
         if u32::try_from(n).is_err() {
             return Err(format!("{n} equations exceed the solver's 32-bit row indices"));
         }
@@ -36,7 +36,7 @@ impl SymbolicLdlt {
         let mut up_idx = Vec::with_capacity(analysed.nnz() / 2 + n);
         up_ptr.push(0);
         for c in 0..n {
-            let rows = &analysed.row_idx[analysed.col_ptr[c]..analysed.col_ptr[c + 1]];
+            let rows = &analysed.row_idx()[analysed.col_ptr()[c]..analysed.col_ptr()[c + 1]];
             up_idx.extend(rows.iter().copied().take_while(|&r| r <= c));
             up_ptr.push(up_idx.len());
         }
@@ -126,7 +126,7 @@ impl SymbolicLdlt {
             n,
             perm,
             perm_inv,
-            orig_col_ptr: pattern.col_ptr.clone(),
+            orig_col_ptr: pattern.col_ptr().to_vec(),
             a_col_ptr,
             a_row_idx,
             a_src,
@@ -142,13 +142,13 @@ impl SymbolicLdlt {
 /// `pattern` with every pair of equations within each clique added: both
 /// triangles, rows sorted and unique. Clique indices must be below `n`.
 pub(super) fn with_clique_pairs(pattern: &Pattern, cliques: &[Vec<usize>]) -> Result<Pattern, String> {
-    let n = pattern.n;
+    let n = pattern.n();
     if let Some(eq) = cliques.iter().flatten().copied().find(|&eq| eq >= n) {
         return Err(format!("clique equation {eq} is not below {n}"));
     }
     // room for the original rows and every clique row (duplicates included),
     // then each column sorted and compacted in place
-    let mut room: Vec<usize> = (0..n).map(|c| pattern.col_ptr[c + 1] - pattern.col_ptr[c]).collect();
+    let mut room: Vec<usize> = (0..n).map(|c| pattern.col_ptr()[c + 1] - pattern.col_ptr()[c]).collect();
     for clique in cliques {
         for &c in clique {
             room[c] += clique.len();
@@ -163,7 +163,7 @@ pub(super) fn with_clique_pairs(pattern: &Pattern, cliques: &[Vec<usize>]) -> Re
     let mut rows = vec![0usize; start[n]];
     let mut next = start[..n].to_vec();
     for c in 0..n {
-        let col = &pattern.row_idx[pattern.col_ptr[c]..pattern.col_ptr[c + 1]];
+        let col = &pattern.row_idx()[pattern.col_ptr()[c]..pattern.col_ptr()[c + 1]];
         rows[next[c]..next[c] + col.len()].copy_from_slice(col);
         next[c] += col.len();
     }
@@ -192,7 +192,9 @@ pub(super) fn with_clique_pairs(pattern: &Pattern, cliques: &[Vec<usize>]) -> Re
         col_ptr.push(kept);
     }
     rows.truncate(kept);
-    Ok(Pattern { n, col_ptr, row_idx: rows })
+    // symmetric with its diagonal, as the given pattern was (a clique adds
+    // both triangles of its pairs); `Pattern::new` checks it, once per analysis
+    Pattern::new(n, col_ptr, rows).map_err(|e| e.to_string())
 }
 
 /// Upper triangle of `P A P^T` by column, rows ascending, for a symmetric
@@ -203,11 +205,11 @@ pub(super) fn with_clique_pairs(pattern: &Pattern, cliques: &[Vec<usize>]) -> Re
 /// `j = perm_inv[r] >= i` is `B[j, i] = B[i, j]` by symmetry, appended to
 /// column `j`, so every column receives its rows in ascending order.
 fn permuted_upper(pattern: &Pattern, perm: &[usize], perm_inv: &[usize]) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
-    let n = pattern.n;
+    let n = pattern.n();
     let mut col_ptr = vec![0usize; n + 1];
     for i in 0..n {
         let c = perm[i];
-        for &r in &pattern.row_idx[pattern.col_ptr[c]..pattern.col_ptr[c + 1]] {
+        for &r in &pattern.row_idx()[pattern.col_ptr()[c]..pattern.col_ptr()[c + 1]] {
             let j = perm_inv[r];
             if j >= i {
                 col_ptr[j + 1] += 1;
@@ -223,8 +225,8 @@ fn permuted_upper(pattern: &Pattern, perm: &[usize], perm_inv: &[usize]) -> (Vec
     let mut src = vec![0usize; nnz];
     for i in 0..n {
         let c = perm[i];
-        for p in pattern.col_ptr[c]..pattern.col_ptr[c + 1] {
-            let j = perm_inv[pattern.row_idx[p]];
+        for p in pattern.col_ptr()[c]..pattern.col_ptr()[c + 1] {
+            let j = perm_inv[pattern.row_idx()[p]];
             if j >= i {
                 rows[next[j]] = i;
                 src[next[j]] = p;

@@ -63,7 +63,7 @@ fn imported_case(model: &Model, dir: &Path) -> CaseFile {
 /// (the DOF owning each equation of another model).
 fn dense_z(sys: &DampedSystem, omega: f64, order: &[DofRef]) -> Mat<C64> {
     let a = sys.assembly();
-    let eq: Vec<usize> = order.iter().map(|&r| a.dofs.equation(r).expect("the same free DOFs")).collect();
+    let eq: Vec<usize> = order.iter().map(|&r| a.dofs().equation(r).expect("the same free DOFs")).collect();
     let mut to = vec![usize::MAX; a.n()];
     for (k, &e) in eq.iter().enumerate() {
         to[e] = k;
@@ -71,8 +71,8 @@ fn dense_z(sys: &DampedSystem, omega: f64, order: &[DofRef]) -> Mat<C64> {
     let z = sys.z_values(omega);
     let mut m = Mat::<C64>::zeros(a.n(), a.n());
     for col in 0..a.n() {
-        for p in a.pattern.col_ptr[col]..a.pattern.col_ptr[col + 1] {
-            m[(to[a.pattern.row_idx[p]], to[col])] = z[p];
+        for p in a.pattern().col_ptr()[col]..a.pattern().col_ptr()[col + 1] {
+            m[(to[a.pattern().row_idx()[p]], to[col])] = z[p];
         }
     }
     m
@@ -94,7 +94,7 @@ fn an_imported_model_has_the_dynamic_stiffness_and_receptances_of_the_native_one
         assert!(!imported.imported().is_empty() && imported.beams().is_empty(), "the matrices, not the beams");
         let (a, b) = (DampedSystem::new(native.clone()).unwrap(), DampedSystem::new(imported).unwrap());
         assert_eq!(a.n(), b.n(), "{}: the same free DOFs", native.title);
-        let order: Vec<DofRef> = (0..a.n()).map(|e| a.assembly().dofs.dof_of(e)).collect();
+        let order: Vec<DofRef> = (0..a.n()).map(|e| a.assembly().dofs().dof_of(e)).collect();
         let eqs: Vec<usize> =
             dofs.iter().map(|&(n, d)| order.iter().position(|&r| r == DofRef::new(n, d)).unwrap()).collect();
         let lines: Vec<f64> = (1..=60).map(|i| 6.7 * f64::from(i)).collect();

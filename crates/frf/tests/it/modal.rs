@@ -46,7 +46,7 @@ fn receptance_peaks_lie_at_the_predicted_damped_frequencies() {
     ];
     for (model, tip, count) in cases {
         let sys = DampedSystem::new(model).unwrap();
-        let solver = ZSolver::new(&sys.assembly().pattern).unwrap();
+        let solver = ZSolver::new(sys.assembly().pattern()).unwrap();
         let modes = complex_modes(&sys).unwrap();
         // the lightly damped ones (zeta < 1 %)
         let light: Vec<_> = modes.oscillatory.iter().take_while(|m| m.damping_ratio < 0.01).collect();

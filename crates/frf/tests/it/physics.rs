@@ -50,8 +50,8 @@ fn dense_viscous_receptance(sys: &DampedSystem, omega: f64) -> Mat<C64> {
     let mut z = Mat::<C64>::zeros(n, n);
     let mut add = |values: &[f64], c: C64| {
         for col in 0..n {
-            for p in a.pattern.col_ptr[col]..a.pattern.col_ptr[col + 1] {
-                z[(a.pattern.row_idx[p], col)] += c * values[p];
+            for p in a.pattern().col_ptr()[col]..a.pattern().col_ptr()[col + 1] {
+                z[(a.pattern().row_idx()[p], col)] += c * values[p];
             }
         }
     };
@@ -99,8 +99,8 @@ fn dense_z(sys: &DampedSystem, omega: f64) -> Mat<C64> {
     let values = sys.z_values(omega);
     let mut z = Mat::<C64>::zeros(a.n(), a.n());
     for col in 0..a.n() {
-        for p in a.pattern.col_ptr[col]..a.pattern.col_ptr[col + 1] {
-            z[(a.pattern.row_idx[p], col)] += values[p];
+        for p in a.pattern().col_ptr()[col]..a.pattern().col_ptr()[col + 1] {
+            z[(a.pattern().row_idx()[p], col)] += values[p];
         }
     }
     z
@@ -119,7 +119,7 @@ fn the_model_is_reciprocal_by_a_dense_lu_of_the_whole_z() {
         let sys = DampedSystem::new(model).unwrap();
         let n = sys.n();
         let eqs: Vec<usize> = (0..n).step_by((n / 12).max(1)).collect();
-        let dofs: Vec<DofRef> = eqs.iter().map(|&e| sys.assembly().dofs.dof_of(e)).collect();
+        let dofs: Vec<DofRef> = eqs.iter().map(|&e| sys.assembly().dofs().dof_of(e)).collect();
         let channels: Vec<Channel> = dofs.iter().flat_map(|&a| dofs.iter().map(move |&b| Channel::new(a, b))).collect();
         let freqs = [2.7, 41.0, 157.0, 612.0];
         let h = synthesize(&sys, &channels, &freqs).unwrap();

@@ -22,8 +22,10 @@ fn damping() -> impl Strategy<Value = (f64, f64, Option<f64>)> {
 fn frame(members: &[TreeMember], groups: [(f64, f64, Option<f64>); 2]) -> Model {
     let mut m = tree_frame(members, &(0..members.len()).collect::<Vec<_>>(), true);
     for (g, (alpha, beta, mu)) in groups.into_iter().enumerate() {
-        let group = m.group_mut(g);
-        (group.alpha, group.beta, group.mu) = (alpha, beta, mu);
+        m.set(Quantity::GroupAlpha(g), alpha).unwrap();
+        m.set(Quantity::GroupBeta(g), beta).unwrap();
+        // an infinite mu is the viscous group (`None`)
+        m.set(Quantity::GroupMu(g), mu.unwrap_or(f64::INFINITY)).unwrap();
     }
     m
 }
@@ -42,7 +44,7 @@ proptest! {
         a in any::<prop::sample::Index>(), b in any::<prop::sample::Index>(),
     ) {
         let sys = DampedSystem::new(frame(&members, d)).unwrap();
-        let dofs = &sys.assembly().dofs;
+        let dofs = sys.assembly().dofs();
         let (a, b) = (dofs.dof_of(a.index(sys.n())), dofs.dof_of(b.index(sys.n())));
         prop_assume!(a != b);
         let h = synthesize(&sys, &[Channel::new(a, b), Channel::new(b, a)], &[freq]).unwrap();
@@ -65,8 +67,8 @@ proptest! {
         let mut xzx = C64::new(0.0, 0.0);
         let mut scale = 0.0f64;
         for col in 0..a.n() {
-            for p in a.pattern.col_ptr[col]..a.pattern.col_ptr[col + 1] {
-                let row = a.pattern.row_idx[p];
+            for p in a.pattern().col_ptr()[col]..a.pattern().col_ptr()[col + 1] {
+                let row = a.pattern().row_idx()[p];
                 xzx += x[row].conj() * z[p] * x[col];
                 scale += x[row].norm() * z[p].norm() * x[col].norm();
             }
@@ -86,7 +88,7 @@ proptest! {
             slow.set(Quantity::GroupMu(g), 1e12).unwrap();
             viscous.set(Quantity::GroupMu(g), f64::INFINITY).unwrap();
         }
-        let dof = slow.assembly().dofs.dof_of(a.index(slow.n()));
+        let dof = slow.assembly().dofs().dof_of(a.index(slow.n()));
         let ch = [Channel::new(dof, dof)];
         let (hs, hv) = (synthesize(&slow, &ch, &[freq]).unwrap(), synthesize(&viscous, &ch, &[freq]).unwrap());
         prop_assert!(rel(hs.get(0, 0), hv.get(0, 0)) < 1e-6, "{} vs viscous {}", hs.get(0, 0), hv.get(0, 0));

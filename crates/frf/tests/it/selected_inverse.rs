@@ -24,11 +24,11 @@ fn dominant_symmetric(n: usize, per_col: usize, rng: &mut ChaCha8Rng) -> (Patter
 /// `Z^-1` by faer's dense LU with partial pivoting, solving against the
 /// identity: independent of the sparse code under test.
 fn dense_inverse(pattern: &Pattern, values: &[C64]) -> Mat<C64> {
-    let n = pattern.n;
+    let n = pattern.n();
     let mut z = Mat::<C64>::zeros(n, n);
     for c in 0..n {
-        for p in pattern.col_ptr[c]..pattern.col_ptr[c + 1] {
-            z[(pattern.row_idx[p], c)] = values[p];
+        for p in pattern.col_ptr()[c]..pattern.col_ptr()[c + 1] {
+            z[(pattern.row_idx()[p], c)] = values[p];
         }
     }
     let mut h = Mat::<C64>::identity(n, n);
@@ -57,7 +57,7 @@ fn random_cliques(n: usize, count: usize, rng: &mut ChaCha8Rng) -> Vec<Vec<usize
 /// beam `i` to beam `i + run - 1`, for every `i`.
 fn element_run_cliques(asm: &Assembly, run: usize) -> Vec<Vec<usize>> {
     let beams: Vec<&[usize]> =
-        asm.blocks.iter().filter(|b| matches!(b.source, BlockSource::Beam(_))).map(|b| b.eqs.as_slice()).collect();
+        asm.blocks().iter().filter(|b| matches!(b.source(), BlockSource::Beam(_))).map(|b| b.eqs()).collect();
     beams
         .windows(run)
         .map(|w| {
@@ -132,7 +132,7 @@ fn selected_inverse_of_a_frame_equals_unit_solves() {
     let n = sys.n();
     let cliques = element_run_cliques(sys.assembly(), 4);
     for (name, cliques) in [("no cliques", Vec::new()), ("runs of 4 elements", cliques)] {
-        let solver = ZSolver::with_cliques(&sys.assembly().pattern, &cliques).unwrap();
+        let solver = ZSolver::with_cliques(sys.assembly().pattern(), &cliques).unwrap();
         let mut ws = solver.workspace();
         let mut inv = SelectedInverse::new();
         let all: Vec<usize> = (0..n).collect();
@@ -175,7 +175,7 @@ fn selected_inverse_of_a_frame_equals_unit_solves() {
 #[test]
 fn cliques_change_the_factor_only_where_the_pattern_lacks_them() {
     let sys = DampedSystem::new(samples::frame_grid(3, 4, 4)).unwrap();
-    let pattern = &sys.assembly().pattern;
+    let pattern = sys.assembly().pattern();
     let plain = ZSolver::new(pattern).unwrap();
     let same = ZSolver::with_cliques(pattern, &[]).unwrap();
     let elements = ZSolver::with_cliques(pattern, &element_run_cliques(sys.assembly(), 1)).unwrap();
@@ -204,7 +204,7 @@ fn selected_inverse_is_refused_without_ldlt_factors() {
     // [[0, 1], [1, 0]] blocks: every pivot is zero, so factorize falls back
     let zero = C64::new(0.0, 0.0);
     let one = C64::new(1.0, 0.0);
-    let pattern = Pattern { n: 4, col_ptr: vec![0, 2, 4, 6, 8], row_idx: vec![0, 1, 0, 1, 2, 3, 2, 3] };
+    let pattern = Pattern::new(4, vec![0, 2, 4, 6, 8], vec![0, 1, 0, 1, 2, 3, 2, 3]).unwrap();
     let values = [zero, one, one, zero, zero, one, one, zero];
     let solver = ZSolver::new(&pattern).unwrap();
     let mut ws = solver.workspace();

@@ -108,7 +108,7 @@ struct MeasuredData {
 fn measured_data(case: CaseFile, system: &DampedSystem, files: &[PathBuf]) -> Result<MeasuredData> {
     if files.is_empty() {
         let study = Study::from_case(case)?;
-        let source = match (study.case.measurement.as_ref().and_then(|m| m.data.as_ref()), &study.case.truth) {
+        let source = match (study.case().measurement.as_ref().and_then(|m| m.data.as_ref()), &study.case().truth) {
             (Some(p), _) => format!("measured file {} (from the case)", p.display()),
             (None, Some(t)) if t.noise > 0.0 => format!(
                 "synthesised from the case's truth model ({} % noise, seed {})",
@@ -118,11 +118,12 @@ fn measured_data(case: CaseFile, system: &DampedSystem, files: &[PathBuf]) -> Re
             (None, Some(_)) => "synthesised from the case's truth model (noise-free)".into(),
             (None, None) => "the case's data".into(),
         };
-        let masked = describe_masked(&study.masked);
+        let masked = describe_masked(study.masked());
         // compared in the kind the data were measured in, as with --measured
         let set = study.measured_as_read();
-        let gains = (study.gains, study.gains_reason.clone());
-        return Ok(MeasuredData { case: study.case, set, source, masked, notes: study.notes, gains });
+        let gains = (study.gains(), study.gains_reason().to_string());
+        let (case, notes) = (study.case().clone(), study.notes().to_vec());
+        return Ok(MeasuredData { case, set, source, masked, notes, gains });
     }
     let mut sets = Vec::new();
     let mut masked = Vec::new();

@@ -26,7 +26,7 @@ pub(crate) struct DiagnoseArgs<'a> {
 
 pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
     let mut study = Study::load(args.case)?;
-    let mut inputs = study.case.inputs();
+    let mut inputs = study.case().inputs();
     inputs.extend(args.measured.map(Path::to_path_buf));
     let mut output = match (args.apply, args.out) {
         (Some(_), Some(out)) => Some(Outputs::file(out, &inputs)?),
@@ -37,8 +37,8 @@ pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
     // it twice. The new case gets the synthesised data beside it instead
     // (as every step of `rfm fix` does), written before the case.
     let synthesised = args.measured.is_none()
-        && study.case.measurement.as_ref().is_some_and(|m| m.data.is_none())
-        && study.case.truth.is_some();
+        && study.case().measurement.as_ref().is_some_and(|m| m.data.is_none())
+        && study.case().truth.is_some();
     let mut data_output = match (args.apply, args.out) {
         (Some(_), Some(out)) if synthesised => {
             let path = data_beside(out);
@@ -48,13 +48,14 @@ pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
     };
     let (measured, notes) = match args.measured {
         Some(path) => {
-            let read = read_measured_for(&study.system, path, study.case.measurement.as_ref())?;
+            let read = read_measured_for(study.system(), path, study.case().measurement.as_ref())?;
             study.set_gains_for(&read)?;
             let mut notes = read.notes.clone();
-            if study.gains != Gains::None {
+            if study.gains() != Gains::None {
                 notes.push(format!(
                     "model FRFs are multiplied by fitted gains ({}): {}",
-                    study.gains, study.gains_reason
+                    study.gains(),
+                    study.gains_reason()
                 ));
             }
             print_notes(&notes, args.json)?;
@@ -62,13 +63,13 @@ pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
             (read.set.to_receptance(), notes)
         }
         None => {
-            print_notes(&study.notes, args.json)?;
-            print_masked(&describe_masked(&study.masked), args.json)?;
-            (study.measured.clone(), study.notes.clone())
+            print_notes(study.notes(), args.json)?;
+            print_masked(&describe_masked(study.masked()), args.json)?;
+            (study.measured().clone(), study.notes().to_vec())
         }
     };
     if !args.json {
-        outln!("{}", study.case.model.title);
+        outln!("{}", study.case().model.title);
         outln!(
             "fitting every candidate effect to {} channels x {} lines ({} to {} Hz) ...",
             measured.channels().len(),
@@ -82,7 +83,7 @@ pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
     bar.enable_steady_tick(std::time::Duration::from_millis(120));
     let start = std::time::Instant::now();
     let opts = study.diagnose_options()?;
-    let d = diagnose_with(&study.case.model, &measured, &opts, |stage| {
+    let d = diagnose_with(&study.case().model, &measured, &opts, |stage| {
         let line = format!("{stage} ({:.2} s)", start.elapsed().as_secs_f64());
         if args.verbose {
             bar.suspend(|| eprintln!("{line}"));
@@ -98,9 +99,9 @@ pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
     if let Some(rank) = args.apply {
         let out = args.out.ok_or("--apply needs --out FILE for the new case file")?;
         let data = data_output.as_ref().map(|(_, path)| path.clone());
-        let editor = d.apply_with_data(&study.case, rank, data.as_deref())?;
+        let editor = d.apply_with_data(study.case(), rank, data.as_deref())?;
         if let Some((mut data, path)) = data_output.take() {
-            data.write_file(frf::io::csv::to_csv_string(&study.measured).as_bytes())?;
+            data.write_file(frf::io::csv::to_csv_string(study.measured()).as_bytes())?;
             data.commit()?;
             if !args.json {
                 outln!("\nwrote {} with the data synthesised from the case's [truth]", path.display());

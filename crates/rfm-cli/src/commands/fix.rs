@@ -5,18 +5,16 @@
 use std::path::Path;
 
 use rfm_update::Study;
-use rfm_update::fix::{FixOptions, FixOutcome, FixProgress, FixStop, fix as run_fix};
+use rfm_update::fix::{CONSISTENT, FixOptions, FixOutcome, FixProgress, FixStop, fix as run_fix};
 
 use super::{Result, print_masked, print_notes};
 use crate::exit::Exit;
 use crate::output::Outputs;
+use crate::report::fix_report::step_file;
 use crate::table::{Table, num};
 
 /// The data a case synthesised from its `[truth]`, written beside the steps.
 const DATA_FILE: &str = "measured.csv";
-
-/// A misfit within this many times the noise is consistent with it.
-pub(crate) const CONSISTENT: f64 = 1.5;
 
 /// Options of the fix command.
 pub(crate) struct FixArgs<'a> {
@@ -27,17 +25,12 @@ pub(crate) struct FixArgs<'a> {
     pub(crate) report: crate::report::ReportOptions,
 }
 
-/// The name of the case file written after step `k` (1-based).
-pub(crate) fn step_file(k: usize) -> String {
-    format!("step-{k}.toml")
-}
-
 pub(crate) fn fix(args: &FixArgs<'_>) -> Result<Exit> {
     let study = Study::load(args.case)?;
-    let inputs = study.case.inputs();
+    let inputs = study.case().inputs();
     // the data every written case reads: the case's own file, or the data
     // synthesised from its [truth], written once beside the steps
-    let synthesised = study.case.measurement.as_ref().and_then(|m| m.data.as_ref()).is_none();
+    let synthesised = study.case().measurement.as_ref().and_then(|m| m.data.as_ref()).is_none();
     // one more than the steps: the loop may end by replacing an early effect
     let mut names: Vec<String> = (1..=args.steps + 1).map(step_file).collect();
     names.extend(["results.json", "report.html"].map(String::from));
@@ -46,16 +39,16 @@ pub(crate) fn fix(args: &FixArgs<'_>) -> Result<Exit> {
     }
     let known: Vec<&str> = names.iter().map(String::as_str).collect();
     let mut output = Outputs::folder(args.out, &inputs, &known)?;
-    print_notes(&study.notes, args.json)?;
-    print_masked(&rfm_update::study::describe_masked(&study.masked), args.json)?;
+    print_notes(study.notes(), args.json)?;
+    print_masked(&rfm_update::study::describe_masked(study.masked()), args.json)?;
     if !args.json {
-        outln!("{}", study.case.model.title);
+        outln!("{}", study.case().model.title);
         outln!(
             "closing the loop on {} channels x {} lines ({} to {} Hz), at most {} steps",
-            study.measured.channels().len(),
-            study.measured.n_freq(),
-            num(study.measured.frequencies_hz()[0]),
-            num(*study.measured.frequencies_hz().last().expect("lines")),
+            study.measured().channels().len(),
+            study.measured().n_freq(),
+            num(study.measured().frequencies_hz()[0]),
+            num(*study.measured().frequencies_hz().last().expect("lines")),
             args.steps
         );
     }
@@ -66,7 +59,7 @@ pub(crate) fn fix(args: &FixArgs<'_>) -> Result<Exit> {
         ..FixOptions::default()
     };
     let json = args.json;
-    let outcome = run_fix(&study.case, &study.measured, &opts, |p| {
+    let outcome = run_fix(study.case(), study.measured(), &opts, |p| {
         if json {
             return;
         }
@@ -102,7 +95,7 @@ pub(crate) fn fix(args: &FixArgs<'_>) -> Result<Exit> {
 
     let data_file = synthesised.then(|| output.path(DATA_FILE));
     if synthesised {
-        output.write(DATA_FILE, frf::io::csv::to_csv_string(&study.measured).as_bytes())?;
+        output.write(DATA_FILE, frf::io::csv::to_csv_string(study.measured()).as_bytes())?;
     }
     for (k, s) in outcome.steps.iter().enumerate() {
         let name = step_file(k + 1);
@@ -114,7 +107,7 @@ pub(crate) fn fix(args: &FixArgs<'_>) -> Result<Exit> {
         output.write(&name, text.as_bytes())?;
     }
     output.write("results.json", serde_json::to_string_pretty(&outcome)?.as_bytes())?;
-    crate::report::fix_report::write(&study, &outcome, &args.report.for_case(&study.case), &mut output)?;
+    crate::report::fix_report::write(&study, &outcome, &args.report.for_case(study.case()), &mut output)?;
     let written = output.commit()?;
     if !json {
         outln!("\nwrote {} files into {}", written.len(), args.out.display());

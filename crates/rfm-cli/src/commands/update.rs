@@ -38,18 +38,18 @@ pub(crate) fn update(
 ) -> Result<Exit> {
     let mut study = Study::load(case)?;
     let mut output = out
-        .map(|dir| Outputs::folder(dir, &study.case.inputs(), &["results.json", "updated.toml", "report.html"]))
+        .map(|dir| Outputs::folder(dir, &study.case().inputs(), &["results.json", "updated.toml", "report.html"]))
         .transpose()?;
     if over.lines == Some(0) {
         return Err(Failure::new(Exit::Usage, "--lines 0: give at least one measured line to fit"));
     }
     if let Some(n) = over.lines
-        && let Some(u) = study.case.update.as_mut()
+        && study.case().update.is_some()
     {
-        u.frequencies = Some(fe_model::case::FrequencyChoice::Lines(n));
+        study.set_update_frequencies(fe_model::case::FrequencyChoice::Lines(n))?;
     }
     let method = over.method.as_deref();
-    if study.case.update.is_none() {
+    if study.case().update.is_none() {
         return Err("the case has no [update] section".into());
     }
     let method = match method {
@@ -61,18 +61,18 @@ pub(crate) fn update(
         Method::Rfm => study.rfm_options().max_iterations,
         Method::OutputError => study.output_error_options()?.max_iterations,
     });
-    print_notes(&study.notes, json)?;
-    print_masked(&rfm_update::study::describe_masked(&study.masked), json)?;
+    print_notes(study.notes(), json)?;
+    print_masked(&rfm_update::study::describe_masked(study.masked()), json)?;
     if !json {
-        outln!("{}", study.case.model.title);
-        print_history(&study.case.history)?;
+        outln!("{}", study.case().model.title);
+        print_history(&study.case().history)?;
         let what = match method {
             Method::Rfm => "the response function method",
             Method::OutputError => "output-error Levenberg-Marquardt",
         };
         outln!(
             "updating {} parameters with {what} at {} lines ({} to {} Hz)",
-            study.parameters.len(),
+            study.parameters().len(),
             lines.len(),
             num(lines[0]),
             num(lines[lines.len() - 1])
@@ -116,11 +116,11 @@ pub(crate) fn update(
     };
     bar.finish_and_clear();
     // the misfit the case's history speaks of, after this update
-    let noise = rfm_update::diagnose::estimate_noise(&study.measured);
-    let gains = study.gains != fe_model::case::Gains::None;
-    let misfit = rfm_update::diagnose::log_misfit_with(&outcome.system, &study.measured, HISTORY_LINES, gains)?;
+    let noise = rfm_update::diagnose::estimate_noise(study.measured());
+    let gains = study.gains() != fe_model::case::Gains::None;
+    let misfit = rfm_update::diagnose::log_misfit_with(&outcome.system, study.measured(), HISTORY_LINES, gains)?;
     // worse than the start over the whole band, not only at the fitted lines
-    let misfit_initial = rfm_update::diagnose::log_misfit_with(&study.system, &study.measured, HISTORY_LINES, gains)?;
+    let misfit_initial = rfm_update::diagnose::log_misfit_with(study.system(), study.measured(), HISTORY_LINES, gains)?;
     if misfit > WORSE_BY * misfit_initial && !outcome.worse_than_start {
         outcome.worse_than_start = true;
         outcome.warnings.push(format!(
@@ -133,16 +133,16 @@ pub(crate) fn update(
         outln!("{}", serde_json::to_string_pretty(&outcome)?);
     } else {
         print_outcome(&outcome)?;
-        if !study.case.history.is_empty() {
+        if !study.case().history.is_empty() {
             outln!("the fall of the misfit, from the case's history to this update:");
-            print_history(&[study.case.history.clone(), vec![step.clone()]].concat())?;
+            print_history(&[study.case().history.clone(), vec![step.clone()]].concat())?;
         }
     }
     if let Some(mut output) = output.take() {
         let path = output.write("results.json", serde_json::to_string_pretty(&outcome)?.as_bytes())?;
         let updated = write_updated_model(&study, &outcome, &step, &mut output)?;
         let report =
-            crate::report::update_report::write(&study, &outcome, &mut output, case, &report.for_case(&study.case))?;
+            crate::report::update_report::write(&study, &outcome, &mut output, case, &report.for_case(study.case()))?;
         output.commit()?;
         if !json {
             outln!("\nwrote {} and {}", path.display(), updated.display());
@@ -163,22 +163,22 @@ fn write_updated_model(
     step: &fe_model::HistoryEntry,
     output: &mut Outputs,
 ) -> Result<std::path::PathBuf> {
-    let values = rfm_update::params::quantity_values(&study.parameters, outcome.system.model());
+    let values = rfm_update::params::quantity_values(study.parameters(), outcome.system.model());
     let mut comment = format!(
         "Updated by rfm ({}, status {}, misfit {:.3e}) from {}",
         outcome.method,
         outcome.status.name(),
         outcome.residual,
-        study.case.path.display()
+        study.case().path.display()
     );
     if outcome.worse_than_start {
         comment.push_str(
             "\nWARNING: this update made the misfit WORSE than the initial model's: these values are not an improvement",
         );
     }
-    let mut editor = study.case.editor()?;
+    let mut editor = study.case().editor()?;
     editor.set_values(&values, &comment)?;
-    if study.gains != fe_model::case::Gains::None {
+    if study.gains() != fe_model::case::Gains::None {
         // the next run (diagnose, compare, update) fits the gains too; their values are kept
         let fitted: Vec<fe_model::case::FittedGain> = outcome
             .gains
@@ -189,7 +189,7 @@ fn write_updated_model(
                 phase_deg: g.phase_deg,
             })
             .collect();
-        editor.set_gains(study.gains, &fitted)?;
+        editor.set_gains(study.gains(), &fitted)?;
     }
     editor.push_history(step)?;
     let text = editor.text_at(&output.path("updated.toml"))?;

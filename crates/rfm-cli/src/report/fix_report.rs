@@ -10,14 +10,20 @@ use frf::correlation::{BandSpec, correlate};
 use frf::synthesize;
 use rfm_update::Study;
 use rfm_update::diagnose::{EffectKind, Ranked};
-use rfm_update::fix::FixOutcome;
+use rfm_update::fix::{CONSISTENT, FixOutcome};
 
 use super::html::{Block, Report, Section, Table, Tone};
 use super::plot::structure::{Highlight, HighlightKind};
 use super::{ModelFrfs, ReportOptions, Result, plot, sig};
-use crate::commands::fix::{CONSISTENT, step_file};
 use crate::output::Outputs;
 use crate::table::{num, percent};
+
+/// The name of the case file written after step `k` (1-based): the
+/// command writes it, the report names it beside the step (here, below the
+/// command, so that the two do not import each other).
+pub(crate) fn step_file(k: usize) -> String {
+    format!("step-{k}.toml")
+}
 
 /// How an effect is marked on the structure: at its nodes for a joint, a
 /// support or a mass, along its elements for a change over a region.
@@ -70,15 +76,15 @@ pub(crate) fn write(study: &Study, outcome: &FixOutcome, opts: &ReportOptions, o
     // the model after the last step, with every effect added
     let fixed = match outcome.steps.last() {
         Some(s) => {
-            let text = s.case.text_at(&study.case.path)?;
-            Some(damping::DampedSystem::new(fe_model::CaseFile::parse(&study.case.path, &text)?.model)?)
+            let text = s.case.text_at(&study.case().path)?;
+            Some(damping::DampedSystem::new(fe_model::CaseFile::parse(&study.case().path, &text)?.model)?)
         }
         None => None,
     };
-    let mut report = Report::new(format!("{}: closing the loop", study.case.model.title));
+    let mut report = Report::new(format!("{}: closing the loop", study.case().model.title));
     report.subtitle = Some(format!(
         "rfm fix, case file {}: {} effect(s) added; {}",
-        study.case.path.display(),
+        study.case().path.display(),
         outcome.steps.len(),
         outcome.stop.describe()
     ));
@@ -107,10 +113,10 @@ pub(crate) fn write(study: &Study, outcome: &FixOutcome, opts: &ReportOptions, o
     )?);
     // the effects in the fixed model (a replaced one is not)
     let highlights: Vec<Highlight> = outcome.effects.iter().map(highlight).collect();
-    let drawn = fixed.as_ref().map_or(&study.case.model, |f| f.model());
+    let drawn = fixed.as_ref().map_or(&study.case().model, |f| f.model());
     fall.push(super::structure_figure(
         drawn,
-        &study.measured,
+        study.measured(),
         &highlights,
         if highlights.is_empty() {
             "Nothing was added: the nominal model."
@@ -235,19 +241,19 @@ pub(crate) fn write(study: &Study, outcome: &FixOutcome, opts: &ReportOptions, o
     report.sections.push(rest);
 
     // the nominal and the final model against the data
-    let measured = &study.measured;
+    let measured = study.measured();
     let model = |label: &str, colour, sys: &damping::DampedSystem| -> Result<ModelFrfs> {
         let frfs = synthesize(sys, measured.channels(), measured.frequencies_hz())?;
         let correlation = correlate(measured, &frfs, &BandSpec::Auto)?;
         Ok(ModelFrfs { label: label.into(), colour, frfs, correlation })
     };
-    let mut models = vec![model("nominal model", plot::INITIAL, &study.system)?];
+    let mut models = vec![model("nominal model", plot::INITIAL, study.system())?];
     if let Some(f) = &fixed {
         models.push(model("fixed model", plot::UPDATED, f)?);
     }
     let notes = vec!["The nominal model and the model after the last step against the measured FRFs.".to_string()];
     report.sections.push(super::correlation_section(measured, &models, opts, out, notes)?);
-    let last_system = fixed.as_ref().unwrap_or(&study.system);
+    let last_system = fixed.as_ref().unwrap_or(study.system());
     let comparison = super::modes::compare_modes(last_system, measured);
     let against = if fixed.is_some() { "the fixed model" } else { "the nominal model" };
     report.sections.push(super::modes::section(

@@ -27,7 +27,7 @@ pub(crate) fn write(
     case_path: &Path,
     opts: &ReportOptions,
 ) -> Result<PathBuf> {
-    let measured = &study.measured;
+    let measured = study.measured();
     let channels = measured.channels();
     let freqs = measured.frequencies_hz();
     // a model singular at a line (an RFM run that wandered off, an undamped
@@ -48,7 +48,7 @@ pub(crate) fn write(
     };
     let updated_label = if outcome.gains.is_empty() { "updated model" } else { "updated model (with fitted gains)" };
     let models = [
-        model("initial model", plot::INITIAL, &study.system, &[])?,
+        model("initial model", plot::INITIAL, study.system(), &[])?,
         model(updated_label, plot::UPDATED, &outcome.system, &outcome.gains)?,
     ];
     let (all_lines_db, stride) = rfm_update::history::rms_db_per_iteration(study, outcome, measured);
@@ -62,7 +62,7 @@ pub(crate) fn write(
         which_lines.push_str(", without the fitted gains");
     }
 
-    let mut report = Report::new(format!("{}: model updating", study.case.model.title));
+    let mut report = Report::new(format!("{}: model updating", study.case().model.title));
     report.subtitle =
         Some(format!("rfm update, {} method, case file {}", method_name(&outcome.method), case_path.display()));
     let mut first = summary(study, outcome, &models);
@@ -182,9 +182,9 @@ fn status_text(s: &Status) -> String {
 
 fn summary(study: &Study, outcome: &UpdateOutcome, models: &[ModelFrfs; 2]) -> Section {
     let (a, b) = (&models[0].correlation, &models[1].correlation);
-    let measured = &study.measured;
+    let measured = study.measured();
     let f = measured.frequencies_hz();
-    let source = match (&study.case.measurement.as_ref().and_then(|m| m.data.clone()), &study.case.truth) {
+    let source = match (&study.case().measurement.as_ref().and_then(|m| m.data.clone()), &study.case().truth) {
         (Some(path), _) => format!("measured file {}", path.display()),
         (None, Some(t)) if t.noise > 0.0 => {
             format!(
@@ -200,7 +200,7 @@ fn summary(study: &Study, outcome: &UpdateOutcome, models: &[ModelFrfs; 2]) -> S
     let first = outcome.history.first().map_or(f64::NAN, |r| r.residual);
     let mut s = Section::new("Summary");
     s.push(Block::Facts(vec![
-        ("case".into(), study.case.path.display().to_string()),
+        ("case".into(), study.case().path.display().to_string()),
         ("data".into(), source),
         (
             "measurement".into(),

@@ -265,9 +265,9 @@ fn compare_json_agrees_with_the_library() {
     let c = &json["correlation"];
 
     let study = Study::load(&case_file).unwrap();
-    let model = DampedSystem::new(study.case.model.clone()).unwrap();
-    let frfs = frf::synthesize(&model, study.measured.channels(), study.measured.frequencies_hz()).unwrap();
-    let lib = correlate(&study.measured, &frfs, &BandSpec::Auto).unwrap();
+    let model = DampedSystem::new(study.case().model.clone()).unwrap();
+    let frfs = frf::synthesize(&model, study.measured().channels(), study.measured().frequencies_hz()).unwrap();
+    let lib = correlate(study.measured(), &frfs, &BandSpec::Auto).unwrap();
 
     let close = |a: &serde_json::Value, b: f64| {
         let a = a.as_f64().unwrap_or_else(|| panic!("not a number: {a}"));

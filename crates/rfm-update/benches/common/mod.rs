@@ -116,7 +116,7 @@ pub(crate) fn workload(family: Family, params: usize, measured: usize, freqs: us
         qs.push(Quantity::ElementMass(e));
     }
     qs.truncate(params);
-    let dofs = &sys.assembly().dofs;
+    let dofs = sys.assembly().dofs();
     let uy: Vec<_> = (0..sys.n()).map(|eq| dofs.dof_of(eq)).filter(|d| d.dof == Dof::Uy).collect();
     let meas: Vec<_> = spread(uy.len(), measured).map(|i| uy[i]).collect();
     let reference = meas[meas.len() / 2];

@@ -245,7 +245,7 @@ pub fn run(
 ) -> Result<OeResult, UpdateError> {
     let p0 = params.values(sys);
     let mut src = FullModel {
-        solver: ZSolver::new(&sys.assembly().pattern)?,
+        solver: ZSolver::new(sys.assembly().pattern())?,
         plan: ChannelPlan::new(sys, data.measured.channels())?,
         sys,
         params,

@@ -134,7 +134,7 @@ pub(super) fn assemble_line(
     }
 
     // 1: one factorisation
-    scratch.z.resize(sys.assembly().pattern.nnz(), ZERO);
+    scratch.z.resize(sys.assembly().pattern().nnz(), ZERO);
     match cache {
         None => sys.z_values_into(omega, &mut scratch.z),
         Some(cache) => cache.values_into(&sys.coefficients(omega), &mut scratch.z),

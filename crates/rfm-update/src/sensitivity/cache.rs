@@ -35,17 +35,17 @@ impl ZCache {
     pub(super) fn new(sys: &DampedSystem) -> Self {
         let a = sys.assembly();
         let mut units = UnitStore::default();
-        let (mut blocks, mut positions, mut terms) = (Vec::with_capacity(a.blocks.len()), Vec::new(), Vec::new());
-        for b in &a.blocks {
+        let (mut blocks, mut positions, mut terms) = (Vec::with_capacity(a.blocks().len()), Vec::new(), Vec::new());
+        for b in a.blocks() {
             let p0 = positions.len() as u32;
-            positions.extend(b.positions.iter().map(|&p| p as u32));
+            positions.extend(b.positions().iter().map(|&p| p as u32));
             let t0 = terms.len() as u32;
             // Assembly::accumulate skips terms whose value is zero
-            for t in b.terms.iter().filter(|t| t.value != 0.0) {
-                let slot = 2 * b.group as u32 + u32::from(t.kind == MatrixKind::Mass);
-                terms.push((slot, t.value, units.offset_of(&t.unit)));
+            for t in b.terms().iter().filter(|t| t.value() != 0.0) {
+                let slot = 2 * b.group() as u32 + u32::from(t.kind() == MatrixKind::Mass);
+                terms.push((slot, t.value(), units.offset_of(t.unit())));
             }
-            blocks.push((p0, b.positions.len() as u32, t0, terms.len() as u32));
+            blocks.push((p0, b.positions().len() as u32, t0, terms.len() as u32));
         }
         ZCache { blocks, positions, terms, units: units.values }
     }

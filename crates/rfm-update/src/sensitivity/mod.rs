@@ -152,7 +152,7 @@ mod tests {
         let cache = ZCache::new(&sys);
         for f in [3.0, 170.0] {
             let omega = 2.0 * std::f64::consts::PI * f;
-            let mut fast = vec![ZERO; sys.assembly().pattern.nnz()];
+            let mut fast = vec![ZERO; sys.assembly().pattern().nnz()];
             cache.values_into(&sys.coefficients(omega), &mut fast);
             assert_eq!(fast, sys.z_values(omega));
         }
@@ -164,7 +164,7 @@ mod tests {
     #[test]
     fn coefficient_rules_and_the_derivative_fallback_agree() {
         let (sys, params) = every_kind();
-        let solver = ZSolver::new(&sys.assembly().pattern).unwrap();
+        let solver = ZSolver::new(sys.assembly().pattern()).unwrap();
         let r = DofRef::new(4, Dof::Uy);
         let channels = [Channel::new(r, r), Channel::new(DofRef::new(3, Dof::Rz), r)];
         let plan = ChannelPlan::new(&sys, &channels).unwrap();
@@ -198,7 +198,7 @@ mod tests {
         let (truth, params) = every_kind();
         let mut sys = truth.clone();
         sys.set(params[0], 1.7 * sys.get(params[0])).unwrap();
-        let solver = ZSolver::new(&sys.assembly().pattern).unwrap();
+        let solver = ZSolver::new(sys.assembly().pattern()).unwrap();
         let (a, b) = (DofRef::new(4, Dof::Uy), DofRef::new(2, Dof::Ux));
         let channels: Vec<Channel> = [(2, Dof::Ux), (3, Dof::Rz), (4, Dof::Uy), (4, Dof::Rz)]
             .iter()

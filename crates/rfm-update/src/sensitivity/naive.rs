@@ -25,11 +25,11 @@ use crate::error::UpdateError;
 
 /// Values on the assembly's pattern as a dense matrix.
 fn dense(sys: &DampedSystem, values: &[C64]) -> Mat<C64> {
-    let pat = &sys.assembly().pattern;
+    let pat = sys.assembly().pattern();
     let mut m = Mat::<C64>::zeros(sys.n(), sys.n());
-    for c in 0..pat.n {
-        for p in pat.col_ptr[c]..pat.col_ptr[c + 1] {
-            m[(pat.row_idx[p], c)] += values[p];
+    for c in 0..pat.n() {
+        for p in pat.col_ptr()[c]..pat.col_ptr()[c + 1] {
+            m[(pat.row_idx()[p], c)] += values[p];
         }
     }
     m

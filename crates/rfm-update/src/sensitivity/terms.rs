@@ -126,19 +126,19 @@ impl TermTable {
     ) -> Self {
         let derivs: Vec<Derivative> = params.iter().map(|&q| sys.derivative(q, omega)).collect();
         let groups = sys.model().groups();
-        let blocks = &sys.assembly().blocks;
+        let blocks = sys.assembly().blocks();
         // do the rules reproduce every coefficient of the derivatives?
         let rules_hold = use_rules
             && params.iter().zip(&derivs).all(|(&q, d)| {
                 d.terms.iter().all(|&(b, t, c)| {
-                    let group = rule_group(q, blocks[b].group);
-                    Rule::of(q).coefficient(groups, group, blocks[b].terms[t].kind, omega) == c
+                    let group = rule_group(q, blocks[b].group());
+                    Rule::of(q).coefficient(groups, group, blocks[b].terms()[t].kind(), omega) == c
                 })
             });
         let mut term_offset = Vec::with_capacity(blocks.len() + 1);
         term_offset.push(0usize);
         for b in blocks {
-            term_offset.push(term_offset.last().copied().unwrap_or(0) + b.terms.len());
+            term_offset.push(term_offset.last().copied().unwrap_or(0) + b.terms().len());
         }
         let total = term_offset[blocks.len()];
         // the parameters using each assembly term (ascending, as pushed)
@@ -166,7 +166,7 @@ impl TermTable {
             (0..blocks.len()).filter(|&b| (term_offset[b]..term_offset[b + 1]).any(used)).collect();
         // bucket the used blocks by their smallest solver row (counting sort)
         let n = solver.n();
-        let first_row = |b: usize| blocks[b].eqs.iter().map(|&e| solver.position(e)).min().unwrap_or(0);
+        let first_row = |b: usize| blocks[b].eqs().iter().map(|&e| solver.position(e)).min().unwrap_or(0);
         let mut bucket = vec![0u32; n + 1];
         for &b in &used_blocks {
             bucket[first_row(b) + 1] += 1;
@@ -195,33 +195,33 @@ impl TermTable {
         let mut pair_rules = Vec::new();
         for &b in &order {
             let block = &blocks[b];
-            let nb = block.eqs.len();
+            let nb = block.eqs().len();
             assert!(nb <= MAX_BLOCK, "blocks have at most two nodes of six DOFs");
             let mut rows = [0u32; MAX_BLOCK];
-            for (r, &e) in rows.iter_mut().zip(&block.eqs) {
+            for (r, &e) in rows.iter_mut().zip(block.eqs()) {
                 *r = solver.position(e) as u32;
             }
             let t0 = terms.len() as u32;
-            for (t, term) in block.terms.iter().enumerate() {
+            for (t, term) in block.terms().iter().enumerate() {
                 let f = term_offset[b] + t;
                 if !used(f) {
                     continue;
                 }
-                let unit = units.offset_of(&term.unit);
+                let unit = units.offset_of(term.unit());
                 let who = &users[users_ptr[f] as usize..users_ptr[f + 1] as usize];
                 let mut new_class = || {
                     let class = if rules_hold { classes.len() } else { terms.len() } as u32;
                     for &i in who {
                         pairs.push((i, class));
                         let q = params[i as usize];
-                        pair_rules.push((Rule::of(q), rule_group(q, block.group), term.kind));
+                        pair_rules.push((Rule::of(q), rule_group(q, block.group()), term.kind()));
                     }
                     class
                 };
                 let class = if rules_hold {
                     let mut h = FxHasher::default();
-                    h.write_usize(block.group);
-                    h.write_u32(u32::from(term.kind == MatrixKind::Mass));
+                    h.write_usize(block.group());
+                    h.write_u32(u32::from(term.kind() == MatrixKind::Mass));
                     for &i in who {
                         h.write_u32(i);
                     }
@@ -229,13 +229,13 @@ impl TermTable {
                     let same = |c: u32| {
                         let (g, kind, f0) = classes[c as usize];
                         let them = &users[users_ptr[f0] as usize..users_ptr[f0 + 1] as usize];
-                        g == block.group && kind == term.kind && them == who
+                        g == block.group() && kind == term.kind() && them == who
                     };
                     match class_of.get(&key).copied().filter(|&c| same(c)) {
                         Some(c) => c,
                         None => {
                             let c = new_class();
-                            classes.push((block.group, term.kind, f));
+                            classes.push((block.group(), term.kind(), f));
                             class_of.insert(key, c);
                             c
                         }
@@ -244,7 +244,7 @@ impl TermTable {
                     new_class()
                 };
                 class_of_term[f] = class;
-                terms.push(TermRef { unit, class, value: term.value });
+                terms.push(TermRef { unit, class, value: term.value() });
             }
             items.push(Item { rows, nb: nb as u32, t0, t1: terms.len() as u32 });
         }

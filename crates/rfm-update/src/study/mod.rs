@@ -59,41 +59,28 @@ impl Method {
 }
 
 /// A case made ready for updating.
+///
+/// Its parts agree with one another: the system is the case's model, the
+/// measured data are receptances on the case's channels, the gains are
+/// decided from the case and the data, and the updating lines are those the
+/// case chooses among the measured lines. So they are read through
+/// accessors, and changed only by the methods that keep them agreeing
+/// ([`Study::set_update_frequencies`], [`Study::set_gains_for`]).
 #[derive(Clone, Debug)]
 pub struct Study {
-    /// The case file.
-    pub case: CaseFile,
-    /// The initial model.
-    pub system: DampedSystem,
-    /// The truth model of a simulated study.
-    pub truth: Option<DampedSystem>,
-    /// Measured receptances on the measurement lines.
-    pub measured: FrfSet,
-    /// Parameters to update (empty when the case has no `[update]`).
-    pub parameters: Vec<Parameter>,
-    /// Lines used for updating (Hz).
-    pub update_frequencies_hz: Vec<f64>,
-    /// What the case's `[measurement] mask` left out of the measured file.
-    pub masked: Vec<frf::io::Masked>,
-    /// What reading the measured file changed or passed over (lines at
-    /// 0 Hz dropped, units scaled, kinds converted, datasets skipped), one
-    /// line each, to be shown and stored with the results.
-    pub notes: Vec<String>,
-    /// The kind of the measured data as read (`measured` itself is
-    /// receptance, for the updating methods); comparisons are made in it,
-    /// whichever way the data arrive.
-    pub measured_kind: FrfKind,
-    /// The unknown gains every comparison and fit of this study applies to
-    /// the model's FRFs ([`crate::gain`]): `Gains::None` for per-newton data
-    /// unless the case asks for gains.
-    pub gains: Gains,
-    /// Why those gains, in words (for the notes and reports).
-    pub gains_reason: String,
-    /// The references whose data are per volt (uncalibrated).
-    pub per_volt: Vec<DofRef>,
-    /// How the test nodes were paired with the model's by coordinates
-    /// (empty unless the case asks for it).
-    pub pairing: Vec<PairingReport>,
+    case: CaseFile,
+    system: DampedSystem,
+    truth: Option<DampedSystem>,
+    measured: FrfSet,
+    parameters: Vec<Parameter>,
+    update_frequencies_hz: Vec<f64>,
+    masked: Vec<frf::io::Masked>,
+    notes: Vec<String>,
+    measured_kind: FrfKind,
+    gains: Gains,
+    gains_reason: String,
+    per_volt: Vec<DofRef>,
+    pairing: Vec<PairingReport>,
 }
 
 /// A test node paired with a model node by coordinates, as stored with the
@@ -245,6 +232,105 @@ impl Study {
             study.update_frequencies_hz = study.lines_for(study.method())?;
         }
         Ok(study)
+    }
+
+    /// The case file.
+    pub fn case(&self) -> &CaseFile {
+        &self.case
+    }
+
+    /// The initial model.
+    pub fn system(&self) -> &DampedSystem {
+        &self.system
+    }
+
+    /// The truth model of a simulated study.
+    pub fn truth(&self) -> Option<&DampedSystem> {
+        self.truth.as_ref()
+    }
+
+    /// Measured receptances on the measurement lines.
+    pub fn measured(&self) -> &FrfSet {
+        &self.measured
+    }
+
+    /// Parameters to update (empty when the case has no `[update]`).
+    pub fn parameters(&self) -> &[Parameter] {
+        &self.parameters
+    }
+
+    /// Lines used for updating (Hz) by the case's method: the case's
+    /// choice, else the method's default ([`Study::lines_for`]); empty when
+    /// the case has no `[update]`.
+    pub fn update_frequencies_hz(&self) -> &[f64] {
+        &self.update_frequencies_hz
+    }
+
+    /// What the case's `[measurement] mask` left out of the measured file.
+    pub fn masked(&self) -> &[frf::io::Masked] {
+        &self.masked
+    }
+
+    /// What reading the measured file changed or passed over (lines at
+    /// 0 Hz dropped, units scaled, kinds converted, datasets skipped), one
+    /// line each, to be shown and stored with the results.
+    pub fn notes(&self) -> &[String] {
+        &self.notes
+    }
+
+    /// The kind of the measured data as read ([`Study::measured`] itself
+    /// is receptance, for the updating methods); comparisons are made in
+    /// it, whichever way the data arrive.
+    pub fn measured_kind(&self) -> FrfKind {
+        self.measured_kind
+    }
+
+    /// The unknown gains every comparison and fit of this study applies to
+    /// the model's FRFs ([`crate::gain`]): `Gains::None` for per-newton data
+    /// unless the case asks for gains.
+    pub fn gains(&self) -> Gains {
+        self.gains
+    }
+
+    /// Why those gains, in words (for the notes and reports).
+    pub fn gains_reason(&self) -> &str {
+        &self.gains_reason
+    }
+
+    /// The references whose data are per volt (uncalibrated).
+    pub fn per_volt(&self) -> &[DofRef] {
+        &self.per_volt
+    }
+
+    /// How the test nodes were paired with the model's by coordinates
+    /// (empty unless the case asks for it).
+    pub fn pairing(&self) -> &[PairingReport] {
+        &self.pairing
+    }
+
+    /// Sets the case's `[update] frequencies` to `choice` and the updating
+    /// lines with it ([`Study::update_frequencies_hz`]), so that both
+    /// methods and every output fit the lines it designates. Refused
+    /// (`UpdateError::Case`) when the case has no `[update]`, and as
+    /// [`Study::lines_for`] refuses a choice that designates no measured line.
+    pub fn set_update_frequencies(&mut self, choice: FrequencyChoice) -> Result<(), UpdateError> {
+        let Some(update) = self.case.update.as_mut() else {
+            return Err(UpdateError::Case(
+                self.case.error(None, "the case has no [update] section to choose updating lines for"),
+            ));
+        };
+        let before = update.frequencies.replace(choice);
+        match self.lines_for(self.method()) {
+            Ok(lines) => {
+                self.update_frequencies_hz = lines;
+                Ok(())
+            }
+            Err(e) => {
+                // a refused choice leaves the study as it was
+                self.case.update.as_mut().expect("checked above").frequencies = before;
+                Err(e)
+            }
+        }
     }
 
     /// The updating method the case asks for (`rfm` when it does not say).

@@ -120,21 +120,21 @@ fn apply_every(case: CaseFile, dir: &Path) -> BTreeSet<String> {
     let title = case.model.title.clone();
     let study = Study::from_case(case).unwrap_or_else(|e| panic!("{title}: {e}"));
     let opts = DiagnoseOptions::default();
-    let d = diagnose(&study.case.model, &study.measured, &opts).unwrap_or_else(|e| panic!("{title}: {e}"));
+    let d = diagnose(&study.case().model, study.measured(), &opts).unwrap_or_else(|e| panic!("{title}: {e}"));
     // the new cases go into another folder than the case's
     let out = dir.join("written");
     std::fs::create_dir_all(&out).unwrap();
-    let synthesised = study.case.measurement.as_ref().and_then(|m| m.data.as_ref()).is_none();
+    let synthesised = study.case().measurement.as_ref().and_then(|m| m.data.as_ref()).is_none();
     let data = out.join("measured.csv");
     if synthesised {
-        std::fs::write(&data, frf::io::csv::to_csv_string(&study.measured)).unwrap();
+        std::fs::write(&data, frf::io::csv::to_csv_string(study.measured())).unwrap();
     }
     let target = out.join("applied.toml");
     let mut kinds = BTreeSet::new();
     for (i, r) in d.ranking.iter().enumerate() {
         let rank = i + 1;
         let editor = d
-            .apply_with_data(&study.case, rank, synthesised.then_some(data.as_path()))
+            .apply_with_data(study.case(), rank, synthesised.then_some(data.as_path()))
             .unwrap_or_else(|e| panic!("{title}, rank {rank} ({}): {e}", r.description));
         let text = editor.text_at(&target).unwrap_or_else(|e| panic!("{title}, rank {rank}: {e}"));
         // the data path is relative to the new file and names the same data
@@ -143,26 +143,26 @@ fn apply_every(case: CaseFile, dir: &Path) -> BTreeSet<String> {
         assert!(Path::new(written).is_relative(), "{title}, rank {rank}: data path {written}");
         std::fs::write(&target, &text).unwrap();
         let applied = Study::load(&target).unwrap_or_else(|e| panic!("{title}, rank {rank} ({}): {e}", r.description));
-        let misfit = log_misfit(&applied.system, &applied.measured, r.lines).unwrap();
+        let misfit = log_misfit(applied.system(), applied.measured(), r.lines).unwrap();
         // the written case is the fitted candidate: the same misfit on the
         // same lines as the candidate's model with its fitted values, built
         // in memory
         let c = &d.candidates[r.candidate];
-        let mut fitted = c.model(&study.case.model).unwrap();
+        let mut fitted = c.model(&study.case().model).unwrap();
         for p in &r.parameters {
             let param = fitted.parameter(&p.name).unwrap_or_else(|e| panic!("{title}, rank {rank}: {e}"));
             for &q in &param.quantities {
                 fitted.set(q, p.value).unwrap();
             }
         }
-        let expected = log_misfit(&DampedSystem::new(fitted).unwrap(), &study.measured, r.lines).unwrap();
+        let expected = log_misfit(&DampedSystem::new(fitted).unwrap(), study.measured(), r.lines).unwrap();
         assert!(
             (misfit - expected).abs() <= 1e-9 * expected.max(1e-3),
             "{title}, rank {rank} ({}): misfit {misfit} of the written case, {expected} of the fitted candidate",
             r.description
         );
         // the case records the fall from the nominal model
-        let history: Vec<f64> = applied.case.history.iter().map(|h| h.misfit).collect();
+        let history: Vec<f64> = applied.case().history.iter().map(|h| h.misfit).collect();
         assert_eq!(history, vec![d.nominal_misfit, r.misfit], "{title}, rank {rank}");
         kinds.insert(format!("{:?}", r.kind));
         if r.description.contains("one group per direction") {

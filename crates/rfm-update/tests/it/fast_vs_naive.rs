@@ -77,7 +77,7 @@ fn worst_relative_difference(fast: &[FrequencyBlock], slow: &[FrequencyBlock], n
 
 fn check(sys: &DampedSystem, names: &[&str], channels: &[Channel], freqs: &[f64], measured: &frf::FrfSet) {
     let params: Vec<_> = names.iter().map(|n| sys.model().quantity(n).unwrap()).collect();
-    let solver = ZSolver::new(&sys.assembly().pattern).unwrap();
+    let solver = ZSolver::new(sys.assembly().pattern()).unwrap();
     let plan = ChannelPlan::new(sys, channels).unwrap();
     for (label, hybrid) in [("model", Hybrid::Model), ("measured", Hybrid::Measured(measured))] {
         let fast = assemble(sys, &solver, &plan, &params, freqs, hybrid).unwrap();

@@ -11,5 +11,6 @@ mod output_error;
 mod paper_cases;
 mod per_direction;
 mod sensitivity;
+mod study;
 mod trust;
 mod truths;

@@ -52,15 +52,15 @@ fn every_paper_case_loads_and_has_truth_and_parameters() {
     let names = include_str!("../../../../cases/paper-cases.txt").lines().map(str::trim);
     for name in names.filter(|l| !l.is_empty() && !l.starts_with('#')) {
         let study = Study::load(&case(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
-        assert!(study.truth.is_some(), "{name}");
+        assert!(study.truth().is_some(), "{name}");
         // its acceptance, which `cargo xtask reproduce` holds its runs to
-        let check = study.case.check.as_ref().unwrap_or_else(|| panic!("{name} has no [check]"));
+        let check = study.case().check.as_ref().unwrap_or_else(|| panic!("{name} has no [check]"));
         assert!(check.rfm.is_some() || check.output_error.is_some(), "{name}: {check:?}");
-        assert!(!study.parameters.is_empty(), "{name}");
-        assert!(!study.update_frequencies_hz.is_empty(), "{name}");
+        assert!(!study.parameters().is_empty(), "{name}");
+        assert!(!study.update_frequencies_hz().is_empty(), "{name}");
         // the chosen lines are lines of the data and avoid its resonances
-        for f in &study.update_frequencies_hz {
-            assert!(study.measured.line_of(*f).is_some(), "{name}: {f} Hz");
+        for f in study.update_frequencies_hz() {
+            assert!(study.measured().line_of(*f).is_some(), "{name}: {f} Hz");
         }
     }
 }
@@ -72,7 +72,7 @@ fn every_paper_case_loads_and_has_truth_and_parameters() {
 #[test]
 fn noisy_beam_output_error_is_within_three_sd_and_flags_weak_parameters() {
     let mut study = Study::load(&case("two-material-beam-noisy")).unwrap();
-    study.case.update.as_mut().unwrap().frequencies = Some(fe_model::case::FrequencyChoice::Lines(200));
+    study.set_update_frequencies(fe_model::case::FrequencyChoice::Lines(200)).unwrap();
     let opts = study.output_error_options().unwrap();
     let outcome = study.run_output_error(&opts, |_| {}).unwrap();
     assert_eq!(outcome.status, Status::Converged);
@@ -115,7 +115,7 @@ fn tutorial_data_is_reproducible_from_its_truth() {
 #[test]
 fn flexible_clamp_twin_output_error_recovers_the_identifiable_parameters() {
     let mut study = Study::load(&case("cantilever-flexible-clamp")).unwrap();
-    study.case.update.as_mut().unwrap().frequencies = Some(fe_model::case::FrequencyChoice::Lines(200));
+    study.set_update_frequencies(fe_model::case::FrequencyChoice::Lines(200)).unwrap();
     let opts = study.output_error_options().unwrap();
     let outcome = study.run_output_error(&opts, |_| {}).unwrap();
     let unc = outcome.uncertainty.as_ref().unwrap();
@@ -144,10 +144,10 @@ fn f_frame_output_error_stops_within_the_noise_near_the_optimum() {
     let study = Study::load(&case("f-frame")).unwrap();
     let opts = study.output_error_options().unwrap();
     let lines = study.lines_for(rfm_update::Method::OutputError).unwrap();
-    let measured = study.measured.at_frequencies(&lines).unwrap();
+    let measured = study.measured().at_frequencies(&lines).unwrap();
     let params = study.parameter_set();
     let data = rfm_update::output_error::OeData { measured: &measured, weights: None };
-    let mut sys = study.system.clone();
+    let mut sys = study.system().clone();
     let first = rfm_update::output_error::run(&mut sys, &params, &data, &opts, |_| {}).unwrap();
     assert_eq!(first.status, Status::Converged);
     assert!(first.flat_valley);

@@ -101,7 +101,7 @@ pub(crate) fn lossy_rotation() -> Clamp {
 /// FRFs (1 % noise) as its measured data, and loaded.
 pub(crate) fn nominal_case(clamp: &Clamp, dir: &Path) -> CaseFile {
     let truth = CaseFile::parse(&dir.join("truth.toml"), &clamp.truth_text()).expect("the truth case loads");
-    let measured = Study::from_case(truth).expect("the truth synthesises").measured;
+    let measured = Study::from_case(truth).expect("the truth synthesises").measured().clone();
     std::fs::create_dir_all(dir).unwrap();
     std::fs::write(dir.join("measured.csv"), frf::io::csv::to_csv_string(&measured)).unwrap();
     let text = format!(
@@ -116,7 +116,7 @@ fn diagnosis(clamp: &Clamp) -> (Diagnosis, tempfile::TempDir) {
     let tmp = tempfile::tempdir().unwrap();
     let case = nominal_case(clamp, tmp.path());
     let study = Study::from_case(case).unwrap();
-    let d = diagnose(&study.case.model, &study.measured, &DiagnoseOptions::default()).unwrap();
+    let d = diagnose(&study.case().model, study.measured(), &DiagnoseOptions::default()).unwrap();
     for r in d.ranking.iter().take(6) {
         println!("{:>14.1}  {}", r.delta_bic, r.description);
     }

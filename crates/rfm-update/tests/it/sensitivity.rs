@@ -23,7 +23,7 @@ fn model_sensitivity_is_minus_the_frf_jacobian() {
     let channels =
         vec![Channel::new(r, r), Channel::new(DofRef::new(2, Dof::Ux), r), Channel::new(DofRef::new(3, Dof::Rz), r)];
     let freqs = [17.0, 83.0, 240.0];
-    let solver = ZSolver::new(&sys.assembly().pattern).unwrap();
+    let solver = ZSolver::new(sys.assembly().pattern()).unwrap();
     let plan = ChannelPlan::new(&sys, &channels).unwrap();
     let blocks = assemble(&sys, &solver, &plan, &params, &freqs, Hybrid::Model).unwrap();
     for (i, &q) in params.iter().enumerate() {
@@ -57,10 +57,10 @@ fn rfm_equation_is_exact_for_linear_parameters_with_complete_data() {
     let u_true = truth.get(kr) / model.get(kr) - 1.0;
     let r = DofRef::new(4, Dof::Uy);
     let n = model.n();
-    let channels: Vec<Channel> = (0..n).map(|e| Channel::new(model.assembly().dofs.dof_of(e), r)).collect();
+    let channels: Vec<Channel> = (0..n).map(|e| Channel::new(model.assembly().dofs().dof_of(e), r)).collect();
     let freqs = [23.0, 140.0];
     let measured = synthesize(&truth, &channels, &freqs).unwrap();
-    let solver = ZSolver::new(&model.assembly().pattern).unwrap();
+    let solver = ZSolver::new(model.assembly().pattern()).unwrap();
     let plan = ChannelPlan::new(&model, &channels).unwrap();
     let blocks = assemble(&model, &solver, &plan, &[kr], &freqs, Hybrid::Measured(&measured)).unwrap();
     for (k, b) in blocks.iter().enumerate() {

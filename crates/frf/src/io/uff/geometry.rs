@@ -37,7 +37,7 @@ use fe_model::case::ChannelMap;
 use fe_model::{Dimension, Dof, DofRef};
 
 use super::map::map_test_dof;
-use super::read::numbers;
+use super::numbers::numbers;
 use super::{Direction, RawDataset, TestDof, UffFile};
 
 /// Datasets kept by the reader for [`UffFile::geometry`].

@@ -46,6 +46,7 @@
 mod frfs;
 mod geometry;
 mod map;
+mod numbers;
 mod read;
 pub(crate) mod units;
 mod write;

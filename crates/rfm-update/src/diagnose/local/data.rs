@@ -118,14 +118,14 @@ impl LocalData {
         // The symbolic analysis makes each D a clique of the factor, so that
         // the selected inverse holds every S = H_0[D, D] (about the cost of
         // the factorisation, where a solve per equation would cost N solves).
-        let solver = ZSolver::with_cliques(&nominal.assembly().pattern, &slots)?;
+        let solver = ZSolver::with_cliques(nominal.assembly().pattern(), &slots)?;
         let per_line: Vec<Line> = lines
             .par_iter()
             .map_init(
                 || (solver.workspace(), Vec::new(), Vec::new(), SelectedInverse::new()),
                 |(ws, z, x, inv), &f| {
                     let omega = 2.0 * std::f64::consts::PI * f;
-                    z.resize(nominal.assembly().pattern.nnz(), ZERO);
+                    z.resize(nominal.assembly().pattern().nnz(), ZERO);
                     nominal.z_values_into(omega, z);
                     solver.factorize(ws, z, f)?;
                     let k = w_eqs.len();

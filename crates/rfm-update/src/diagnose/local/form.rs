@@ -39,7 +39,7 @@ fn item(model: &fe_model::Model, source: BlockSource) -> Item {
 fn whole_equations(nominal: &Assembly, part: &Assembly) -> Vec<Option<usize>> {
     (0..part.n())
         .map(|eq| {
-            part.dofs.dofs_of(eq).iter().find_map(|&r| match nominal.dofs.slot(r) {
+            part.dofs().dofs_of(eq).iter().find_map(|&r| match nominal.dofs().slot(r) {
                 Some(fe_model::Slot::Free(e)) => Some(e),
                 _ => None,
             })
@@ -89,49 +89,49 @@ impl LocalForm {
         }
         // each candidate block: the nominal block of the same element, spring or mass
         let by_item: HashMap<Item, usize> =
-            a0.blocks.iter().enumerate().map(|(i, b)| (item(nominal_part.model(), b.source), i)).collect();
+            a0.blocks().iter().enumerate().map(|(i, b)| (item(nominal_part.model(), b.source()), i)).collect();
         let counterpart: Vec<Option<usize>> =
-            a.blocks.iter().map(|b| by_item.get(&item(cand.model(), b.source)).copied()).collect();
-        if counterpart.iter().flatten().count() != a0.blocks.len() {
+            a.blocks().iter().map(|b| by_item.get(&item(cand.model(), b.source())).copied()).collect();
+        if counterpart.iter().flatten().count() != a0.blocks().len() {
             return None;
         }
         let (g0, g) = (nominal_part.model().groups(), cand.model().groups());
-        let mut touched = vec![false; a.blocks.len()];
+        let mut touched = vec![false; a.blocks().len()];
         for &q in params.quantities() {
             match q {
                 Quantity::GroupAlpha(i) | Quantity::GroupBeta(i) | Quantity::GroupMu(i) => {
-                    a.group_blocks[i].iter().for_each(|&b| touched[b] = true);
+                    a.group_blocks(i).iter().for_each(|&b| touched[b] = true);
                 }
                 _ => a.terms_of(q).iter().for_each(|&(b, _)| touched[b] = true),
             }
         }
         for (b, t) in touched.iter_mut().enumerate() {
-            let Some(b0) = counterpart[b].map(|i| &a0.blocks[i]) else {
+            let Some(b0) = counterpart[b].map(|i| &a0.blocks()[i]) else {
                 *t = true;
                 continue;
             };
-            let bc = &a.blocks[b];
+            let bc = &a.blocks()[b];
             let same_eqs =
-                b0.eqs.len() == bc.eqs.len() && b0.eqs.iter().zip(&bc.eqs).all(|(&e0, &e)| map[e] == map0[e0]);
-            let same_group = b0.group == bc.group && g0.get(b0.group) == g.get(bc.group);
-            let same_terms = b0.terms.len() == bc.terms.len()
+                b0.eqs().len() == bc.eqs().len() && b0.eqs().iter().zip(bc.eqs()).all(|(&e0, &e)| map[e] == map0[e0]);
+            let same_group = b0.group() == bc.group() && g0.get(b0.group()) == g.get(bc.group());
+            let same_terms = b0.terms().len() == bc.terms().len()
                 && b0
-                    .terms
+                    .terms()
                     .iter()
-                    .zip(&bc.terms)
-                    .all(|(x, y)| x.value == y.value && x.kind == y.kind && x.unit == y.unit);
+                    .zip(bc.terms())
+                    .all(|(x, y)| x.value() == y.value() && x.kind() == y.kind() && x.unit() == y.unit());
             if !(same_eqs && same_group && same_terms) {
                 *t = true;
             }
         }
-        let blocks: Vec<usize> = (0..a.blocks.len()).filter(|&b| touched[b]).collect();
+        let blocks: Vec<usize> = (0..a.blocks().len()).filter(|&b| touched[b]).collect();
         let nominal_blocks: Vec<usize> = blocks.iter().filter_map(|&b| counterpart[b]).collect();
         // D: the nominal equations of the changed blocks, before and after
-        let mut cand_eqs: Vec<usize> = blocks.iter().flat_map(|&b| a.blocks[b].eqs.iter().copied()).collect();
+        let mut cand_eqs: Vec<usize> = blocks.iter().flat_map(|&b| a.blocks()[b].eqs().iter().copied()).collect();
         cand_eqs.sort_unstable();
         cand_eqs.dedup();
         let mut eqs: Vec<usize> = cand_eqs.iter().filter_map(|&e| map[e]).collect();
-        eqs.extend(nominal_blocks.iter().flat_map(|&b| a0.blocks[b].eqs.iter().filter_map(|&e| map0[e])));
+        eqs.extend(nominal_blocks.iter().flat_map(|&b| a0.blocks()[b].eqs().iter().filter_map(|&e| map0[e])));
         eqs.sort_unstable();
         eqs.dedup();
         let added: Vec<usize> = cand_eqs.iter().copied().filter(|&e| map[e].is_none()).collect();

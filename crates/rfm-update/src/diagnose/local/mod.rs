@@ -132,7 +132,7 @@ mod tests {
     fn check_model(model: &fe_model::Model, kinds: &mut Vec<EffectKind>, new_joints: &mut usize) {
         let nominal = DampedSystem::new(model.clone()).unwrap();
         let uy: Vec<DofRef> =
-            (0..nominal.n()).map(|eq| nominal.assembly().dofs.dof_of(eq)).filter(|d| d.dof == Dof::Uy).collect();
+            (0..nominal.n()).map(|eq| nominal.assembly().dofs().dof_of(eq)).filter(|d| d.dof == Dof::Uy).collect();
         let channels: Vec<Channel> = uy.iter().step_by(2).map(|&r| Channel::new(r, uy[uy.len() - 1])).collect();
         let lines = [3.0, 17.0, 41.0, 88.0];
         let opts = CandidateOptions { band_hz: (1.0, 100.0), ..CandidateOptions::default() };
@@ -174,7 +174,7 @@ mod tests {
         let forms: Vec<&LocalForm> = locals.iter().flatten().map(|l| &l.form).collect();
         let data = LocalData::new(&nominal, &channels, &lines, &forms).unwrap();
         // S from the selected inverse equals S from unit solves (the fallback)
-        let solver = ZSolver::with_cliques(&nominal.assembly().pattern, &data.slots).unwrap();
+        let solver = ZSolver::with_cliques(nominal.assembly().pattern(), &data.slots).unwrap();
         let mut ws = solver.workspace();
         let z = nominal.z_values(2.0 * std::f64::consts::PI * lines[1]);
         solver.factorize(&mut ws, &z, lines[1]).unwrap();
@@ -199,7 +199,7 @@ mod tests {
             let (h, sens) = response.evaluate(&lines, true).unwrap();
             let mut truth = sys;
             params.set_values(&mut truth, &values).unwrap();
-            let solver = ZSolver::new(&truth.assembly().pattern).unwrap();
+            let solver = ZSolver::new(truth.assembly().pattern()).unwrap();
             let plan = ChannelPlan::new(&truth, &channels).unwrap();
             let blocks =
                 sensitivity::assemble(&truth, &solver, &plan, params.quantities(), &lines, Hybrid::Model).unwrap();

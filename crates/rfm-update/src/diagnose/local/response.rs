@@ -22,7 +22,7 @@ impl LocalData {
         let d = form.eqs.len();
         let a0 = nominal.assembly();
         let nominal_blocks: Vec<Placed> =
-            form.nominal_blocks.iter().map(|&b| Placed::new(&a0.blocks[b], |e| form.nominal_index(e))).collect();
+            form.nominal_blocks.iter().map(|&b| Placed::new(&a0.blocks()[b], |e| form.nominal_index(e))).collect();
         let nominal_z = self
             .lines
             .iter()
@@ -30,9 +30,9 @@ impl LocalData {
                 let coefs = nominal.coefficients(2.0 * std::f64::consts::PI * f);
                 let mut z = vec![ZERO; d * d];
                 for (p, &b) in nominal_blocks.iter().zip(&form.nominal_blocks) {
-                    let block = &a0.blocks[b];
-                    for t in &block.terms {
-                        p.add(&t.unit, -coefs[block.group].of(t.kind) * t.value, &mut z, d);
+                    let block = &a0.blocks()[b];
+                    for t in block.terms() {
+                        p.add(t.unit(), -coefs[block.group()].of(t.kind()) * t.value(), &mut z, d);
                     }
                 }
                 z
@@ -53,9 +53,9 @@ impl LocalData {
             })
             .collect();
         let a = sys.assembly();
-        let mut placed: Vec<Option<Placed>> = (0..a.blocks.len()).map(|_| None).collect();
+        let mut placed: Vec<Option<Placed>> = (0..a.blocks().len()).map(|_| None).collect();
         for &b in &form.blocks {
-            placed[b] = Some(Placed::new(&a.blocks[b], |e| form.candidate_index(e)));
+            placed[b] = Some(Placed::new(&a.blocks()[b], |e| form.candidate_index(e)));
         }
         let mut refs: Vec<usize> = self.picks.iter().map(|&(_, f)| f).collect();
         refs.sort_unstable();
@@ -84,7 +84,7 @@ struct Placed {
 
 impl Placed {
     fn new(block: &Block, index: impl Fn(usize) -> usize) -> Self {
-        Placed { idx: block.eqs.iter().map(|&e| index(e)).collect() }
+        Placed { idx: block.eqs().iter().map(|&e| index(e)).collect() }
     }
 
     /// `out += c * unit` with `out` row-major `n x n`.
@@ -198,9 +198,9 @@ impl Response for LocalResponse<'_> {
                 w.z[i * n..i * n + d].copy_from_slice(row);
             }
             for &b in &self.form.blocks {
-                let (block, p) = (&a.blocks[b], self.placed[b].as_ref().expect("changed blocks are placed"));
-                for t in block.terms.iter().filter(|t| t.value != 0.0) {
-                    p.add(&t.unit, coefs[block.group].of(t.kind) * t.value, &mut w.z, n);
+                let (block, p) = (&a.blocks()[b], self.placed[b].as_ref().expect("changed blocks are placed"));
+                for t in block.terms().iter().filter(|t| t.value() != 0.0) {
+                    p.add(t.unit(), coefs[block.group()].of(t.kind()) * t.value(), &mut w.z, n);
                 }
             }
             // condensed onto D: dZ = A - B C^-1 B^T, with G = C^-1 B^T
@@ -273,9 +273,9 @@ impl Response for LocalResponse<'_> {
                     w.dzi.fill(ZERO);
                     for &q in &p.quantities {
                         for (b, t, c) in self.sys.derivative(q, omega).terms {
-                            let term = &a.blocks[b].terms[t];
+                            let term = &a.blocks()[b].terms()[t];
                             let p = self.placed[b].as_ref().expect("a parameter's blocks are changed blocks");
-                            p.add(&term.unit, c * term.value, &mut w.dzi, n);
+                            p.add(term.unit(), c * term.value(), &mut w.dzi, n);
                         }
                     }
                     condense(&w.dzi, &w.g, d, e, &mut w.dzi_c);

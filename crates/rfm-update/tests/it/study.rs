@@ -1,0 +1,45 @@
+//! What a `Study` keeps consistent: the updating lines follow the case's
+//! choice of them, set only through `Study::set_update_frequencies`.
+
+use std::path::PathBuf;
+
+use fe_model::case::FrequencyChoice;
+use rfm_update::{Method, Study, UpdateError};
+
+fn case(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases").join(format!("{name}.toml"))
+}
+
+#[test]
+fn the_updating_lines_follow_the_case_and_a_refused_choice_changes_nothing() {
+    let mut study = Study::load(&case("two-material-beam")).unwrap();
+    assert_eq!(study.update_frequencies_hz(), study.lines_for(study.method()).unwrap());
+    study.set_update_frequencies(FrequencyChoice::Lines(7)).unwrap();
+    assert_eq!(study.update_frequencies_hz().len(), 7);
+    assert_eq!(study.update_frequencies_hz(), study.lines_for(Method::OutputError).unwrap());
+    assert_eq!(study.measured_at_update_lines().unwrap().frequencies_hz(), study.update_frequencies_hz());
+
+    let f = study.measured().frequencies_hz();
+    let between = 0.5 * (f[0] + f[1]);
+    match study.set_update_frequencies(FrequencyChoice::List(vec![between])) {
+        Err(UpdateError::Lines(m)) => {
+            assert_eq!(m, format!("updating point {between} Hz is not a line of the measured data"))
+        }
+        other => panic!("expected UpdateError::Lines, got {other:?}"),
+    }
+    assert_eq!(study.update_frequencies_hz().len(), 7);
+    assert_eq!(study.case().update.as_ref().unwrap().frequencies, Some(FrequencyChoice::Lines(7)));
+}
+
+#[test]
+fn a_case_without_an_update_has_no_updating_lines_to_set() {
+    let mut study = Study::load(&case("tutorial/l-frame")).unwrap();
+    assert!(study.case().update.is_none() && study.update_frequencies_hz().is_empty());
+    match study.set_update_frequencies(FrequencyChoice::Lines(5)) {
+        Err(UpdateError::Case(e)) => {
+            assert_eq!(e.message, "the case has no [update] section to choose updating lines for")
+        }
+        other => panic!("expected UpdateError::Case, got {other:?}"),
+    }
+    assert!(study.update_frequencies_hz().is_empty());
+}
