@@ -277,6 +277,7 @@ impl Model {
         }
         positive(format!("group `{g}`: stiffness"), group.stiffness)?;
         positive(format!("group `{g}`: mass"), group.mass)?;
+        positive(format!("group `{g}`: damping"), group.damping)?;
         self.groups.push(group);
         Ok(self.groups.len() - 1)
     }

@@ -62,6 +62,7 @@ pub(super) fn raw_group(ctx: &Ctx<'_>, name: &str, g: &Spanned<RawGroup>) -> Res
         mu: r.mu.filter(|m| m.is_finite()),
         stiffness: r.stiffness,
         mass: r.mass,
+        damping: r.damping,
     })
 }
 

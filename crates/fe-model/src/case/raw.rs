@@ -132,6 +132,9 @@ pub(super) struct RawGroup {
     pub(super) stiffness: f64,
     #[serde(default = "one")]
     pub(super) mass: f64,
+    /// Factor on the group's imported damping matrices.
+    #[serde(default = "one")]
+    pub(super) damping: f64,
 }
 
 pub(super) fn one() -> f64 {

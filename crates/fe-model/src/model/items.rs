@@ -250,12 +250,15 @@ pub struct Group {
     pub stiffness: f64,
     /// Mass factor of the whole group.
     pub mass: f64,
+    /// Factor on the group's imported viscous damping matrices (nominal 1;
+    /// nothing to scale in a group without one).
+    pub damping: f64,
 }
 
 impl Group {
     /// An undamped group with unit factors.
     pub fn new(name: &str) -> Self {
-        Group { name: name.into(), alpha: 0.0, beta: 0.0, mu: None, stiffness: 1.0, mass: 1.0 }
+        Group { name: name.into(), alpha: 0.0, beta: 0.0, mu: None, stiffness: 1.0, mass: 1.0, damping: 1.0 }
     }
 
     /// Builder: Rayleigh coefficients.
