@@ -2,4 +2,5 @@
 
 mod complex_modes;
 mod frames_3d;
+mod imported_damping;
 mod modal_physics;
