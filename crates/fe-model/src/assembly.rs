@@ -251,15 +251,24 @@ fn raw_blocks(model: &Model) -> Vec<RawBlock> {
         let terms = dim
             .dofs()
             .iter()
-            .enumerate()
-            .map(|(i0, &d)| {
+            .map(|&d| {
+                // r r^T on the node's DOFs along (or about) the axis of d,
+                // and -r r^T to the other node: in global axes r is e_d
+                let r: Vec<(usize, f64)> = sp
+                    .direction(dim, d)
+                    .into_iter()
+                    .map(|(g, c)| (dim.local(g).expect("of the dimension"), c))
+                    .collect();
                 let mut u = vec![0.0; n * n];
-                u[i0 * n + i0] = 1.0;
-                if n == 2 * nd {
-                    let i1 = nd + i0;
-                    u[i1 * n + i1] = 1.0;
-                    u[i0 * n + i1] = -1.0;
-                    u[i1 * n + i0] = -1.0;
+                for &(i, ci) in &r {
+                    for &(j, cj) in &r {
+                        u[i * n + j] = ci * cj;
+                        if n == 2 * nd {
+                            u[(nd + i) * n + nd + j] = ci * cj;
+                            u[i * n + nd + j] = -(ci * cj);
+                            u[(nd + i) * n + j] = -(ci * cj);
+                        }
+                    }
                 }
                 (
                     MatrixKind::Stiffness,

@@ -28,6 +28,7 @@ mod imported;
 mod measurement;
 mod raw;
 mod spec;
+mod spring_axes;
 #[cfg(test)]
 mod tests;
 mod truth;

@@ -8,7 +8,8 @@
 //! frame in space (six DOFs per node), fixed when it is made
 //! ([`Model::with_dimension`]); every `add_*` refuses a DOF, coordinate or
 //! value the dimension does not have. The items themselves are in `items.rs`,
-//! the parts and the geometry the model derives in `geometry.rs`.
+//! the parts and the geometry the model derives in `geometry.rs`, springs in
+//! their own axes in `spring_axes.rs`.
 
 use std::collections::HashMap;
 
@@ -18,10 +19,12 @@ use crate::error::ModelError;
 
 mod geometry;
 mod items;
+mod spring_axes;
 pub use items::{
     Beam, ElementId, Group, LumpedMass, Material, Node, NodeId, RotaryInertia, Section, Spring, Support, Tie,
     rectangle_torsion,
 };
+pub use spring_axes::{SpringAxesError, spring_axes};
 
 /// A frame model, planar or in space.
 ///
@@ -442,7 +445,7 @@ impl Model {
             return Err(ModelError::Invalid { what: ctx, reason: "has no non-zero stiffness".into() });
         }
         self.require_group(group, &ctx)?;
-        self.springs.push(Spring { name: name.into(), a: NodeId(a), b: b.map(NodeId), k, group });
+        self.springs.push(Spring { name: name.into(), a: NodeId(a), b: b.map(NodeId), k, group, axes: None });
         Ok(self.springs.len() - 1)
     }
 

@@ -4,3 +4,4 @@ mod complex_modes;
 mod frames_3d;
 mod imported_damping;
 mod modal_physics;
+mod spring_axes;

@@ -186,6 +186,10 @@ pub(super) struct RawSpring {
     pub(super) kry: Option<Spanned<f64>>,
     pub(super) krz: Option<Spanned<f64>>,
     pub(super) group: Spanned<String>,
+    /// In space: the spring's local x axis ...
+    pub(super) x_axis: Option<Spanned<[f64; 3]>>,
+    /// ... and a vector in its local x-y plane.
+    pub(super) xy_vector: Option<Spanned<[f64; 3]>>,
 }
 
 impl RawSpring {

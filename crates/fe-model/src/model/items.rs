@@ -189,11 +189,15 @@ pub struct Spring {
     pub a: NodeId,
     /// Second node, or `None` for a spring to ground.
     pub b: Option<NodeId>,
-    /// Stiffnesses per DOF (N/m along, N m/rad about the global axes);
-    /// zero in the DOFs the spring does not join.
+    /// Stiffnesses per DOF (N/m along, N m/rad about the global axes, or
+    /// the spring's own axes when it has them); zero in the DOFs the spring
+    /// does not join.
     pub k: PerDof,
     /// Index into [`Model::groups`].
     pub group: usize,
+    /// The spring's own axes (rows: local x, y, z in global components) in
+    /// a 3D model, set by [`Model::orient_spring`]; `None`: the global axes.
+    pub axes: Option<[[f64; 3]; 3]>,
 }
 
 /// A lumped mass with rotary inertia at a node.
