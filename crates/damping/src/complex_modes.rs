@@ -7,7 +7,8 @@
 //! Z(s) = K + s^2 M + s C_v + sum_g s mu_g / (mu_g + s) C_g
 //! ```
 //!
-//! where `C_v` collects the viscous groups and the sum runs over the groups
+//! where `C_v` collects the viscous groups (and the imported viscous damping
+//! matrices of any group) and the sum runs over the groups
 //! with a finite relaxation parameter. `Z(s)` is rational in `s`, so the
 //! problem is turned into a linear one by *internal variables*. Each
 //! finite-`mu` group's damping matrix is factorised, on the equations the
@@ -162,8 +163,8 @@ struct Operators<'a> {
 impl<'a> Operators<'a> {
     fn new(sys: &'a DampedSystem) -> Self {
         let a = sys.assembly();
-        let nnz = a.pattern().nnz();
-        let mut c_viscous = vec![0.0; nnz];
+        // the imported damping matrices are viscous whatever their group's kernel
+        let mut c_viscous = a.real_values(MatrixKind::Damping);
         let mut relaxing = Vec::new();
         for (g, group) in sys.model().groups().iter().enumerate() {
             if group.alpha == 0.0 && group.beta == 0.0 {

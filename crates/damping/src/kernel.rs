@@ -8,7 +8,9 @@
 //! ```
 //!
 //! so that each group contributes a complex coefficient times its stiffness
-//! terms and another times its mass terms.
+//! terms and another times its mass terms. A group imported with a viscous
+//! damping matrix `C` (times the group's damping factor, which its terms
+//! carry) adds `j w C` besides: the coefficient `j w` on its damping terms.
 
 use fe_model::{Group, MatrixKind};
 use num_complex::Complex64 as C64;
@@ -30,13 +32,15 @@ pub struct GroupCoefficients {
     pub stiffness: C64,
     /// Multiplies the group's mass terms: `-w^2 + j w h beta`.
     pub mass: C64,
+    /// Multiplies the group's (imported, viscous) damping terms: `j w`.
+    pub damping: C64,
 }
 
 impl GroupCoefficients {
     /// Coefficients of group `g` at angular frequency `omega` (rad/s).
     pub fn new(g: &Group, omega: f64) -> Self {
         let jwh = J * omega * relaxation_factor(g.mu, omega);
-        GroupCoefficients { stiffness: 1.0 + jwh * g.alpha, mass: -omega * omega + jwh * g.beta }
+        GroupCoefficients { stiffness: 1.0 + jwh * g.alpha, mass: -omega * omega + jwh * g.beta, damping: J * omega }
     }
 
     /// The coefficient for a term of the given kind.
@@ -44,18 +48,31 @@ impl GroupCoefficients {
         match kind {
             MatrixKind::Stiffness => self.stiffness,
             MatrixKind::Mass => self.mass,
+            MatrixKind::Damping => self.damping,
         }
     }
 }
 
 /// Coefficients of the damping-parameter derivatives of one group, already
 /// multiplied by the parameter (relative form `(dZ/dp) p`), per matrix kind.
+/// None of alpha, beta and mu acts on an imported damping matrix.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DampingDerivative {
     /// On stiffness terms.
     pub stiffness: C64,
     /// On mass terms.
     pub mass: C64,
+}
+
+impl DampingDerivative {
+    /// The coefficient for a term of the given kind (zero on damping terms).
+    pub fn of(&self, kind: MatrixKind) -> C64 {
+        match kind {
+            MatrixKind::Stiffness => self.stiffness,
+            MatrixKind::Mass => self.mass,
+            MatrixKind::Damping => C64::new(0.0, 0.0),
+        }
+    }
 }
 
 /// `(dZ/dalpha) alpha = j w h alpha K_g`.

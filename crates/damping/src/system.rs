@@ -129,7 +129,8 @@ impl DampedSystem {
         v
     }
 
-    /// The kernel matrix `G(w) = sum_g h_g(w) C_g` on the pattern.
+    /// The kernel matrix `G(w) = sum_g h_g(w) C_g` on the pattern (with
+    /// the imported viscous damping matrices, `h = 1`).
     pub fn g_values(&self, omega: f64) -> Vec<C64> {
         let groups = self.model.groups();
         let mut v = vec![C64::new(0.0, 0.0); self.assembly.pattern().nnz()];
@@ -140,6 +141,8 @@ impl DampedSystem {
                 Some(match t.kind() {
                     MatrixKind::Stiffness => h * g.alpha,
                     MatrixKind::Mass => h * g.beta,
+                    // viscous: j w C
+                    MatrixKind::Damping => C64::new(1.0, 0.0),
                 })
             },
             &mut v,
@@ -160,10 +163,7 @@ impl DampedSystem {
                 };
                 for &b in self.assembly.group_blocks(g) {
                     for (t, term) in self.assembly.blocks()[b].terms().iter().enumerate() {
-                        let c = match term.kind() {
-                            MatrixKind::Stiffness => d.stiffness,
-                            MatrixKind::Mass => d.mass,
-                        };
+                        let c = d.of(term.kind());
                         if c != C64::new(0.0, 0.0) && term.value() != 0.0 {
                             terms.push((b, t, c));
                         }

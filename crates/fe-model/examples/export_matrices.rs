@@ -1,5 +1,6 @@
 //! Exports a case's model as another finite element code would: a Matrix
-//! Market stiffness and mass file per group, over the free equations, with
+//! Market stiffness and mass file per group (and the damping file of a
+//! group imported with one), over the free equations, with
 //! the DOF table and the node coordinates. It made the worked example of
 //! `docs/imported-models.md` (`cases/imported/`):
 //!
@@ -28,10 +29,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     write(format!("{prefix}-dofs.txt"), exported.dof_table())?;
     write(format!("{prefix}-nodes.txt"), export::node_file(model))?;
-    for (group, k, m) in &exported.groups {
-        let from = format!("group `{group}` of {}", case.path.display());
-        write(format!("{prefix}-{group}-K.mtx"), matrix_market::write(k, &format!("stiffness of {from}")))?;
-        write(format!("{prefix}-{group}-M.mtx"), matrix_market::write(m, &format!("mass of {from}")))?;
+    for g in &exported.groups {
+        let (group, from) = (&g.name, format!("group `{}` of {}", g.name, case.path.display()));
+        write(format!("{prefix}-{group}-K.mtx"), matrix_market::write(&g.stiffness, &format!("stiffness of {from}")))?;
+        write(format!("{prefix}-{group}-M.mtx"), matrix_market::write(&g.mass, &format!("mass of {from}")))?;
+        if !g.damping.entries.is_empty() {
+            let text = matrix_market::write(&g.damping, &format!("viscous damping of {from}"));
+            write(format!("{prefix}-{group}-C.mtx"), text)?;
+        }
     }
     Ok(())
 }

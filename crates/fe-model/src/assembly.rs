@@ -43,6 +43,9 @@ pub enum MatrixKind {
     Stiffness,
     /// Mass M.
     Mass,
+    /// A viscous damping matrix C of the user's own (imported), entering
+    /// `Z` as `j w C` whatever its group's kernel.
+    Damping,
 }
 
 /// The model item a block comes from (index into the model's list).
@@ -254,15 +257,24 @@ fn raw_blocks(model: &Model) -> Vec<RawBlock> {
         let terms = dim
             .dofs()
             .iter()
-            .enumerate()
-            .map(|(i0, &d)| {
+            .map(|&d| {
+                // r r^T on the node's DOFs along (or about) the axis of d,
+                // and -r r^T to the other node: in global axes r is e_d
+                let r: Vec<(usize, f64)> = sp
+                    .direction(dim, d)
+                    .into_iter()
+                    .map(|(g, c)| (dim.local(g).expect("of the dimension"), c))
+                    .collect();
                 let mut u = vec![0.0; n * n];
-                u[i0 * n + i0] = 1.0;
-                if n == 2 * nd {
-                    let i1 = nd + i0;
-                    u[i1 * n + i1] = 1.0;
-                    u[i0 * n + i1] = -1.0;
-                    u[i1 * n + i0] = -1.0;
+                for &(i, ci) in &r {
+                    for &(j, cj) in &r {
+                        u[i * n + j] = ci * cj;
+                        if n == 2 * nd {
+                            u[(nd + i) * n + nd + j] = ci * cj;
+                            u[i * n + nd + j] = -(ci * cj);
+                            u[(nd + i) * n + j] = -(ci * cj);
+                        }
+                    }
                 }
                 (
                     MatrixKind::Stiffness,
@@ -295,6 +307,7 @@ fn raw_blocks(model: &Model) -> Vec<RawBlock> {
         let factor = match b.kind {
             ImportedKind::Stiffness => (MatrixKind::Stiffness, Quantity::GroupStiffness(b.group)),
             ImportedKind::Mass => (MatrixKind::Mass, Quantity::GroupMass(b.group)),
+            ImportedKind::Damping => (MatrixKind::Damping, Quantity::GroupDamping(b.group)),
         };
         let terms = vec![(factor.0, vec![factor.1], LocalMatrix(b.values.clone()))];
         out.push((BlockSource::Imported(i), b.group, b.dofs.clone(), terms));
@@ -511,14 +524,14 @@ impl Assembly {
         }
     }
 
-    /// Values of the whole K or M on the pattern.
+    /// Values of the whole K, M or (imported) C on the pattern.
     pub fn real_values(&self, kind: MatrixKind) -> Vec<f64> {
         let mut v = vec![0.0; self.pattern.nnz()];
         self.accumulate(|_, t| (t.kind == kind).then_some(1.0), &mut v);
         v
     }
 
-    /// Values of `K_g` or `M_g` of one group.
+    /// Values of `K_g`, `M_g` or the imported `C_g` of one group.
     pub fn group_values(&self, group: usize, kind: MatrixKind) -> Vec<f64> {
         let mut v = vec![0.0; self.pattern.nnz()];
         self.accumulate(|b, t| (b.group == group && t.kind == kind).then_some(1.0), &mut v);

@@ -29,6 +29,7 @@ mod lookup;
 mod measurement;
 mod raw;
 mod spec;
+mod spring_axes;
 #[cfg(test)]
 mod tests;
 mod truth;

@@ -1,13 +1,16 @@
 //! The user's own finite element model: per-group stiffness and mass
 //! matrices exported from another code (as Matrix Market files with a DOF
-//! table), taken into a [`Model`] beside or instead of its beams.
+//! table), optionally a viscous damping matrix per group, taken into a
+//! [`Model`] beside or instead of its beams.
 //!
 //! An imported matrix is kept as blocks, one per pair of nodes it couples
 //! (and one per node for the entries among its own DOFs), so that it
 //! assembles, differentiates and cuts into parts ([`Model::part`]) as
 //! beams do: a block of group `g` is a unit matrix times `group.g.stiffness`
 //! (or `.mass`), and the group's damping acts on it as on any element
-//! (`C_g = alpha K_g + beta M_g` through the group's kernel). Without
+//! (`C_g = alpha K_g + beta M_g` through the group's kernel). A damping
+//! block is a unit matrix times `group.g.damping` and adds `j w C` to `Z`,
+//! viscous whatever the group's kernel. Without
 //! element geometry the model knows no zero-energy motions of its own, so
 //! the kinematic check of a mechanism passes over a model with imported
 //! matrices; a DOF without stiffness is still refused, and a singular `Z`
@@ -53,9 +56,7 @@ impl Model {
         table: &[DofRef],
         m: &SymmetricCoo,
     ) -> Result<(), ModelError> {
-        let what = || {
-            format!("the imported {} of group #{group}", if kind == ImportedKind::Mass { "mass" } else { "stiffness" })
-        };
+        let what = || format!("the imported {} of group #{group}", kind.key());
         if group >= self.groups.len() {
             return Err(ModelError::UnknownGroup { name: format!("#{group}"), context: what() });
         }

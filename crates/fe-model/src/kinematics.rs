@@ -127,10 +127,17 @@ pub fn zero_energy_motions(model: &Model) -> ZeroEnergy {
     }
     for sp in &model.springs {
         for &d in dim.dofs().iter().filter(|&&d| sp.k[d] > 0.0) {
-            rows.push(match sp.b {
-                Some(b) => difference(index(sp.a), index(b), d),
-                None => motion(index(sp.a), d),
-            });
+            // along (or about) the spring's axis of d: the global DOFs
+            // weighted by its components
+            let mut row = Row::new();
+            for (g, c) in sp.direction(dim, d) {
+                let part = match sp.b {
+                    Some(b) => difference(index(sp.a), index(b), g),
+                    None => motion(index(sp.a), g),
+                };
+                row.extend(part.into_iter().map(|(k, v)| (k, c * v)));
+            }
+            rows.push(row);
         }
     }
 

@@ -8,7 +8,8 @@
 //! frame in space (six DOFs per node), fixed when it is made
 //! ([`Model::with_dimension`]); every `add_*` refuses a DOF, coordinate or
 //! value the dimension does not have. The items themselves are in `items.rs`,
-//! the parts and the geometry the model derives in `geometry.rs`.
+//! the parts and the geometry the model derives in `geometry.rs`, springs in
+//! their own axes in `spring_axes.rs`.
 
 use std::collections::HashMap;
 
@@ -18,11 +19,14 @@ use crate::error::ModelError;
 
 mod geometry;
 mod items;
+mod spring_axes;
+
 pub use crate::dof::NodeId;
 pub use items::{
     Beam, ElementId, Group, ImportedBlock, ImportedKind, LumpedMass, Material, Node, RotaryInertia, Section, Spring,
     Support, Tie, rectangle_torsion,
 };
+pub use spring_axes::{SpringAxesError, spring_axes};
 
 /// A frame model, planar or in space.
 ///
@@ -295,6 +299,7 @@ impl Model {
         }
         positive(format!("group `{g}`: stiffness"), group.stiffness)?;
         positive(format!("group `{g}`: mass"), group.mass)?;
+        positive(format!("group `{g}`: damping"), group.damping)?;
         Ok(())
     }
 
@@ -458,7 +463,7 @@ impl Model {
             return Err(ModelError::Invalid { what: ctx, reason: "has no non-zero stiffness".into() });
         }
         self.require_group(group, &ctx)?;
-        self.springs.push(Spring { name: name.into(), a: NodeId(a), b: b.map(NodeId), k, group });
+        self.springs.push(Spring { name: name.into(), a: NodeId(a), b: b.map(NodeId), k, group, axes: None });
         Ok(self.springs.len() - 1)
     }
 

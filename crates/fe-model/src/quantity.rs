@@ -6,6 +6,7 @@
 //! |---|---|
 //! | `group.<g>.alpha` / `.beta` / `.mu` | damping of group g (`mu` in rad/s) |
 //! | `group.<g>.stiffness` / `.mass` | factors on `K_g` and `M_g` (nominal 1) |
+//! | `group.<g>.damping` | factor on the group's imported viscous damping matrix `C_g` (nominal 1) |
 //! | `material.<m>.E` / `.rho` | Young's modulus, density |
 //! | `element.<id>.stiffness` / `.mass` | factors on one element (nominal 1) |
 //! | `element.<id>.bending` | factor on one element's bending stiffness alone (nominal 1) |
@@ -59,12 +60,15 @@ pub enum Quantity {
     MassM(usize),
     /// Rotary inertia of a lumped mass about the axis of a rotation DOF.
     MassJ(usize, Dof),
+    /// Factor on a group's imported viscous damping matrices (last, so
+    /// that the order of the others is as it was).
+    GroupDamping(usize),
 }
 
 /// How a quantity enters the dynamic stiffness.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum QuantityKind {
-    /// Multiplies some stiffness or mass terms (E, rho, k, m, factors).
+    /// Multiplies some stiffness, mass or damping terms (E, rho, k, m, factors).
     Factor,
     /// A damping coefficient or relaxation parameter of a group.
     Damping,
@@ -95,6 +99,7 @@ impl fmt::Display for QuantityName<'_> {
             Quantity::GroupMu(g) => write!(f, "group.{}.mu", m.groups[g].name),
             Quantity::GroupStiffness(g) => write!(f, "group.{}.stiffness", m.groups[g].name),
             Quantity::GroupMass(g) => write!(f, "group.{}.mass", m.groups[g].name),
+            Quantity::GroupDamping(g) => write!(f, "group.{}.damping", m.groups[g].name),
             Quantity::MaterialE(i) => write!(f, "material.{}.E", m.materials[i].name),
             Quantity::MaterialRho(i) => write!(f, "material.{}.rho", m.materials[i].name),
             Quantity::ElementStiffness(i) => write!(f, "element.{}.stiffness", m.beams[i].id),
@@ -127,10 +132,10 @@ impl Parameter {
     }
 }
 
-const FORMS: &str = "group.<name>.{alpha,beta,mu,stiffness,mass}, material.<name>.{E,rho}, \
+const FORMS: &str = "group.<name>.{alpha,beta,mu,stiffness,mass,damping}, material.<name>.{E,rho}, \
                      element.<id>.{stiffness,bending,mass,added_mass}, spring.<name>.{kx,ky,kr}, mass.<name>.{m,j}";
 
-const FORMS_3D: &str = "group.<name>.{alpha,beta,mu,stiffness,mass}, material.<name>.{E,rho}, \
+const FORMS_3D: &str = "group.<name>.{alpha,beta,mu,stiffness,mass,damping}, material.<name>.{E,rho}, \
                         element.<id>.{stiffness,bending,mass,added_mass}, spring.<name>.{kx,ky,kz,krx,kry,krz}, \
                         mass.<name>.{m,jx,jy,jz}";
 
@@ -154,7 +159,8 @@ impl Model {
                     "mu" => Quantity::GroupMu(g),
                     "stiffness" => Quantity::GroupStiffness(g),
                     "mass" => Quantity::GroupMass(g),
-                    _ => return Err(bad_field("alpha, beta, mu, stiffness, mass")),
+                    "damping" => Quantity::GroupDamping(g),
+                    _ => return Err(bad_field("alpha, beta, mu, stiffness, mass, damping")),
                 })
             }
             "material" => {
@@ -247,6 +253,7 @@ impl Model {
             Quantity::GroupMu(g) => self.groups[g].mu.unwrap_or(f64::INFINITY),
             Quantity::GroupStiffness(g) => self.groups[g].stiffness,
             Quantity::GroupMass(g) => self.groups[g].mass,
+            Quantity::GroupDamping(g) => self.groups[g].damping,
             Quantity::MaterialE(i) => self.materials[i].e,
             Quantity::MaterialRho(i) => self.materials[i].rho,
             Quantity::ElementStiffness(i) => self.beams[i].stiffness_factor,
@@ -289,6 +296,7 @@ impl Model {
             Quantity::GroupMu(g) => self.groups[g].mu = value.is_finite().then_some(value),
             Quantity::GroupStiffness(g) => self.groups[g].stiffness = value,
             Quantity::GroupMass(g) => self.groups[g].mass = value,
+            Quantity::GroupDamping(g) => self.groups[g].damping = value,
             Quantity::MaterialE(i) => self.materials[i].e = value,
             Quantity::MaterialRho(i) => self.materials[i].rho = value,
             Quantity::ElementStiffness(i) => self.beams[i].stiffness_factor = value,

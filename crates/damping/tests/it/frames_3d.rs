@@ -75,7 +75,7 @@ fn unit(v: [f64; 3]) -> [f64; 3] {
 }
 
 /// The rotation by `angle` about `axis` (Rodrigues' formula), as a map of points.
-fn rotation(axis: [f64; 3], angle: f64) -> impl Fn([f64; 3]) -> [f64; 3] {
+pub(super) fn rotation(axis: [f64; 3], angle: f64) -> impl Fn([f64; 3]) -> [f64; 3] {
     let [x, y, z] = unit(axis);
     let (s, c) = angle.sin_cos();
     let r = [

@@ -2,4 +2,6 @@
 
 mod complex_modes;
 mod frames_3d;
+mod imported_damping;
 mod modal_physics;
+mod spring_axes;

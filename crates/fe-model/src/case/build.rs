@@ -37,6 +37,7 @@ pub(super) fn raw_group(ctx: &Ctx<'_>, name: &str, g: &Spanned<RawGroup>) -> Res
         mu: r.mu.filter(|m| m.is_finite()),
         stiffness: r.stiffness,
         mass: r.mass,
+        damping: r.damping,
     })
 }
 
@@ -292,7 +293,9 @@ pub(super) fn add_spring(ctx: &Ctx<'_>, model: &mut Model, s: &Spanned<RawSpring
         k[d] = v;
     }
     let g = group_ref(ctx, model, &r.group)?;
-    model.add_spring(&r.name, a, b, k, g).map_err(|e| ctx.model_err(s.span(), e))
+    let i = model.add_spring(&r.name, a, b, k, g).map_err(|e| ctx.model_err(s.span(), e))?;
+    super::spring_axes::orient(ctx, model, i, r)?;
+    Ok(i)
 }
 
 /// The joints of a case: each node is split, the listed elements move to a

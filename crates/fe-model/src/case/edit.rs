@@ -246,7 +246,7 @@ fn rewrite_imported_paths(doc: &mut DocumentMut, base: &Path, target: &Path) {
     }
     if let Some(Item::ArrayOfTables(groups)) = imported.get_mut("groups") {
         for t in groups.iter_mut() {
-            for key in ["dofs", "stiffness", "mass"] {
+            for key in ["dofs", "stiffness", "mass", "damping"] {
                 if let Some(v) = t.get_mut(key).and_then(Item::as_value_mut) {
                     rewrite(v);
                 }

@@ -10,6 +10,7 @@
 //! dofs = "frame-dofs.txt"          # the DOF of each matrix row: node dof
 //! stiffness = "frame-K.mtx"        # Matrix Market coordinate files
 //! mass = "frame-M.mtx"
+//! damping = "frame-C.mtx"          # optional: a viscous damping matrix
 //! ```
 //!
 //! An error in one of these files names that file, its line and column.
@@ -56,7 +57,7 @@ pub(super) fn files(ctx: &Ctx<'_>, raw: &Spanned<RawImported>) -> Vec<PathBuf> {
     let r = raw.get_ref();
     let names = r.groups.iter().flat_map(|g| {
         let g = g.get_ref();
-        [Some(&g.dofs), g.stiffness.as_ref(), g.mass.as_ref()]
+        [Some(&g.dofs), g.stiffness.as_ref(), g.mass.as_ref(), g.damping.as_ref()]
     });
     std::iter::once(r.nodes.as_ref()).chain(names).flatten().map(|n| resolve(ctx, n.get_ref())).collect()
 }
@@ -146,10 +147,18 @@ pub(super) fn add_imported(
             }
         }
         listed.extend(table.dofs.iter().copied());
-        if e.stiffness.is_none() && e.mass.is_none() {
-            return Err(ctx.err(entry.span(), "an imported group needs a `stiffness` or a `mass` matrix, or both"));
+        if e.stiffness.is_none() && e.mass.is_none() && e.damping.is_none() {
+            return Err(ctx.err(
+                entry.span(),
+                "an imported group needs a `stiffness`, a `mass` or a `damping` matrix (or several)",
+            ));
         }
-        for (kind, file) in [(ImportedKind::Stiffness, &e.stiffness), (ImportedKind::Mass, &e.mass)] {
+        let kinds = [
+            (ImportedKind::Stiffness, &e.stiffness),
+            (ImportedKind::Mass, &e.mass),
+            (ImportedKind::Damping, &e.damping),
+        ];
+        for (kind, file) in kinds {
             let Some(file) = file else { continue };
             let (path, text) = read(ctx, file)?;
             let m = matrix_market::read(&text).map_err(|x| in_file(&path, &text, x))?;

@@ -69,6 +69,7 @@ pub(super) struct RawImportedGroup {
     pub(super) dofs: Spanned<String>,
     pub(super) stiffness: Option<Spanned<String>>,
     pub(super) mass: Option<Spanned<String>>,
+    pub(super) damping: Option<Spanned<String>>,
 }
 
 #[derive(Deserialize)]
@@ -150,6 +151,9 @@ pub(super) struct RawGroup {
     pub(super) stiffness: f64,
     #[serde(default = "one")]
     pub(super) mass: f64,
+    /// Factor on the group's imported damping matrices.
+    #[serde(default = "one")]
+    pub(super) damping: f64,
 }
 
 pub(super) fn one() -> f64 {
@@ -201,6 +205,10 @@ pub(super) struct RawSpring {
     pub(super) kry: Option<Spanned<f64>>,
     pub(super) krz: Option<Spanned<f64>>,
     pub(super) group: Spanned<String>,
+    /// In space: the spring's local x axis ...
+    pub(super) x_axis: Option<Spanned<[f64; 3]>>,
+    /// ... and a vector in its local x-y plane.
+    pub(super) xy_vector: Option<Spanned<[f64; 3]>>,
 }
 
 impl RawSpring {

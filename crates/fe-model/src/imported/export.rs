@@ -8,16 +8,29 @@ use std::fmt::Write as _;
 use super::SymmetricCoo;
 use crate::assembly::{Assembly, MatrixKind};
 use crate::dof::DofRef;
-use crate::model::Model;
+use crate::model::{Group, Model};
 
 /// The group matrices of a model over its free equations.
 #[derive(Clone, Debug)]
 pub struct Exported {
     /// The DOF of each row: the owner of each equation.
     pub dofs: Vec<DofRef>,
-    /// Per group with any stiffness or mass: its name, `K_g` and `M_g`
-    /// (lower triangles, the group factors applied).
-    pub groups: Vec<(String, SymmetricCoo, SymmetricCoo)>,
+    /// Per group with any stiffness, mass or imported damping.
+    pub groups: Vec<ExportedGroup>,
+}
+
+/// One group's matrices: lower triangles, the group factors applied.
+#[derive(Clone, Debug)]
+pub struct ExportedGroup {
+    /// The group's name.
+    pub name: String,
+    /// `K_g`.
+    pub stiffness: SymmetricCoo,
+    /// `M_g`.
+    pub mass: SymmetricCoo,
+    /// The group's imported viscous damping matrix (empty without one; the
+    /// group's own `alpha K_g + beta M_g` is not in it).
+    pub damping: SymmetricCoo,
 }
 
 /// Exports the group matrices of `model`, assembled as `assembly`.
@@ -36,14 +49,13 @@ pub fn export(model: &Model, assembly: &Assembly) -> Exported {
         SymmetricCoo { n: p.n(), entries }
     };
     let groups = (0..model.groups().len())
-        .map(|g| {
-            let (k, m) = (
-                lower(assembly.group_values(g, MatrixKind::Stiffness)),
-                lower(assembly.group_values(g, MatrixKind::Mass)),
-            );
-            (model.groups()[g].name.clone(), k, m)
+        .map(|g| ExportedGroup {
+            name: model.groups()[g].name.clone(),
+            stiffness: lower(assembly.group_values(g, MatrixKind::Stiffness)),
+            mass: lower(assembly.group_values(g, MatrixKind::Mass)),
+            damping: lower(assembly.group_values(g, MatrixKind::Damping)),
         })
-        .filter(|(_, k, m)| !(k.entries.is_empty() && m.entries.is_empty()))
+        .filter(|e| !(e.stiffness.entries.is_empty() && e.mass.entries.is_empty() && e.damping.entries.is_empty()))
         .collect();
     Exported { dofs: (0..assembly.n()).map(|eq| assembly.dofs().dof_of(eq)).collect(), groups }
 }
@@ -77,15 +89,19 @@ pub fn as_imported(model: &Model) -> Result<Model, crate::error::ModelError> {
     let exported = export(model, &assembly);
     let mut m = Model::with_dimension(&model.title, model.dimension());
     for g in model.groups() {
-        m.add_group(g.clone())?;
+        // the factors are in the exported matrices: the copy's are 1
+        m.add_group(Group { stiffness: 1.0, mass: 1.0, damping: 1.0, ..g.clone() })?;
     }
     for n in model.nodes() {
         m.add_node_at(n.id.0, n.position())?;
     }
-    for (name, k, mass) in &exported.groups {
-        let g = m.group_index(name).expect("added above");
-        m.add_imported(g, super::ImportedKind::Stiffness, &exported.dofs, k)?;
-        m.add_imported(g, super::ImportedKind::Mass, &exported.dofs, mass)?;
+    for e in &exported.groups {
+        let g = m.group_index(&e.name).expect("added above");
+        m.add_imported(g, super::ImportedKind::Stiffness, &exported.dofs, &e.stiffness)?;
+        m.add_imported(g, super::ImportedKind::Mass, &exported.dofs, &e.mass)?;
+        if !e.damping.entries.is_empty() {
+            m.add_imported(g, super::ImportedKind::Damping, &exported.dofs, &e.damping)?;
+        }
     }
     for n in model.nodes() {
         let held: Vec<_> = m

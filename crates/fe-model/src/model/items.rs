@@ -179,11 +179,15 @@ pub struct Spring {
     pub a: NodeId,
     /// Second node, or `None` for a spring to ground.
     pub b: Option<NodeId>,
-    /// Stiffnesses per DOF (N/m along, N m/rad about the global axes);
-    /// zero in the DOFs the spring does not join.
+    /// Stiffnesses per DOF (N/m along, N m/rad about the global axes, or
+    /// the spring's own axes when it has them); zero in the DOFs the spring
+    /// does not join.
     pub k: PerDof,
     /// Index into [`Model::groups`].
     pub group: usize,
+    /// The spring's own axes (rows: local x, y, z in global components) in
+    /// a 3D model, set by [`Model::orient_spring`]; `None`: the global axes.
+    pub axes: Option<[[f64; 3]; 3]>,
 }
 
 /// A lumped mass with rotary inertia at a node.
@@ -240,12 +244,15 @@ pub struct Group {
     pub stiffness: f64,
     /// Mass factor of the whole group.
     pub mass: f64,
+    /// Factor on the group's imported viscous damping matrices (nominal 1;
+    /// nothing to scale in a group without one).
+    pub damping: f64,
 }
 
 impl Group {
     /// An undamped group with unit factors.
     pub fn new(name: &str) -> Self {
-        Group { name: name.into(), alpha: 0.0, beta: 0.0, mu: None, stiffness: 1.0, mass: 1.0 }
+        Group { name: name.into(), alpha: 0.0, beta: 0.0, mu: None, stiffness: 1.0, mass: 1.0, damping: 1.0 }
     }
 
     /// Builder: Rayleigh coefficients.
@@ -286,6 +293,21 @@ pub enum ImportedKind {
     Stiffness,
     /// A mass matrix, scaled by the group's mass factor.
     Mass,
+    /// A viscous damping matrix, scaled by the group's damping factor: it
+    /// enters `Z(w)` as `j w C`, beside the group's own damping
+    /// (`alpha K_g + beta M_g` through its kernel).
+    Damping,
+}
+
+impl ImportedKind {
+    /// `stiffness`, `mass` or `damping`: the key of its file in a case.
+    pub fn key(self) -> &'static str {
+        match self {
+            ImportedKind::Stiffness => "stiffness",
+            ImportedKind::Mass => "mass",
+            ImportedKind::Damping => "damping",
+        }
+    }
 }
 
 /// The entries of an imported group matrix between the DOFs of one node,
@@ -294,7 +316,7 @@ pub enum ImportedKind {
 pub struct ImportedBlock {
     /// Index into [`Model::groups`](super::Model::groups).
     pub group: usize,
-    /// Stiffness or mass.
+    /// Stiffness, mass or damping.
     pub kind: ImportedKind,
     /// The node, twice, or the two nodes (smaller id first).
     pub nodes: [NodeId; 2],

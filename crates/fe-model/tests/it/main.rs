@@ -4,3 +4,4 @@ mod bending;
 mod elements;
 mod frame3d;
 mod properties;
+mod spring_axes;

@@ -120,3 +120,91 @@ fn replace_nth_entry_value(text: &str, k: usize, value: &str) -> String {
         .join("\n")
         + "\n"
 }
+
+/// The example with a viscous damping matrix in its group: dashpots at
+/// four top corners (the rows of `table-dofs.txt` named here), in
+/// `table-frame-C.mtx`, and the truth's with its factor 1.6.
+fn with_dashpots(dir: &Path, matrix: impl Fn(&[(usize, f64)]) -> String) -> PathBuf {
+    let case = copy_with(dir, "table.toml", |t| {
+        t.replacen(
+            "mass = \"table-frame-M.mtx\"\n",
+            "mass = \"table-frame-M.mtx\"\ndamping = \"table-frame-C.mtx\"\n",
+            1,
+        )
+        .replacen("[truth.set]\n", "[truth.set]\n\"group.frame.damping\" = 1.6\n", 1)
+        .replacen("\"group.frame.beta\"]", "\"group.frame.beta\", \"group.frame.damping\"]", 1)
+    });
+    let table = std::fs::read_to_string(dir.join("table-dofs.txt")).unwrap();
+    let rows: Vec<&str> = table.lines().filter(|l| !l.starts_with('#') && !l.trim().is_empty()).collect();
+    let row = |dof: &str| rows.iter().position(|l| l.trim() == dof).unwrap() + 1;
+    let dashpots: Vec<(usize, f64)> =
+        [("5 ux", 40.0), ("10 uz", 60.0), ("15 uy", 40.0), ("20 ux", 60.0)].map(|(d, c)| (row(d), c)).to_vec();
+    std::fs::write(dir.join("table-frame-C.mtx"), matrix(&dashpots)).unwrap();
+    case
+}
+
+/// A damping matrix's factor is updated like the group's other parameters
+/// and found within three standard deviations of the truth.
+#[test]
+fn update_finds_the_factor_of_an_imported_damping_matrix() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = with_dashpots(dir.path(), |d| {
+        let mut s = format!("%%MatrixMarket matrix coordinate real symmetric\n192 192 {}\n", d.len());
+        for &(r, c) in d {
+            s.push_str(&format!("{r} {r} {c}\n"));
+        }
+        s
+    });
+    let out_dir = dir.path().join("out");
+    let out = rfm(&["update", case.to_str().unwrap(), "--json", "--out", out_dir.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let u: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(u["status"], "converged");
+    let truth = CaseFile::load(&case).unwrap().truth.unwrap();
+    let model = &truth.model;
+    let parameters = u["uncertainty"]["parameters"].as_array().unwrap();
+    let damping = parameters.iter().find(|p| p["name"] == "group.frame.damping").expect("the factor is a parameter");
+    assert!(damping["relative_std"].as_f64().unwrap() < 0.1, "the data determine it: {damping}");
+    for p in parameters {
+        let name = p["name"].as_str().unwrap();
+        let want = model.get(model.quantity(name).unwrap());
+        let z = (p["value"].as_f64().unwrap() / want).ln().abs() / p["relative_std"].as_f64().unwrap();
+        assert!(z < 3.0, "{name}: {p} vs the truth's {want}");
+    }
+}
+
+#[test]
+fn a_bad_damping_matrix_is_refused_at_its_line_and_column() {
+    let dir = tempfile::tempdir().unwrap();
+    // a row beyond the matrix's 192
+    let case =
+        with_dashpots(dir.path(), |_| "%%MatrixMarket matrix coordinate real symmetric\n192 192 1\n193 1 5.0\n".into());
+    let out = rfm(&["compare", case.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{err}");
+    assert!(err.contains("table-frame-C.mtx:3:1:"), "{err}");
+}
+
+/// With the damping matrix's factor the only change in the truth, the
+/// diagnosis ranks the change of that matrix first, with its value.
+#[test]
+fn diagnose_names_a_change_of_an_imported_damping_matrix() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = with_dashpots(dir.path(), |d| {
+        let mut s = format!("%%MatrixMarket matrix coordinate real symmetric\n192 192 {}\n", d.len());
+        for &(r, c) in d {
+            s.push_str(&format!("{r} {r} {c}\n"));
+        }
+        s
+    });
+    let text = std::fs::read_to_string(&case).unwrap();
+    let text = text.replace("\"group.frame.stiffness\" = 0.94\n", "").replace("\"group.frame.alpha\" = 3.0e-6\n", "");
+    std::fs::write(&case, text).unwrap();
+    let out = rfm(&["diagnose", case.to_str().unwrap(), "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let d: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let first = &d["ranking"][0];
+    assert_eq!(first["description"], "change of the damping matrix of group `frame`", "{first}");
+    let value = first["parameters"][0]["value"].as_f64().unwrap();
+    assert!((value / 1.6 - 1.0).abs() < 0.01, "{first}");
+}

@@ -7,6 +7,7 @@ mod diagnose;
 mod fixtures;
 mod gains;
 mod imported;
+mod imported_diagnosis;
 mod inspect;
 mod measurement;
 mod nothing_lost;

@@ -25,8 +25,9 @@ pub(super) struct ZCache {
     /// Per block: `(first position, number of local entries, first term, end of terms)`.
     pub(super) blocks: Vec<(u32, u32, u32, u32)>,
     pub(super) positions: Vec<u32>,
-    /// Per non-zero term: `(slot, value, unit offset)`; the slot is `2 g` for
-    /// group `g`'s stiffness terms and `2 g + 1` for its mass terms.
+    /// Per non-zero term: `(slot, value, unit offset)`; the slot is `3 g` for
+    /// group `g`'s stiffness terms, `3 g + 1` for its mass terms and `3 g + 2`
+    /// for its (imported) damping terms.
     pub(super) terms: Vec<(u32, f64, u32)>,
     pub(super) units: Vec<f64>,
 }
@@ -42,7 +43,7 @@ impl ZCache {
             let t0 = terms.len() as u32;
             // Assembly::accumulate skips terms whose value is zero
             for t in b.terms().iter().filter(|t| t.value() != 0.0) {
-                let slot = 2 * b.group() as u32 + u32::from(t.kind() == MatrixKind::Mass);
+                let slot = 3 * b.group() as u32 + kind_index(t.kind());
                 terms.push((slot, t.value(), units.offset_of(t.unit())));
             }
             blocks.push((p0, b.positions().len() as u32, t0, terms.len() as u32));
@@ -53,7 +54,7 @@ impl ZCache {
     /// `Z(w)` into `out`, given each group's coefficients at `w`: the loop of
     /// `Assembly::accumulate` with the coefficients of `z_values_into`.
     pub(super) fn values_into(&self, coefs: &[GroupCoefficients], out: &mut [C64]) {
-        let by_slot: Vec<C64> = coefs.iter().flat_map(|c| [c.stiffness, c.mass]).collect();
+        let by_slot: Vec<C64> = coefs.iter().flat_map(|c| [c.stiffness, c.mass, c.damping]).collect();
         out.fill(ZERO);
         for &(p0, len, t0, t1) in &self.blocks {
             let positions = &self.positions[p0 as usize..(p0 + len) as usize];
@@ -67,6 +68,16 @@ impl ZCache {
                 }
             }
         }
+    }
+}
+
+/// 0, 1, 2 for a stiffness, mass or damping term: its place among its
+/// group's coefficients.
+pub(super) fn kind_index(kind: MatrixKind) -> u32 {
+    match kind {
+        MatrixKind::Stiffness => 0,
+        MatrixKind::Mass => 1,
+        MatrixKind::Damping => 2,
     }
 }
 

@@ -77,10 +77,7 @@ impl Rule {
             Rule::Mu => kernel::d_mu(&groups[group], omega),
             Rule::Factor => return GroupCoefficients::new(&groups[group], omega).of(kind),
         };
-        match kind {
-            MatrixKind::Stiffness => d.stiffness,
-            MatrixKind::Mass => d.mass,
-        }
+        d.of(kind)
     }
 }
 
@@ -221,7 +218,7 @@ impl TermTable {
                 let class = if rules_hold {
                     let mut h = FxHasher::default();
                     h.write_usize(block.group());
-                    h.write_u32(u32::from(term.kind() == MatrixKind::Mass));
+                    h.write_u32(super::cache::kind_index(term.kind()));
                     for &i in who {
                         h.write_u32(i);
                     }

@@ -172,3 +172,44 @@ fn fast_assembly_equals_dense_formulation_in_space() {
     let measured = synthesize(&truth, &channels, &freqs).unwrap();
     check(&sys, &names, &channels, &freqs, &measured);
 }
+
+/// The same on an imported model whose frame group has a viscous damping
+/// matrix of its own beside its alpha and beta: the damping factor is a
+/// parameter like the others, its terms in a class of their own.
+#[test]
+fn fast_assembly_equals_dense_formulation_with_an_imported_damping_matrix() {
+    use fe_model::imported::{ImportedKind, SymmetricCoo, export};
+    let native = samples::space_portal();
+    let a = fe_model::Assembly::new(&native).unwrap();
+    let exported = export::export(&native, &a);
+    let mut model = export::as_imported(&native).unwrap();
+    // dashpots at a few free DOFs and between two of them
+    let c = SymmetricCoo { n: a.n(), entries: vec![(2, 2, 30.0), (5, 5, 12.0), (9, 5, -4.0), (9, 9, 8.0)] };
+    let f = model.group_index("frame").unwrap();
+    model.add_imported(f, ImportedKind::Damping, &exported.dofs, &c).unwrap();
+    let truth = DampedSystem::new(model).unwrap();
+    let mut sys = truth.clone();
+    for (name, factor) in [("group.frame.damping", 1.8), ("group.joint.mu", 0.4), ("group.frame.stiffness", 1.05)] {
+        let q = sys.model().quantity(name).unwrap();
+        sys.set(q, factor * sys.get(q)).unwrap();
+    }
+    let names = [
+        "group.frame.damping",
+        "group.frame.alpha",
+        "group.frame.beta",
+        "group.frame.stiffness",
+        "group.frame.mass",
+        "group.joint.mu",
+        "group.joint.stiffness",
+    ];
+    let responses = [(7, Dof::Ux), (7, Dof::Uy), (7, Dof::Uz), (5, Dof::Uz), (4, Dof::Ry), (2, Dof::Ux)];
+    let mut channels = Vec::new();
+    for reference in [DofRef::new(7, Dof::Uy), DofRef::new(5, Dof::Uz)] {
+        for &(node, dof) in &responses {
+            channels.push(Channel::new(DofRef::new(node, dof), reference));
+        }
+    }
+    let freqs = [23.0, 61.0, 173.0, 420.0];
+    let measured = synthesize(&truth, &channels, &freqs).unwrap();
+    check(&sys, &names, &channels, &freqs, &measured);
+}

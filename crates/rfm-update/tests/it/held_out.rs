@@ -101,7 +101,7 @@ fn truth_of(role: Role, h: &HiddenEffect) -> Option<f64> {
         Role::Mass => h.value("m"),
         Role::Inertia => h.value("j"),
         Role::StiffnessFactor => h.value("factor"),
-        Role::MassFactor | Role::Alpha | Role::Mu => None,
+        Role::MassFactor | Role::Alpha | Role::Mu | Role::DampingFactor => None,
     }
 }
 

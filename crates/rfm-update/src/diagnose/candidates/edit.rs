@@ -15,7 +15,8 @@ pub(crate) enum Edit {
     Mass { node: u32, name: String, group: String, m: f64, j: f64, dim: Dimension },
     /// The rigid support of a node (the DOFs `fixed`) replaced, in the
     /// `released` DOFs, by ground springs `k` in a damping group of their
-    /// own; the other fixed DOFs stay fixed. With `per_direction`, one
+    /// own; the other fixed DOFs stay fixed. With nothing `fixed`, springs
+    /// to ground at a free node. With `per_direction`, one
     /// spring per released DOF, each in a group of its own (see
     /// [`direction_name`]), all starting as `group`.
     Support {
@@ -171,6 +172,13 @@ impl Edit {
                     format!("lumped mass at node {node}")
                 }
             }
+            Edit::Support { node, fixed, released, group, dim, per_direction, .. } if fixed.is_empty() => {
+                format!(
+                    "spring to ground at node {node} ({}; {})",
+                    springs(released, dim),
+                    damping(group, *per_direction)
+                )
+            }
             Edit::Support { node, released, group, dim, per_direction, .. } => {
                 format!(
                     "flexible, lossy support at node {node} ({}; {})",
@@ -204,7 +212,8 @@ impl Edit {
         values: &[f64],
         comment: &str,
     ) -> Result<(), CaseError> {
-        if let Edit::Support { node, .. } = self
+        if let Edit::Support { node, fixed, .. } = self
+            && !fixed.is_empty()
             && editor.remove_supports_at(*node) == 0
         {
             return Err(editor.error(format!("node {node} has no support entry to replace by springs")));

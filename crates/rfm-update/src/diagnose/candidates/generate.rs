@@ -11,10 +11,13 @@
 //! a mass.
 //!
 //! A 3D model gets the same families in its own DOFs: supports release every
-//! fixed DOF, a joint springs the three rotations (and in its fuller variant
+//! fixed DOF (that the structure there gives stiffness), a joint springs the three rotations (and in its fuller variant
 //! the translations too), a mass acts on the three translations (its rotary
 //! inertia is the same about every axis), and members are told apart by
-//! their directions in space.
+//! their directions in space. An imported model (matrices without element
+//! geometry) gets what needs none: its supports released, a spring to
+//! ground at each of its free nodes, a mass at each node, and the changes of
+//! each group (`imported.rs`).
 
 use std::collections::{HashMap, HashSet};
 
@@ -22,7 +25,7 @@ use fe_model::{Dimension, Group, Model, NodeId, PerDof};
 use rayon::prelude::*;
 
 mod points;
-use points::{existing_joints, joint, mass, mass_nodes, supports};
+use points::{existing_joints, ground_spring, imported_stiffness_nodes, joint, mass, mass_nodes, supports};
 pub(crate) mod twins;
 
 use super::edit::Edit;
@@ -171,9 +174,12 @@ impl<'a> Ctx<'a> {
         g
     }
 
-    /// The nodes of the beams at `node`, and the node itself.
+    /// The nodes of the beams at `node`, of the imported blocks that couple
+    /// it to others, and the node itself.
     fn ring(&self, node: u32) -> Vec<u32> {
         let mut v: Vec<u32> = self.at(node).iter().flat_map(|&i| self.model.beams()[i].nodes.map(|n| n.0)).collect();
+        let coupled = self.model.imported().iter().filter(|b| b.nodes.contains(&NodeId(node)));
+        v.extend(coupled.flat_map(|b| b.nodes.map(|n| n.0)));
         v.push(node);
         v.sort_unstable();
         v.dedup();
@@ -418,6 +424,7 @@ pub fn generate(model: &Model, opts: &CandidateOptions) -> Vec<Candidate> {
     for node in supported {
         specs.extend(supports(&ctx, node));
     }
+    specs.extend(imported_stiffness_nodes(&ctx).into_iter().filter_map(|node| ground_spring(&ctx, node)));
 
     // joints where members meet at an angle: each member but the first (the
     // through-member keeps the node) detached

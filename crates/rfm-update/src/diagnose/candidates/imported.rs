@@ -1,10 +1,12 @@
 //! Candidates of an imported model (matrices without element geometry):
-//! a change of each imported group's stiffness, mass and damping. Masses
+//! a change of each imported group's stiffness, mass and damping (its
+//! alpha and mu, and the factor on its own damping matrix where it has one). Masses
 //! at its nodes and springs at its supports come from the usual
 //! generators, which count the imported matrices in a node's stiffness
 //! (`Ctx::local_stiffness`) and its nodes as places for a mass.
 
 use fe_model::Model;
+use fe_model::imported::ImportedKind;
 
 use super::edit::Edit;
 use super::{EffectKind, Fitted, Head, Role};
@@ -31,7 +33,8 @@ pub(super) fn imported_groups(model: &Model) -> Vec<(usize, Vec<u32>)> {
 
 /// The changes of an imported group, as the updating parameters the group
 /// has: its stiffness and mass factors, and its damping where it has any
-/// (a parameter is updated relative to its start, which must not be zero).
+/// (a parameter is updated relative to its start, which must not be zero):
+/// alpha (and mu), and the factor on an imported damping matrix.
 /// `alpha` and `mu` make the fitted entries of damping parameters.
 pub(super) fn group_changes(
     model: &Model,
@@ -82,6 +85,18 @@ pub(super) fn group_changes(
             fitted.push(mu(format!("group.{name}.mu")));
         }
         out.push((head(kind, format!("{} of group `{name}`", kind.label())), Edit::Set, fitted));
+    }
+    if model.imported().iter().any(|b| b.group == group && b.kind == ImportedKind::Damping) {
+        out.push((
+            head(EffectKind::ViscousDamping, format!("change of the damping matrix of group `{name}`")),
+            Edit::Set,
+            vec![Fitted {
+                name: format!("group.{name}.damping"),
+                role: Role::DampingFactor,
+                bounds: Some((1e-3, 1e3)),
+                plausible: (0.02, 50.0, "a factor beyond 0.02 .. 50 on the group's damping matrix"),
+            }],
+        ));
     }
     out
 }

@@ -97,12 +97,14 @@ pub enum Role {
     StiffnessFactor,
     /// A mass factor.
     MassFactor,
+    /// A factor on an imported viscous damping matrix.
+    DampingFactor,
 }
 
 impl Role {
     /// Stiffness and mass values (as opposed to damping).
     pub fn is_stiffness_or_mass(self) -> bool {
-        !matches!(self, Role::Alpha | Role::Mu)
+        !matches!(self, Role::Alpha | Role::Mu | Role::DampingFactor)
     }
 }
 

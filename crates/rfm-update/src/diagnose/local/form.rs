@@ -18,8 +18,8 @@ enum Item {
     Beam(u32),
     Spring(String),
     Mass(String),
-    /// An imported block: group, mass (not stiffness), its two nodes.
-    Imported(usize, bool, u32, u32),
+    /// An imported block: group, matrix, its two nodes.
+    Imported(usize, fe_model::imported::ImportedKind, u32, u32),
 }
 
 fn item(model: &fe_model::Model, source: BlockSource) -> Item {
@@ -29,7 +29,7 @@ fn item(model: &fe_model::Model, source: BlockSource) -> Item {
         BlockSource::Mass(i) => Item::Mass(model.masses()[i].name.clone()),
         BlockSource::Imported(i) => {
             let b = &model.imported()[i];
-            Item::Imported(b.group, b.kind == fe_model::imported::ImportedKind::Mass, b.nodes[0].0, b.nodes[1].0)
+            Item::Imported(b.group, b.kind, b.nodes[0].0, b.nodes[1].0)
         }
     }
 }

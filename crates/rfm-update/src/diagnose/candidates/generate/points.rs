@@ -1,6 +1,7 @@
 //! The candidates at a node: a flexible, lossy support in place of a rigid
-//! one, a flexible, lossy joint (at a corner or in line), a lumped mass, and
-//! the joints the model already has, as modelled.
+//! one, a spring to ground at a free node of an imported model, a flexible,
+//! lossy joint (at a corner or in line), a lumped mass, and the joints the
+//! model already has, as modelled.
 
 use std::collections::{HashMap, HashSet};
 
@@ -23,7 +24,11 @@ fn spring(ctx: &Ctx<'_>, name: &str, d: Dof, reference: f64) -> Fitted {
 }
 
 /// The flexible, lossy support candidates of a supported node: every fixed
-/// DOF released onto a ground spring, viscous and non-viscous.
+/// DOF that the structure there gives stiffness released onto a ground
+/// spring, viscous and non-viscous. (At a node of an imported solid, the
+/// rotations are held because nothing gives them stiffness: they stay
+/// held. A node whose rows the export left out has no stiffness to compete
+/// with at all, and no candidate: the matrices do not say how it is held.)
 pub(super) fn supports(ctx: &Ctx<'_>, node: u32) -> Vec<Spec> {
     let model = ctx.model;
     let mut fixed: Vec<Dof> =
@@ -31,22 +36,23 @@ pub(super) fn supports(ctx: &Ctx<'_>, node: u32) -> Vec<Spec> {
     fixed.sort();
     fixed.dedup();
     let kref = ctx.local_stiffness(node);
-    if fixed.is_empty() || fixed.iter().any(|&d| kref[d] <= 0.0) {
+    let released: Vec<Dof> = fixed.iter().copied().filter(|&d| kref[d] > 0.0).collect();
+    if released.is_empty() {
         return Vec::new();
     }
     let mut out = Vec::new();
     for non_viscous in [false, true] {
         let name = unique_name(model, &format!("support_{node}"));
         let mut k = PerDof::default();
-        for &d in &fixed {
+        for &d in &released {
             k[d] = 100.0 * kref[d];
         }
-        let mut fitted: Vec<Fitted> = fixed.iter().map(|&d| spring(ctx, &name, d, kref[d])).collect();
+        let mut fitted: Vec<Fitted> = released.iter().map(|&d| spring(ctx, &name, d, kref[d])).collect();
         fitted.extend(ctx.group_damping(&name, non_viscous));
         let edit = Edit::Support {
             node,
             fixed: fixed.clone(),
-            released: fixed.clone(),
+            released: released.clone(),
             name: name.clone(),
             group: ctx.damping_group(&name, non_viscous),
             k,
@@ -58,13 +64,72 @@ pub(super) fn supports(ctx: &Ctx<'_>, node: u32) -> Vec<Spec> {
             description: edit.describe(EffectKind::FlexibleSupport),
             nodes: vec![node],
             elements: Vec::new(),
-            dofs: fixed.clone(),
+            dofs: released.clone(),
             // the released DOFs enter every element at the node
             part_nodes: ctx.ring(node),
         };
         out.push((head, edit, fitted));
     }
     out
+}
+
+/// A spring to ground at a node of an imported model that nothing holds in
+/// some translation (an unmodelled support, mount or contact), in the
+/// translations the matrices give stiffness, viscous: one of the effects
+/// rfm can propose without element geometry. It starts soft (a hundredth
+/// of the stiffness there), as the nominal model has none.
+pub(super) fn ground_spring(ctx: &Ctx<'_>, node: u32) -> Option<Spec> {
+    let model = ctx.model;
+    let held: Vec<Dof> =
+        model.supports().iter().filter(|s| s.node.0 == node).flat_map(|s| s.dofs.iter().copied()).collect();
+    let kref = ctx.local_stiffness(node);
+    let sprung: Vec<Dof> =
+        ctx.dim.translations().iter().copied().filter(|d| !held.contains(d) && kref[*d] > 0.0).collect();
+    if sprung.is_empty() {
+        return None;
+    }
+    let name = unique_name(model, &format!("ground_{node}"));
+    let mut k = PerDof::default();
+    for &d in &sprung {
+        k[d] = 1e-2 * kref[d];
+    }
+    let mut fitted: Vec<Fitted> = sprung.iter().map(|&d| spring(ctx, &name, d, kref[d])).collect();
+    fitted.extend(ctx.group_damping(&name, false));
+    // a support with nothing fixed before: the springs are all it adds
+    let edit = Edit::Support {
+        node,
+        fixed: Vec::new(),
+        released: sprung.clone(),
+        name: name.clone(),
+        group: ctx.damping_group(&name, false),
+        k,
+        dim: ctx.dim,
+        per_direction: false,
+    };
+    let head = Head {
+        kind: EffectKind::FlexibleSupport,
+        description: edit.describe(EffectKind::FlexibleSupport),
+        nodes: vec![node],
+        elements: Vec::new(),
+        dofs: sprung,
+        part_nodes: ctx.ring(node),
+    };
+    Some((head, edit, fitted))
+}
+
+/// The nodes of an imported model's stiffness matrices (where a spring to
+/// ground is a candidate), in id order.
+pub(super) fn imported_stiffness_nodes(ctx: &Ctx<'_>) -> Vec<u32> {
+    let mut nodes: Vec<u32> = ctx
+        .model
+        .imported()
+        .iter()
+        .filter(|b| b.kind == fe_model::imported::ImportedKind::Stiffness)
+        .flat_map(|b| b.dofs.iter().map(|r| r.node.0))
+        .collect();
+    nodes.sort_unstable();
+    nodes.dedup();
+    nodes
 }
 
 /// A flexible, lossy joint detaching `beams` from `node`: rotational
