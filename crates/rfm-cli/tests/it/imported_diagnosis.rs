@@ -222,7 +222,9 @@ fn diagnose_names_a_hidden_support_spring_or_mass_of_an_imported_model_first() {
     // a 0.4 kg box on rail 7-8 (node 21)
     let box_ =
         |c: &str| c.to_string() + "[groups.box]\n[[masses]]\nname = \"box\"\nnode = 21\nm = 0.4\ngroup = \"box\"\n";
-    let trials: [(&str, &dyn Fn(&str) -> String, &str); 3] = [
+    // each trial: its name, the truth written into the case, the leader wanted
+    type Trial<'a> = (&'a str, &'a dyn Fn(&str) -> String, &'a str);
+    let trials: [Trial<'_>; 3] = [
         ("pad", &pad, "flexible, lossy support at node 2 ("),
         ("stop", &stop, "spring to ground at node 20 ("),
         ("box", &box_, "lumped mass at node 21"),
