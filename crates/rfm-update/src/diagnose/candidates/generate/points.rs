@@ -47,30 +47,44 @@ pub(super) fn supports(ctx: &Ctx<'_>, node: u32) -> Vec<Spec> {
         for &d in &released {
             k[d] = 100.0 * kref[d];
         }
-        let mut fitted: Vec<Fitted> = released.iter().map(|&d| spring(ctx, &name, d, kref[d])).collect();
-        fitted.extend(ctx.group_damping(&name, non_viscous));
-        let edit = Edit::Support {
-            node,
-            fixed: fixed.clone(),
-            released: released.clone(),
-            name: name.clone(),
-            group: ctx.damping_group(&name, non_viscous),
-            k,
-            dim: ctx.dim,
-            per_direction: false,
-        };
-        let head = Head {
-            kind: EffectKind::FlexibleSupport,
-            description: edit.describe(EffectKind::FlexibleSupport),
-            nodes: vec![node],
-            elements: Vec::new(),
-            dofs: released.clone(),
-            // the released DOFs enter every element at the node
-            part_nodes: ctx.ring(node),
-        };
-        out.push((head, edit, fitted));
+        out.push(support_spec(ctx, node, name, (fixed.clone(), released.clone()), (k, &kref), non_viscous));
     }
     out
+}
+
+/// The candidate of ground springs `k` at `node` in the DOFs `released` of
+/// those `fixed` (none: springs where nothing held it), each fitted from its
+/// reference stiffness in `kref`, in a damping group of their own.
+fn support_spec(
+    ctx: &Ctx<'_>,
+    node: u32,
+    name: String,
+    (fixed, released): (Vec<Dof>, Vec<Dof>),
+    (k, kref): (PerDof, &PerDof),
+    non_viscous: bool,
+) -> Spec {
+    let mut fitted: Vec<Fitted> = released.iter().map(|&d| spring(ctx, &name, d, kref[d])).collect();
+    fitted.extend(ctx.group_damping(&name, non_viscous));
+    let edit = Edit::Support {
+        node,
+        fixed,
+        released: released.clone(),
+        group: ctx.damping_group(&name, non_viscous),
+        name,
+        k,
+        dim: ctx.dim,
+        per_direction: false,
+    };
+    let head = Head {
+        kind: EffectKind::FlexibleSupport,
+        description: edit.describe(EffectKind::FlexibleSupport),
+        nodes: vec![node],
+        elements: Vec::new(),
+        dofs: released,
+        // the released DOFs enter every element at the node
+        part_nodes: ctx.ring(node),
+    };
+    (head, edit, fitted)
 }
 
 /// A spring to ground at a node of an imported model that nothing holds in
@@ -93,28 +107,8 @@ pub(super) fn ground_spring(ctx: &Ctx<'_>, node: u32) -> Option<Spec> {
     for &d in &sprung {
         k[d] = 1e-2 * kref[d];
     }
-    let mut fitted: Vec<Fitted> = sprung.iter().map(|&d| spring(ctx, &name, d, kref[d])).collect();
-    fitted.extend(ctx.group_damping(&name, false));
     // a support with nothing fixed before: the springs are all it adds
-    let edit = Edit::Support {
-        node,
-        fixed: Vec::new(),
-        released: sprung.clone(),
-        name: name.clone(),
-        group: ctx.damping_group(&name, false),
-        k,
-        dim: ctx.dim,
-        per_direction: false,
-    };
-    let head = Head {
-        kind: EffectKind::FlexibleSupport,
-        description: edit.describe(EffectKind::FlexibleSupport),
-        nodes: vec![node],
-        elements: Vec::new(),
-        dofs: sprung,
-        part_nodes: ctx.ring(node),
-    };
-    Some((head, edit, fitted))
+    Some(support_spec(ctx, node, name, (Vec::new(), sprung), (k, &kref), false))
 }
 
 /// The nodes of an imported model's stiffness matrices (where a spring to
