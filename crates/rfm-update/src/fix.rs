@@ -439,8 +439,12 @@ pub fn fix(
                 progress(FixProgress::LookedAhead { step: steps.len(), ahead: alternatives.last().expect("pushed") });
             }
             let mut best: Option<(f64, Added, Diagnosis)> = None;
-            let look = pair.as_ref().is_none_or(|p| p.misfit > swap::SWAP_ABOVE * noise);
-            for r in distinct_leaders(&d, &current.model, LOOK_AHEAD_WIDTH).into_iter().filter(|_| look) {
+            let singles = if pair.as_ref().is_none_or(|p| p.misfit > swap::SWAP_ABOVE * noise) {
+                distinct_leaders(&d, &current.model, LOOK_AHEAD_WIDTH)
+            } else {
+                Vec::new()
+            };
+            for r in singles {
                 // one alternative that cannot be added (its update left a
                 // mechanism, say) must not end the loop: the others can
                 let tried =

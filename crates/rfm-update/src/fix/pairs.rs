@@ -36,7 +36,7 @@ pub(super) struct Pair {
 /// their diagnosed values (each written as the diagnosis would write it
 /// alone; the two must not touch the same nodes or elements, or the second
 /// edit fails and the pair is skipped).
-pub(super) fn with_both(
+fn with_both(
     current: &CaseFile,
     d: &Diagnosis,
     ranks: (usize, usize),
