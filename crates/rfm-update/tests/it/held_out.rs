@@ -197,21 +197,34 @@ fn draws(singles: usize, pairs: usize) -> Vec<Truth> {
     draws
 }
 
-/// Trial 25 of the reduced set: a mass with rotary inertia and a lossy
-/// corner joint. The first diagnosis, misled by both at once, adds a
-/// stiffness change beside the joint, and the effects added after it make
-/// up for it: the loop ends 2.7 times the noise. Leaving that stiffness
-/// change out together with the effect that compensated it, and diagnosing
-/// again, brings it to 1.6 times.
+/// Trial 28 of the reduced set: a non-viscous damping patch on elements
+/// 17..20 of a cantilever and a splice at node 2. The loop adds the splice
+/// as an in-line joint, a stiffness change of element 18 for the patch,
+/// and a rotary inertia at node 2 (3.6 times the noise). Leaving out the
+/// joint and the stiffness change together, the inertia kept, and
+/// diagnosing again adds the joint back and damping in element 18 instead:
+/// both effects are found, and the misfit falls to 2.8 times the noise,
+/// more than the 10 % a replacement must bring.
+///
+/// (Trial 25, which this test ran before the screen tried stiffness and
+/// mass changes from spread starts, now finds its corner joint first and
+/// adds no early stiffness change to undo.)
 #[test]
 fn the_swap_undoes_an_early_effect_and_what_made_up_for_it() {
-    let truth = &draws(4, 6)[25];
+    let truth = &draws(4, 6)[28];
     let opts = FixOptions { max_steps: 3, ..FixOptions::default() };
-    let trial = run(truth, 7025, &opts);
+    let trial = run(truth, 7028, &opts);
     let o = &trial.outcome;
-    let swapped = o.steps.iter().find(|s| s.replaced.is_some()).expect("a step that replaced earlier ones");
-    println!("{}: {} instead of {:?}", trial.label, swapped.effect.description, swapped.replaced);
-    assert!(o.final_misfit() < 2.0 * NOISE, "the loop ends {:.2} times the noise", o.final_misfit() / NOISE);
+    let at = o.steps.iter().position(|s| s.replaced.is_some()).expect("a step that replaced earlier ones");
+    let swapped = &o.steps[at];
+    let replaced = swapped.replaced.as_deref().unwrap_or_default();
+    println!("{}: {} instead of {replaced}", trial.label, swapped.effect.description);
+    for s in &o.steps {
+        println!("  {} -> {:.2} x noise", s.effect.description, s.misfit_updated / NOISE);
+    }
+    assert!(replaced.contains("stiffness change of element 18"), "the early stiffness change is undone: {replaced}");
+    let before = o.steps[at - 1].misfit_updated;
+    assert!(o.final_misfit() < 0.9 * before, "the swap lowers the misfit from {before:.4} to {:.4}", o.final_misfit());
     assert!(trial.found.iter().all(|&f| f), "both effects found: {:?}", trial.found);
 }
 
@@ -235,7 +248,7 @@ fn the_loop_keeps_its_steps_when_the_last_diagnosis_fails() {
 }
 
 #[test]
-#[ignore = "misses one of its criteria on the reduced set (27/30 first, 26/30 fixed, values 20/23, pairs 4/6 < 80 %); run by cargo xtask heldout"]
+#[ignore = "misses one of its criteria on the reduced set (28/30 first, 26/30 fixed, values 20/23, pairs 4/6 < 80 %); run by cargo xtask heldout"]
 fn the_loop_finds_and_fixes_held_out_effects() {
     let singles = count("HELD_OUT_SINGLE", 4);
     let pairs = count("HELD_OUT_PAIRS", 6);
