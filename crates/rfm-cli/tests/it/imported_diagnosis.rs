@@ -128,6 +128,9 @@ references = ["7:ux", "5:uz"]
 responses = ["5..8:ux", "5..8:uy", "5..8:uz", "18:uz", "20:uz", "22:uz", "24:uz", "10:ux", "14:uy"]
 "#;
 
+/// The nominal case's text turned into a truth's.
+type TruthEdit = fn(&str) -> String;
+
 fn rfm(args: &[&str]) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_rfm")).args(args).output().expect("rfm runs")
 }
@@ -222,12 +225,10 @@ fn diagnose_names_a_hidden_support_spring_or_mass_of_an_imported_model_first() {
     // a 0.4 kg box on rail 7-8 (node 21)
     let box_ =
         |c: &str| c.to_string() + "[groups.box]\n[[masses]]\nname = \"box\"\nnode = 21\nm = 0.4\ngroup = \"box\"\n";
-    // each trial: its name, the truth written into the case, the leader wanted
-    type Trial<'a> = (&'a str, &'a dyn Fn(&str) -> String, &'a str);
-    let trials: [Trial<'_>; 3] = [
-        ("pad", &pad, "flexible, lossy support at node 2 ("),
-        ("stop", &stop, "spring to ground at node 20 ("),
-        ("box", &box_, "lumped mass at node 21"),
+    let trials: [(&str, TruthEdit, &str); 3] = [
+        ("pad", pad, "flexible, lossy support at node 2 ("),
+        ("stop", stop, "spring to ground at node 20 ("),
+        ("box", box_, "lumped mass at node 21"),
     ];
     for (k, (name, truth, want)) in trials.into_iter().enumerate() {
         let (ranked, first) = trial(dir.path(), name, truth, 11 + k as u64);

@@ -251,10 +251,23 @@ impl<'a> Pool<'a> {
             .collect())
     }
 
-    /// Screens `which`: a short fit on `lines` from the starting values.
-    pub(crate) fn screen(&mut self, lines: &LineSet, iterations: usize, which: &[usize]) -> Result<(), UpdateError> {
-        let starts = vec![None; which.len()];
-        for (&i, f) in which.iter().zip(self.fit_all(lines, iterations, which, &starts)?) {
+    /// Screens `which`: a short fit on `lines` from the starting values, and
+    /// with `factor_starts` from [`factor_starts`] too, keeping the best.
+    pub(crate) fn screen(
+        &mut self,
+        lines: &LineSet,
+        iterations: usize,
+        which: &[usize],
+        factor_starts: bool,
+    ) -> Result<(), UpdateError> {
+        // the best fit from the alternative starts and the candidate's own,
+        // where it has alternatives; the others fitted from their own
+        let best = if factor_starts { self.try_factor_starts(lines, iterations, which)? } else { Vec::new() };
+        let rest: Vec<usize> = (0..which.len()).filter(|&k| best.get(k).is_none_or(Option::is_none)).collect();
+        let subset: Vec<usize> = rest.iter().map(|&k| which[k]).collect();
+        let fits = self.fit_all(lines, iterations, &subset, &vec![None; subset.len()])?;
+        let from_best = best.into_iter().enumerate().filter_map(|(k, f)| f.map(|f| (which[k], Ok(f))));
+        for (i, f) in subset.into_iter().zip(fits).chain(from_best) {
             match f {
                 Ok(f) => {
                     self.screened[i] = Some(f);
@@ -330,6 +343,42 @@ impl<'a> Pool<'a> {
             }
         }
         Ok(())
+    }
+
+    /// The screening fits of the candidates of `which` that have
+    /// [`factor_starts`] (one stiffness factor, mass factor or lumped
+    /// mass): from their own start and from each of those, the best kept
+    /// (`None` for the other candidates). A change large enough to move
+    /// modes across several others (a 40 % stiffness loss, a mass of a few
+    /// percent in a frame in space with clustered modes) leaves a fit
+    /// started from the nominal model in a local minimum next to its start.
+    fn try_factor_starts(
+        &self,
+        lines: &LineSet,
+        iterations: usize,
+        which: &[usize],
+    ) -> Result<Vec<Option<Fit>>, UpdateError> {
+        let others: Vec<Vec<Vec<f64>>> = which.iter().map(|&i| factor_starts(&self.candidates[i])).collect();
+        let with: Vec<usize> = (0..which.len()).filter(|&k| !others[k].is_empty()).collect();
+        let mut best: Vec<Option<Fit>> = vec![None; which.len()];
+        if with.is_empty() {
+            return Ok(best);
+        }
+        let rounds = others.iter().map(Vec::len).max().unwrap_or(0);
+        // round 0 from each candidate's own start, then its alternatives
+        for r in 0..=rounds {
+            let ks: Vec<usize> = with.iter().copied().filter(|&k| r <= others[k].len()).collect();
+            let subset: Vec<usize> = ks.iter().map(|&k| which[k]).collect();
+            let tries: Vec<Option<Vec<f64>>> = ks.iter().map(|&k| (r > 0).then(|| others[k][r - 1].clone())).collect();
+            for (&k, f) in ks.iter().zip(self.fit_all(lines, iterations, &subset, &tries)?) {
+                if let Ok(f) = f
+                    && best[k].as_ref().is_none_or(|b| f.cost < b.cost)
+                {
+                    best[k] = Some(f);
+                }
+            }
+        }
+        Ok(best)
     }
 
     /// `which` ordered by their screening: fits on more residuals first
@@ -497,7 +546,7 @@ pub(crate) fn search(
     let all = pool.add(candidates::generate(pool.model, copts));
     let to_screen = if all.len() > opts.prescreen_above {
         let pre = LineSet::new(pool.nominal, measured, opts.prescreen_lines, opts.gains)?;
-        pool.screen(&pre, opts.prescreen_iterations, &all)?;
+        pool.screen(&pre, opts.prescreen_iterations, &all, false)?;
         trace(&format!("pre-screened {} candidates on {} lines", all.len(), pre.data.n_freq()));
         let mut best = pool.by_screening(&all);
         best.truncate(opts.prescreen_keep);
@@ -505,7 +554,10 @@ pub(crate) fn search(
     } else {
         all.clone()
     };
-    pool.screen(&coarse, opts.screen_iterations, &to_screen)?;
+    // the alternative starts of stiffness and mass changes where there are
+    // few candidates (a large model's screen keeps its time)
+    let factor_starts = all.len() <= opts.prescreen_above;
+    pool.screen(&coarse, opts.screen_iterations, &to_screen, factor_starts)?;
     trace(&format!("screened {} candidates on {} lines", to_screen.len(), coarse.data.n_freq()));
     let order = pool.by_screening(&all);
     let keep = pool.leaders(&order, opts.keep);
@@ -515,7 +567,7 @@ pub(crate) fn search(
     // around the leaders: fuller variants, and on large models finer windows
     let refined = pool.refine(copts, REFINED_LEADERS);
     if !refined.is_empty() {
-        pool.screen(&coarse, opts.screen_iterations, &refined)?;
+        pool.screen(&coarse, opts.screen_iterations, &refined, factor_starts)?;
         let best: Vec<usize> = pool.by_screening(&refined).into_iter().take(REFINED_FITS).collect();
         pool.full_fit(full, &coarse, (opts.iterations, opts.screen_iterations), &best, None)?;
         trace(&format!("refined around the leaders: {} candidates, {} fitted", refined.len(), best.len()));
@@ -539,6 +591,24 @@ pub(crate) fn search(
     pool.hold_undetermined(full, &coarse, (opts.iterations, opts.screen_iterations))?;
     trace("held what the data do not determine");
     Ok(())
+}
+
+/// Other starting values of a candidate of one stiffness factor (a loss of
+/// 10 % to 70 % of the nominal stiffness), mass factor (1.5 and 2 times
+/// the nominal mass) or lumped mass, with its rotary inertia or without
+/// (0.3 % to 10 % of the structure's mass, beside its own 0.1 %), spread
+/// over the plausible range so that one of them starts in the basin of the
+/// truth; none for other candidates.
+fn factor_starts(c: &Candidate) -> Vec<Vec<f64>> {
+    let start = c.start_values();
+    let scales: &[f64] = match c.roles.as_slice() {
+        [Role::StiffnessFactor] => &[0.3, 0.45, 0.6, 0.75, 0.9],
+        [Role::MassFactor] => &[1.5, 2.0],
+        // a mass with its rotary inertia: both scaled together
+        [Role::Mass] | [Role::Mass, Role::Inertia] => &[3.0, 10.0, 30.0, 100.0],
+        _ => &[],
+    };
+    scales.iter().map(|f| start.iter().map(|v| v * f).collect()).collect()
 }
 
 /// Twins of candidates added by [`Pool::twins`].

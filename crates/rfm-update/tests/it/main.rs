@@ -6,6 +6,7 @@ mod calibration;
 mod fast_vs_naive;
 mod held_out;
 mod hidden_effects;
+mod hidden_effects_3d;
 mod numerics;
 mod output_error;
 mod paper_cases;
