@@ -19,17 +19,21 @@
 //!   Woodbury update, the accelerance conversion, the covariance scale. It
 //!   takes minutes.
 //!
-//! Both skip one test, the hidden-effect study of rfm-update: it takes a
-//! minute or more per run, and the low-rank update it exercises is checked
-//! directly against whole candidate models by
+//! Both skip the studies of rfm-update's diagnosis ([`SLOW_TESTS`]: the
+//! hidden-effect studies in the plane and in space, the held-out loop):
+//! each takes a minute or more per run, and the low-rank update they
+//! exercise is checked directly against whole candidate models by
 //! `diagnose::local::tests::low_rank_updates_equal_the_candidate_models`
-//! (for cargo-mutants the skip is in `.cargo/mutants.toml`).
+//! (for cargo-mutants the skips are in `.cargo/mutants.toml`; a test here
+//! keeps the two lists, and that file's paths, true).
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
-/// The test that `--classic` leaves out (see the module docs).
-const SLOW_TEST: &str = "hidden_effects::diagnosis_names_hidden_effects_and_updating_recovers_them";
+/// The tests both runs leave out (see the module docs), as libtest's
+/// `--skip` filters.
+const SLOW_TESTS: [&str; 3] =
+    ["hidden_effects::diagnosis_names_hidden_effects_and_updating_recovers_them", "hidden_effects_3d::", "held_out::"];
 
 /// A bug planted by hand: `from` becomes `to` everywhere in `file`.
 struct Bug {
@@ -194,7 +198,8 @@ fn run_tests(copy: &Path, target: &PathBuf, package: &str) -> Result<(bool, Vec<
     let mut test = crate::cargo();
     base(&mut test);
     let out = test
-        .args(["--", "--skip", SLOW_TEST])
+        .arg("--")
+        .args(SLOW_TESTS.iter().flat_map(|t| ["--skip", t]))
         .stderr(Stdio::null())
         .output()
         .map_err(|e| format!("cannot run cargo: {e}"))?;
@@ -220,5 +225,25 @@ mod tests {
             assert_ne!(plant(&text, bug).unwrap(), text);
         }
         assert!(plant("nothing here", &CLASSIC[0]).unwrap_err().contains("no longer in the file"));
+    }
+
+    /// `.cargo/mutants.toml` names files that exist (a module moved into a
+    /// folder would otherwise drop out of the run without a word) and skips
+    /// the same tests as `--classic`.
+    #[test]
+    fn the_mutants_config_names_existing_files_and_the_same_skips() {
+        let text = std::fs::read_to_string(crate::root().join(".cargo/mutants.toml")).unwrap();
+        let quoted = |l: &str| l.trim().strip_prefix('"').and_then(|r| r.split('"').next()).map(str::to_string);
+        let files: Vec<String> = text.lines().filter_map(quoted).filter(|q| q.starts_with("crates/")).collect();
+        assert!(files.len() >= 10, "{files:?}");
+        for f in &files {
+            assert!(crate::root().join(f).is_file(), ".cargo/mutants.toml examines {f}, which does not exist");
+        }
+        let skips: Vec<String> = text
+            .lines()
+            .filter_map(|l| l.trim().strip_prefix("\"--skip\", "))
+            .filter_map(|r| r.strip_prefix('"')?.split('"').next().map(str::to_string))
+            .collect();
+        assert_eq!(skips, SLOW_TESTS.map(str::to_string));
     }
 }

@@ -293,6 +293,9 @@ pub(crate) fn relative_path(path: &Path, base: &Path) -> PathBuf {
 /// An absolute path without `.` or `..`, through symbolic links where the
 /// path (or its nearest existing ancestor) exists.
 fn resolved(path: &Path) -> PathBuf {
+    // the folder of a bare file name (`out.toml`) is the empty path, which
+    // `absolute` refuses: it is the current folder
+    let path = if path.as_os_str().is_empty() { Path::new(".") } else { path };
     let abs = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
     let mut clean = PathBuf::new();
     for c in abs.components() {
@@ -474,5 +477,15 @@ data = \"data/measured.csv\"   # from the lab
         assert_eq!(relative_path(Path::new("/a/b/c.csv"), Path::new("/a/b")), PathBuf::from("c.csv"));
         assert_eq!(relative_path(Path::new("/a/b/c.csv"), Path::new("/a/d/e")), PathBuf::from("../../b/c.csv"));
         assert_eq!(relative_path(Path::new("/a/./b/../b/c.csv"), Path::new("/a")), PathBuf::from("b/c.csv"));
+    }
+
+    /// `--out lap-with-joint.toml`: the new case's folder is the empty
+    /// path, the current folder, and its data path stays relative.
+    #[test]
+    fn the_folder_of_a_bare_file_name_is_the_current_one() {
+        let here = std::env::current_dir().expect("current folder");
+        let data = here.join("data").join("measured.uff");
+        let target = Path::new("out.toml");
+        assert_eq!(relative_path(&data, target.parent().expect("a parent")), PathBuf::from("data/measured.uff"));
     }
 }
