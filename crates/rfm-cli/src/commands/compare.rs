@@ -211,11 +211,12 @@ pub(crate) fn compare(
         measured_data(case, &system, measured_files)?;
     print_notes(&notes, json)?;
     print_masked(&masked, json)?;
-    let mut frfs = synthesize(&system, measured.channels(), measured.frequencies_hz())?;
-    // the gains that bring the model closest to the data (closed form), in the data's kind
+    // the model's FRFs in the data's kind: what the tables, the gains and the overlays compare
+    let mut frfs = synthesize(&system, measured.channels(), measured.frequencies_hz())?.converted(measured.kind());
+    // the gains that bring the model closest to the data (closed form),
     // weighted as the fits weight them: by the measured coherence when the data carry it
     let weights = rfm_update::study::line_weights_for(&case, &measured)?;
-    let fitted = gain::fit_gains(&frfs.converted(measured.kind()), &measured, weights.as_deref(), gains.0)?;
+    let fitted = gain::fit_gains(&frfs, &measured, weights.as_deref(), gains.0)?;
     fitted.apply(&mut frfs);
     let coherent = (0..measured.channels().len()).any(|c| measured.coherence(c).is_some());
     let mut notes = notes;

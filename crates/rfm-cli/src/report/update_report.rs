@@ -27,14 +27,18 @@ pub(crate) fn write(
     case_path: &Path,
     opts: &ReportOptions,
 ) -> Result<PathBuf> {
-    let measured = study.measured();
+    // the data as they were measured (accelerance per volt, say), which the
+    // model's FRFs are converted to: what the overlays show
+    let as_read = study.measured_as_read();
+    let measured = &as_read;
     let channels = measured.channels();
     let freqs = measured.frequencies_hz();
     // a model singular at a line (an RFM run that wandered off, an undamped
     // model on a resonance) is shown everywhere else, and the report says where
     let mut singular = Vec::new();
-    let mut model = |label: &str, colour, sys: &damping::DampedSystem, gains: &[Gain]| -> Result<ModelFrfs> {
-        let (mut frfs, lines) = synthesize_regular(sys, channels, freqs)?;
+    let mut model = |label: &str, colour, sys: &damping::DampedSystem, gains: Option<&[Gain]>| -> Result<ModelFrfs> {
+        let (frfs, lines) = synthesize_regular(sys, channels, freqs)?;
+        let mut frfs = frfs.converted(measured.kind());
         if !lines.is_empty() {
             singular.push(format!(
                 "The {label}'s dynamic stiffness is singular to working precision at {} Hz: its FRFs there are left \
@@ -42,14 +46,25 @@ pub(crate) fn write(
                 lines.iter().map(|&f| super::short(f)).collect::<Vec<_>>().join(", ")
             ));
         }
-        Gain::apply_all(gains, &mut frfs);
+        match gains {
+            Some(gains) => Gain::apply_all(gains, &mut frfs),
+            // the initial model with the gains that fit it best, when the
+            // study fits gains: without them it would sit the data's
+            // unknown level (tens of dB on data per volt) off the curves
+            None if !outcome.gains.is_empty() => study.fit_gains(&frfs, measured)?.apply(&mut frfs),
+            None => {}
+        }
         let correlation = correlate(measured, &frfs, &BandSpec::Auto)?;
         Ok(ModelFrfs { label: label.into(), colour, frfs, correlation })
     };
-    let updated_label = if outcome.gains.is_empty() { "updated model" } else { "updated model (with fitted gains)" };
+    let (initial_label, updated_label) = if outcome.gains.is_empty() {
+        ("initial model", "updated model")
+    } else {
+        ("initial model (with the gains that fit it)", "updated model (with fitted gains)")
+    };
     let models = [
-        model("initial model", plot::INITIAL, study.system(), &[])?,
-        model(updated_label, plot::UPDATED, &outcome.system, &outcome.gains)?,
+        model(initial_label, plot::INITIAL, study.system(), None)?,
+        model(updated_label, plot::UPDATED, &outcome.system, Some(&outcome.gains))?,
     ];
     let (all_lines_db, stride) = rfm_update::history::rms_db_per_iteration(study, outcome, measured);
     let mut which_lines = if stride == 1 {
@@ -182,7 +197,7 @@ fn status_text(s: &Status) -> String {
 
 fn summary(study: &Study, outcome: &UpdateOutcome, models: &[ModelFrfs; 2]) -> Section {
     let (a, b) = (&models[0].correlation, &models[1].correlation);
-    let measured = study.measured();
+    let measured = &study.measured_as_read();
     let f = measured.frequencies_hz();
     let source = match (&study.case().measurement.as_ref().and_then(|m| m.data.clone()), &study.case().truth) {
         (Some(path), _) => format!("measured file {}", path.display()),
