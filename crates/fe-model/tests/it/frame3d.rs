@@ -358,8 +358,10 @@ fn a_3d_model_refuses_what_only_a_planar_one_has_and_the_reverse() {
     planar.add_node(1, 0.0, 0.0).unwrap();
     assert!(planar.add_node_at(2, [0.0, 0.0, 0.1]).unwrap_err().to_string().contains("dimension = 3"));
     assert!(planar.add_support(1, &[Dof::Uz]).unwrap_err().to_string().contains("`uz` is not a DOF of a planar model"));
-    assert!(planar.add_spring("s", 1, None, [0.0, 0.0, 1.0, 0.0, 0.0, 0.0], g).is_err());
-    assert!(planar.add_mass("m", 1, 1.0, [1.0, 0.0, 0.0], g).is_err());
+    let e = planar.add_spring("s", 1, None, [0.0, 0.0, 1.0, 0.0, 0.0, 0.0], g).unwrap_err().to_string();
+    assert!(e.contains("`uz` is not a DOF of a planar model"), "{e}");
+    let e = planar.add_mass("m", 1, 1.0, [1.0, 0.0, 0.0], g).unwrap_err().to_string();
+    assert!(e.contains("rotary inertia about x or y"), "{e}");
     let mut spatial = Model::with_dimension("s", Dimension::Spatial);
     let steel = spatial.add_material("steel", 2e11, 7800.0).unwrap();
     assert!(spatial.add_section(Section::planar("p", 1e-4, 1e-8)).unwrap_err().to_string().contains("Iy"));

@@ -81,7 +81,7 @@ pub(crate) fn fix(args: &FixArgs<'_>) -> Result<Exit> {
                 ),
             },
             FixProgress::Updated { step, effect, misfit, status } => {
-                format!("step {}: added {effect} and updated ({status:?}); misfit {misfit:.4e}", step + 1)
+                format!("step {}: added {effect} and updated ({}); misfit {misfit:.4e}", step + 1, status.name())
             }
         };
         // an error here would be the same as at the next print, which reports it
@@ -142,7 +142,14 @@ fn print_outcome(o: &FixOutcome) -> Result<()> {
         );
     }
     if let Some(s) = o.steps.last() {
-        outln!("\nparameters after the last update (relative standard deviation from the noise):");
+        // the standard deviation shown is the one that includes model error
+        // (the residual beyond the noise), which equals the noise's alone when
+        // the fit reaches the noise
+        let inflated = s.uncertainty.as_ref().is_some_and(|u| u.inflation > 1.0);
+        outln!(
+            "\nparameters after the last update (relative standard deviation{}):",
+            if inflated { ", widened for the misfit beyond the noise" } else { " from the noise" }
+        );
         let mut t = Table::new(&["parameter", "value", "+-1 sd"]);
         for (i, p) in s.parameters.iter().enumerate() {
             let sd = s

@@ -430,9 +430,13 @@ mod tests {
         let (k, s, v) = label_units("in/s/lbf").unwrap();
         assert_eq!((k, v), (FrfKind::Mobility, false));
         assert!((s - 0.0254 / LBF).abs() < 1e-15);
-        for bad in ["m/s^2", "N/m", "V/N", "furlong/N", "m/s^3/N"] {
-            assert!(label_units(bad).is_err(), "{bad}");
+        // labels that parse but are no FRF, and labels that do not parse
+        for bad in ["m/s^2", "N/m", "V/N", "m/s^3/N"] {
+            let e = label_units(bad).unwrap_err();
+            assert!(e.contains(&format!("`{bad}` are not the units of an FRF")), "{e}");
         }
+        let e = label_units("furlong/N").unwrap_err();
+        assert!(e.contains("`furlong/N` is not a units label rfm can read"), "{e}");
     }
 
     fn dims(s: &str) -> Option<(i32, i32, i32, f64)> {
