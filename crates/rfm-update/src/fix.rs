@@ -29,7 +29,6 @@
 
 use fe_model::{CaseEditor, CaseFile, HistoryEntry};
 use frf::FrfSet;
-use serde::Serialize;
 
 use crate::diagnose::{self, DiagnoseOptions, Diagnosis, Ranked};
 use crate::error::UpdateError;
@@ -62,7 +61,8 @@ impl Default for FixOptions {
 }
 
 /// One step of the loop: the effect added and the update after it.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct FixStep {
     /// The effect added, as the diagnosis ranked it.
     pub effect: Ranked,
@@ -87,7 +87,7 @@ pub struct FixStep {
     /// when it did: their descriptions joined by " and ".
     pub replaced: Option<String>,
     /// The case after this step (write it with [`CaseEditor::text_at`]).
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     pub case: CaseEditor,
 }
 
@@ -108,7 +108,8 @@ impl FixStep {
 }
 
 /// A first effect tried by looking one step ahead.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct LookAhead {
     /// The effect.
     pub effect: String,
@@ -125,8 +126,9 @@ pub struct LookAhead {
 }
 
 /// Why the loop stopped.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum FixStop {
     /// No candidate explains the remaining misfit beyond the noise.
     NothingSignificant,
@@ -164,7 +166,8 @@ impl FixStop {
 }
 
 /// The outcome of the loop.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct FixOutcome {
     /// The data's estimated relative noise (RMS per value).
     pub noise: f64,

@@ -29,7 +29,6 @@ use fe_model::DofRef;
 use fe_model::case::{FittedGain, GainKey, Gains, MeasurementSpec, UpdateSpec};
 use frf::{Channel, FrfSet};
 use num_complex::Complex64 as C64;
-use serde::Serialize;
 
 use crate::error::UpdateError;
 
@@ -102,7 +101,8 @@ pub struct FittedGains {
 }
 
 /// A fitted gain for reports and `results.json`.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct GainReport {
     /// `1:uy` or `H(31:uy,1:uy)`.
     pub key: String,

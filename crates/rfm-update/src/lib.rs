@@ -109,6 +109,7 @@ pub mod verdict;
 pub use error::UpdateError;
 
 /// Serialises a value through its `Display` form (DOF names such as `31:uy`).
+#[cfg(feature = "serde")]
 pub(crate) fn serialize_display<T: std::fmt::Display, S: serde::Serializer>(v: &T, s: S) -> Result<S::Ok, S::Error> {
     s.collect_str(v)
 }

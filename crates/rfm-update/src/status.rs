@@ -4,10 +4,9 @@
 //! ([`crate::output_error`]) both speak these words, and the study
 //! ([`crate::verdict`]) turns a solver's stop into the status outputs print.
 
-use serde::Serialize;
-
 /// One iteration's record.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct IterationRecord {
     /// 0 for the initial model.
     pub iteration: usize,
@@ -36,8 +35,9 @@ pub struct IterationRecord {
 /// tell a global minimum from a local one. So `converged` in a result means
 /// that the residual is consistent with the noise, never only that the
 /// iteration stopped.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum Status {
     /// The iteration reached a stationary point and the residual is within
     /// [`crate::verdict::NOISE_FACTOR`] times the noise (or the noise is not

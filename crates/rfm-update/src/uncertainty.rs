@@ -43,14 +43,14 @@
 //! resolve.
 
 use fe_model::Quantity;
-use serde::Serialize;
 
 use crate::lstsq;
 use crate::output_error::OeResult;
 use crate::params::ParameterSet;
 
 /// Uncertainty of one parameter.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct ParameterUncertainty {
     /// Name.
     pub name: String,
@@ -77,7 +77,8 @@ pub struct ParameterUncertainty {
 }
 
 /// Uncertainty of a whole fit.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct UncertaintyReport {
     /// Per parameter.
     pub parameters: Vec<ParameterUncertainty>,

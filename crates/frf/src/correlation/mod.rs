@@ -68,6 +68,15 @@
 //!
 //! The measures of one value or one FRF are in [`measure`], the bands in
 //! [`band`]; this file holds the result types and [`correlate`].
+//!
+//! # JSON
+//!
+//! With the `serde` feature, [`Correlation`] and its parts implement
+//! `Serialize` (`json.rs`): the kind, the number of lines and their range,
+//! the totals, every channel and band with its label, and the worst five
+//! channels and three bands by name; not the per-line errors. A number
+//! that is not finite (a measure over no lines) is written by `serde_json`
+//! as `null`.
 
 use num_complex::Complex64 as C64;
 
@@ -75,6 +84,8 @@ use crate::error::{FrfError, MismatchError};
 use crate::set::{Channel, FrfKind, FrfSet};
 
 mod band;
+#[cfg(feature = "serde")]
+mod json;
 mod measure;
 
 pub use band::{Band, BandSpec, bands, resonances};
@@ -124,6 +135,7 @@ pub struct BandCorrelation {
 
 /// Error measures at one line over all channels (for error-versus-frequency plots).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct LineError {
     /// Frequency (Hz).
     pub frequency_hz: f64,
@@ -137,6 +149,7 @@ pub struct LineError {
 
 /// Error measures over all channels and lines.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Totals {
     /// RMS log-magnitude error (dB).
     pub rms_db: f64,
@@ -155,6 +168,7 @@ pub struct Totals {
     /// (channel, line) pairs used.
     pub values_used: usize,
     /// (channel, line) pairs left out (zero or non-finite values).
+    #[cfg_attr(feature = "serde", serde(rename = "values_excluded"))]
     pub lines_excluded: usize,
 }
 

@@ -22,14 +22,14 @@ use super::{Result, load_case, print_masked, print_notes};
 use crate::exit::Exit;
 use crate::output::Outputs;
 use crate::report::html::{Block, Report, Section};
-use crate::report::json::CorrelationJson;
 use crate::report::modes::{ModesJson, compare_modes, mode_table_rows, rows};
 use crate::report::{self, ModelFrfs, ReportOptions, plot, sig, signed};
 use crate::table::Table;
 
-/// What `--json` prints and `compare.json` holds.
+/// What `--json` prints and `compare.json` holds: the library's results
+/// (the correlation, the fitted gains) with what only the command knows.
 #[derive(Serialize)]
-struct CompareJson {
+struct CompareJson<'a> {
     case: String,
     title: String,
     /// Where the measured data came from.
@@ -40,7 +40,7 @@ struct CompareJson {
     bands: String,
     /// The FRF kind compared: the data's, whichever way they arrive.
     kind: String,
-    correlation: CorrelationJson,
+    correlation: &'a Correlation,
     /// The unknown gains the model's FRFs were multiplied by (`none`,
     /// `per-reference`, `per-channel`) and why.
     gain_setting: String,
@@ -224,6 +224,7 @@ pub(crate) fn compare(
         notes.push("the gains are fitted with each line weighted by its measured coherence".into());
     }
     let correlation = correlate(&measured, &frfs, &spec)?;
+    let model = ModelFrfs { label: "model".into(), colour: plot::UPDATED, frfs, correlation };
     let comparison = compare_modes(&system, &measured);
     let (modes, modes_error) = match comparison.as_ref().map(rows) {
         Ok(m) => (Some(m), None),
@@ -236,7 +237,7 @@ pub(crate) fn compare(
         model: "the case's model (initial values)".into(),
         bands: bands.to_string(),
         kind: measured.kind().to_string(),
-        correlation: CorrelationJson::from(&correlation),
+        correlation: &model.correlation,
         gain_setting: format!("{} ({})", gains.0, gains.1),
         gains: fitted.reports(),
         modes,
@@ -247,7 +248,7 @@ pub(crate) fn compare(
     if json {
         outln!("{}", serde_json::to_string_pretty(&doc)?);
     } else {
-        print_tables(&case, &measured, &source, &correlation)?;
+        print_tables(&case, &measured, &source, &model.correlation)?;
         print_gains(&doc.gains)?;
         match &comparison {
             Ok(_) => {
@@ -264,7 +265,6 @@ pub(crate) fn compare(
     }
     if let Some(mut output) = output {
         let path = output.write("compare.json", serde_json::to_string_pretty(&doc)?.as_bytes())?;
-        let model = ModelFrfs { label: "model".into(), colour: plot::UPDATED, frfs, correlation };
         let mut report = Report::new(format!("{}: model against measurement", case.model.title));
         report.subtitle = Some(format!("rfm compare, case file {}", case_path.display()));
         report.sections = report_sections(
@@ -293,7 +293,7 @@ fn report_sections(
     source: &str,
     model: &ModelFrfs,
     modes: std::result::Result<&frf::ModalComparison, &String>,
-    doc: &CompareJson,
+    doc: &CompareJson<'_>,
     opts: &ReportOptions,
     out: &mut Outputs,
 ) -> Result<Vec<Section>> {

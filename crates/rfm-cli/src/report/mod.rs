@@ -1,6 +1,5 @@
 //! Plots and reports: SVG figures ([`plot`]), the self-contained HTML
-//! report ([`html`]), the JSON form of an FRF correlation ([`json`]), the
-//! report sections shared by `rfm compare`, `rfm update` and `rfm fix`
+//! report ([`html`]), the report sections shared by `rfm compare`, `rfm update` and `rfm fix`
 //! (this module: the correlation, the overlays of every channel, the
 //! structure, the definitions), the modal comparison ([`modes`]), the
 //! update report ([`update_report`]) and the report of the loop
@@ -11,7 +10,6 @@
 
 pub(crate) mod fix_report;
 pub(crate) mod html;
-pub(crate) mod json;
 pub(crate) mod modes;
 pub(crate) mod plot;
 pub(crate) mod update_report;

@@ -77,7 +77,6 @@ mod search;
 
 use damping::DampedSystem;
 use frf::FrfSet;
-use serde::Serialize;
 
 pub use candidates::{Candidate, CandidateOptions, EffectKind, Role};
 
@@ -163,7 +162,8 @@ impl Default for DiagnoseOptions {
 }
 
 /// A fitted parameter of a candidate.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct FittedParameter {
     /// Name (in the candidate's model).
     pub name: String,
@@ -179,7 +179,8 @@ pub struct FittedParameter {
 }
 
 /// One ranked candidate.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Ranked {
     /// Kind.
     pub kind: EffectKind,
@@ -223,12 +224,13 @@ pub struct Ranked {
     /// Fitted on the full line set (false: screening only).
     pub fully_fitted: bool,
     /// Index of the candidate in [`Diagnosis::candidates`].
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     pub candidate: usize,
 }
 
 /// A candidate whose fit failed, and why.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Unfitted {
     /// The candidate.
     pub description: String,
@@ -237,7 +239,8 @@ pub struct Unfitted {
 }
 
 /// The outcome of a diagnosis.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Diagnosis {
     /// Estimated relative noise of the data (RMS per complex value).
     pub noise: f64,
@@ -258,7 +261,7 @@ pub struct Diagnosis {
     /// Candidates that could not be fitted, with the reason.
     pub unfitted: Vec<Unfitted>,
     /// The candidates (same indices as [`Ranked::candidate`]).
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     pub candidates: Vec<Candidate>,
 }
 

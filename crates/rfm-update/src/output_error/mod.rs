@@ -63,7 +63,6 @@ use faer::Mat;
 use fe_model::DofRef;
 use frf::{FrfSet, ZSolver};
 use num_complex::Complex64 as C64;
-use serde::Serialize;
 
 pub(crate) use response::{Evaluated, Response};
 
@@ -76,8 +75,9 @@ use crate::sensitivity::ChannelPlan;
 use crate::status::{IterationRecord, Status};
 
 /// Form of the residual; see the module docs.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum Misfit {
     /// `(H - M) / |M|`.
     Relative,
@@ -146,10 +146,11 @@ impl Default for OeOptions {
 }
 
 /// A fitted gain of one reference.
-#[derive(Clone, Copy, Debug, Serialize)]
+#[derive(Clone, Copy, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Gain {
     /// The reference DOF.
-    #[serde(serialize_with = "crate::serialize_display")]
+    #[cfg_attr(feature = "serde", serde(serialize_with = "crate::serialize_display"))]
     pub reference: DofRef,
     /// Magnitude of the gain.
     pub magnitude: f64,

@@ -18,7 +18,6 @@ use damping::DampedSystem;
 use fe_model::case::{FrequencyChoice, Gains, MeasurementSpec};
 use fe_model::{CaseFile, DofRef, Parameter};
 use frf::{Channel, FrfKind, FrfSet, NoiseModel};
-use serde::Serialize;
 
 pub use crate::measured::read_measured_for;
 pub use natural_frequencies::{FrequencyTable, MAX_UNDAMPED_DOFS, natural_frequencies};
@@ -30,8 +29,9 @@ use crate::gain;
 use crate::params::ParameterSet;
 
 /// An updating method.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "kebab-case")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "kebab-case"))]
 pub enum Method {
     /// The response function method (the paper's).
     Rfm,
@@ -85,7 +85,8 @@ pub struct Study {
 
 /// A test node paired with a model node by coordinates, as stored with the
 /// results (`[measurement] pair = "coordinates"`).
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct PairingReport {
     /// Test node label.
     pub test_node: i64,

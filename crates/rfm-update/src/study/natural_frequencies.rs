@@ -2,7 +2,6 @@
 //! modes, undamped ones for larger models, none for the largest.
 
 use damping::DampedSystem;
-use serde::Serialize;
 
 use super::Study;
 
@@ -11,7 +10,8 @@ use super::Study;
 /// damped model's complex modes, which include the stiffening a slow
 /// exponential kernel adds; undamped frequencies for models too large for
 /// the dense complex modal analysis (see `kind`).
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct FrequencyTable {
     /// Initial model.
     pub initial: Vec<f64>,

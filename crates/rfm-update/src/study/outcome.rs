@@ -1,7 +1,6 @@
 //! What an updating run on a study returns, as stored with the results.
 
 use damping::DampedSystem;
-use serde::Serialize;
 
 use super::{FrequencyTable, PairingReport, Study};
 use crate::output_error::Gain;
@@ -9,7 +8,8 @@ use crate::status::{IterationRecord, Status};
 use crate::uncertainty::UncertaintyReport;
 
 /// One parameter's values for reporting.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct ParameterReport {
     /// Dotted name.
     pub name: String,
@@ -31,7 +31,8 @@ impl ParameterReport {
 }
 
 /// The outcome of an updating run on a study.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct UpdateOutcome {
     /// Method used.
     pub method: String,
@@ -80,12 +81,13 @@ pub struct UpdateOutcome {
     /// How test nodes were paired with model nodes by coordinates.
     pub pairing: Vec<PairingReport>,
     /// The updated model.
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     pub system: DampedSystem,
 }
 
 /// One restart of the output-error fit from a spread start.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Restart {
     /// Residual RMS at the start.
     pub start_residual: f64,

@@ -36,7 +36,6 @@ mod imported;
 mod per_direction;
 
 use fe_model::{Dof, ElementId, Model, ModelError, NodeId, Parameter};
-use serde::Serialize;
 
 pub(crate) use edit::Edit;
 pub use generate::generate;
@@ -45,8 +44,9 @@ pub(crate) use generate::twins::twins;
 pub(crate) use per_direction::per_direction_variant;
 
 /// The kind of a candidate effect.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum EffectKind {
     /// A support that is flexible (and lossy) instead of rigid.
     FlexibleSupport,
@@ -80,11 +80,12 @@ impl EffectKind {
 }
 
 /// What a fitted parameter of a candidate is, physically.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum Role {
     /// A spring stiffness of a support or joint, in one DOF.
-    Spring(#[serde(serialize_with = "crate::serialize_display")] Dof),
+    Spring(#[cfg_attr(feature = "serde", serde(serialize_with = "crate::serialize_display"))] Dof),
     /// The stiffness-proportional damping coefficient of the effect's group.
     Alpha,
     /// The relaxation parameter of the effect's group.
