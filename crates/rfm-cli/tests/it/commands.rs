@@ -153,6 +153,28 @@ fn the_walkthrough_shows_what_rfm_update_prints() {
     }
 }
 
+/// The diagnosis the walkthrough shows (step 2) is what the command prints:
+/// every line of it, but for `...`, begins a line of `rfm diagnose`'s output
+/// for the tutorial, in order (the document leaves out the fitted values
+/// at the right of the table).
+#[test]
+fn the_walkthrough_shows_what_rfm_diagnose_prints() {
+    let doc =
+        std::fs::read_to_string(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../docs/walkthrough.md")).unwrap();
+    let shown = printed_after(&doc, "rfm diagnose cases/tutorial/l-frame.toml");
+    assert!(shown.len() > 6, "{shown:?}");
+    let out = rfm(&["diagnose", case("tutorial/l-frame").to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let printed = text(&out.stdout);
+    let mut lines = printed.lines();
+    for line in shown.iter().filter(|l| !l.is_empty() && l.as_str() != "...") {
+        assert!(
+            lines.any(|p| p.starts_with(line.as_str())),
+            "the walkthrough shows\n{line}\nwhich rfm diagnose does not print (in this order):\n{printed}"
+        );
+    }
+}
+
 /// The largest relative difference of two sets' values (and whether their
 /// kinds, channels and lines agree).
 fn max_relative_difference(a: &FrfSet, b: &FrfSet) -> f64 {
