@@ -345,23 +345,40 @@ impl Candidate {
     /// The first plausibility problem of the given values, if any, judged
     /// only on the parameters that `determined` marks (a value the data do
     /// not determine says nothing about the structure). Damping is judged by
-    /// its largest loss factor in the band, which for an exponential kernel
-    /// depends on alpha and mu together: `alpha w mu^2 / (mu^2 + w^2)`, at
-    /// most `alpha mu / 2`, reached at `w = mu`.
+    /// its loss factor in the band, which for an exponential kernel depends
+    /// on alpha and mu together: `alpha w mu^2 / (mu^2 + w^2)`, at most
+    /// `alpha mu / 2`, reached at `w = mu`. The damping of elements (a
+    /// material's) is implausible where that exceeds 1 anywhere in the band:
+    /// no structural material loses more than it stores per radian. The
+    /// damping of a support's or joint's springs is a damper beside a
+    /// spring, and a viscous damper's force rightly exceeds its spring's
+    /// above the corner frequency `k / c`: a loss factor of 0.3 at 100 Hz is
+    /// 1.2 at 400 Hz (held-out trial 0 of the full study: the right support,
+    /// found with its true alpha, was set aside for that). It is implausible
+    /// only above 1 over the whole band, where the spring would hold nothing
+    /// the damper does not.
     pub fn implausible(&self, values: &[f64], determined: &[bool]) -> Option<String> {
+        let springs = matches!(self.edit, Edit::Support { .. } | Edit::Joint { .. });
         (0..self.parameters.len()).filter(|&i| determined[i]).find_map(|i| {
             let v = values[i];
             if self.roles[i] == Role::Alpha {
                 // the relaxation parameter of the same group
                 let mu_name = self.parameters[i].strip_suffix(".alpha").map(|g| format!("{g}.mu"));
                 let mu = self.parameters.iter().position(|p| Some(p) == mu_name.as_ref()).map(|m| values[m]);
-                let eta = max_loss_factor(v, mu, self.band_rad);
-                return (eta > 1.0).then(|| {
-                    format!(
-                        "{} = {v:.4e} is not plausible: a loss factor of {eta:.2} (above 1) in the band",
-                        self.parameters[i]
-                    )
-                });
+                let (least, most) = loss_factor_range(v, mu, self.band_rad);
+                let name = &self.parameters[i];
+                return if springs {
+                    (least > 1.0).then(|| {
+                        format!(
+                            "{name} = {v:.4e} is not plausible: a loss factor of at least {least:.2} (above 1) \
+                             over the whole band"
+                        )
+                    })
+                } else {
+                    (most > 1.0).then(|| {
+                        format!("{name} = {v:.4e} is not plausible: a loss factor of {most:.2} (above 1) in the band")
+                    })
+                };
             }
             let (lo, hi, why) = self.plausible[i];
             (v < lo || v > hi).then(|| format!("{} = {v:.4e} is not plausible: {why}", self.parameters[i]))
@@ -402,16 +419,18 @@ impl Candidate {
     }
 }
 
-/// The largest loss factor of damping `alpha` (with relaxation parameter
-/// `mu`, viscous when `None`) over the band `(w_lo, w_hi)` (rad/s): the
-/// ratio of the imaginary to the real part of `1 + j w h(w) alpha`, to first
-/// order, `alpha w mu^2 / (mu^2 + w^2)`, which rises to `w = mu` and falls after.
-pub(crate) fn max_loss_factor(alpha: f64, mu: Option<f64>, (w_lo, w_hi): (f64, f64)) -> f64 {
+/// The smallest and the largest loss factor of damping `alpha` (with
+/// relaxation parameter `mu`, viscous when `None`) over the band
+/// `(w_lo, w_hi)` (rad/s): the ratio of the imaginary to the real part of
+/// `1 + j w h(w) alpha`, to first order, `alpha w mu^2 / (mu^2 + w^2)`,
+/// which rises to `w = mu` and falls after, so that its least is at one
+/// end of the band and its most at `mu` or an end.
+pub(crate) fn loss_factor_range(alpha: f64, mu: Option<f64>, (w_lo, w_hi): (f64, f64)) -> (f64, f64) {
     match mu {
-        None => alpha * w_hi,
+        None => (alpha * w_lo, alpha * w_hi),
         Some(mu) => {
-            let w = mu.clamp(w_lo, w_hi);
-            alpha * w * mu * mu / (mu * mu + w * w)
+            let eta = |w: f64| alpha * w * mu * mu / (mu * mu + w * w);
+            (eta(w_lo).min(eta(w_hi)), eta(mu.clamp(w_lo, w_hi)))
         }
     }
 }
