@@ -3,6 +3,8 @@
 //! effect is written into a new case file in another folder; the written
 //! case loads, reads its measured data through a path relative to itself,
 //! and its misfit with the fitted values equals the diagnosis's to 1e-6.
+//! Its `[update]` holds the effect's determined parameters and all its
+//! damping parameters, determined or not.
 //! The per-direction variants of supports and joints (a spring and a group
 //! per direction) are among them.
 
@@ -141,6 +143,26 @@ fn apply_every(case: CaseFile, dir: &Path) -> BTreeSet<String> {
         let table: toml::Table = text.parse().unwrap();
         let written = table["measurement"]["data"].as_str().expect("a data path");
         assert!(Path::new(written).is_relative(), "{title}, rank {rank}: data path {written}");
+        // the effect's determined parameters and all its damping parameters
+        // are updated next; an undetermined stiffness or mass is not
+        let updated: Vec<&str> =
+            table["update"]["parameters"].as_array().unwrap().iter().filter_map(|v| v.as_str()).collect();
+        let own: Vec<String> =
+            study.case().update.iter().flat_map(|u| u.parameters.iter().map(|p| p.name.clone())).collect();
+        // (the case's own [update] parameters stay, whatever the effect says of them)
+        for p in r.parameters.iter().filter(|p| !own.contains(&p.name)) {
+            let damping = !p.role.is_stiffness_or_mass();
+            assert_eq!(
+                updated.contains(&p.name.as_str()),
+                p.determined || damping,
+                "{title}, rank {rank}: {} (determined {}) in [update] {updated:?}",
+                p.name,
+                p.determined
+            );
+            if damping && !p.determined {
+                kinds.insert("undetermined damping updated".into());
+            }
+        }
         std::fs::write(&target, &text).unwrap();
         let applied = Study::load(&target).unwrap_or_else(|e| panic!("{title}, rank {rank} ({}): {e}", r.description));
         let misfit = log_misfit(applied.system(), applied.measured(), r.lines).unwrap();
@@ -199,7 +221,7 @@ fn every_ranked_effect_applies_to_the_tutorial_the_papers_cases_and_samples() {
     let dir = tmp.path().join("per-direction");
     kinds.extend(apply_every(crate::per_direction::nominal_case(&crate::per_direction::lossy_rotation(), &dir), &dir));
     println!("applied: {kinds:?}");
-    for kind in ["FlexibleSupport per direction", "FlexibleJoint per direction"] {
+    for kind in ["FlexibleSupport per direction", "FlexibleJoint per direction", "undetermined damping updated"] {
         assert!(kinds.contains(kind), "no {kind} was applied");
     }
     for kind in [
