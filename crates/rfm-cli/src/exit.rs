@@ -295,6 +295,7 @@ mod tests {
             uncertainty: None,
             gains: Vec::new(),
             noise_estimate: Some(0.01),
+            residual_noise: Some(0.01),
             masked: Vec::new(),
             notes: Vec::new(),
             warnings: Vec::new(),

@@ -97,6 +97,8 @@ impl Study {
             uncertainty: None,
             gains: Vec::new(),
             noise_estimate: noise,
+            // the RFM's equations carry no line weights
+            residual_noise: noise,
             masked: describe_masked(&self.masked),
             notes: self.notes.clone(),
             warnings,
