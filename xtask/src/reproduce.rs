@@ -44,9 +44,11 @@ struct Run {
 
 /// The exit codes of `rfm update` when the fit ended without converging but
 /// wrote its results (rfm's exit table: not converged, stalled, model
-/// inadequate, local minimum, worse than the start): the case's `[check]`
-/// judges the status, so reproduce reads the results rather than stopping.
-const WRITTEN_NOT_CONVERGED: [i32; 5] = [5, 8, 9, 10, 11];
+/// inadequate, local minimum, worse than the start, run-away): the case's
+/// `[check]` judges the status, so reproduce reads the results rather than
+/// stopping. A test keeps it equal to the codes `docs/reliability.md` says
+/// write their results.
+const WRITTEN_NOT_CONVERGED: [i32; 6] = [5, 8, 9, 10, 11, 12];
 
 fn run_rfm(rfm: &Path, args: &[&OsStr], what: &str) -> Result<(), String> {
     let status = Command::new(rfm).args(args).status().map_err(|e| format!("cannot run {}: {e}", rfm.display()))?;
@@ -267,4 +269,28 @@ fn diagnosis_loop(
          {:.0} times, from {nominal:.3e} (nominal model) to {last:.3e}",
         nominal / last,
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every code of rfm's exit table that says the results are written
+    /// (`docs/reliability.md`, which a test of rfm keeps equal to the
+    /// binary's table) is one reproduce reads on, and no other.
+    #[test]
+    fn reproduce_reads_the_results_of_every_code_that_writes_them() {
+        let doc = std::fs::read_to_string(crate::root().join("docs/reliability.md")).unwrap();
+        let table = &doc[doc.find("## Exit codes").unwrap()..];
+        let written: Vec<i32> = table
+            .lines()
+            .skip_while(|l| !l.starts_with("| code"))
+            .skip(2)
+            .take_while(|l| l.starts_with("| "))
+            .filter(|l| l.contains(" written") && !l.contains("not written"))
+            .map(|l| l.trim_matches('|').split(" | ").next().unwrap().trim().parse().unwrap())
+            .filter(|&code| code != 0)
+            .collect();
+        assert_eq!(written, WRITTEN_NOT_CONVERGED);
+    }
 }

@@ -49,6 +49,9 @@ pub(crate) enum Exit {
     /// An update ended with a larger misfit than the initial model's (the
     /// RFM can); its outputs say so.
     WorseThanStart,
+    /// An update's misfit is within the noise, but a parameter ended on its
+    /// bound or ran away: its value is no estimate.
+    Runaway,
     /// Ctrl-C, SIGTERM or SIGHUP stopped the run (128 + SIGINT).
     Interrupted,
 }
@@ -56,7 +59,7 @@ pub(crate) enum Exit {
 impl Exit {
     /// Every code with its meaning, in order: printed by `rfm --help` and
     /// copied in `docs/reliability.md`.
-    pub(crate) const TABLE: [(Exit, &'static str); 13] = [
+    pub(crate) const TABLE: [(Exit, &'static str); 14] = [
         (Exit::Success, "success (for update: the fit converged)"),
         (Exit::Internal, "internal error (a bug in rfm; please report it)"),
         (Exit::Usage, "wrong command line"),
@@ -72,6 +75,10 @@ impl Exit {
         ),
         (Exit::LocalMinimum, "local minimum: above the noise, and restarts disagree (best fit written)"),
         (Exit::WorseThanStart, "worse than the start: the update raised the misfit (results written, marked so)"),
+        (
+            Exit::Runaway,
+            "run-away: a parameter ended on its bound or moved a hundredfold where the data do not hold it (results written)",
+        ),
         (Exit::Interrupted, "interrupted by Ctrl-C, SIGTERM or SIGHUP (outputs all old or all new)"),
     ];
 
@@ -90,6 +97,7 @@ impl Exit {
             Exit::ModelInadequate => 9,
             Exit::LocalMinimum => 10,
             Exit::WorseThanStart => 11,
+            Exit::Runaway => 12,
             Exit::Interrupted => 130,
         }
     }
@@ -107,6 +115,7 @@ impl Exit {
             Status::Stalled => Exit::Stalled,
             Status::ModelInadequate => Exit::ModelInadequate,
             Status::LocalMinimum => Exit::LocalMinimum,
+            Status::Runaway => Exit::Runaway,
             Status::Failed(_) => Exit::Numerics,
         }
     }
@@ -268,12 +277,14 @@ mod tests {
         assert_eq!(Exit::of_status(&Status::MaxIterations), Exit::NotConverged);
         assert_eq!(Exit::of_status(&Status::ModelInadequate), Exit::ModelInadequate);
         assert_eq!(Exit::of_status(&Status::LocalMinimum), Exit::LocalMinimum);
+        assert_eq!(Exit::of_status(&Status::Runaway), Exit::Runaway);
         // one code per outcome that is not a success
-        let codes: Vec<u8> = [Status::Stalled, Status::MaxIterations, Status::ModelInadequate, Status::LocalMinimum]
-            .iter()
-            .map(|s| Exit::of_status(s).code())
-            .collect();
-        assert_eq!(codes, [8, 5, 9, 10]);
+        let codes: Vec<u8> =
+            [Status::Stalled, Status::MaxIterations, Status::ModelInadequate, Status::LocalMinimum, Status::Runaway]
+                .iter()
+                .map(|s| Exit::of_status(s).code())
+                .collect();
+        assert_eq!(codes, [8, 5, 9, 10, 12]);
         assert_eq!(Exit::of_status(&Status::Failed("singular".into())), Exit::Numerics);
     }
 
@@ -295,6 +306,7 @@ mod tests {
             uncertainty: None,
             gains: Vec::new(),
             noise_estimate: Some(0.01),
+            residual_noise: Some(0.01),
             masked: Vec::new(),
             notes: Vec::new(),
             warnings: Vec::new(),

@@ -134,6 +134,28 @@ pub fn solve(a: &Mat<f64>, b: &[f64], rcond: f64) -> LstsqSolution {
     }
 }
 
+/// A parameter whose component along the unresolved direction exceeds this
+/// takes part in the combination the data cannot separate.
+const IN_COMBINATION: f64 = 0.1;
+
+/// The index of the smallest singular value with it and the largest, when
+/// the smallest is below 1e-6 of the largest (a nearly singular problem).
+fn weakest_direction(sv: &[f64]) -> Option<(usize, f64, f64)> {
+    let smax = sv.first().copied()?;
+    let (k, &smin) = sv.iter().enumerate().min_by(|a, b| a.1.total_cmp(b.1))?;
+    (!(smax == 0.0 || smin > 1e-6 * smax)).then_some((k, smin, smax))
+}
+
+/// Which of `n` parameters take part in the weakest direction when the
+/// problem is nearly singular (the combination [`unresolved_combination`]
+/// names, which prints the three largest parts); all false when it is not.
+pub(crate) fn unresolved_parameters(sv: &[f64], v: &Mat<f64>, n: usize) -> Vec<bool> {
+    match weakest_direction(sv) {
+        Some((k, _, _)) => (0..n).map(|i| i < v.nrows() && v[(i, k)].abs() > IN_COMBINATION).collect(),
+        None => vec![false; n],
+    }
+}
+
 /// Names the parameter combination along the weakest direction of a
 /// column-scaled sensitivity matrix (singular values `sv`, right singular
 /// vectors as the columns of `v`, one row per parameter of `names`) when it
@@ -142,17 +164,13 @@ pub fn solve(a: &Mat<f64>, b: &[f64], rcond: f64) -> LstsqSolution {
 /// uncertainty.
 pub(crate) fn unresolved_combination(sv: &[f64], v: &Mat<f64>, names: &[String]) -> Option<String> {
     let n = names.len();
-    let smax = sv.first().copied()?;
-    let (k, &smin) = sv.iter().enumerate().min_by(|a, b| a.1.total_cmp(b.1))?;
-    if smax == 0.0 || smin > 1e-6 * smax {
-        return None;
-    }
+    let (k, smin, smax) = weakest_direction(sv)?;
     let mut parts: Vec<(f64, usize)> = (0..n.min(v.nrows())).map(|i| (v[(i, k)], i)).collect();
     parts.sort_by(|a, b| b.0.abs().total_cmp(&a.0.abs()));
     let terms: Vec<String> = parts
         .iter()
         .take(3)
-        .filter(|(c, _)| c.abs() > 0.1)
+        .filter(|(c, _)| c.abs() > IN_COMBINATION)
         .map(|(c, i)| format!("{:+.2} ln({})", c, names[*i]))
         .collect();
     Some(format!(

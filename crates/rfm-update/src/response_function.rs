@@ -107,6 +107,8 @@ pub struct RfmResult {
     /// The parameter combination the data cannot separate, when the scaled
     /// sensitivity is nearly singular (see the module docs).
     pub unresolved: Option<String>,
+    /// The parameters that take part in that combination.
+    pub undetermined: Vec<bool>,
 }
 
 /// Without bounds of its own, a parameter stays within this factor of its
@@ -361,6 +363,7 @@ pub fn run(
         .collect();
     let names: Vec<String> = params.params().iter().map(|p| p.name.clone()).collect();
     let unresolved = crate::lstsq::unresolved_combination(&best_svd.0, &best_svd.1, &names);
+    let undetermined = crate::lstsq::unresolved_parameters(&best_svd.0, &best_svd.1, names.len());
     Ok(RfmResult {
         history,
         status,
@@ -370,6 +373,7 @@ pub fn run(
         bounds,
         singular_values: best_svd.0,
         unresolved,
+        undetermined,
     })
 }
 
@@ -425,6 +429,7 @@ mod tests {
             Status::LocalMinimum,
             Status::Stalled,
             Status::MaxIterations,
+            Status::Runaway,
             Status::Failed("x".into()),
         ];
         // a new variant breaks this match: add it to `all` and to RUN_STATUSES
@@ -435,6 +440,7 @@ mod tests {
                 | Status::LocalMinimum
                 | Status::Stalled
                 | Status::MaxIterations
+                | Status::Runaway
                 | Status::Failed(_) => {}
             }
         }

@@ -32,7 +32,8 @@ pub struct IterationRecord {
 /// point), [`Status::Stalled`], [`Status::MaxIterations`] or
 /// [`Status::Failed`]; the study then compares the residual with the data's
 /// noise ([`crate::verdict`]) and, for the output-error fit, restarts it to
-/// tell a global minimum from a local one. So `converged` in a result means
+/// tell a global minimum from a local one; for the RFM, it checks that no
+/// parameter ended on a bound or ran away. So `converged` in a result means
 /// that the residual is consistent with the noise, never only that the
 /// iteration stopped.
 #[derive(Clone, Debug, PartialEq)]
@@ -57,6 +58,11 @@ pub enum Status {
     Stalled,
     /// The iteration limit was reached; the best iterate is returned.
     MaxIterations,
+    /// The misfit is within the noise, but a parameter ended on its bound or
+    /// ran away (moved by more than [`crate::verdict::RUNAWAY_FACTOR`] where
+    /// the data do not hold it): its value is no estimate. Only the RFM
+    /// ends so (see [`crate::verdict::with_parameters`]).
+    Runaway,
     /// The model could not be evaluated any more; the best iterate is returned.
     Failed(String),
 }
@@ -70,6 +76,7 @@ impl Status {
             Status::LocalMinimum => "local_minimum",
             Status::Stalled => "stalled",
             Status::MaxIterations => "max_iterations",
+            Status::Runaway => "runaway",
             Status::Failed(_) => "failed",
         }
     }
@@ -94,6 +101,9 @@ impl Status {
                 "no step lowers the misfit, which stays above the noise (the best iterate is reported)".to_string()
             }
             Status::MaxIterations => "the iteration limit was reached (the best iterate is reported)".to_string(),
+            Status::Runaway => "a parameter ended on its bound or ran away (moved by more than a factor of 100 \
+                                where the data do not hold it): its value is no estimate, whatever the misfit"
+                .to_string(),
             Status::Failed(why) => format!("{why} (the best iterate is reported)"),
         }
     }

@@ -55,19 +55,44 @@ pub fn classify(raw: &Status, noise_ratio: Option<f64>, restarts_agree: Option<b
     }
 }
 
+/// Whether the data hold each parameter where a run left it: the run ends
+/// within the noise (`status` is [`Status::Converged`], so the values
+/// explain the data) and the parameter is neither on a bound (`at_bound`)
+/// nor part of a combination the data cannot separate (`undetermined`).
+pub fn held(status: &Status, at_bound: &[bool], undetermined: &[bool]) -> Vec<bool> {
+    let within = *status == Status::Converged;
+    at_bound.iter().zip(undetermined).map(|(&bound, &loose)| within && !bound && !loose).collect()
+}
+
 /// One warning per parameter that moved by more than [`RUNAWAY_FACTOR`]
-/// either way from its initial value.
-pub fn runaways(names: &[String], initial: &[f64], updated: &[f64]) -> Vec<String> {
+/// either way from its initial value where the data do not hold it
+/// (`held`, see [`held`]). How far a parameter moved says nothing by itself:
+/// the monopile's mu starts 2e4 times its truth on purpose and the RFM brings
+/// it there, to a misfit of 1e-13; a parameter the data hold is an estimate
+/// however far it came.
+pub fn runaways(names: &[String], initial: &[f64], updated: &[f64], held: &[bool]) -> Vec<String> {
     names
         .iter()
         .zip(initial.iter().zip(updated))
-        .filter_map(|(name, (&p0, &p))| {
+        .zip(held)
+        .filter_map(|((name, (&p0, &p)), &held)| {
             let factor = p / p0;
-            (!(1.0 / RUNAWAY_FACTOR..=RUNAWAY_FACTOR).contains(&factor)).then(|| {
+            (!held && !(1.0 / RUNAWAY_FACTOR..=RUNAWAY_FACTOR).contains(&factor)).then(|| {
                 format!("{name} moved by a factor of {factor:.3e} from its initial value: a run-away, not an estimate")
             })
         })
         .collect()
+}
+
+/// The status of a run whose values may include a parameter on its bound or
+/// run away (`untrusted`): a run that would be converged is
+/// [`Status::Runaway`], as its misfit within the noise does not make such a
+/// value an estimate; any other keeps its status, already not a success.
+pub fn with_parameters(status: Status, untrusted: bool) -> Status {
+    match status {
+        Status::Converged if untrusted => Status::Runaway,
+        other => other,
+    }
 }
 
 /// Point `i` (from 1) of the Halton sequence in base `base`: a spread of
@@ -126,10 +151,34 @@ mod tests {
     #[test]
     fn parameters_moved_more_than_a_hundredfold_are_flagged() {
         let names: Vec<String> = ["a", "b", "c", "d"].iter().map(|s| s.to_string()).collect();
-        let w = runaways(&names, &[1.0, 1.0, 2.0, 1e-5], &[99.0, 0.009, 2.0, 1e10]);
+        let w = runaways(&names, &[1.0, 1.0, 2.0, 1e-5], &[99.0, 0.009, 2.0, 1e10], &[false; 4]);
         assert_eq!(w.len(), 2, "{w:?}");
         assert!(w[0].starts_with("b moved by a factor of 9.000e-3"), "{w:?}");
         assert!(w[1].starts_with("d moved by a factor of 1.000e15"), "{w:?}");
+    }
+
+    /// A parameter the data hold is an estimate however far it moved; one on
+    /// a bound, in an unresolved combination or of a run above the noise is not.
+    #[test]
+    fn a_far_move_the_data_hold_is_no_runaway() {
+        let names: Vec<String> = ["a", "b", "c"].iter().map(|s| s.to_string()).collect();
+        let (start, end) = ([34120.0, 1.0, 1.0], [1.706, 1e6, 1e-3]);
+        let held_all = held(&Status::Converged, &[false, false, false], &[false, false, false]);
+        assert_eq!(held_all, [true, true, true]);
+        assert!(runaways(&names, &start, &end, &held_all).is_empty());
+        let some = held(&Status::Converged, &[false, true, false], &[false, false, true]);
+        let w = runaways(&names, &start, &end, &some);
+        assert!(w.len() == 2 && w[0].starts_with("b moved") && w[1].starts_with("c moved"), "{w:?}");
+        let above = held(&Status::Stalled, &[false; 3], &[false; 3]);
+        assert_eq!(runaways(&names, &start, &end, &above).len(), 3);
+    }
+
+    #[test]
+    fn a_converged_run_with_an_untrusted_parameter_is_a_runaway() {
+        assert_eq!(with_parameters(Status::Converged, true), Status::Runaway);
+        assert_eq!(with_parameters(Status::Converged, false), Status::Converged);
+        assert_eq!(with_parameters(Status::Stalled, true), Status::Stalled);
+        assert_eq!(with_parameters(Status::MaxIterations, true), Status::MaxIterations);
     }
 
     #[test]

@@ -104,8 +104,8 @@ pub struct HistoryEntry {
 
 /// How an updating run may end, as its results name it (the statuses of
 /// `rfm_update::status::Status`, whose tests keep the two lists equal).
-pub const RUN_STATUSES: [&str; 6] =
-    ["converged", "model_inadequate", "local_minimum", "stalled", "max_iterations", "failed"];
+pub const RUN_STATUSES: [&str; 7] =
+    ["converged", "model_inadequate", "local_minimum", "stalled", "max_iterations", "runaway", "failed"];
 
 /// What `cargo xtask reproduce` requires of a case's results (`[check]`):
 /// the case's acceptance, as data. See `docs/case-files.md`.

@@ -268,7 +268,7 @@ fn check_errors_name_the_key_and_its_line() {
         (
             "[check.rfm]\nstatus = [\"ok\"]\n",
             "status = [\"ok\"]",
-            "(available: converged, model_inadequate, local_minimum, stalled, max_iterations, failed)",
+            "(available: converged, model_inadequate, local_minimum, stalled, max_iterations, runaway, failed)",
         ),
         ("[check.rfm]\nstatus = []\n", "[check.rfm]", "needs at least one `status`"),
         ("[check.rfm]\nmax_error = 1e-8\n", "[check.rfm]", "missing field `status`"),

@@ -136,6 +136,12 @@ pub(crate) fn update(
         if !study.case().history.is_empty() {
             outln!("the fall of the misfit, from the case's history to this update:");
             print_history(&[study.case().history.clone(), vec![step.clone()]].concat())?;
+            if let (Some(ratio), true) = (outcome.noise_ratio, outcome.residual_noise != outcome.noise_estimate) {
+                outln!(
+                    "(misfits over the band, unweighted; the status weighs the fit's residual and the noise alike: \
+                     {ratio:.2} times the noise)"
+                );
+            }
         }
     }
     if let Some(mut output) = output.take() {
@@ -164,8 +170,9 @@ fn write_updated_model(
     output: &mut Outputs,
 ) -> Result<std::path::PathBuf> {
     let values = rfm_update::params::quantity_values(study.parameters(), outcome.system.model());
+    let times = outcome.noise_ratio.map_or(String::new(), |r| format!(", {r:.2} times the noise"));
     let mut comment = format!(
-        "Updated by rfm ({}, status {}, misfit {:.3e}) from {}",
+        "Updated by rfm ({}, status {}, misfit {:.3e}{times}) from {}",
         outcome.method,
         outcome.status.name(),
         outcome.residual,
@@ -218,6 +225,18 @@ fn print_history(history: &[fe_model::HistoryEntry]) -> Result<()> {
     }
     outln!("{}\n", t.render());
     Ok(())
+}
+
+/// The noise level the residual is compared with, and when the fit weights
+/// its lines, how it relates to the data's own.
+fn noise_level(outcome: &UpdateOutcome, noise: f64) -> String {
+    match outcome.noise_estimate {
+        Some(plain) if plain != noise => format!(
+            "{noise:.3e} under the fit's {} weights, as its residual is (the data's, unweighted: {plain:.3e})",
+            if outcome.coherence_weighted { "coherence" } else { "line" }
+        ),
+        _ => format!("estimated from the data {noise:.3e}"),
+    }
 }
 
 fn print_outcome(outcome: &UpdateOutcome) -> Result<()> {
@@ -308,20 +327,20 @@ fn print_outcome(outcome: &UpdateOutcome) -> Result<()> {
              (--method output-error gives standard deviations)"
         );
     }
-    if let (Some(noise), Some(ratio)) = (outcome.noise_estimate, outcome.noise_ratio) {
+    if let (Some(noise), Some(ratio)) = (outcome.residual_noise, outcome.noise_ratio) {
         let reading = match outcome.status {
             _ if ratio <= rfm_update::verdict::NOISE_FACTOR => {
-                "the model explains the data down to their noise".to_string()
+                format!("the fit leaves {ratio:.2} times it: the model explains the data down to their noise")
             }
             Status::ModelInadequate => format!(
-                "the fit leaves {ratio:.1} times the noise at a minimum its restarts confirm: something the parameters cannot represent remains (try rfm diagnose on the updated case)"
+                "the fit leaves {ratio:.1} times it at a minimum its restarts confirm: something the parameters cannot represent remains (try rfm diagnose on the updated case)"
             ),
             _ => format!(
-                "the fit leaves {ratio:.1} times the noise; it is not known to be the best fit ({})",
+                "the fit leaves {ratio:.1} times it; it is not known to be the best fit ({})",
                 outcome.status.name()
             ),
         };
-        outln!("\nnoise level estimated from the data {noise:.3e}: {reading}");
+        outln!("\nnoise level {}: {reading}", noise_level(outcome, noise));
     }
     if !outcome.restarts.is_empty() {
         let ends: Vec<String> = outcome.restarts.iter().map(|r| format!("{:.3e}", r.residual)).collect();

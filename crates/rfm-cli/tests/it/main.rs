@@ -14,3 +14,4 @@ mod nothing_lost;
 mod pairing;
 mod report;
 mod space_frame;
+mod trust;

@@ -87,6 +87,17 @@ use crate::error::UpdateError;
 /// complex value), from the roughness of `ln M` over adjacent lines; see the
 /// module docs. `None` when there are too few lines.
 pub fn estimate_noise(measured: &FrfSet) -> Option<f64> {
+    estimate_noise_weighted(measured, None)
+}
+
+/// [`estimate_noise`] of the weighted values `w ln M`: each second
+/// difference is multiplied by the weight of its middle line
+/// (`weights[c * n_freq + k]`, channel-major as the study's line weights;
+/// lines of weight 0 are left out). With weights that vary slowly from line to line this is the
+/// noise level of a residual weighted the same way, which is what a
+/// weighted fit's residual must be compared with.
+pub fn estimate_noise_weighted(measured: &FrfSet, weights: Option<&[f64]>) -> Option<f64> {
+    let nf = measured.n_freq();
     let mut d2 = Vec::new();
     for c in 0..measured.channels().len() {
         let h = measured.channel(c);
@@ -94,7 +105,11 @@ pub fn estimate_noise(measured: &FrfSet) -> Option<f64> {
             if h[k - 1].norm() == 0.0 || h[k].norm() == 0.0 || h[k + 1].norm() == 0.0 {
                 continue;
             }
-            let d = (h[k + 1] / h[k]).ln() - (h[k] / h[k - 1]).ln();
+            let w = weights.map_or(1.0, |w| w[c * nf + k]);
+            if w == 0.0 {
+                continue;
+            }
+            let d = w * ((h[k + 1] / h[k]).ln() - (h[k] / h[k - 1]).ln());
             if d.re.is_finite() && d.im.is_finite() {
                 d2.push(d.norm_sqr());
             }

@@ -22,7 +22,7 @@ use frf::{Channel, FrfKind, FrfSet, NoiseModel};
 pub use crate::measured::read_measured_for;
 pub use natural_frequencies::{FrequencyTable, MAX_UNDAMPED_DOFS, natural_frequencies};
 pub use outcome::{ParameterReport, Restart, UpdateOutcome, describe_masked};
-pub use weights::line_weights_for;
+pub use weights::{line_weights_for, residual_noise_for};
 
 use crate::error::UpdateError;
 use crate::gain;

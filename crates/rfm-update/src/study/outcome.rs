@@ -55,6 +55,11 @@ pub struct UpdateOutcome {
     /// Relative noise level of the measured data, estimated from their
     /// roughness (see [`crate::diagnose::estimate_noise`]).
     pub noise_estimate: Option<f64>,
+    /// The noise level weighted as the fit's residual is (by band and
+    /// coherence weights; see [`crate::study::residual_noise_for`]): what
+    /// [`UpdateOutcome::noise_ratio`] compares the residual with. Equal to
+    /// `noise_estimate` for a fit without weights.
+    pub residual_noise: Option<f64>,
     /// What the case's mask rules left out of the measured data, one line
     /// each (`non-finite: line 17, columns 4-5: H(3:uy,2:uy) at 20 Hz is NaN`).
     pub masked: Vec<String>,
@@ -67,8 +72,8 @@ pub struct UpdateOutcome {
     /// its result may not be trusted (noise above its limit, parameters
     /// that ran away, no uncertainty, a misfit worse than the start).
     pub warnings: Vec<String>,
-    /// The final residual as a multiple of the estimated noise (what the
-    /// status is decided on; `None` when the noise is unknown).
+    /// The final residual as a multiple of [`UpdateOutcome::residual_noise`]
+    /// (what the status is decided on; `None` when the noise is unknown).
     pub noise_ratio: Option<f64>,
     /// The restarts of the output-error fit (empty when none were needed).
     pub restarts: Vec<Restart>,

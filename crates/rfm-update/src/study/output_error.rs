@@ -70,7 +70,10 @@ impl Study {
         let params = self.parameter_set();
         let mut sys = self.system.clone();
         let data = OeData { measured: &measured, weights: weights.as_deref() };
-        let noise = crate::diagnose::estimate_noise(&self.measured);
+        // the residual is weighted (band and coherence weights): its noise
+        // must be weighted the same way, or a coherence below 0.999, whose
+        // weight is below 1, makes any residual look small beside the noise
+        let noise = self.residual_noise(&measured)?;
         let ratio = |r: &output_error::OeResult| noise.filter(|&s| s > 0.0).map(|s| (2.0 * r.sigma2).sqrt() / s);
         let first = output_error::run(&mut sys, &params, &data, opts, on_iteration)?;
         let settled = |r: &output_error::OeResult| {
@@ -146,7 +149,8 @@ impl Study {
             natural_frequencies_hz,
             uncertainty: Some(report),
             gains: result.gains,
-            noise_estimate: noise,
+            noise_estimate: crate::diagnose::estimate_noise(&self.measured),
+            residual_noise: noise,
             masked: describe_masked(&self.masked),
             notes: self.notes.clone(),
             warnings: Vec::new(),

@@ -80,7 +80,12 @@ impl Study {
                 100.0 * verdict::RFM_NOISE_LIMIT
             ));
         }
-        warnings.extend(verdict::runaways(&self.parameter_names(), &self.system_values(), &result.values));
+        let noise_ratio = noise.filter(|&s| s > 0.0).map(|s| result.residual / s);
+        let status = verdict::classify(&result.status, noise_ratio, None);
+        let held = verdict::held(&status, &result.at_bound, &result.undetermined);
+        let runaways = verdict::runaways(&self.parameter_names(), &self.system_values(), &result.values, &held);
+        let status = verdict::with_parameters(status, !runaways.is_empty() || result.at_bound.contains(&true));
+        warnings.extend(runaways);
         let first = result.history.first().map_or(f64::NAN, |r| r.residual);
         let worse_than_start = result.residual > first;
         if worse_than_start {
@@ -90,13 +95,14 @@ impl Study {
                 first, result.residual
             ));
         }
-        let noise_ratio = noise.filter(|&s| s > 0.0).map(|s| result.residual / s);
         let natural_frequencies_hz = self.frequency_table(&sys);
         Ok(UpdateOutcome {
             natural_frequencies_hz,
             uncertainty: None,
             gains: Vec::new(),
             noise_estimate: noise,
+            // the RFM's equations carry no line weights
+            residual_noise: noise,
             masked: describe_masked(&self.masked),
             notes: self.notes.clone(),
             warnings,
@@ -107,7 +113,7 @@ impl Study {
             coherence_weighted: false,
             pairing: self.pairing.clone(),
             method: "rfm".into(),
-            status: verdict::classify(&result.status, noise_ratio, None),
+            status,
             parameters: self.reports(&result.values),
             history: result.history,
             residual: result.residual,

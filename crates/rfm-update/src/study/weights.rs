@@ -29,13 +29,46 @@ impl Study {
     pub fn weights(&self, measured: &FrfSet) -> Result<Option<Vec<f64>>, UpdateError> {
         self.line_weights(measured)
     }
+
+    /// The noise level the weighted residual of a fit to `fitted` (lines of
+    /// this study's data) is compared with (see [`residual_noise_for`]).
+    pub fn residual_noise(&self, fitted: &FrfSet) -> Result<Option<f64>, UpdateError> {
+        residual_noise_for(&self.case, &self.measured, fitted)
+    }
 }
 
 /// The residual weights of a case's measured data `measured` (see
 /// [`Study::line_weights`]): band weights times the coherence weight,
 /// whenever the data carry coherence unless `[update] coherence = false`.
 pub fn line_weights_for(case: &CaseFile, measured: &FrfSet) -> Result<Option<Vec<f64>>, UpdateError> {
+    let coherence = coherence_weights(case, measured)?;
+    Ok(match (band_weights(case, measured), coherence) {
+        (None, None) => None,
+        (Some(w), None) | (None, Some(w)) => Some(w),
+        (Some(band), Some(coherence)) => Some(band.iter().zip(&coherence).map(|(b, c)| b * c).collect()),
+    })
+}
+
+/// The `[update]` band weights at the lines of `measured`, channel-major;
+/// `None` when the case gives none.
+fn band_weights(case: &CaseFile, measured: &FrfSet) -> Option<Vec<f64>> {
     let bands = case.update.as_ref().map_or(&[][..], |u| &u.weights[..]);
+    if bands.is_empty() {
+        return None;
+    }
+    let per_line: Vec<f64> = measured
+        .frequencies_hz()
+        .iter()
+        .map(|&f| bands.iter().filter(|b| b.from <= f && f <= b.to).map(|b| b.weight).product())
+        .collect();
+    Some(per_line.repeat(measured.channels().len()))
+}
+
+/// The coherence weights `sqrt(g / (1 - g))` (capped at coherence 0.999
+/// and scaled to 1 there) at the lines of `measured`, channel-major, a
+/// channel without coherence weighted 1; `None` when the data carry no
+/// coherence or the case turns the weighting off.
+fn coherence_weights(case: &CaseFile, measured: &FrfSet) -> Result<Option<Vec<f64>>, UpdateError> {
     let asked = case.update.as_ref().and_then(|u| u.coherence);
     let has = (0..measured.channels().len()).any(|c| measured.coherence(c).is_some());
     if asked == Some(true) && !has {
@@ -45,23 +78,44 @@ pub fn line_weights_for(case: &CaseFile, measured: &FrfSet) -> Result<Option<Vec
                 .into(),
         ));
     }
-    let coherence = asked.unwrap_or(true) && has;
-    if bands.is_empty() && !coherence {
+    if !(asked.unwrap_or(true) && has) {
         return Ok(None);
     }
     let nf = measured.n_freq();
     let mut w = vec![1.0; nf * measured.channels().len()];
     for (c, chunk) in w.chunks_mut(nf).enumerate() {
-        for (k, wk) in chunk.iter_mut().enumerate() {
-            let f = measured.frequencies_hz()[k];
-            for b in bands.iter().filter(|b| b.from <= f && f <= b.to) {
-                *wk *= b.weight;
-            }
-            if coherence && let Some(coh) = measured.coherence(c) {
-                let g = coh[k].clamp(0.0, 0.999);
-                *wk *= (g / (1.0 - g)).sqrt().min(30.0) / 30.0;
+        if let Some(coh) = measured.coherence(c) {
+            for (wk, &g) in chunk.iter_mut().zip(coh) {
+                let g = g.clamp(0.0, 0.999);
+                *wk = (g / (1.0 - g)).sqrt().min(30.0) / 30.0;
             }
         }
     }
     Ok(Some(w))
+}
+
+/// The noise level that the weighted residual of a fit to `fitted` (lines
+/// of `measured`, the case's data) is compared with: the noise weighted as
+/// the residual is. The coherence weight is the inverse of an FRF
+/// estimate's relative standard deviation up to a constant, so the
+/// coherence-weighted values have one noise level throughout, estimated
+/// from their roughness over every measured line
+/// ([`crate::diagnose::estimate_noise_weighted`]); the band weights are
+/// the user's and multiply it by their RMS over the fitted values. Without
+/// weights this is [`crate::diagnose::estimate_noise`].
+pub fn residual_noise_for(case: &CaseFile, measured: &FrfSet, fitted: &FrfSet) -> Result<Option<f64>, UpdateError> {
+    let coherence = coherence_weights(case, measured)?;
+    let Some(level) = crate::diagnose::estimate_noise_weighted(measured, coherence.as_deref()) else {
+        return Ok(None);
+    };
+    let Some(band) = band_weights(case, fitted) else { return Ok(Some(level)) };
+    let weights = line_weights_for(case, fitted)?.unwrap_or_else(|| vec![1.0; band.len()]);
+    let values = (0..fitted.channels().len()).flat_map(|c| fitted.channel(c).iter().copied());
+    let (sum, n) = band
+        .iter()
+        .zip(&weights)
+        .zip(values)
+        .filter(|&((_, &w), m)| w > 0.0 && m.norm() > 0.0 && m.norm().is_finite())
+        .fold((0.0, 0usize), |(sum, n), ((b, _), _)| (sum + b * b, n + 1));
+    Ok((n > 0).then(|| level * (sum / n as f64).sqrt()))
 }

@@ -3,6 +3,7 @@
 mod apply_every;
 mod bending_loss;
 mod calibration;
+mod coherence_noise;
 mod fast_vs_naive;
 mod held_out;
 mod hidden_effects;

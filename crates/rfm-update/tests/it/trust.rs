@@ -67,3 +67,30 @@ fn a_confirmed_minimum_above_the_noise_is_model_inadequate_with_inflated_uncerta
         assert!(p.relative_std >= p.relative_std_noise * ratio * 0.999, "{}", p.name);
     }
 }
+
+/// The monopile's mu starts 2e4 times its truth on purpose (viscous in
+/// practice) and the RFM brings it there from exact data: a move of a factor
+/// of 5e-5 that the data hold (the misfit falls to 1e-13) is an estimate, not
+/// a run-away, and the run is converged.
+#[test]
+fn a_far_move_to_a_value_the_data_hold_is_no_runaway() {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases/monopile.toml");
+    let study = Study::load(&path).unwrap();
+    let o = study.run_rfm(&study.rfm_options(), |_| {}).unwrap();
+    let p = &o.parameters[0];
+    assert!(p.updated / p.initial < 1e-4, "{} -> {}", p.initial, p.updated);
+    assert!(!o.warnings.iter().any(|w| w.contains("run-away")), "{:?}", o.warnings);
+    assert_eq!(o.status, Status::Converged);
+}
+
+/// At 6 % noise the RFM's misfit ends within the noise with the aluminium's
+/// beta on the bound it may not pass (a factor of 1e6 from its start): the
+/// run is a run-away, never converged.
+#[test]
+fn an_rfm_parameter_on_its_bound_makes_the_run_a_runaway() {
+    let study = beam(0.06);
+    let o = study.run_rfm(&study.rfm_options(), |_| {}).unwrap();
+    assert!(o.noise_ratio.unwrap() <= 1.5, "{:?}", o.noise_ratio);
+    assert!(o.warnings.iter().any(|w| w.starts_with("group.aluminium.beta ended a factor of 1e6")), "{:?}", o.warnings);
+    assert_eq!(o.status, Status::Runaway);
+}

@@ -1,0 +1,78 @@
+//! The RFM says when it cannot be trusted, through the binary: a parameter
+//! on its bound or run away, or a misfit worse than the start, is never a
+//! success, and the results are still written, marked so.
+
+use std::path::Path;
+
+use crate::fixtures::{case, rfm, text};
+
+/// `rfm update CASE --method rfm --out DIR [extra...]`.
+fn update_rfm(case: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
+    let mut args = vec!["update", case.to_str().unwrap(), "--method", "rfm", "--out", out.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    rfm(&args)
+}
+
+fn results(out: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap()
+}
+
+/// At 6 % noise the RFM's misfit ends within the noise with the
+/// aluminium's beta on the bound it may not pass, a factor of 1e6 from its
+/// start: the run is a run-away (exit code 12), not converged (it was, with
+/// exit code 0), and its results say so.
+#[test]
+fn an_rfm_parameter_on_its_bound_is_a_runaway_with_its_exit_code() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let run = update_rfm(&case("two-material-beam-noisy"), &out, &[]);
+    let (stdout, stderr) = (text(&run.stdout), text(&run.stderr));
+    assert_eq!(run.status.code(), Some(12), "{stdout}\n{stderr}");
+    assert!(stderr.contains("exit code 12: run-away: a parameter ended on its bound"), "{stderr}");
+    assert!(stdout.contains("runaway after"), "{stdout}");
+    assert!(stdout.contains("group.aluminium.beta ended a factor of 1e6 from its initial value"), "{stdout}");
+    let json = results(&out);
+    assert_eq!(json["status"], "runaway");
+    assert!(json["noise_ratio"].as_f64().unwrap() <= 1.5, "{}", json["noise_ratio"]);
+    let updated = std::fs::read_to_string(out.join("updated.toml")).unwrap();
+    assert!(updated.contains("status runaway"), "{updated}");
+}
+
+/// The monopile's mu starts 2e4 times its truth on purpose; recovered from
+/// exact data it moved by a factor of 5e-5, which the data hold: converged,
+/// exit code 0, no run-away warning.
+#[test]
+fn a_far_move_the_data_hold_is_converged_without_a_runaway() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let run = update_rfm(&case("monopile"), &out, &[]);
+    let stdout = text(&run.stdout);
+    assert_eq!(run.status.code(), Some(0), "{stdout}\n{}", text(&run.stderr));
+    assert!(!stdout.contains("run-away"), "{stdout}");
+    let json = results(&out);
+    assert_eq!(json["status"], "converged");
+    assert_eq!(json["warnings"], serde_json::json!([]));
+}
+
+/// At 20 % noise on four lines the RFM fits those lines within the noise
+/// and leaves the band worse than the initial model: it says so, exits with
+/// 11, and writes its results marked so.
+#[test]
+fn an_rfm_run_worse_than_its_start_says_so_and_exits_non_zero() {
+    let dir = tempfile::tempdir().unwrap();
+    let source = std::fs::read_to_string(case("two-material-beam-noisy")).unwrap();
+    let noisy = source.replacen("\nnoise = 0.06\n", "\nnoise = 0.2\n", 1).replacen("\nseed = 6\n", "\nseed = 3\n", 1);
+    assert_ne!(noisy, source);
+    let path = dir.path().join("beam-20.toml");
+    std::fs::write(&path, noisy).unwrap();
+    let out = dir.path().join("out");
+    let run = update_rfm(&path, &out, &["--lines", "4"]);
+    let (stdout, stderr) = (text(&run.stdout), text(&run.stderr));
+    assert_eq!(run.status.code(), Some(11), "{stdout}\n{stderr}");
+    assert!(stderr.contains("exit code 11: worse than the start"), "{stderr}");
+    assert!(stdout.contains("the update made the misfit over the band worse than the initial model's"), "{stdout}");
+    let json = results(&out);
+    assert_eq!(json["worse_than_start"], true);
+    let updated = std::fs::read_to_string(out.join("updated.toml")).unwrap();
+    assert!(updated.contains("WARNING: this update made the misfit WORSE"), "{updated}");
+}
