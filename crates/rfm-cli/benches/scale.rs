@@ -1,6 +1,7 @@
 //! How `rfm` scales with the size of the measured data (issue 14): reading
-//! a CSV file with many channels (`rfm inspect`), and comparing a model
-//! with many lines (`rfm compare`, with and without the report). Each run
+//! a CSV file with many channels (`rfm inspect`, as JSON and as text), and
+//! comparing a model with many lines (`rfm compare`, with and without the
+//! report). Each run
 //! is one process of the release binary, timed from outside, with its peak
 //! resident memory read from `/proc` while it runs.
 //!
@@ -141,8 +142,11 @@ fn main() {
     for &n in &channels {
         let path = d.join("channels.csv");
         std::fs::write(&path, many_channels(n)).expect("write");
-        let (t, mib) = timed(&["inspect", "--json", path.to_str().expect("utf-8 path")]);
-        println!("inspect, {n:>7} CSV channels x 3 lines: {:>7.2} s, peak {mib:>7.0} MiB", t.as_secs_f64());
+        let path = path.to_str().expect("utf-8 path");
+        let (t, mib) = timed(&["inspect", "--json", path]);
+        println!("inspect --json, {n:>7} CSV channels x 3 lines: {:>7.2} s, peak {mib:>7.0} MiB", t.as_secs_f64());
+        let (t, mib) = timed(&["inspect", path]);
+        println!("inspect (text), {n:>7} CSV channels x 3 lines: {:>7.2} s, peak {mib:>7.0} MiB", t.as_secs_f64());
     }
     let case = d.join("case.toml");
     std::fs::write(&case, CASE).expect("write");
