@@ -11,8 +11,7 @@
 //! in their order along the curve, draws the same pixels: every peak and
 //! every notch is at its exact height, and nothing between columns changes.
 //! Likewise a shaded span narrower than a pixel is drawn zero pixels wide
-//! and can be left out (and ticks in one column draw the same pixels, so
-//! the overlays draw one, `frf.rs`).
+//! and can be left out.
 
 /// The points of `points` that draw the same polyline: of each run of
 /// consecutive points in one pixel column, the first, the highest, the
