@@ -15,47 +15,97 @@ impl Table {
         self.rows.push(cells);
     }
 
-    /// True when every non-empty cell of column `i` reads as a number
-    /// (digits, signs, exponents, %, units after a space are not numbers).
-    fn numeric(&self, i: usize) -> bool {
-        self.rows.iter().filter_map(|r| r.get(i)).filter(|c| !c.is_empty()).all(|c| {
-            let c = c.trim_end_matches(" %").trim_end_matches('%');
-            c.parse::<f64>().is_ok() || c == "-" || c == "inf"
-        })
-    }
-
     pub(crate) fn render(&self) -> String {
-        let n = self.header.len();
-        let right: Vec<bool> = (0..n).map(|i| i > 0 && self.numeric(i)).collect();
-        let mut width = vec![0; n];
-        for r in std::iter::once(&self.header).chain(&self.rows) {
-            for (i, c) in r.iter().enumerate() {
-                width[i] = width[i].max(c.chars().count());
-            }
+        let mut layout = Layout::new(&self.header);
+        for r in &self.rows {
+            layout.add(r);
         }
-        let line = |r: &Vec<String>| {
-            r.iter()
-                .enumerate()
-                .map(
-                    |(i, c)| if right[i] { format!("{c:>w$}", w = width[i]) } else { format!("{c:<w$}", w = width[i]) },
-                )
-                .collect::<Vec<_>>()
-                .join("  ")
-        };
-        let mut out = line(&self.header).trim_end().to_string();
-        out.push('\n');
-        let rule: Vec<String> = width
-            .iter()
-            .zip(&self.header)
-            .map(|(w, h)| if h.is_empty() { String::new() } else { "-".repeat(*w) })
-            .collect();
-        out.push_str(rule.join("  ").trim_end());
+        let mut out = layout.head(&self.header);
         for r in &self.rows {
             out.push('\n');
-            out.push_str(line(r).trim_end());
+            out.push_str(&layout.line(r));
         }
         out
     }
+}
+
+/// Writes the table of `header` and the rows that `rows` makes, line by
+/// line, each followed by a newline: the text of [`Table::render`]. `rows`
+/// is called twice, once to lay the columns out and once to write them, so
+/// that only one row is held at a time (a listing of 500,000 channels
+/// would otherwise hold millions of cells).
+pub(crate) fn write_streamed<I: Iterator<Item = Vec<String>>>(
+    header: &[&str],
+    rows: impl Fn() -> I,
+    out: &mut impl std::io::Write,
+) -> std::io::Result<()> {
+    let header: Vec<String> = header.iter().map(|s| s.to_string()).collect();
+    let mut layout = Layout::new(&header);
+    for r in rows() {
+        layout.add(&r);
+    }
+    writeln!(out, "{}", layout.head(&header))?;
+    for r in rows() {
+        writeln!(out, "{}", layout.line(&r))?;
+    }
+    Ok(())
+}
+
+/// The widths and alignment of a table's columns, found one row at a time.
+struct Layout {
+    width: Vec<usize>,
+    /// Right-aligned: every non-empty cell below the header reads as a
+    /// number (the first column never is).
+    right: Vec<bool>,
+}
+
+impl Layout {
+    fn new(header: &[String]) -> Self {
+        Layout {
+            width: header.iter().map(|c| c.chars().count()).collect(),
+            right: (0..header.len()).map(|i| i > 0).collect(),
+        }
+    }
+
+    fn add(&mut self, row: &[String]) {
+        for (i, c) in row.iter().enumerate() {
+            self.width[i] = self.width[i].max(c.chars().count());
+            self.right[i] &= c.is_empty() || numeric(c);
+        }
+    }
+
+    /// The header line and the rule under it.
+    fn head(&self, header: &[String]) -> String {
+        let mut out = self.line(header);
+        out.push('\n');
+        let rule: Vec<String> = self
+            .width
+            .iter()
+            .zip(header)
+            .map(|(w, h)| if h.is_empty() { String::new() } else { "-".repeat(*w) })
+            .collect();
+        out.push_str(rule.join("  ").trim_end());
+        out
+    }
+
+    fn line(&self, r: &[String]) -> String {
+        let cells: Vec<String> = r
+            .iter()
+            .enumerate()
+            .map(|(i, c)| {
+                let w = self.width[i];
+                if self.right[i] { format!("{c:>w$}") } else { format!("{c:<w$}") }
+            })
+            .collect();
+        cells.join("  ").trim_end().to_string()
+    }
+}
+
+/// Whether a cell reads as a number (digits, signs, exponents, %; units
+/// after a space are not numbers).
+fn numeric(c: &str) -> bool {
+    let c = c.trim_end_matches(" %").trim_end_matches('%');
+    c.parse::<f64>().is_ok() || c == "-" || c == "inf"
 }
 
 /// A relative uncertainty as a percentage with two significant digits.

@@ -311,7 +311,8 @@ struct Arranged {
     index: Vec<Vec<usize>>,
     responses: Vec<DofRef>,
     references: Vec<DofRef>,
-    lines: Vec<usize>,
+    /// The lines of the band (indices into the set's lines).
+    lines: std::ops::Range<usize>,
 }
 
 fn arrange(set: &FrfSet, opts: &LscfOptions) -> Result<Arranged, LscfError> {
@@ -319,8 +320,9 @@ fn arrange(set: &FrfSet, opts: &LscfOptions) -> Result<Arranged, LscfError> {
         return Err(LscfError::NotReceptance { kind: set.kind() });
     }
     let (lo, hi) = opts.band_hz;
-    let lines: Vec<usize> =
-        (0..set.n_freq()).filter(|&k| set.frequencies_hz()[k] >= lo && set.frequencies_hz()[k] <= hi).collect();
+    // the lines of a set increase: those of the band are one run
+    let f = set.frequencies_hz();
+    let lines = f.partition_point(|&x| x < lo)..f.partition_point(|&x| x <= hi);
     let max_order = *opts.orders.end();
     let references = set.references();
     let mut responses: Vec<DofRef> = Vec::new();
@@ -346,14 +348,14 @@ fn arrange(set: &FrfSet, opts: &LscfOptions) -> Result<Arranged, LscfError> {
         index.push(row);
     }
     for (c, &channel) in set.channels().iter().enumerate() {
-        for &k in &lines {
+        for k in lines.clone() {
             let v = set.get(c, k);
             if !(v.re.is_finite() && v.im.is_finite()) {
                 return Err(LscfError::NotFinite { channel, freq_hz: set.frequencies_hz()[k] });
             }
         }
     }
-    let omega = lines.iter().map(|&k| 2.0 * std::f64::consts::PI * set.frequencies_hz()[k]).collect();
+    let omega = lines.clone().map(|k| 2.0 * std::f64::consts::PI * set.frequencies_hz()[k]).collect();
     Ok(Arranged { omega, index, responses, references, lines })
 }
 
@@ -394,8 +396,8 @@ pub fn lscf(set: &FrfSet, opts: &LscfOptions) -> Result<ModalEstimate, LscfError
     let arr = arrange(set, opts)?;
     let m = arr.references.len();
     let pmax = *opts.orders.end();
-    let f_first = set.frequencies_hz()[arr.lines[0]];
-    let f_last = set.frequencies_hz()[*arr.lines.last().unwrap()];
+    let f_first = set.frequencies_hz()[arr.lines.start];
+    let f_last = set.frequencies_hz()[arr.lines.end - 1];
     let dt = 1.0 / (2.0 * f_last);
     // responses without any signal add nothing (and would make R_o singular)
     let sums: Vec<LagSums> = (0..arr.responses.len())

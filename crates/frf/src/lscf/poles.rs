@@ -24,10 +24,17 @@ pub(super) fn lag_sums(set: &FrfSet, arr: &Arranged, o: usize, dt: f64, p: usize
     let mut r = vec![C64::new(0.0, 0.0); nl];
     let mut s = vec![vec![C64::new(0.0, 0.0); m]; nl];
     let mut t = vec![vec![C64::new(0.0, 0.0); m * m]; nl];
-    let rows: Vec<Vec<C64>> =
-        arr.lines.iter().map(|&k| arr.index[o].iter().map(|&c| set.get(c, k)).collect()).collect();
-    let rms = (rows.iter().flatten().map(|v| v.norm_sqr()).sum::<f64>() / rows.len() as f64).sqrt();
-    for (f, row) in rows.iter().enumerate() {
+    // the response's row at each line, read from the set (a copy of every
+    // row would hold a copy of the data)
+    let channels = &arr.index[o];
+    let mut row = vec![C64::new(0.0, 0.0); m];
+    let rms = (arr.lines.clone().flat_map(|k| channels.iter().map(move |&c| set.get(c, k).norm_sqr())).sum::<f64>()
+        / arr.lines.len() as f64)
+        .sqrt();
+    for (f, k) in arr.lines.clone().enumerate() {
+        for (v, &c) in row.iter_mut().zip(channels) {
+            *v = set.get(c, k);
+        }
         let mag = row.iter().map(|v| v.norm_sqr()).sum::<f64>().sqrt();
         // a line (or response) of zeros carries no information: weight 0
         let w2 = match weighting {

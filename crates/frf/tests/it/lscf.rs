@@ -264,3 +264,70 @@ fn unusable_input_is_refused_with_a_reason() {
     let empty = FrfSet::zeros(vec![1.0, 2.0], grid(&[tip], &[tip]), FrfKind::Receptance).unwrap();
     assert!(matches!(lscf(&empty, &opts).unwrap_err(), LscfError::Band { lines: 0, .. }));
 }
+
+/// The resident memory of this process (`VmRSS`) or its peak since the last
+/// reset (`VmHWM`), in bytes.
+#[cfg(target_os = "linux")]
+fn resident(key: &str) -> u64 {
+    let status = std::fs::read_to_string("/proc/self/status").unwrap();
+    let line = status.lines().find(|l| l.starts_with(key)).unwrap();
+    line.split_whitespace().nth(1).unwrap().parse::<u64>().unwrap() * 1024
+}
+
+/// The estimator holds what it needs a line at a time and the residue fit
+/// a block of lines: on 500,000 lines of two channels it adds less than
+/// the data's own size to what the process holds (the dense fit held its
+/// design matrix twice and a copy of the data, some six times the data).
+/// Measured in a process of its own, this test binary run again for this
+/// test alone, so that no other test's memory counts; its peak is reset
+/// (`/proc/self/clear_refs`) once the data are made.
+#[cfg(target_os = "linux")]
+#[test]
+fn lscf_on_many_lines_holds_less_than_a_copy_of_the_data() {
+    const NAME: &str = "lscf::lscf_on_many_lines_holds_less_than_a_copy_of_the_data";
+    if std::env::var_os("FRF_MEASURE_LSCF").is_none() {
+        let out = std::process::Command::new(std::env::current_exe().unwrap())
+            .args([NAME, "--exact", "--nocapture", "--test-threads=1"])
+            .env("FRF_MEASURE_LSCF", "1")
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{text}");
+        let field = |key: &str| -> f64 {
+            let at = text.find(key).unwrap_or_else(|| panic!("no `{key}` in {text}")) + key.len();
+            text[at..].split_whitespace().next().unwrap().parse().unwrap()
+        };
+        let (data, added) = (field("data bytes:"), field("added bytes:"));
+        assert!(added < data, "lscf added {added} bytes to {data} bytes of data");
+        return;
+    }
+    // two modes (12 and 31 Hz, 2 % damping) at responses 1 and 2 over reference 1
+    let n = 500_000;
+    let freqs: Vec<f64> = (0..n).map(|k| 2.0 + 48.0 * k as f64 / (n - 1) as f64).collect();
+    let reference = DofRef::new(1, Dof::Uy);
+    let channels = vec![Channel::new(reference, reference), Channel::new(DofRef::new(2, Dof::Uy), reference)];
+    let mut h = FrfSet::zeros(freqs.clone(), channels, FrfKind::Receptance).unwrap();
+    let modes = [(12.0, [1.0, 0.6]), (31.0, [0.8, -0.9])];
+    for (k, &f) in freqs.iter().enumerate() {
+        let w = 2.0 * std::f64::consts::PI * f;
+        for c in 0..2 {
+            let v: C64 = modes
+                .iter()
+                .map(|&(fk, phi)| {
+                    let wk = 2.0 * std::f64::consts::PI * fk;
+                    C64::new(phi[c] * phi[0], 0.0) / C64::new(wk * wk - w * w, 0.04 * wk * w)
+                })
+                .sum();
+            h.set(c, k, v);
+        }
+    }
+    let mut opts = LscfOptions::new(2.0, 50.0);
+    opts.orders = 4..=12;
+    std::fs::write("/proc/self/clear_refs", "5").unwrap();
+    let before = resident("VmRSS:");
+    let est = lscf(&h, &opts).unwrap();
+    let added = resident("VmHWM:").saturating_sub(before);
+    // the fit ran: both modes found
+    assert_eq!(est.modes.len(), 2, "{:?}", est.modes.iter().map(|m| m.frequency_hz).collect::<Vec<_>>());
+    println!("data bytes: {} added bytes: {added}", n * 2 * 16);
+}

@@ -14,7 +14,7 @@ pub(crate) fn inspect(file: &Path, json: bool) -> Result<Exit> {
     let report = match frf::io::detect_format(file)? {
         MeasuredFormat::Uff => uff_report(file)?,
         MeasuredFormat::Csv if json => return csv_json(file),
-        MeasuredFormat::Csv => csv_report(file)?,
+        MeasuredFormat::Csv => return csv_text(file),
     };
     if json {
         outln!("{}", serde_json::to_string_pretty(&report)?);
@@ -113,19 +113,6 @@ fn record_json(r: &Record58) -> Value {
     })
 }
 
-fn csv_report(file: &Path) -> Result<Value> {
-    let read = frf::io::csv::read_csv_with(file, &[])?;
-    let set = read.set;
-    let records: Vec<Value> = (0..set.channels().len()).map(|c| csv_record(&set, c)).collect();
-    Ok(json!({
-        "file": file.display().to_string(),
-        "format": "csv",
-        "records": records,
-        "skipped": [],
-        "notes": csv_notes(&read.notes, read.per_volt, &read.units),
-    }))
-}
-
 /// The record of channel `c` of a CSV file: what `inspect` shows of a UFF
 /// record, for a file that has no records.
 fn csv_record(set: &frf::FrfSet, c: usize) -> Value {
@@ -161,8 +148,9 @@ fn csv_notes(notes: &[String], per_volt: bool, units: &str) -> Vec<String> {
     out
 }
 
-/// The JSON of [`csv_report`], written record by record: a file of
-/// 500,000 channels would otherwise hold a JSON tree of several gigabytes.
+/// The JSON report of a CSV file (the shape of a UFF file's), written
+/// record by record: a file of 500,000 channels would otherwise hold a
+/// JSON tree of several gigabytes.
 fn csv_json(file: &Path) -> Result<Exit> {
     use serde::ser::SerializeSeq as _;
     use std::io::Write as _;
@@ -199,59 +187,89 @@ fn csv_json(file: &Path) -> Result<Exit> {
         .map_err(std::io::Error::from)
         .and_then(|()| writeln!(out))
         .and_then(|()| out.flush());
+    finished(written)
+}
+
+/// The text report of a CSV file, written line by line: the table of its
+/// channels is laid out in one pass over the set and written in a second,
+/// each record made when it is needed, so that a file of 500,000 channels
+/// is listed in the memory its set takes.
+fn csv_text(file: &Path) -> Result<Exit> {
+    use std::io::Write as _;
+
+    let read = frf::io::csv::read_csv_with(file, &[])?;
+    let notes = csv_notes(&read.notes, read.per_volt, &read.units);
+    let set = &read.set;
+    let n = set.channels().len();
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+    let mut write = || -> std::io::Result<()> {
+        writeln!(out, "{}", heading(&file.display().to_string(), true, n, 0))?;
+        if n > 0 {
+            let rows = || (0..n).map(|c| record_row(&csv_record(set, c)));
+            crate::table::write_streamed(&RECORD_COLUMNS, rows, &mut out)?;
+        }
+        for note in &notes {
+            writeln!(out, "note: {note}")?;
+        }
+        out.flush()
+    };
+    finished(write())
+}
+
+/// The end of a report written through a buffer.
+fn finished(written: std::io::Result<()>) -> Result<Exit> {
     match written {
-        // the reader has gone (`rfm inspect --json big.csv | head`): nothing is lost
+        // the reader has gone (`rfm inspect big.csv | head`): nothing is lost
         Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(Exit::Success),
         other => other.map(|()| Exit::Success).map_err(Into::into),
     }
 }
 
+/// The columns of the table of records.
+const RECORD_COLUMNS: [&str; 10] =
+    ["record", "line", "response", "reference", "function", "units", "abscissa", "values", "data type", "encoding"];
+
+/// The first line of a report: the file, its format and what it holds.
+fn heading(file: &str, csv: bool, records: usize, skipped: usize) -> String {
+    let count = |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
+    format!(
+        "{file}: {}, {}{}",
+        if csv { "CSV (channels name model DOFs)" } else { "universal file" },
+        if csv { count(records, "channel", "channels") } else { count(records, "dataset 58", "datasets 58") },
+        if skipped == 0 {
+            String::new()
+        } else {
+            format!(", {} skipped", count(skipped, "other dataset", "other datasets"))
+        }
+    )
+}
+
+/// The row of a record (UFF or CSV) in the table of records.
+fn record_row(r: &Value) -> Vec<String> {
+    vec![
+        r["record"].to_string(),
+        r["line"].as_u64().map_or("-".into(), |l| l.to_string()),
+        dof_text(&r["response"]),
+        dof_text(&r["reference"]),
+        function_text(r),
+        units_text(&r["units"]),
+        abscissa_text(&r["abscissa"]),
+        r["abscissa"]["count"].to_string(),
+        r["data_type"]["name"].as_str().unwrap_or_default().to_string(),
+        r["encoding"].as_str().unwrap_or_default().to_string(),
+    ]
+}
+
+/// The text report of a UFF file, from its JSON.
 fn print_report(report: &Value) -> Result<()> {
     let records = report["records"].as_array().map(Vec::as_slice).unwrap_or_default();
     let skipped = report["skipped"].as_array().map(Vec::as_slice).unwrap_or_default();
-    let csv = report["format"] == "csv";
-    let count = |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
-    outln!(
-        "{}: {}, {}{}",
-        report["file"].as_str().unwrap_or_default(),
-        if csv { "CSV (channels name model DOFs)" } else { "universal file" },
-        if csv {
-            count(records.len(), "channel", "channels")
-        } else {
-            count(records.len(), "dataset 58", "datasets 58")
-        },
-        if skipped.is_empty() {
-            String::new()
-        } else {
-            format!(", {} skipped", count(skipped.len(), "other dataset", "other datasets"))
-        }
-    );
+    let file = report["file"].as_str().unwrap_or_default();
+    outln!("{}", heading(file, report["format"] == "csv", records.len(), skipped.len()));
     if !records.is_empty() {
-        let mut t = Table::new(&[
-            "record",
-            "line",
-            "response",
-            "reference",
-            "function",
-            "units",
-            "abscissa",
-            "values",
-            "data type",
-            "encoding",
-        ]);
+        let mut t = Table::new(&RECORD_COLUMNS);
         for r in records {
-            t.row(vec![
-                r["record"].to_string(),
-                r["line"].as_u64().map_or("-".into(), |l| l.to_string()),
-                dof_text(&r["response"]),
-                dof_text(&r["reference"]),
-                function_text(r),
-                units_text(&r["units"]),
-                abscissa_text(&r["abscissa"]),
-                r["abscissa"]["count"].to_string(),
-                r["data_type"]["name"].as_str().unwrap_or_default().to_string(),
-                r["encoding"].as_str().unwrap_or_default().to_string(),
-            ]);
+            t.row(record_row(r));
         }
         outln!("{}", t.render());
     }

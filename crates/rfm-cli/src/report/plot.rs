@@ -16,13 +16,15 @@
 //! styles), [`frame`] (the SVG backend, title and legend), [`axes`] (log
 //! axes, ticks, the frequency axis and the continuous phase); the figures
 //! of the correlation are in [`correlation`], those of the iteration in
-//! [`history`].
+//! [`history`]. Curves with more points than pixel columns are thinned to
+//! the points that draw them ([`decimate`]).
 
 // `::frf` is the crate; `frf` alone is the overlay module below
 use ::frf::C64;
 
 pub(crate) mod axes;
 mod correlation;
+mod decimate;
 mod frame;
 pub(crate) mod frf;
 mod history;

@@ -96,6 +96,7 @@ pub(crate) fn error_vs_frequency(
             for c in curves.iter().rev() {
                 let y: Vec<f64> = c.lines.iter().map(|l| if panel == 0 { l.rms_db } else { l.rms_phase_deg }).collect();
                 for seg in segments(&f, &y, None) {
+                    let seg = super::decimate::per_pixel_column(&seg, |p| chart.backend_coord(p));
                     chart.draw_series(LineSeries::new(seg, c.colour.stroke_width(2)))?;
                 }
             }
@@ -186,8 +187,29 @@ pub(crate) fn channel_errors(title: &str, names: &[String], series: &[ChannelSer
 
 #[cfg(test)]
 mod tests {
+    use super::super::decimate::{most_per_column, polylines};
     use super::super::{INITIAL, UPDATED};
     use super::*;
+
+    #[test]
+    fn errors_at_a_million_lines_draw_at_most_four_points_per_pixel_column() {
+        let n = 1_000_000;
+        let lines: Vec<LineError> = (0..n)
+            .map(|k| {
+                let f = 1.0 + 399.0 * k as f64 / (n - 1) as f64;
+                let ripple = if k % 2 == 0 { 1.0 } else { -1.0 };
+                LineError { frequency_hz: f, rms_db: 3.0 + ripple, rms_phase_deg: 10.0 + ripple, log_misfit: 0.1 }
+            })
+            .collect();
+        let curves = [ErrorCurve { label: "model".into(), colour: UPDATED, lines: &lines }];
+        let svg = error_vs_frequency("errors", &curves, &[], axes::FrequencyScale::Linear).unwrap();
+        let drawn = polylines(&svg, "stroke-width=\"2\"");
+        // dB and phase
+        assert_eq!(drawn.iter().filter(|l| l.len() > 2).count(), 2);
+        for line in &drawn {
+            assert!(most_per_column(line) <= 4, "{} points in a pixel column", most_per_column(line));
+        }
+    }
 
     #[test]
     fn channel_errors_are_bars_and_dots_not_lines() {

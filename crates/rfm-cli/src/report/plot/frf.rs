@@ -7,12 +7,15 @@
 //! so that a model that matches shows as a coloured line inside the black
 //! one. The lines used for updating are ticks on the frequency axis (marks
 //! on the curve would bury it), lines of poor coherence are shaded, and the
-//! phase is drawn continuous ([`super::axes::phases`]).
+//! phase is drawn continuous ([`super::axes::phases`]). Curves and shades
+//! of more lines than pixel columns are thinned to what draws them
+//! ([`super::decimate`]).
 
 use frf::{C64, FrfKind};
 use plotters::prelude::*;
 
 use super::axes::{FreqAxis, FrequencyScale, PhaseAxis, phases};
+use super::decimate::{per_pixel_column, spans_per_pixel};
 use super::{
     Area, DrawResult, FONT, HouseStyle, LegendEntry, MEASURED, Mark, PlotError, frame, range, segments, svg, tick, unit,
 };
@@ -197,7 +200,8 @@ fn draw_channel(
         .y_label_area_size(style.y_area)
         .build_cartesian_2d(axis, y0..y1)?;
     // the shading first, so that the grid and the curves stay on top
-    chart.draw_series(spans.iter().map(|&(a, b, l)| Rectangle::new([(a, y0), (b, y1)], shade(l).filled())))?;
+    let drawn = spans_per_pixel(&spans, |x| chart.backend_coord(&(x, y0)).0);
+    chart.draw_series(drawn.iter().map(|&(a, b, l)| Rectangle::new([(a, y0), (b, y1)], shade(l).filled())))?;
     let mut mesh = chart.configure_mesh();
     mesh.y_desc(y_desc)
         .x_label_formatter(&x_label)
@@ -214,6 +218,7 @@ fn draw_channel(
     for (i, c) in panel.curves.iter().enumerate() {
         let line = c.colour.stroke_width(width_of(i, style.compact));
         for seg in segments(&shown, &db[i], None) {
+            let seg = per_pixel_column(&seg, |p| chart.backend_coord(p));
             chart.draw_series(LineSeries::new(seg, line))?;
         }
     }
@@ -232,8 +237,9 @@ fn draw_channel(
         .x_label_area_size(if style.compact { 34 } else { 44 })
         .y_label_area_size(style.y_area)
         .build_cartesian_2d(axis, phase_axis)?;
+    let drawn = spans_per_pixel(&spans, |x| chart.backend_coord(&(x, phase_axis.lo)).0);
     chart.draw_series(
-        spans.iter().map(|&(a, b, l)| Rectangle::new([(a, phase_axis.lo), (b, phase_axis.hi)], shade(l).filled())),
+        drawn.iter().map(|&(a, b, l)| Rectangle::new([(a, phase_axis.lo), (b, phase_axis.hi)], shade(l).filled())),
     )?;
     chart
         .configure_mesh()
@@ -250,6 +256,7 @@ fn draw_channel(
         // a jump of more than half a turn is a model crossing the measured
         // phase's opposite: split there rather than draw a vertical line
         for seg in segments(&shown, &phase[i], Some(360.0)) {
+            let seg = per_pixel_column(&seg, |p| chart.backend_coord(p));
             chart.draw_series(LineSeries::new(seg, line))?;
         }
     }
@@ -306,6 +313,7 @@ pub(crate) const PANELS_PER_FIGURE: usize = 12;
 
 #[cfg(test)]
 mod tests {
+    use super::super::decimate::{most_per_column, polylines};
     use super::*;
 
     fn curves<'a>(x: &'a [C64], a: &'a [C64]) -> Vec<FrfCurve<'a>> {
@@ -372,6 +380,87 @@ mod tests {
         assert!(svg.contains("Frequency (Hz, logarithmic)"));
         // two curves in two panels each, in five channels
         assert!(svg.matches("<polyline").count() >= 20);
+    }
+
+    #[test]
+    fn a_million_lines_draw_at_most_four_points_per_pixel_column_with_the_peak_in_place() {
+        let n = 1_000_000;
+        let f: Vec<f64> = (0..n).map(|k| 1.0 + 399.0 * k as f64 / (n - 1) as f64).collect();
+        // a resonance at 143 Hz with a ripple of 5 % from line to line, as noise makes
+        let x: Vec<C64> = f
+            .iter()
+            .enumerate()
+            .map(|(k, &v)| {
+                let r = v / 143.0;
+                let ripple = if k % 2 == 0 { 1.05 } else { 0.95 };
+                C64::new(1e-6 * ripple, 0.0) / C64::new(1.0 - r * r, 0.02 * r)
+            })
+            .collect();
+        let figure = |f: &[f64], x: &[C64]| {
+            frf_overlay(&FrfFigure {
+                title: "H(2:uy,11:uy)".into(),
+                frequencies_hz: f,
+                kind: FrfKind::Receptance,
+                panels: vec![FrfPanel {
+                    title: String::new(),
+                    curves: vec![FrfCurve { label: "measured".into(), colour: MEASURED, values: x }],
+                    coherence: None,
+                }],
+                ticks_hz: &[],
+                coherence_threshold: 0.8,
+                scale: FrequencyScale::Linear,
+            })
+            .unwrap()
+        };
+        // the measurement is drawn 3 px wide: its magnitude, then its phase
+        let drawn = polylines(&figure(&f, &x), "stroke-width=\"3\"");
+        assert_eq!(drawn.len(), 2);
+        for line in &drawn {
+            assert!(most_per_column(line) <= 4, "{} points in a pixel column", most_per_column(line));
+        }
+        // the same curve at a few hundred of its lines, among them the first,
+        // the last, the peak and the lowest: a figure with the same axes,
+        // whose curve has fewer points than pixel columns and is drawn point
+        // for point
+        let by_norm = |a: &(usize, &C64), b: &(usize, &C64)| a.1.norm().total_cmp(&b.1.norm());
+        let peak = x.iter().enumerate().max_by(by_norm).unwrap().0;
+        let low = x.iter().enumerate().min_by(by_norm).unwrap().0;
+        let mut keep: Vec<usize> = (0..n).step_by(4001).chain([peak, low, n - 1]).collect();
+        keep.sort_unstable();
+        keep.dedup();
+        let (fs, xs): (Vec<f64>, Vec<C64>) = keep.iter().map(|&k| (f[k], x[k])).unzip();
+        let sparse = polylines(&figure(&fs, &xs), "stroke-width=\"3\"");
+        assert_eq!(sparse[0].len(), keep.len());
+        // drawn y grows downwards: the peak is the least y, the lowest point the greatest
+        let highest = |l: &[(i32, i32)]| l.iter().map(|p| p.1).min();
+        let lowest = |l: &[(i32, i32)]| l.iter().map(|p| p.1).max();
+        assert_eq!(highest(&drawn[0]), highest(&sparse[0]));
+        assert_eq!(lowest(&drawn[0]), lowest(&sparse[0]));
+    }
+
+    #[test]
+    fn coherence_changing_at_every_one_of_a_million_lines_is_shaded_with_at_most_a_shade_per_pixel_column() {
+        let f: Vec<f64> = (0..1_000_000).map(|k| 1.0 + f64::from(k) * 1e-4).collect();
+        let x: Vec<C64> = f.iter().map(|&v| C64::new(1.0 / v, 0.1)).collect();
+        let coherence: Vec<f64> = (0..f.len()).map(|k| [0.99, 0.7, 0.3][k % 3]).collect();
+        let svg = frf_overlay(&FrfFigure {
+            title: "H(3:uy,3:uy)".into(),
+            frequencies_hz: &f,
+            kind: FrfKind::Receptance,
+            panels: vec![FrfPanel {
+                title: String::new(),
+                curves: vec![FrfCurve { label: "measured".into(), colour: MEASURED, values: &x }],
+                coherence: Some(&coherence),
+            }],
+            ticks_hz: &[],
+            coherence_threshold: 0.8,
+            scale: FrequencyScale::Linear,
+        })
+        .unwrap();
+        let fill = |c: RGBColor| format!("fill=\"#{:02X}{:02X}{:02X}\"", c.0, c.1, c.2);
+        let shades = svg.matches(&fill(COHERENCE_SHADE)).count() + svg.matches(&fill(COHERENCE_DARK)).count();
+        // both panels, at most one shade per pixel column of the figure, and the legend's two
+        assert!(shades >= 2 && shades <= 2 * super::super::WIDTH as usize + 2, "{shades} shades");
     }
 
     #[test]

@@ -184,6 +184,7 @@ pub(crate) fn stabilisation(
                 .filter(|(f, v)| axis.shows(**f) && v.is_finite())
                 .map(|(&f, &v)| (f, 0.5 + (y_top - 1.0) * (v - lo) / (hi - lo)))
                 .collect();
+            let pts = super::decimate::per_pixel_column(&pts, |p| chart.backend_coord(p));
             chart.draw_series(LineSeries::new(pts, GRID_BOLD.stroke_width(2)))?;
         }
         for &f in modes_hz.iter().filter(|f| axis.shows(**f)) {
@@ -220,6 +221,19 @@ mod tests {
         assert_eq!(svg.matches("stroke=\"#000000\" stroke-width=\"3\"").count(), 2 + 1);
         assert_eq!(mac_colour(0.0), RGBColor(255, 255, 255));
         assert_eq!(mac_colour(1.0), RGBColor(8, 48, 107));
+    }
+
+    #[test]
+    fn the_summed_magnitude_of_a_million_lines_draws_at_most_four_points_per_pixel_column() {
+        let f: Vec<f64> = (0..1_000_000).map(|k| 1.0 + f64::from(k) * 1e-4).collect();
+        let m: Vec<f64> = f.iter().map(|&x| 1.0 / (1.0 + (x - 20.0).powi(2))).collect();
+        let points = [StabilisationPoint { frequency_hz: 20.0, order: 4, status: PoleStatus::Stable }];
+        let svg = stabilisation(&points, &[20.0], &f, &m, FrequencyScale::Linear).unwrap();
+        let drawn = super::super::decimate::polylines(&svg, "stroke-width=\"2\"");
+        let curve = drawn.iter().max_by_key(|l| l.len()).unwrap();
+        assert!(curve.len() > 100, "{} points", curve.len());
+        let most = super::super::decimate::most_per_column(curve);
+        assert!(most <= 4, "{most} points in a pixel column");
     }
 
     #[test]
