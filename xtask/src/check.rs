@@ -5,7 +5,7 @@
 //! Anything the check needs and the results lack is a failure too, so that
 //! a check never passes by having nothing to look at.
 
-use fe_model::case::{DiagnosisCheck, RunCheck};
+use fe_model::case::{DiagnosisCheck, RUN_STATUSES, RunCheck};
 use serde_json::Value;
 
 /// The status of a `results.json`: a plain name, or the key of a status
@@ -129,6 +129,57 @@ pub(crate) fn diagnosis_failures(check: &DiagnosisCheck, diagnosis: &Value, upda
     out
 }
 
+/// The update of a diagnosis loop (`results.json` with the leader added)
+/// against the check's `status` and the truth that made the data: each
+/// parameter the check's `compare` names within `within_sd` of its true
+/// value (`truths`, one per entry of `compare`, `Err` saying why there is
+/// none), and the residual RMS within `noise` of the truth's noise level
+/// (`None` without a truth).
+pub(crate) fn loop_update_failures(
+    check: &DiagnosisCheck,
+    results: &Value,
+    truths: &[Result<f64, String>],
+    noise: Option<f64>,
+) -> Vec<String> {
+    let mut out = Vec::new();
+    let empty = Vec::new();
+    let params = results["parameters"].as_array().unwrap_or(&empty);
+    let unc = results["uncertainty"]["parameters"].as_array().unwrap_or(&empty);
+    // the compared parameters alone, each with its truth, in the order of `compare`
+    let (mut compared, mut compared_unc) = (Vec::new(), Vec::new());
+    for ((name, truth_name), truth) in check.compare.iter().zip(truths) {
+        let by_name = |list: &Vec<Value>| list.iter().find(|p| p["name"].as_str() == Some(name)).cloned();
+        let (Some(mut p), Some(u)) = (by_name(params), by_name(unc)) else {
+            out.push(format!("{name}: not among the updated parameters and their uncertainty"));
+            continue;
+        };
+        match truth {
+            Ok(t) => p["truth"] = Value::from(*t),
+            Err(why) => out.push(format!("{name}: no true value from {truth_name} ({why})")),
+        }
+        compared.push(p);
+        compared_unc.push(u);
+    }
+    let mut narrowed = results.clone();
+    if !check.compare.is_empty() {
+        narrowed["parameters"] = Value::Array(compared);
+        narrowed["uncertainty"]["parameters"] = Value::Array(compared_unc);
+    }
+    let run = RunCheck {
+        status: if check.status.is_empty() {
+            RUN_STATUSES.iter().map(|s| s.to_string()).collect()
+        } else {
+            check.status.clone()
+        },
+        max_error: None,
+        within_sd: check.within_sd,
+        weak: Vec::new(),
+        noise: check.noise,
+    };
+    out.extend(run_failures(&run, &narrowed, noise));
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -202,7 +253,15 @@ mod tests {
 
     #[test]
     fn the_diagnosis_must_name_its_leader_and_lower_the_misfit() {
-        let c = DiagnosisCheck { leader: "joint at node 13".into(), misfit_fall: Some(10.0) };
+        let c = DiagnosisCheck {
+            leader: "joint at node 13".into(),
+            misfit_fall: Some(10.0),
+            status: Vec::new(),
+            truth: None,
+            compare: Vec::new(),
+            within_sd: None,
+            noise: None,
+        };
         let d = json!({
             "nominal_misfit": 1.39,
             "ranking": [{ "description": "flexible, lossy joint at node 13 (element 13)", "significant": true }],
@@ -216,5 +275,51 @@ mod tests {
         });
         assert_eq!(diagnosis_failures(&c, &wrong, 0.0099).len(), 2);
         assert_eq!(diagnosis_failures(&c, &json!({ "ranking": [] }), 0.0099).len(), 2);
+    }
+
+    #[test]
+    fn the_loop_update_is_held_to_the_truth_that_made_the_data() {
+        let c = DiagnosisCheck {
+            leader: "in-line joint at node 9".into(),
+            misfit_fall: None,
+            status: vec!["converged".into()],
+            truth: Some("lap-joint-truth.toml".into()),
+            compare: vec![("spring.joint_9_9.kr".into(), "spring.lap.kr".into())],
+            within_sd: Some(3.0),
+            noise: None,
+        };
+        let results = |kr: f64, status: &str| {
+            json!({
+                "status": status,
+                "parameters": [
+                    { "name": "spring.joint_9_9.kr", "updated": kr },
+                    { "name": "group.joint_9_9.alpha", "updated": 2.1e-4 },
+                ],
+                "uncertainty": {
+                    "parameters": [
+                        { "name": "spring.joint_9_9.kr", "relative_std": 0.001, "well_determined": true },
+                        { "name": "group.joint_9_9.alpha", "relative_std": 0.001, "well_determined": true },
+                    ],
+                    "residual_rms": 0.0047,
+                },
+            })
+        };
+        // 2 sd from the truth passes; the alpha the check does not compare is not judged
+        assert!(loop_update_failures(&c, &results(2000.0 * 1.002, "converged"), &[Ok(2000.0)], Some(0.01)).is_empty());
+        let f = loop_update_failures(&c, &results(2000.0 * 1.004, "converged"), &[Ok(2000.0)], Some(0.01));
+        assert!(f.len() == 1 && f[0].starts_with("spring.joint_9_9.kr:") && f[0].contains("3.99 standard deviations"));
+        let f = loop_update_failures(&c, &results(2000.0, "model_inadequate"), &[Ok(2000.0)], Some(0.01));
+        assert_eq!(f, vec!["status `model_inadequate`, the check allows converged".to_string()]);
+        // a truth the truth's model lacks, or a parameter the update lacks, is a failure
+        let f = loop_update_failures(&c, &results(2000.0, "converged"), &[Err("no spring `lap`".into())], Some(0.01));
+        assert!(f.iter().any(|f| f.contains("no true value from spring.lap.kr (no spring `lap`)")), "{f:?}");
+        let mut renamed = results(2000.0, "converged");
+        renamed["parameters"][0]["name"] = json!("spring.joint_9_10.kr");
+        let f = loop_update_failures(&c, &renamed, &[Ok(2000.0)], Some(0.01));
+        assert!(f.iter().any(|f| f.contains("not among the updated parameters")), "{f:?}");
+        // the residual against the truth's noise level
+        let noisy = DiagnosisCheck { noise: Some(0.2), ..c.clone() };
+        let f = loop_update_failures(&noisy, &results(2000.0, "converged"), &[Ok(2000.0)], Some(0.01));
+        assert!(f.len() == 1 && f[0].contains("53.0 % from the truth's noise 0.01"), "{f:?}");
     }
 }

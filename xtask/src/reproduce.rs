@@ -26,10 +26,14 @@ const MORE_CASES: [&str; 1] = ["imported/table"];
 /// The loops: a name (as `reproduce` takes it) and its case, a model
 /// missing an effect and data with it (a data file, or the case's
 /// `[truth]`), held to the case's `[check.diagnosis]`. The tutorial's is
-/// the walkthrough of `docs/walkthrough.md`; the table's is a frame in
-/// space with a loose corner joint.
-const LOOPS: [(&str, &str); 2] =
-    [("tutorial", "cases/tutorial/l-frame.toml"), ("table-frame", "cases/table-frame.toml")];
+/// the walkthrough of `docs/walkthrough.md`; the lap joint's that of
+/// `docs/walkthrough-test-data.md` (test data per volt, with coherence);
+/// the table's is a frame in space with a loose corner joint.
+const LOOPS: [(&str, &str); 3] = [
+    ("tutorial", "cases/tutorial/l-frame.toml"),
+    ("lap-joint", "cases/tutorial/lap-joint.toml"),
+    ("table-frame", "cases/table-frame.toml"),
+];
 
 /// One finished `rfm update` run, as its summary row, with the check it was
 /// held to and what it missed.
@@ -214,6 +218,39 @@ pub(crate) fn reproduce(cases: &[String]) -> Result<(), String> {
     Ok(())
 }
 
+/// The update of a loop against its check's `status` and the case whose
+/// `[truth]` made its data (`[check.diagnosis]`'s `truth`), as
+/// [`check::loop_update_failures`]; nothing when the check sets neither.
+/// The true values of the compared parameters are written into `results`
+/// for the summary's columns.
+fn loop_update_failures(check: &fe_model::case::DiagnosisCheck, results: &mut serde_json::Value) -> Vec<String> {
+    let Some(path) = &check.truth else {
+        if check.status.is_empty() {
+            return Vec::new();
+        }
+        return check::loop_update_failures(check, results, &[], None);
+    };
+    let truth = match CaseFile::load(path) {
+        Ok(case) => case.truth,
+        Err(e) => return vec![format!("the truth {}: {e}", path.display())],
+    };
+    let Some(truth) = truth else { return vec![format!("the truth {} has no [truth]", path.display())] };
+    let values: Vec<Result<f64, String>> = check
+        .compare
+        .iter()
+        .map(|(_, name)| truth.model.quantity(name).map(|q| truth.model.get(q)).map_err(|e| e.to_string()))
+        .collect();
+    let failures = check::loop_update_failures(check, results, &values, Some(truth.noise));
+    if let Some(params) = results["parameters"].as_array_mut() {
+        for ((name, _), value) in check.compare.iter().zip(&values) {
+            if let (Some(p), Ok(v)) = (params.iter_mut().find(|p| p["name"].as_str() == Some(name)), value) {
+                p["truth"] = serde_json::Value::from(*v);
+            }
+        }
+    }
+    failures
+}
+
 /// One of the [`LOOPS`] (the tutorial's is the walkthrough of
 /// `docs/walkthrough.md`): compare the model with its data, diagnose, add
 /// the leading effect, update, and hold the result to the case's
@@ -261,7 +298,9 @@ fn diagnosis_loop(
     // diagnosis over every line, the update over its chosen lines)
     let nominal = json["nominal_misfit"].as_f64().unwrap_or(f64::NAN);
     let last = run.json["residual"].as_f64().unwrap_or(f64::NAN);
-    run.failures = Some(check::diagnosis_failures(check, &json, last));
+    let mut failures = check::diagnosis_failures(check, &json, last);
+    failures.extend(loop_update_failures(check, &mut run.json));
+    run.failures = Some(failures);
     runs.push(run);
     let leader = ranking.first().and_then(|l| l["description"].as_str()).unwrap_or("?");
     Ok(format!(

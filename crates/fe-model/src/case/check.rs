@@ -75,9 +75,63 @@ pub(super) fn parse_check(
             {
                 return Err(ctx.err(f.span(), "`misfit_fall` is a factor of at least 1"));
             }
+            // the update with the leader added, against the truth that made the data
+            let needs_truth = |span: std::ops::Range<usize>, key: &str| {
+                ctx.err(span, format!("`{key}` compares with the truth that made the data: name its case in `truth`"))
+            };
+            let positive = |v: &Option<Spanned<f64>>, key: &str| -> Result<Option<f64>, CaseError> {
+                let Some(v) = v else { return Ok(None) };
+                if !(*v.get_ref() > 0.0 && v.get_ref().is_finite()) {
+                    return Err(ctx.err(v.span(), format!("`{key}` must be positive and finite")));
+                }
+                if r.truth.is_none() {
+                    return Err(needs_truth(v.span(), key));
+                }
+                Ok(Some(*v.get_ref()))
+            };
+            for s in &r.status {
+                if !RUN_STATUSES.contains(&s.get_ref().as_str()) {
+                    let hint = hint(s.get_ref(), &RUN_STATUSES, "available");
+                    return Err(ctx.err(s.span(), format!("unknown status `{}`{hint}", s.get_ref())));
+                }
+            }
+            let within_sd = positive(&r.within_sd, "within_sd")?;
+            let noise = positive(&r.noise, "noise")?;
+            let compare: Vec<(String, String)> = match &r.compare {
+                None => Vec::new(),
+                Some(c) => {
+                    if r.truth.is_none() {
+                        return Err(needs_truth(c.span(), "compare"));
+                    }
+                    if c.get_ref().is_empty() || within_sd.is_none() {
+                        return Err(ctx.err(
+                            c.span(),
+                            "`compare` names updated parameters and their true quantities for `within_sd`, \
+                             which needs both",
+                        ));
+                    }
+                    c.get_ref().iter().map(|(k, v)| (k.clone(), v.get_ref().clone())).collect()
+                }
+            };
+            if let (Some(w), true) = (&r.within_sd, compare.is_empty()) {
+                return Err(ctx.err(w.span(), "`within_sd` checks the parameters `compare` names, and it names none"));
+            }
+            let truth = r.truth.as_ref().map(|t| {
+                let p = std::path::Path::new(t.get_ref());
+                if p.is_absolute() {
+                    p.to_path_buf()
+                } else {
+                    ctx.path.parent().unwrap_or(std::path::Path::new(".")).join(p)
+                }
+            });
             Some(DiagnosisCheck {
                 leader: r.leader.get_ref().clone(),
                 misfit_fall: r.misfit_fall.as_ref().map(|f| *f.get_ref()),
+                status: r.status.iter().map(|s| s.get_ref().clone()).collect(),
+                truth,
+                compare,
+                within_sd,
+                noise,
             })
         }
     };

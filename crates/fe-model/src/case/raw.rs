@@ -385,4 +385,10 @@ pub(super) struct RawRunCheck {
 pub(super) struct RawDiagnosisCheck {
     pub(super) leader: Spanned<String>,
     pub(super) misfit_fall: Option<Spanned<f64>>,
+    #[serde(default)]
+    pub(super) status: Vec<Spanned<String>>,
+    pub(super) truth: Option<Spanned<String>>,
+    pub(super) compare: Option<Spanned<BTreeMap<String, Spanned<String>>>>,
+    pub(super) within_sd: Option<Spanned<f64>>,
+    pub(super) noise: Option<Spanned<f64>>,
 }

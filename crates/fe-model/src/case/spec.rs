@@ -3,6 +3,7 @@
 //! the acceptance checks. Plain data, checked when read.
 
 use std::ops::Range;
+use std::path::PathBuf;
 
 use crate::model::Model;
 use crate::quantity::{Parameter, Quantity};
@@ -147,4 +148,21 @@ pub struct DiagnosisCheck {
     /// How many times at least the misfit must fall once the leading
     /// candidate is added and updated.
     pub misfit_fall: Option<f64>,
+    /// The statuses the update with the leader added may end with (names
+    /// of [`RUN_STATUSES`]; empty: any). `converged` says that the residual
+    /// is consistent with the noise of the data.
+    pub status: Vec<String>,
+    /// The case whose `[truth]` made the data (a case that reads its data
+    /// from a file keeps its truth apart), resolved from the case's folder:
+    /// what `compare`, `within_sd` and `noise` compare with.
+    pub truth: Option<PathBuf>,
+    /// Parameters of the update with the leader added, each with the
+    /// quantity of the truth's model that holds its true value.
+    pub compare: Vec<(String, String)>,
+    /// Largest `|ln(updated / truth)|` of each compared parameter, in the
+    /// update's own standard deviations of `ln p`.
+    pub within_sd: Option<f64>,
+    /// Largest relative distance between the residual RMS the update
+    /// leaves and the truth's noise level.
+    pub noise: Option<f64>,
 }

@@ -250,7 +250,18 @@ fn check_tables_are_read_per_run() {
     assert_eq!((oe.within_sd, oe.noise, oe.weak), (Some(3.0), Some(0.1), vec!["group.beam.stiffness".to_string()]));
     let d = c.diagnosis.unwrap();
     assert_eq!((d.leader.as_str(), d.misfit_fall), ("joint at node 3", Some(10.0)));
+    assert!(d.status.is_empty() && d.truth.is_none() && d.compare.is_empty());
     assert!(parse(&checked("")).unwrap().check.is_none());
+    // the update of the loop against the truth that made the data, from the case's folder
+    let text = checked(
+        "[check.diagnosis]\nleader = \"joint\"\nstatus = [\"converged\"]\ntruth = \"t.toml\"\n\
+         compare = { \"spring.j.kr\" = \"spring.lap.kr\" }\nwithin_sd = 3\nnoise = 0.2\n",
+    );
+    let d = parse(&text).unwrap().check.unwrap().diagnosis.unwrap();
+    assert_eq!(d.status, vec!["converged".to_string()]);
+    assert_eq!(d.compare, vec![("spring.j.kr".to_string(), "spring.lap.kr".to_string())]);
+    assert_eq!((d.within_sd, d.noise), (Some(3.0), Some(0.2)));
+    assert_eq!(d.truth.as_deref().and_then(|p| p.file_name()), Some(std::ffi::OsStr::new("t.toml")));
 }
 
 #[test]
@@ -289,6 +300,31 @@ fn check_errors_name_the_key_and_its_line() {
         ),
         ("[check.diagnosis]\nleader = \" \"\n", "leader = \" \"", "`leader` must name the effect"),
         ("[check.diagnosis]\nleader = \"joint\"\nmisfit_fall = 0.5\n", "misfit_fall = 0.5", "a factor of at least 1"),
+        (
+            "[check.diagnosis]\nleader = \"joint\"\nstatus = [\"convergd\"]\n",
+            "status = [\"convergd\"]",
+            "unknown status `convergd`; did you mean `converged`?",
+        ),
+        (
+            "[check.diagnosis]\nleader = \"joint\"\nwithin_sd = 3\n",
+            "within_sd = 3",
+            "`within_sd` compares with the truth that made the data: name its case in `truth`",
+        ),
+        (
+            "[check.diagnosis]\nleader = \"joint\"\ntruth = \"t.toml\"\nwithin_sd = 3\n",
+            "within_sd = 3",
+            "`within_sd` checks the parameters `compare` names, and it names none",
+        ),
+        (
+            "[check.diagnosis]\nleader = \"joint\"\ntruth = \"t.toml\"\ncompare = { \"a.b.c\" = \"d.e.f\" }\n",
+            "compare = { \"a.b.c\" = \"d.e.f\" }",
+            "`compare` names updated parameters and their true quantities for `within_sd`, which needs both",
+        ),
+        (
+            "[check.diagnosis]\nleader = \"joint\"\ntruth = \"t.toml\"\nnoise = -1\n",
+            "noise = -1",
+            "`noise` must be positive and finite",
+        ),
     ];
     for (check, line, words) in cases {
         let text = checked(check);

@@ -225,7 +225,7 @@ pub(crate) fn compare(
     }
     let correlation = correlate(&measured, &frfs, &spec)?;
     let model = ModelFrfs { label: "model".into(), colour: plot::UPDATED, frfs, correlation };
-    let comparison = compare_modes(&system, &measured);
+    let comparison = compare_modes(&system, &measured, |c| fitted.of_channel(c));
     let (modes, modes_error) = match comparison.as_ref().map(rows) {
         Ok(m) => (Some(m), None),
         Err(e) => (None, Some(e.clone())),

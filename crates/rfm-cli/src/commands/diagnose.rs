@@ -124,6 +124,34 @@ fn data_beside(case: &Path) -> PathBuf {
     case.with_file_name(format!("{stem}-measured.csv"))
 }
 
+/// Candidates whose fits failed listed in the text after the ranking; the
+/// rest are in `--json`.
+const UNFITTED_SHOWN: usize = 5;
+
+/// How many candidates' fits failed, how many of them are left out of the
+/// ranking, and the first few with the stage and the reason (nothing when
+/// every fit succeeded).
+fn unfitted_lines(d: &Diagnosis) -> Vec<String> {
+    if d.unfitted.is_empty() {
+        return Vec::new();
+    }
+    let ranked = d.unfitted.iter().filter(|u| u.ranked).count();
+    let mut out = vec![format!(
+        "{} of {} candidates could not be fitted: {} not ranked, {ranked} ranked by an earlier, shorter fit:",
+        d.unfitted.len(),
+        d.tried,
+        d.unfitted.len() - ranked
+    )];
+    for u in d.unfitted.iter().take(UNFITTED_SHOWN) {
+        let place = if u.ranked { ", ranked as screened only" } else { "" };
+        out.push(format!("    {} ({} failed{place}): {}", u.description, u.stage, u.reason));
+    }
+    if d.unfitted.len() > UNFITTED_SHOWN {
+        out.push(format!("    ... ({} more in --json, under `unfitted`)", d.unfitted.len() - UNFITTED_SHOWN));
+    }
+    out
+}
+
 fn print_diagnosis(d: &Diagnosis, top: usize) -> Result<()> {
     outln!(
         "noise level estimated from the data: {:.2} %; nominal model misfit: {:.2} % (RMS relative)\n",
@@ -160,8 +188,10 @@ fn print_diagnosis(d: &Diagnosis, top: usize) -> Result<()> {
             .chain(r.held.iter().map(|h| format!("{h} held (not determined)")))
             .collect::<Vec<_>>()
             .join(", ");
+        let full_fit_failed = d.unfitted.iter().any(|u| u.ranked && u.description == r.description);
         let note = match (&r.implausible_reason, r.fully_fitted) {
             (Some(why), _) => format!("implausible: {why}"),
+            (None, false) if full_fit_failed => "screened only: its full fit failed".into(),
             (None, false) => "screened only".into(),
             (None, true) => String::new(),
         };
@@ -178,17 +208,12 @@ fn print_diagnosis(d: &Diagnosis, top: usize) -> Result<()> {
     outln!("{}", t.render());
     outln!(
         "\n(dBIC: change of the Bayesian information criterion; below -10 the evidence is very strong; \
-         {} candidates tried)",
-        d.tried
+         {} candidates tried, {} of them replaced by a variant)",
+        d.tried,
+        d.superseded
     );
-    if !d.unfitted.is_empty() {
-        outln!("{} candidates could not be fitted and are not ranked:", d.unfitted.len());
-        for u in d.unfitted.iter().take(5) {
-            outln!("    {}: {}", u.description, u.reason);
-        }
-        if d.unfitted.len() > 5 {
-            outln!("    ... ({} more in --json)", d.unfitted.len() - 5);
-        }
+    for line in unfitted_lines(d) {
+        outln!("{line}");
     }
     match d.recommended {
         None if d.consistent() => {
@@ -215,4 +240,89 @@ fn print_diagnosis(d: &Diagnosis, top: usize) -> Result<()> {
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use rfm_update::diagnose::{EffectKind, FitStage, Ranked, Unfitted};
+
+    use super::*;
+    use crate::commands::WithNotes;
+
+    fn diagnosis(unfitted: Vec<Unfitted>) -> Diagnosis {
+        let ranked = Ranked {
+            kind: EffectKind::StiffnessChange,
+            gains: Vec::new(),
+            description: "stiffness change of element 3".into(),
+            nodes: Vec::new(),
+            elements: vec![3],
+            dof: Vec::new(),
+            damping: None,
+            explained: 0.4,
+            misfit: 0.02,
+            lines: 60,
+            delta_bic: -30.0,
+            significant: true,
+            plausible: true,
+            implausible_reason: None,
+            parameters: Vec::new(),
+            held: Vec::new(),
+            fully_fitted: false,
+            candidate: 0,
+        };
+        Diagnosis {
+            noise: 0.01,
+            nominal_misfit: 0.1,
+            n_residuals: 400,
+            ranking: vec![ranked],
+            recommended: None,
+            tried: 40,
+            superseded: 2,
+            gains: false,
+            unfitted,
+            candidates: Vec::new(),
+        }
+    }
+
+    fn failed(description: &str, stage: FitStage, ranked: bool) -> Unfitted {
+        Unfitted { description: description.into(), reason: format!("singular at {description}"), stage, ranked }
+    }
+
+    /// The text tells how many fits failed, how many of those are not
+    /// ranked, and the first few with stage and reason; the JSON lists all.
+    #[test]
+    fn failed_fits_are_counted_in_the_text_and_listed_in_the_json() {
+        let mut unfitted = vec![failed("stiffness change of element 3", FitStage::FullFit, true)];
+        unfitted.extend((1..=6).map(|n| failed(&format!("lumped mass at node {n}"), FitStage::Screening, false)));
+        let d = diagnosis(unfitted);
+        let text = unfitted_lines(&d);
+        assert_eq!(
+            text[0],
+            "7 of 40 candidates could not be fitted: 6 not ranked, 1 ranked by an earlier, shorter fit:"
+        );
+        assert_eq!(
+            text[1],
+            "    stiffness change of element 3 (full fit failed, ranked as screened only): \
+             singular at stiffness change of element 3"
+        );
+        assert_eq!(text[2], "    lumped mass at node 1 (screening failed): singular at lumped mass at node 1");
+        assert_eq!(text.len(), 1 + UNFITTED_SHOWN + 1, "{text:#?}");
+        assert_eq!(text[UNFITTED_SHOWN + 1], "    ... (2 more in --json, under `unfitted`)");
+        assert!(unfitted_lines(&diagnosis(Vec::new())).is_empty());
+
+        let json = serde_json::to_value(WithNotes { notes: &[], result: &d }).unwrap();
+        let listed = json["unfitted"].as_array().expect("unfitted in the JSON");
+        assert_eq!(listed.len(), 7);
+        assert_eq!(
+            listed[0],
+            serde_json::json!({
+                "description": "stiffness change of element 3",
+                "reason": "singular at stiffness change of element 3",
+                "stage": "full-fit",
+                "ranked": true,
+            })
+        );
+        assert_eq!(listed[6]["stage"], "screening");
+        assert_eq!((json["tried"].as_u64(), json["superseded"].as_u64()), (Some(40), Some(2)));
+    }
 }

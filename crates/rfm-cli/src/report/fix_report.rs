@@ -254,7 +254,16 @@ pub(crate) fn write(study: &Study, outcome: &FixOutcome, opts: &ReportOptions, o
     let notes = vec!["The nominal model and the model after the last step against the measured FRFs.".to_string()];
     report.sections.push(super::correlation_section(measured, &models, opts, out, notes)?);
     let last_system = fixed.as_ref().unwrap_or(study.system());
-    let comparison = super::modes::compare_modes(last_system, measured);
+    // the gains that bring the final model closest to the data, when the case fits gains
+    let gains = match study.gains() {
+        fe_model::case::Gains::None => None,
+        _ => {
+            Some(study.fit_gains(&synthesize(last_system, measured.channels(), measured.frequencies_hz())?, measured)?)
+        }
+    };
+    let comparison = super::modes::compare_modes(last_system, measured, |c| {
+        gains.as_ref().map_or(frf::C64::new(1.0, 0.0), |g| g.of_channel(c))
+    });
     let against = if fixed.is_some() { "the fixed model" } else { "the nominal model" };
     report.sections.push(super::modes::section(
         comparison.as_ref(),

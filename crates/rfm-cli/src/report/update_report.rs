@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 
 use frf::correlation::{BandSpec, correlate};
-use frf::synthesize_regular;
+use frf::{C64, synthesize_regular};
 use rfm_update::output_error::Gain;
 use rfm_update::status::Status;
 use rfm_update::study::FrequencyTable;
@@ -162,7 +162,10 @@ pub(crate) fn write(
         outcome.frequencies_hz.len()
     )];
     report.sections.push(super::correlation_section(measured, &models, opts, out, notes)?);
-    let comparison = super::modes::compare_modes(&outcome.system, measured);
+    let comparison = super::modes::compare_modes(&outcome.system, measured, |c| {
+        let reference = measured.channels()[c].reference;
+        outcome.gains.iter().find(|g| g.reference == reference).map_or(C64::new(1.0, 0.0), Gain::factor)
+    });
     report.sections.push(super::modes::section(
         comparison.as_ref(),
         "the updated model",

@@ -243,7 +243,29 @@ pub struct Ranked {
     pub candidate: usize,
 }
 
-/// A candidate whose fit failed, and why.
+/// The stage of the search at which a candidate's fit failed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize), serde(rename_all = "kebab-case"))]
+pub enum FitStage {
+    /// The brief fits of every candidate of a large model on a few lines.
+    PreScreening,
+    /// The short fits on the screening lines.
+    Screening,
+    /// The full fits on the diagnosis's lines.
+    FullFit,
+}
+
+impl std::fmt::Display for FitStage {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            FitStage::PreScreening => "pre-screening",
+            FitStage::Screening => "screening",
+            FitStage::FullFit => "full fit",
+        })
+    }
+}
+
+/// A candidate whose last fit failed, and why.
 #[derive(Clone, Debug)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Unfitted {
@@ -251,6 +273,12 @@ pub struct Unfitted {
     pub description: String,
     /// Why its fit failed.
     pub reason: String,
+    /// The stage whose fit failed.
+    pub stage: FitStage,
+    /// Still ranked, by the fit of an earlier stage (a candidate whose full
+    /// fit failed stays in the ranking as screened only); when false it is
+    /// not in the ranking at all.
+    pub ranked: bool,
 }
 
 /// The outcome of a diagnosis.
@@ -270,10 +298,16 @@ pub struct Diagnosis {
     pub recommended: Option<usize>,
     /// How many candidates were tried.
     pub tried: usize,
+    /// How many of them gave way to a variant: one that holds what the data
+    /// do not determine, or a twin that did not beat its original.
+    pub superseded: usize,
     /// Whether every fit (and the nominal misfit) fitted an unknown gain
     /// per reference.
     pub gains: bool,
-    /// Candidates that could not be fitted, with the reason.
+    /// Candidates whose last fit failed, with the stage and the reason:
+    /// every candidate tried is ranked, superseded by a variant that holds
+    /// what the data do not determine, or here (or both, when it is ranked
+    /// by an earlier stage's fit).
     pub unfitted: Vec<Unfitted>,
     /// The candidates (same indices as [`Ranked::candidate`]).
     #[cfg_attr(feature = "serde", serde(skip))]
@@ -378,6 +412,18 @@ pub fn diagnose_with(
     opts: &DiagnoseOptions,
     mut progress: impl FnMut(&str),
 ) -> Result<Diagnosis, UpdateError> {
+    diagnose_in(model, measured, opts, &mut progress, |_| {})
+}
+
+/// As [`diagnose_with`], with `prepare` given the pool before the search
+/// (where the tests make chosen fits fail).
+fn diagnose_in(
+    model: &fe_model::Model,
+    measured: &FrfSet,
+    opts: &DiagnoseOptions,
+    progress: &mut dyn FnMut(&str),
+    prepare: impl FnOnce(&mut Pool<'_>),
+) -> Result<Diagnosis, UpdateError> {
     let lines = measured.frequencies_hz();
     if lines.len() < 10 {
         return Err(UpdateError::Data(format!(
@@ -394,7 +440,8 @@ pub fn diagnose_with(
     let mut copts = opts.candidates.clone();
     copts.band_hz = (lines[0], lines[lines.len() - 1]);
     let mut pool = Pool::new(model, &nominal, s2, copts.band_hz);
-    search::search(&mut pool, measured, &full, opts, &copts, &mut progress)?;
+    prepare(&mut pool);
+    search::search(&mut pool, measured, &full, opts, &copts, progress)?;
     Ok(rank(pool, noise, &full, opts))
 }
 
@@ -442,11 +489,16 @@ fn rank(pool: Pool<'_>, noise: f64, full: &LineSet, opts: &DiagnoseOptions) -> D
         pool.by_screening(&rest).into_iter().map(|i| ranked(i, pool.screened[i].as_ref().expect("screened"), false)),
     );
     let recommended = ranking.iter().position(|r| r.fully_fitted && r.significant && r.plausible).map(|r| r + 1);
+    let ranked: std::collections::HashSet<usize> = ranking.iter().map(|r| r.candidate).collect();
     let unfitted = (0..pool.candidates.len())
-        .filter(|&i| pool.screened[i].is_none() && pool.full[i].is_none())
-        .map(|i| Unfitted {
-            description: pool.candidates[i].description.clone(),
-            reason: pool.failure[i].clone().unwrap_or_else(|| "not fitted".into()),
+        .filter_map(|i| {
+            let (stage, reason) = pool.failure[i].clone()?;
+            Some(Unfitted {
+                description: pool.candidates[i].description.clone(),
+                reason,
+                stage,
+                ranked: ranked.contains(&i),
+            })
         })
         .collect();
     Diagnosis {
@@ -456,8 +508,85 @@ fn rank(pool: Pool<'_>, noise: f64, full: &LineSet, opts: &DiagnoseOptions) -> D
         ranking,
         recommended,
         tried: pool.candidates.len(),
+        superseded: pool.superseded.iter().filter(|&&s| s).count(),
         gains: full.gains,
         unfitted,
         candidates: pool.candidates,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use damping::DampedSystem;
+    use fe_model::{Dof, DofRef, Group, samples};
+    use frf::{Channel, NoiseModel, synthesize};
+
+    use super::*;
+
+    /// Fits made to fail at each stage are counted with their stage and
+    /// reason, and every other candidate stays ranked: screenings that fail
+    /// leave the candidate out of the ranking, a full fit that fails leaves
+    /// it ranked as screened only, and a variant holding what the data do
+    /// not determine supersedes its fuller candidate only when its own fit
+    /// succeeded.
+    #[test]
+    fn candidates_whose_fits_fail_are_counted_and_the_rest_ranked() {
+        // a cantilever on a flexible, lossy clamp, measured across its axis:
+        // the clamp's axial spring is not determined, so its held variant is fitted
+        let nominal = samples::cantilever(10);
+        let mut truth = nominal.clone();
+        truth.remove_support(1);
+        let g = truth.add_group(Group::new("clamp").rayleigh(3e-4, 0.0)).unwrap();
+        truth.add_spring("clamp", 1, None, [1e12, 1e10, 2e4], g).unwrap();
+        let tip = DofRef::new(11, Dof::Uy);
+        let channels: Vec<Channel> = (3..=11).step_by(2).map(|n| Channel::new(DofRef::new(n, Dof::Uy), tip)).collect();
+        let lines: Vec<f64> = (2..=400).map(|i| 0.75 * f64::from(i)).collect();
+        let mut measured = synthesize(&DampedSystem::new(truth).unwrap(), &channels, &lines).unwrap();
+        NoiseModel::relative(0.01, 3).apply(&mut measured);
+
+        fn fail(c: &Candidate, stage: FitStage) -> bool {
+            match stage {
+                FitStage::Screening => c.kind == EffectKind::LumpedMass,
+                FitStage::FullFit => c.kind == EffectKind::StiffnessChange || !c.held.is_empty(),
+                FitStage::PreScreening => false,
+            }
+        }
+        let opts = DiagnoseOptions::default();
+        let d = diagnose_in(&nominal, &measured, &opts, &mut |_| {}, |pool| pool.forced_failure = Some(fail)).unwrap();
+
+        let masses = d.candidates.iter().filter(|c| c.kind == EffectKind::LumpedMass).count();
+        let held = d.candidates.iter().filter(|c| !c.held.is_empty()).count();
+        let stiffness_ranked: Vec<&Ranked> =
+            d.ranking.iter().filter(|r| r.kind == EffectKind::StiffnessChange).collect();
+        assert!(masses > 0 && held > 0, "{masses} masses, {held} held variants: nothing to fail");
+        for u in &d.unfitted {
+            assert!(u.reason.contains(&format!("made to fail by the test at {}", u.stage)), "{u:?}");
+        }
+        let count = |stage: FitStage, ranked: bool| {
+            d.unfitted.iter().filter(|u| u.stage == stage && u.ranked == ranked).count()
+        };
+        // every mass fails its screening and is left out of the ranking
+        assert_eq!(count(FitStage::Screening, false), masses, "{:#?}", d.unfitted);
+        assert!(d.ranking.iter().all(|r| r.kind != EffectKind::LumpedMass));
+        // every held variant fails its full fit and has no screening to fall back on
+        assert_eq!(count(FitStage::FullFit, false), held, "{:#?}", d.unfitted);
+        // the stiffness changes fitted fully fail and stay ranked as screened only
+        let full_failed = count(FitStage::FullFit, true);
+        assert!(full_failed > 0, "{:#?}", d.unfitted);
+        assert!(stiffness_ranked.iter().all(|r| !r.fully_fitted));
+        assert_eq!(
+            d.unfitted.iter().filter(|u| u.ranked).count(),
+            full_failed,
+            "only full fits fail for ranked candidates"
+        );
+        assert_eq!(d.unfitted.len(), masses + held + full_failed);
+        // the clamp whose held variant failed keeps its own full fit
+        let clamp = d.ranking.iter().find(|r| r.kind == EffectKind::FlexibleSupport && r.fully_fitted);
+        let clamp = clamp.expect("the fuller clamp stays ranked when its held variant fails");
+        assert!(clamp.held.is_empty() && clamp.parameters.iter().any(|p| !p.determined), "{clamp:?}");
+        assert!(d.leader().is_some_and(|l| l.kind == EffectKind::FlexibleSupport), "{:?}", d.ranking.first());
+        // every candidate tried is ranked, superseded or unfitted
+        let unranked = d.unfitted.iter().filter(|u| !u.ranked).count();
+        assert_eq!(d.tried, d.ranking.len() + d.superseded + unranked);
     }
 }

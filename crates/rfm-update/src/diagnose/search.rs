@@ -12,7 +12,7 @@ use rayon::prelude::*;
 
 use super::candidates::{self, Candidate, CandidateOptions, EffectKind, Role};
 use super::local::{LocalCandidate, LocalData};
-use super::{DiagnoseOptions, informative_lines};
+use super::{DiagnoseOptions, FitStage, informative_lines};
 use crate::error::UpdateError;
 use crate::output_error::{self, Misfit, OeData, OeOptions};
 use crate::params::ParameterSet;
@@ -169,14 +169,21 @@ pub(crate) struct Pool<'a> {
     pub(crate) screened: Vec<Option<Fit>>,
     /// The full fit of each candidate, when it had one.
     pub(crate) full: Vec<Option<Fit>>,
-    /// Why a candidate could not be fitted (its last attempt).
-    pub(crate) failure: Vec<Option<String>>,
+    /// Why a candidate's last attempt at a fit failed, and at which stage
+    /// (`None` once a later attempt succeeds).
+    pub(crate) failure: Vec<Option<(FitStage, String)>>,
     /// Candidates superseded by a variant that holds what the data did not determine.
     pub(crate) superseded: Vec<bool>,
     /// Noise variance per real residual.
     s2: f64,
     /// Starting values of relaxation parameters tried in full fits (rad/s).
     mu_starts: Vec<f64>,
+    /// Makes the fits of the candidates it picks fail at a stage: the
+    /// failures a real search meets (a singular low-rank and whole-model
+    /// system at a line, a misfit that is not finite) hang on floating-point
+    /// coincidences that no test can place on chosen candidates.
+    #[cfg(test)]
+    pub(crate) forced_failure: Option<fn(&Candidate, FitStage) -> bool>,
 }
 
 impl<'a> Pool<'a> {
@@ -195,6 +202,8 @@ impl<'a> Pool<'a> {
             superseded: Vec::new(),
             s2,
             mu_starts,
+            #[cfg(test)]
+            forced_failure: None,
         }
     }
 
@@ -224,9 +233,10 @@ impl<'a> Pool<'a> {
     }
 
     /// Fits `which` on `lines` with `iterations`, from their starting values
-    /// (or `starts`); returns the fits in the order of `which`.
+    /// (or `starts`), for `stage`; returns the fits in the order of `which`.
     fn fit_all(
         &self,
+        stage: FitStage,
         lines: &LineSet,
         iterations: usize,
         which: &[usize],
@@ -239,6 +249,12 @@ impl<'a> Pool<'a> {
             .zip(starts)
             .map(|(&i, start)| {
                 let c = &self.candidates[i];
+                #[cfg(test)]
+                if self.forced_failure.is_some_and(|fail| fail(c, stage)) {
+                    return Err(format!("made to fail by the test at {stage}"));
+                }
+                #[cfg(not(test))]
+                let _ = stage;
                 let local = self.locals[i].as_ref().map(|l| (&data, l));
                 let start = start.as_deref();
                 // a low-rank update that cannot be evaluated (a singular
@@ -251,10 +267,13 @@ impl<'a> Pool<'a> {
             .collect())
     }
 
-    /// Screens `which`: a short fit on `lines` from the starting values, and
-    /// with `factor_starts` from [`factor_starts`] too, keeping the best.
+    /// Screens `which` (at `stage`, pre-screening or screening): a short fit
+    /// on `lines` from the starting values, and with `factor_starts` from
+    /// [`factor_starts`] too, keeping the best. A candidate whose fit fails
+    /// keeps the fit of an earlier stage, if any.
     pub(crate) fn screen(
         &mut self,
+        stage: FitStage,
         lines: &LineSet,
         iterations: usize,
         which: &[usize],
@@ -262,10 +281,10 @@ impl<'a> Pool<'a> {
     ) -> Result<(), UpdateError> {
         // the best fit from the alternative starts and the candidate's own,
         // where it has alternatives; the others fitted from their own
-        let best = if factor_starts { self.try_factor_starts(lines, iterations, which)? } else { Vec::new() };
+        let best = if factor_starts { self.try_factor_starts(stage, lines, iterations, which)? } else { Vec::new() };
         let rest: Vec<usize> = (0..which.len()).filter(|&k| best.get(k).is_none_or(Option::is_none)).collect();
         let subset: Vec<usize> = rest.iter().map(|&k| which[k]).collect();
-        let fits = self.fit_all(lines, iterations, &subset, &vec![None; subset.len()])?;
+        let fits = self.fit_all(stage, lines, iterations, &subset, &vec![None; subset.len()])?;
         let from_best = best.into_iter().enumerate().filter_map(|(k, f)| f.map(|f| (which[k], Ok(f))));
         for (i, f) in subset.into_iter().zip(fits).chain(from_best) {
             match f {
@@ -273,7 +292,7 @@ impl<'a> Pool<'a> {
                     self.screened[i] = Some(f);
                     self.failure[i] = None;
                 }
-                Err(why) => self.failure[i] = Some(why),
+                Err(why) => self.failure[i] = Some((stage, why)),
             }
         }
         Ok(())
@@ -319,7 +338,8 @@ impl<'a> Pool<'a> {
                         Some(s)
                     })
                     .collect();
-                for (slot, f) in best.iter_mut().zip(self.fit_all(coarse, short_iterations, &subset, &tries)?) {
+                let fits = self.fit_all(FitStage::FullFit, coarse, short_iterations, &subset, &tries)?;
+                for (slot, f) in best.iter_mut().zip(fits) {
                     if let Ok(f) = f
                         && slot.as_ref().is_none_or(|b| f.cost < b.cost)
                     {
@@ -333,13 +353,13 @@ impl<'a> Pool<'a> {
                 }
             }
         }
-        for (&i, f) in which.iter().zip(self.fit_all(lines, full_iterations, which, &starts)?) {
+        for (&i, f) in which.iter().zip(self.fit_all(FitStage::FullFit, lines, full_iterations, which, &starts)?) {
             match f {
                 Ok(f) => {
                     self.full[i] = Some(f);
                     self.failure[i] = None;
                 }
-                Err(why) => self.failure[i] = Some(why),
+                Err(why) => self.failure[i] = Some((FitStage::FullFit, why)),
             }
         }
         Ok(())
@@ -354,6 +374,7 @@ impl<'a> Pool<'a> {
     /// started from the nominal model in a local minimum next to its start.
     fn try_factor_starts(
         &self,
+        stage: FitStage,
         lines: &LineSet,
         iterations: usize,
         which: &[usize],
@@ -370,7 +391,7 @@ impl<'a> Pool<'a> {
             let ks: Vec<usize> = with.iter().copied().filter(|&k| r <= others[k].len()).collect();
             let subset: Vec<usize> = ks.iter().map(|&k| which[k]).collect();
             let tries: Vec<Option<Vec<f64>>> = ks.iter().map(|&k| (r > 0).then(|| others[k][r - 1].clone())).collect();
-            for (&k, f) in ks.iter().zip(self.fit_all(lines, iterations, &subset, &tries)?) {
+            for (&k, f) in ks.iter().zip(self.fit_all(stage, lines, iterations, &subset, &tries)?) {
                 if let Ok(f) = f
                     && best[k].as_ref().is_none_or(|b| f.cost < b.cost)
                 {
@@ -488,7 +509,9 @@ impl<'a> Pool<'a> {
 
     /// For every full fit with parameters the data do not determine, the
     /// variant that holds them (see [`Candidate::holding`]) is fitted fully
-    /// from the determined values and supersedes the fuller one.
+    /// from the determined values and supersedes the fuller one, once its
+    /// own full fit succeeded: a variant whose fit fails is counted among
+    /// the failures, and the fuller one stays in the ranking.
     pub(crate) fn hold_undetermined(
         &mut self,
         lines: &LineSet,
@@ -497,6 +520,8 @@ impl<'a> Pool<'a> {
     ) -> Result<(), UpdateError> {
         let mut fits: Vec<(usize, Vec<f64>)> = Vec::new();
         let mut new: Vec<(Candidate, Vec<f64>)> = Vec::new();
+        // (fuller candidate, description of the variant holding its undetermined parameters)
+        let mut held_by: Vec<(usize, String)> = Vec::new();
         for i in self.by_full_fit() {
             let f = self.full[i].as_ref().expect("fully fitted");
             let held: Vec<usize> = (0..f.determined.len()).filter(|&p| !f.determined[p]).collect();
@@ -510,6 +535,7 @@ impl<'a> Pool<'a> {
             let start: Vec<f64> =
                 (0..original.len()).filter(|&p| !h.held.contains(&original[p])).map(|p| f.values[p]).collect();
             assert_eq!(start.len(), h.parameters.len(), "the held variant fits a subset");
+            let description = h.description.clone();
             // the held variant may be a candidate of its own already (a plain mass)
             match self.candidates.iter().position(|c| c.description == h.description) {
                 Some(j) if self.full[j].is_none() && !fits.iter().any(|(k, _)| *k == j) => fits.push((j, start)),
@@ -517,7 +543,7 @@ impl<'a> Pool<'a> {
                 None if new.iter().any(|(c, _)| c.description == h.description) => {}
                 None => new.push((h, start)),
             }
-            self.superseded[i] = true;
+            held_by.push((i, description));
         }
         for (h, start) in new {
             let j = self.add(vec![h])[0];
@@ -526,6 +552,12 @@ impl<'a> Pool<'a> {
         let (which, starts): (Vec<usize>, Vec<Option<Vec<f64>>>) = fits.into_iter().map(|(j, s)| (j, Some(s))).unzip();
         if !which.is_empty() {
             self.full_fit(lines, coarse, iterations, &which, Some(starts))?;
+        }
+        for (i, description) in held_by {
+            let variant = self.candidates.iter().position(|c| c.description == description);
+            if variant.is_some_and(|j| self.full[j].is_some()) {
+                self.superseded[i] = true;
+            }
         }
         Ok(())
     }
@@ -546,7 +578,7 @@ pub(crate) fn search(
     let all = pool.add(candidates::generate(pool.model, copts));
     let to_screen = if all.len() > opts.prescreen_above {
         let pre = LineSet::new(pool.nominal, measured, opts.prescreen_lines, opts.gains)?;
-        pool.screen(&pre, opts.prescreen_iterations, &all, false)?;
+        pool.screen(FitStage::PreScreening, &pre, opts.prescreen_iterations, &all, false)?;
         trace(&format!("pre-screened {} candidates on {} lines", all.len(), pre.data.n_freq()));
         let mut best = pool.by_screening(&all);
         best.truncate(opts.prescreen_keep);
@@ -557,7 +589,7 @@ pub(crate) fn search(
     // the alternative starts of stiffness and mass changes where there are
     // few candidates (a large model's screen keeps its time)
     let factor_starts = all.len() <= opts.prescreen_above;
-    pool.screen(&coarse, opts.screen_iterations, &to_screen, factor_starts)?;
+    pool.screen(FitStage::Screening, &coarse, opts.screen_iterations, &to_screen, factor_starts)?;
     trace(&format!("screened {} candidates on {} lines", to_screen.len(), coarse.data.n_freq()));
     let order = pool.by_screening(&all);
     let keep = pool.leaders(&order, opts.keep);
@@ -567,7 +599,7 @@ pub(crate) fn search(
     // around the leaders: fuller variants, and on large models finer windows
     let refined = pool.refine(copts, REFINED_LEADERS);
     if !refined.is_empty() {
-        pool.screen(&coarse, opts.screen_iterations, &refined, factor_starts)?;
+        pool.screen(FitStage::Screening, &coarse, opts.screen_iterations, &refined, factor_starts)?;
         let best: Vec<usize> = pool.by_screening(&refined).into_iter().take(REFINED_FITS).collect();
         pool.full_fit(full, &coarse, (opts.iterations, opts.screen_iterations), &best, None)?;
         trace(&format!("refined around the leaders: {} candidates, {} fitted", refined.len(), best.len()));
