@@ -47,8 +47,9 @@ impl Diagnosis {
     /// The case with ranked effect `rank` (1-based) added at its fitted
     /// values, as an editor whose [`CaseEditor::text_at`] gives the new
     /// file. The effect's determined parameters, and its damping
-    /// parameters whether determined or not, join the case's `[update]` (created, with the output-error method, when the case has
-    /// none), and the history records the nominal misfit (when the case has
+    /// parameters whether determined or not, join the case's `[update]`
+    /// (created, with the output-error method, when the case has none),
+    /// and the history records the nominal misfit (when the case has
     /// no history yet) and the misfit with the effect, so that `rfm update`
     /// shows the whole fall. The result is checked to load and to carry the
     /// fitted values.
@@ -88,9 +89,9 @@ impl Diagnosis {
         // (its real part, alpha mu w^2 / (mu^2 + w^2)), and the spring's
         // fitted value and standard deviation would be conditional on that
         // choice (held-out trial 11 of the full study: a support's kx 27 %
-        // low at 1.8 % sd with its alpha held; 8 % high at 12 % sd with it
-        // free). Updated, its correlation widens the spring's standard
-        // deviation to what the data really say. An undetermined stiffness
+        // low at 1.8 % sd, 17 sd from its truth, with its alpha held; 0.9 sd
+        // from it with alpha updated). Updated, its correlation widens the
+        // spring's standard deviation to what the data really say. An undetermined stiffness
         // or mass (a spring that ran rigid) stays out.
         for p in r.parameters.iter().filter(|p| p.determined || !p.role.is_stiffness_or_mass()) {
             if !names.contains(&p.name) {
