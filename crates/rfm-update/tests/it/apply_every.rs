@@ -133,6 +133,9 @@ fn apply_every(case: CaseFile, dir: &Path) -> BTreeSet<String> {
     }
     let target = out.join("applied.toml");
     let mut kinds = BTreeSet::new();
+    // the case's own [update] parameters stay, whatever an effect says of them
+    let own: Vec<String> =
+        study.case().update.iter().flat_map(|u| u.parameters.iter().map(|p| p.name.clone())).collect();
     for (i, r) in d.ranking.iter().enumerate() {
         let rank = i + 1;
         let editor = d
@@ -147,9 +150,6 @@ fn apply_every(case: CaseFile, dir: &Path) -> BTreeSet<String> {
         // are updated next; an undetermined stiffness or mass is not
         let updated: Vec<&str> =
             table["update"]["parameters"].as_array().unwrap().iter().filter_map(|v| v.as_str()).collect();
-        let own: Vec<String> =
-            study.case().update.iter().flat_map(|u| u.parameters.iter().map(|p| p.name.clone())).collect();
-        // (the case's own [update] parameters stay, whatever the effect says of them)
         for p in r.parameters.iter().filter(|p| !own.contains(&p.name)) {
             let damping = !p.role.is_stiffness_or_mass();
             assert_eq!(
