@@ -18,7 +18,10 @@
 //! with the data), when the significant ones are all implausible (the
 //! missing effect is not among the candidates), when an update does not
 //! lower the misfit, or after the given number of steps. When it then
-//! leaves more than 1.5 times the noise, each effect but the last, and each
+//! leaves more than 1.5 times the noise, the form of each effect is revised
+//! with the others in place (its other variants, a kind that stands in for
+//! it, or nothing; [`revise`]), and if the misfit still stays above that,
+//! each effect but the last, and each
 //! pair of effects, is left out in turn and the data diagnosed again
 //! without them, adding as many effects as were left out: an effect added
 //! early may only have mimicked the missing one, and another added later
@@ -37,6 +40,7 @@ use crate::study::{ParameterReport, Study};
 use crate::uncertainty::UncertaintyReport;
 
 mod pairs;
+mod revise;
 mod swap;
 
 /// Options of the loop.
@@ -86,6 +90,10 @@ pub struct FixStep {
     /// it (left out, the others kept, and these added instead; see [`fix`]),
     /// when it did: their descriptions joined by " and ".
     pub replaced: Option<String>,
+    /// The effect was taken out again, not added: with the others revised
+    /// it no longer paid for its parameters ([`revise`]); `misfit_added`
+    /// and `misfit_updated` are both the misfit without it, updated.
+    pub removed: bool,
     /// The case after this step (write it with [`CaseEditor::text_at`]).
     #[cfg_attr(feature = "serde", serde(skip))]
     pub case: CaseEditor,
@@ -102,6 +110,7 @@ impl FixStep {
             uncertainty: a.outcome.uncertainty,
             alternatives,
             replaced,
+            removed: false,
             case: a.editor,
         }
     }
@@ -199,6 +208,7 @@ impl FixOutcome {
         let mut v = vec![("nominal".to_string(), self.nominal_misfit)];
         for (k, s) in self.steps.iter().enumerate() {
             let label = match &s.replaced {
+                _ if s.removed => format!("- {}", s.effect.description),
                 Some(r) => format!("+ {} instead of {r}", s.effect.description),
                 None => format!("+ {}", s.effect.description),
             };
@@ -235,8 +245,10 @@ pub enum FixProgress<'a> {
     Updated {
         /// Effects added before this one.
         step: usize,
-        /// The effect added.
+        /// The effect added (or, with `removed`, taken out).
         effect: &'a str,
+        /// The effect was taken out, not added ([`FixStep::removed`]).
+        removed: bool,
         /// The misfit after the update.
         misfit: f64,
         /// How the update ended.
@@ -525,6 +537,7 @@ pub fn fix(
             progress(FixProgress::Updated {
                 step: steps.len(),
                 effect: &added.effect.description,
+                removed: false,
                 misfit: added.misfit_updated,
                 status: &added.outcome.status,
             });
@@ -543,8 +556,42 @@ pub fn fix(
     };
     let (stop, mut last) = stop;
     let mut effects: Vec<Ranked> = steps.iter().map(|s| s.effect.clone()).collect();
-    let misfit = steps.last().map_or(nominal_misfit, |s| s.misfit_updated);
-    if steps.len() >= 2
+    let mut misfit = steps.last().map_or(nominal_misfit, |s| s.misfit_updated);
+    if !applied.is_empty() && misfit > CONSISTENT * noise {
+        let (kept, revised) = revise::revise(case, &applied, &current, measured, opts, (misfit, noise));
+        if !kept.is_empty() {
+            for r in kept {
+                let effect = if r.removed {
+                    r.replaced.clone()
+                } else {
+                    format!("{} instead of {}", r.added.effect.description, r.replaced)
+                };
+                progress(FixProgress::Updated {
+                    step: steps.len(),
+                    effect: &effect,
+                    removed: r.removed,
+                    misfit: r.added.misfit_updated,
+                    status: &r.added.outcome.status,
+                });
+                current = r.added.case.clone();
+                misfit = r.added.misfit_updated;
+                if r.removed {
+                    effects.remove(r.index);
+                    let mut s = FixStep::of(r.added, Vec::new(), None);
+                    // nothing was added: the misfit without it is the updated one
+                    s.misfit_added = s.misfit_updated;
+                    s.removed = true;
+                    steps.push(s);
+                } else {
+                    effects[r.index] = r.added.effect.clone();
+                    steps.push(FixStep::of(r.added, Vec::new(), Some(r.replaced)));
+                }
+            }
+            applied = revised;
+            last = None;
+        }
+    }
+    if applied.len() >= 2
         && misfit > swap::SWAP_ABOVE * noise
         && let Some((outs, added)) = swap::swap(case, &applied, measured, opts, misfit)
     {
@@ -562,6 +609,7 @@ pub fn fix(
             progress(FixProgress::Updated {
                 step: steps.len(),
                 effect: &effect,
+                removed: false,
                 misfit: a.misfit_updated,
                 status: &a.outcome.status,
             });

@@ -80,8 +80,9 @@ pub(crate) fn fix(args: &FixArgs<'_>) -> Result<Exit> {
                     ahead.effect, ahead.misfit_ahead
                 ),
             },
-            FixProgress::Updated { step, effect, misfit, status } => {
-                format!("step {}: added {effect} and updated ({}); misfit {misfit:.4e}", step + 1, status.name())
+            FixProgress::Updated { step, effect, removed, misfit, status } => {
+                let verb = if removed { "took out" } else { "added" };
+                format!("step {}: {verb} {effect} and updated ({}); misfit {misfit:.4e}", step + 1, status.name())
             }
         };
         // an error here would be the same as at the next print, which reports it

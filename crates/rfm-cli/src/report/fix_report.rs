@@ -91,14 +91,12 @@ pub(crate) fn write(study: &Study, outcome: &FixOutcome, opts: &ReportOptions, o
 
     let stages = outcome.stages();
     let mut fall = Section::new("The fall of the misfit");
-    let short: Vec<String> =
-        std::iter::once("nominal".to_string())
-            .chain(
-                outcome.steps.iter().enumerate().flat_map(|(k, s)| {
-                    [format!("+ {}: {}", k + 1, short_effect(&s.effect)), format!("updated {}", k + 1)]
-                }),
-            )
-            .collect();
+    let short: Vec<String> = std::iter::once("nominal".to_string())
+        .chain(outcome.steps.iter().enumerate().flat_map(|(k, s)| {
+            let sign = if s.removed { "-" } else { "+" };
+            [format!("{sign} {}: {}", k + 1, short_effect(&s.effect)), format!("updated {}", k + 1)]
+        }))
+        .collect();
     let misfits: Vec<f64> = stages.iter().map(|(_, m)| *m).collect();
     fall.push(out.figure(
         "misfit-steps",
@@ -155,6 +153,7 @@ pub(crate) fn write(study: &Study, outcome: &FixOutcome, opts: &ReportOptions, o
     for (k, s) in outcome.steps.iter().enumerate() {
         let e = &s.effect;
         let title = match &s.replaced {
+            _ if s.removed => format!("Step {}: {} taken out again", k + 1, e.description),
             Some(r) => format!("Step {}: {} instead of {r}", k + 1, e.description),
             None => format!("Step {}: {}", k + 1, e.description),
         };
