@@ -11,7 +11,8 @@
 //! default options on the nominal frame, and prints one JSON line: sizes,
 //! the number of candidates, the wall time, the peak memory, and whether the
 //! leader is the hidden stiffness loss at the right element (or a neighbour).
-//! `--verbose` prints the first six of the ranking to stderr.
+//! `--verbose` prints the stages as they end, the first six of the
+//! ranking, the noise estimate and the nominal misfit to stderr.
 
 mod point;
 
@@ -21,7 +22,7 @@ use damping::DampedSystem;
 use fe_model::{Dof, samples};
 use frf::{Channel, NoiseModel, synthesize};
 use point::{arg, peak_kib};
-use rfm_update::diagnose::{DiagnoseOptions, EffectKind, diagnose};
+use rfm_update::diagnose::{DiagnoseOptions, EffectKind, diagnose_with};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -52,10 +53,21 @@ fn main() {
     NoiseModel::relative(0.01, 7).apply(&mut data);
 
     let t = Instant::now();
-    let d = diagnose(&nominal, &data, &DiagnoseOptions::default()).expect("diagnosis runs");
+    let verbose = args.iter().any(|a| a == "--verbose");
+    let d = diagnose_with(&nominal, &data, &DiagnoseOptions::default(), |stage| {
+        if verbose {
+            eprintln!("{:>8.2} s  {stage}", t.elapsed().as_secs_f64());
+        }
+    })
+    .expect("diagnosis runs");
     let seconds = t.elapsed().as_secs_f64();
-    for r in d.ranking.iter().take(if args.iter().any(|a| a == "--verbose") { 6 } else { 0 }) {
+    for r in d.ranking.iter().take(if verbose { 6 } else { 0 }) {
         eprintln!("{:<50} explained {:.4} dBIC {:.1}", r.description, r.explained, r.delta_bic);
+    }
+    if verbose {
+        let nominal_sys = DampedSystem::new(nominal.clone()).expect("assembles");
+        let misfit = rfm_update::diagnose::log_misfit(&nominal_sys, &data, 200).unwrap_or(f64::NAN);
+        eprintln!("noise estimate {:.4}, nominal misfit {misfit:.4}", d.noise);
     }
     let top = &d.ranking[0];
     let near = |e: &u32| e.abs_diff(element) <= 1;

@@ -197,6 +197,13 @@ fn draws(singles: usize, pairs: usize) -> Vec<Truth> {
     draws
 }
 
+/// Trial `index` of a study of `singles` per family and `pairs` pairs, run
+/// through the loop of three steps as the study runs it (its seed too).
+fn trial_of(singles: usize, pairs: usize, index: usize) -> Trial {
+    let opts = FixOptions { max_steps: 3, ..FixOptions::default() };
+    run(&draws(singles, pairs)[index], 7000 + index as u64, &opts)
+}
+
 /// Trial 25 of the reduced set: a non-viscous corner joint and a mass with
 /// rotary inertia on the column of an L-frame. With the mass missing, the
 /// joint is chosen viscous, and the mass is then added without its rotary
@@ -207,9 +214,7 @@ fn draws(singles: usize, pairs: usize) -> Vec<Truth> {
 /// own diagnosis's neighbours.
 #[test]
 fn the_revision_mends_forms_chosen_while_another_effect_was_missing() {
-    let truth = &draws(4, 6)[25];
-    let opts = FixOptions { max_steps: 3, ..FixOptions::default() };
-    let trial = run(truth, 7025, &opts);
+    let trial = trial_of(4, 6, 25);
     let o = &trial.outcome;
     let revised: Vec<String> = o
         .steps
@@ -238,9 +243,7 @@ fn the_revision_mends_forms_chosen_while_another_effect_was_missing() {
 /// in element 8, which completes the patch: 1.0 times the noise.
 #[test]
 fn the_swap_undoes_an_early_effect_and_what_made_up_for_it() {
-    let truth = &draws(12, 16)[74];
-    let opts = FixOptions { max_steps: 3, ..FixOptions::default() };
-    let trial = run(truth, 7074, &opts);
+    let trial = trial_of(12, 16, 74);
     let o = &trial.outcome;
     let swapped = o.steps.iter().find(|s| s.replaced.is_some()).expect("a step that replaced earlier ones");
     println!("{}: {} instead of {:?}", trial.label, swapped.effect.description, swapped.replaced);
@@ -255,9 +258,7 @@ fn the_swap_undoes_an_early_effect_and_what_made_up_for_it() {
 /// not fail as a whole.
 #[test]
 fn the_loop_keeps_its_steps_when_the_last_diagnosis_fails() {
-    let truth = &draws(12, 16)[34];
-    let opts = FixOptions { max_steps: 3, ..FixOptions::default() };
-    let trial = run(truth, 7034, &opts);
+    let trial = trial_of(12, 16, 34);
     let o = &trial.outcome;
     println!("{}: {} steps, diagnosis error {:?}", trial.label, o.steps.len(), o.diagnosis_error);
     assert!(trial.found.iter().all(|&f| f), "the splice is found: {:?}", trial.found);
@@ -276,9 +277,7 @@ fn the_loop_keeps_its_steps_when_the_last_diagnosis_fails() {
 /// beside the right node with the splice.
 #[test]
 fn two_effects_that_mislead_one_at_a_time_are_fitted_together() {
-    let truth = &draws(12, 16)[76];
-    let opts = FixOptions { max_steps: 3, ..FixOptions::default() };
-    let trial = run(truth, 7076, &opts);
+    let trial = trial_of(12, 16, 76);
     let o = &trial.outcome;
     let pair = o.steps[0].alternatives.iter().find(|a| a.with.is_some()).expect("pairs tried at the first step");
     println!("{}: {} with {:?}: {:.2} x noise", trial.label, pair.effect, pair.with, pair.misfit_ahead / NOISE);
