@@ -9,7 +9,7 @@
 //! see [`crate::output_error`], and the RFM's relative misfit). So a run is called
 //! [`Status::Converged`] only when its residual is within [`NOISE_FACTOR`]
 //! times the noise estimated from the data
-//! ([`crate::diagnose::estimate_noise`]). Above it, the fit either sits in a
+//! ([`crate::diagnose::estimate_noise_against`]). Above it, the fit either sits in a
 //! local minimum (restarts from spread starts find a lower one, or disagree)
 //! or the model cannot represent the data (restarts end at the same
 //! minimum: [`Status::ModelInadequate`]).

@@ -116,7 +116,7 @@ pub(crate) fn update(
     };
     bar.finish_and_clear();
     // the misfit the case's history speaks of, after this update
-    let noise = rfm_update::diagnose::estimate_noise(study.measured());
+    let noise = rfm_update::diagnose::estimate_noise_against(&outcome.system, study.measured())?;
     let gains = study.gains() != fe_model::case::Gains::None;
     let misfit = rfm_update::diagnose::log_misfit_with(&outcome.system, study.measured(), HISTORY_LINES, gains)?;
     // worse than the start over the whole band, not only at the fitted lines

@@ -53,7 +53,8 @@ pub struct UpdateOutcome {
     /// Fitted gain per reference, when requested.
     pub gains: Vec<Gain>,
     /// Relative noise level of the measured data, estimated from their
-    /// roughness (see [`crate::diagnose::estimate_noise`]).
+    /// roughness and that of their residual against the updated model (see
+    /// [`crate::diagnose::estimate_noise_against`]).
     pub noise_estimate: Option<f64>,
     /// The noise level weighted as the fit's residual is (by band and
     /// coherence weights; see [`crate::study::residual_noise_for`]): what

@@ -149,7 +149,7 @@ impl Study {
             natural_frequencies_hz,
             uncertainty: Some(report),
             gains: result.gains,
-            noise_estimate: crate::diagnose::estimate_noise(&self.measured),
+            noise_estimate: crate::diagnose::estimate_noise_against(&sys, &self.measured)?,
             residual_noise: noise,
             masked: describe_masked(&self.masked),
             notes: self.notes.clone(),

@@ -71,7 +71,7 @@ impl Study {
             })
             .collect();
         warnings.extend(result.unresolved.clone());
-        let noise = crate::diagnose::estimate_noise(&self.measured);
+        let noise = crate::diagnose::estimate_noise_against(&self.system, &self.measured)?;
         if let Some(s) = noise.filter(|&s| s > verdict::RFM_NOISE_LIMIT) {
             warnings.push(format!(
                 "the data's noise ({:.2} %) is above the {:.1} % where the RFM is biased (its equations have \

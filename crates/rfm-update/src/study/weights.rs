@@ -33,7 +33,7 @@ impl Study {
     /// The noise level the weighted residual of a fit to `fitted` (lines of
     /// this study's data) is compared with (see [`residual_noise_for`]).
     pub fn residual_noise(&self, fitted: &FrfSet) -> Result<Option<f64>, UpdateError> {
-        residual_noise_for(&self.case, &self.measured, fitted)
+        residual_noise_for(&self.case, &self.system, &self.measured, fitted)
     }
 }
 
@@ -99,13 +99,19 @@ fn coherence_weights(case: &CaseFile, measured: &FrfSet) -> Result<Option<Vec<f6
 /// the residual is. The coherence weight is the inverse of an FRF
 /// estimate's relative standard deviation up to a constant, so the
 /// coherence-weighted values have one noise level throughout, estimated
-/// from their roughness over every measured line
-/// ([`crate::diagnose::estimate_noise_weighted`]); the band weights are
-/// the user's and multiply it by their RMS over the fitted values. Without
-/// weights this is [`crate::diagnose::estimate_noise`].
-pub fn residual_noise_for(case: &CaseFile, measured: &FrfSet, fitted: &FrfSet) -> Result<Option<f64>, UpdateError> {
+/// from their roughness over every measured line, and from that of their
+/// residual against the model `sys` where that is lower (on lines coarse
+/// against the peaks the data's own roughness is mostly the dynamics;
+/// [`crate::diagnose::estimate_noise_against_weighted`]); the band weights
+/// are the user's and multiply it by their RMS over the fitted values.
+pub fn residual_noise_for(
+    case: &CaseFile,
+    sys: &damping::DampedSystem,
+    measured: &FrfSet,
+    fitted: &FrfSet,
+) -> Result<Option<f64>, UpdateError> {
     let coherence = coherence_weights(case, measured)?;
-    let Some(level) = crate::diagnose::estimate_noise_weighted(measured, coherence.as_deref()) else {
+    let Some(level) = crate::diagnose::estimate_noise_against_weighted(sys, measured, coherence.as_deref())? else {
         return Ok(None);
     };
     let Some(band) = band_weights(case, fitted) else { return Ok(Some(level)) };
