@@ -24,8 +24,8 @@
 //! part, and its median (robust to the few lines at sharp resonances) gives
 //! the variance ([`estimate_noise`]). On a grid coarse against the peaks
 //! the response itself is rough; the residual against the nominal model,
-//! which shares its dynamics, is not, and the lower of the two levels is
-//! taken ([`estimate_noise_against`]).
+//! which shares its dynamics, is not, and its level is taken where it is
+//! clearly the lower ([`estimate_noise_against`]).
 //!
 //! To stay fast with many candidates, all are first fitted briefly on a
 //! coarse subset of lines (screening), and the leaders are then fitted fully
@@ -138,10 +138,13 @@ fn level_of(mut d2: Vec<f64>) -> Option<f64> {
 /// the residual's roughness.
 const NOISE_TRIPLETS: usize = 40;
 
+/// The residual's level replaces the data's own below this fraction of it.
+const CLEARLY_LOWER: f64 = 0.7;
+
 /// The noise level of measured receptances read against a model of them:
-/// the lower of [`estimate_noise`] and the same roughness of the residual
-/// `ln(M / H)` against the model's receptances `H`, at up to 40 triplets of
-/// adjacent lines spread over the band. The roughness of `ln M` alone is
+/// [`estimate_noise`], or the same roughness of the residual `ln(M / H)`
+/// against the model's receptances `H`, at up to 40 triplets of adjacent
+/// lines spread over the band, where that is below 0.7 times it. The roughness of `ln M` alone is
 /// the noise only where the FRFs are smooth from line to line; on lines
 /// coarse against the peaks, or dense modes, it is mostly the dynamics (a
 /// frame of 96k DOFs on 200 lines: 47 % read against 1 % injected, and
@@ -194,8 +197,10 @@ pub fn estimate_noise_against_weighted(
             }
         }
     }
+    // the residual's level, read on fewer lines, only where it is clearly
+    // lower: where both agree, the data's own (on every line) is the surer
     Ok(match (own, level_of(d2)) {
-        (Some(a), Some(b)) => Some(a.min(b)),
+        (Some(a), Some(b)) if b < CLEARLY_LOWER * a => Some(b),
         (a, b) => a.or(b),
     })
 }

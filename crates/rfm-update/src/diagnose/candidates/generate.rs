@@ -545,6 +545,22 @@ pub(crate) fn refine(
             let run = &ctx.runs[r];
             let range = lo.saturating_sub(reach)..(hi + reach + 1).min(run.len());
             specs.extend(all_windows(&ctx, run, range, kinds));
+            // a stiffness loss and a mass gain over the same elements both
+            // lower the frequencies there, and on a large model with few
+            // sensors the first pass can lead with either: there the other
+            // kind is tried too, over the windows within one element of the
+            // leader's (the 100k-DOF bench frame led with a mass change over
+            // its hidden stiffness loss); a small model's first pass has
+            // tried both at every element
+            let other: &[EffectKind] = match c.kind {
+                EffectKind::StiffnessChange => &WINDOW_KINDS[1..2],
+                EffectKind::MassChange => &WINDOW_KINDS[..1],
+                _ => &[],
+            };
+            if !ctx.small() && !other.is_empty() {
+                let near = lo.saturating_sub(1)..(hi + 2).min(run.len());
+                specs.extend(all_windows(&ctx, run, near, other));
+            }
             // a mass spread over a window may be a lumped mass (with its
             // rotary inertia) at one of its nodes
             if c.kind == EffectKind::MassChange {
