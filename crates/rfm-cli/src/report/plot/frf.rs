@@ -223,11 +223,17 @@ fn draw_channel(
         }
     }
     let tick_height = 0.06 * (y1 - y0);
+    // one tick per pixel column: thousands of updating lines would each
+    // draw the same pixels, and bloat the file
+    let mut columns = std::collections::HashSet::new();
+    let ticks: Vec<f64> = fig
+        .ticks_hz
+        .iter()
+        .copied()
+        .filter(|&t| axis.shows(t) && columns.insert(chart.backend_coord(&(t, y0)).0))
+        .collect();
     chart.draw_series(
-        fig.ticks_hz
-            .iter()
-            .filter(|&&t| axis.shows(t))
-            .map(|&t| PathElement::new(vec![(t, y0), (t, y0 + tick_height)], MEASURED.stroke_width(1))),
+        ticks.iter().map(|&t| PathElement::new(vec![(t, y0), (t, y0 + tick_height)], MEASURED.stroke_width(1))),
     )?;
 
     let mut chart = ChartBuilder::on(bottom)
@@ -345,6 +351,29 @@ mod tests {
         }
         assert!(svg.matches("<polyline").count() >= 4);
         assert!(!svg.contains("<circle"), "updating lines are ticks, not circles on the curve");
+    }
+
+    #[test]
+    fn a_hundred_thousand_updating_lines_draw_one_tick_per_pixel_column() {
+        let f: Vec<f64> = (1..=1000).map(f64::from).collect();
+        let x: Vec<C64> = f.iter().map(|&v| C64::new(1.0 / v, 0.1)).collect();
+        let ticks: Vec<f64> = (0..100_000).map(|k| 1.0 + 999.0 * f64::from(k) / 99_999.0).collect();
+        let figure = |ticks: &[f64]| {
+            frf_overlay(&FrfFigure {
+                title: "H(3:uy,3:uy)".into(),
+                frequencies_hz: &f,
+                kind: FrfKind::Receptance,
+                panels: vec![FrfPanel { title: String::new(), curves: curves(&x, &x), coherence: None }],
+                ticks_hz: ticks,
+                coherence_threshold: 0.8,
+                scale: FrequencyScale::Linear,
+            })
+            .unwrap()
+        };
+        let without = figure(&[]).matches("<polyline").count();
+        let ticks_drawn = figure(&ticks).matches("<polyline").count() - without;
+        // the plot is some hundreds of pixels wide: one tick in each column
+        assert!((100..2_000).contains(&ticks_drawn), "{ticks_drawn} ticks drawn for 100,000 lines");
     }
 
     #[test]
