@@ -20,7 +20,7 @@
 //! - in null trials (2 % noise) nothing is significant in at least 95 %.
 //!
 //! The reduced set is 4 trials per family, 6 pairs and 10 null trials (a
-//! few minutes), and CI runs it: 28/30 right first, 30/30 within 1.5 times
+//! few minutes), and CI runs it: 28/30 right first, 29/30 within 1.5 times
 //! the noise, true values within 3 sd 22/25, both effects of a pair 6/6,
 //! null trials clean 10/10. `cargo xtask heldout` runs the full study (12
 //! per family, 16 pairs, 20 null trials) with the same criteria. `HELD_OUT_SINGLE` (per
