@@ -206,13 +206,15 @@ pub(super) fn revise(
         let before = parameter_count(&refs(&applied)) as f64;
         let score = |m: f64, k: f64| n * (m * m - misfit * misfit) / (noise * noise) + (k - before) * n.ln();
         let mut best: Option<(f64, Option<usize>, Added)> = None;
+        // built once: updated for the effect taken out, diagnosed for its
+        // replacements
+        let without_built = build(nominal, &without, Some(&warm), &[], opts);
         // taken out: an effect added to make up for a wrong form of
         // another may not be needed once that is mended (trial 25: a stiff
         // in-line joint beside the corner joint)
-        if !without.is_empty()
-            && let Ok((case, editor)) = build(nominal, &without, Some(&warm), &[], opts)
+        if let Ok((case, editor)) = &without_built
             && let Ok((editor, case, m, outcome)) =
-                update_case(&case, editor, without[0].0, measured, opts, step, false)
+                update_case(case, editor.clone(), without[0].0, measured, opts, step, false)
             && m.is_finite()
         {
             let bic = score(m, parameter_count(&without) as f64);
@@ -221,10 +223,8 @@ pub(super) fn revise(
                 best = Some((bic, None, a));
             }
         }
-        let d = (|| {
-            let (case, _) = build(nominal, &without, Some(&warm), &[], opts)?;
-            diagnose::diagnose(&case.model, measured, &opts.diagnose).map(|d| (d, case))
-        })();
+        let d = without_built
+            .and_then(|(case, _)| diagnose::diagnose(&case.model, measured, &opts.diagnose).map(|d| (d, case)));
         if let Ok((d, without_case)) = &d {
             for other in neighbours(d, &own, &without_case.model) {
                 let mut tried = refs(&applied);
