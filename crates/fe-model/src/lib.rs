@@ -72,7 +72,9 @@ pub use assembly::{Assembly, Block, BlockSource, MatrixKind, Pattern, Term};
 pub use case::{CaseEditor, CaseFile, HistoryEntry};
 pub use dof::{Dimension, Dof, DofMap, DofRef, PerDof, Slot};
 pub use error::{CaseError, Location, ModelError};
-pub use model::{Beam, ElementId, Group, LumpedMass, Material, Model, Node, NodeId, RotaryInertia, Section, Spring};
+pub use model::{
+    Beam, ElementId, Group, LumpedMass, Material, Model, Node, NodeId, PartIndex, RotaryInertia, Section, Spring,
+};
 pub use quantity::{Parameter, Quantity, QuantityKind};
 
 /// A number for a message: as written for ordinary magnitudes, in exponent

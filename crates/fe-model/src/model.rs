@@ -18,6 +18,7 @@ use crate::element::frame3d;
 use crate::error::ModelError;
 
 mod geometry;
+pub use geometry::PartIndex;
 mod items;
 mod spring_axes;
 
@@ -616,6 +617,61 @@ mod tests {
     use super::*;
     use crate::assembly::{Assembly, BlockSource};
     use crate::samples;
+
+    /// The indexed cut gives the same part as the whole-model scan, for
+    /// every one and every two nodes of a model with a chain of ties,
+    /// springs to ground and between nodes, masses, supports and an
+    /// imported block.
+    #[test]
+    fn the_indexed_part_is_the_scanned_part() {
+        use crate::dof::DofRef;
+        use crate::imported::{ImportedKind, SymmetricCoo};
+        let mut m = samples::frame_with_joint();
+        m.add_node(5, 1.0, 1.0).unwrap();
+        m.add_node(6, 1.0, 1.0).unwrap();
+        m.add_node(7, 2.0, 1.0).unwrap();
+        m.add_tie(4, 5, &[Dof::Ux]).unwrap();
+        m.add_tie(5, 6, &[Dof::Uy]).unwrap();
+        let (steel, sec, frame) = (0, 0, 0);
+        m.add_beam(3, [6, 7], steel, sec, frame).unwrap();
+        m.add_spring("ground", 6, None, [1e5, 0.0, 0.0], frame).unwrap();
+        m.add_mass("end", 7, 0.2, 0.0, frame).unwrap();
+        m.add_support(7, &[Dof::Uy]).unwrap();
+        let table = [DofRef::new(4, Dof::Rz), DofRef::new(7, Dof::Rz)];
+        let k = SymmetricCoo { n: 2, entries: vec![(0, 0, 10.0), (1, 0, -10.0), (1, 1, 10.0)] };
+        m.add_imported(frame, ImportedKind::Stiffness, &table, &k).unwrap();
+        let index = PartIndex::new(&m);
+        let ids: Vec<u32> = m.nodes().iter().map(|n| n.id.0).collect();
+        let mut sets: Vec<Vec<NodeId>> = ids.iter().map(|&a| vec![NodeId(a)]).collect();
+        for &a in &ids {
+            for &b in &ids {
+                sets.push(vec![NodeId(a), NodeId(b)]);
+            }
+        }
+        let mut nonempty = 0;
+        for nodes in &sets {
+            let (scanned, indexed) = (m.part(nodes), m.part_indexed(&index, nodes));
+            let show = |p: &Model| {
+                format!(
+                    "{:?} {:?} {:?} {:?} {:?} {:?} {:?}",
+                    p.nodes(),
+                    p.beams(),
+                    p.springs(),
+                    p.masses(),
+                    p.supports(),
+                    p.ties(),
+                    p.imported()
+                )
+            };
+            assert_eq!(show(&indexed), show(&scanned), "nodes {nodes:?}");
+            assert_eq!(indexed.node_index, scanned.node_index, "nodes {nodes:?}");
+            nonempty += usize::from(!scanned.imported().is_empty() && !scanned.ties().is_empty());
+        }
+        assert!(nonempty > 0, "no part held both a tie and the imported block");
+        // the tie chain 4-5-6 is followed from either end
+        let ids = |p: &Model| p.nodes().iter().map(|n| n.id.0).collect::<Vec<_>>();
+        assert_eq!(ids(&m.part_indexed(&index, &[NodeId(6)])), [4, 5, 6]);
+    }
 
     /// A part keeps what lies on its nodes, pulls in tied nodes, and
     /// assembles the same blocks as the whole model, though it floats free.

@@ -56,6 +56,75 @@ impl Model {
         }
     }
 
+    /// The same part as [`Self::part`], cut with an index of the items at
+    /// each node: it touches only what lies on the part's nodes, where
+    /// `part` looks through the whole model. A diagnosis cuts one part per
+    /// candidate (60,000 on a 100k-DOF frame, where the whole-model scan
+    /// took 40 s of CPU); build the index once with [`PartIndex::new`].
+    pub fn part_indexed(&self, index: &PartIndex, nodes: &[NodeId]) -> Model {
+        let mut keep: Vec<usize> = nodes.iter().filter_map(|id| self.node_index.get(id).copied()).collect();
+        keep.sort_unstable();
+        keep.dedup();
+        // closure over ties, as in `part`, by a walk along the ties at kept nodes
+        let mut queue = keep.clone();
+        while let Some(i) = queue.pop() {
+            for &t in &index.ties[i] {
+                for n in self.ties[t].nodes {
+                    let j = self.node_index[&n];
+                    if let Err(at) = keep.binary_search(&j) {
+                        keep.insert(at, j);
+                        queue.push(j);
+                    }
+                }
+            }
+        }
+        let kept = |id: &NodeId| keep.binary_search(&self.node_index[id]).is_ok();
+        // the items at kept nodes, in model order, with every node kept
+        let at = |lists: &[Vec<usize>]| -> Vec<usize> {
+            let mut items: Vec<usize> = keep.iter().flat_map(|&i| lists[i].iter().copied()).collect();
+            items.sort_unstable();
+            items.dedup();
+            items
+        };
+        let nodes: Vec<Node> = keep.iter().map(|&i| self.nodes[i].clone()).collect();
+        let node_index = nodes.iter().enumerate().map(|(i, n)| (n.id, i)).collect();
+        Model {
+            title: self.title.clone(),
+            dimension: self.dimension,
+            nodes,
+            node_index,
+            materials: self.materials.clone(),
+            sections: self.sections.clone(),
+            beams: at(&index.beams)
+                .into_iter()
+                .map(|i| &self.beams[i])
+                .filter(|b| b.nodes.iter().all(kept))
+                .cloned()
+                .collect(),
+            springs: at(&index.springs)
+                .into_iter()
+                .map(|i| &self.springs[i])
+                .filter(|s| kept(&s.a) && s.b.as_ref().is_none_or(kept))
+                .cloned()
+                .collect(),
+            masses: at(&index.masses).into_iter().map(|i| self.masses[i].clone()).collect(),
+            supports: at(&index.supports).into_iter().map(|i| self.supports[i].clone()).collect(),
+            ties: at(&index.ties)
+                .into_iter()
+                .map(|i| &self.ties[i])
+                .filter(|t| t.nodes.iter().all(kept))
+                .cloned()
+                .collect(),
+            groups: self.groups.clone(),
+            imported: at(&index.imported)
+                .into_iter()
+                .map(|i| &self.imported[i])
+                .filter(|b| b.nodes.iter().all(kept))
+                .cloned()
+                .collect(),
+        }
+    }
+
     /// Indices of the beams with an end at `node`.
     pub fn beams_at(&self, node: NodeId) -> Vec<usize> {
         self.beams.iter().enumerate().filter(|(_, b)| b.nodes.contains(&node)).map(|(i, _)| i).collect()
@@ -104,5 +173,44 @@ impl Model {
             .sum();
         let lumped: f64 = self.masses.iter().map(|m| m.m * self.groups[m.group].mass).sum();
         beams + lumped + self.imported_mass()
+    }
+}
+
+/// The items at each node of a model (by node index), for
+/// [`Model::part_indexed`]. It belongs to the model it was built from, as
+/// that model stands: an index of another model, or of this one before an
+/// item was added or removed, cuts wrong parts.
+pub struct PartIndex {
+    beams: Vec<Vec<usize>>,
+    springs: Vec<Vec<usize>>,
+    masses: Vec<Vec<usize>>,
+    supports: Vec<Vec<usize>>,
+    ties: Vec<Vec<usize>>,
+    imported: Vec<Vec<usize>>,
+}
+
+impl PartIndex {
+    /// The index of `model`.
+    pub fn new(model: &Model) -> PartIndex {
+        let lists = |nodes: &mut dyn Iterator<Item = (usize, NodeId)>| {
+            let mut at = vec![Vec::new(); model.nodes.len()];
+            for (item, node) in nodes {
+                let list: &mut Vec<usize> = &mut at[model.node_index[&node]];
+                if list.last() != Some(&item) {
+                    list.push(item);
+                }
+            }
+            at
+        };
+        PartIndex {
+            beams: lists(&mut model.beams.iter().enumerate().flat_map(|(i, b)| b.nodes.map(|n| (i, n)))),
+            springs: lists(&mut model.springs.iter().enumerate().flat_map(|(i, s)| {
+                std::iter::once((i, s.a)).chain(s.b.map(|b| (i, b)))
+            })),
+            masses: lists(&mut model.masses.iter().enumerate().map(|(i, m)| (i, m.node))),
+            supports: lists(&mut model.supports.iter().enumerate().map(|(i, s)| (i, s.node))),
+            ties: lists(&mut model.ties.iter().enumerate().flat_map(|(i, t)| t.nodes.map(|n| (i, n)))),
+            imported: lists(&mut model.imported.iter().enumerate().flat_map(|(i, b)| b.nodes.map(|n| (i, n)))),
+        }
     }
 }

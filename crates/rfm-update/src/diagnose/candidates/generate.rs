@@ -21,7 +21,7 @@
 
 use std::collections::{HashMap, HashSet};
 
-use fe_model::{Dimension, Group, Model, NodeId, PerDof};
+use fe_model::{Dimension, Group, Model, NodeId, PartIndex, PerDof};
 use rayon::prelude::*;
 
 mod points;
@@ -68,6 +68,8 @@ type Spec = (Head, Edit, Vec<Fitted>);
 /// starting values, bounds and plausible ranges.
 struct Ctx<'a> {
     model: &'a Model,
+    /// The items at each node, to cut each candidate's part.
+    parts: PartIndex,
     dim: Dimension,
     /// Beams (indices) at each node id.
     beams_at: HashMap<u32, Vec<usize>>,
@@ -108,6 +110,7 @@ impl<'a> Ctx<'a> {
         let two_pi = 2.0 * std::f64::consts::PI;
         Ctx {
             model,
+            parts: PartIndex::new(model),
             dim: model.dimension(),
             beams_at,
             runs,
@@ -406,7 +409,7 @@ fn build(ctx: &Ctx<'_>, specs: Vec<Spec>) -> Vec<Candidate> {
     specs
         .into_par_iter()
         .filter_map(|(head, edit, fitted)| {
-            let mut c = Candidate::new(ctx.model, head, edit, fitted)?;
+            let mut c = Candidate::indexed(ctx.model, &ctx.parts, head, edit, fitted)?;
             c.band_rad = band;
             Some(c)
         })

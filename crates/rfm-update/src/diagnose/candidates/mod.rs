@@ -35,7 +35,7 @@ mod generate;
 mod imported;
 mod per_direction;
 
-use fe_model::{Dof, ElementId, Model, ModelError, NodeId, Parameter};
+use fe_model::{Dof, ElementId, Model, ModelError, NodeId, Parameter, PartIndex};
 
 pub(crate) use edit::Edit;
 pub use generate::generate;
@@ -187,7 +187,24 @@ impl Candidate {
     /// apply to the whole model either).
     pub(crate) fn new(model: &Model, head: Head, edit: Edit, fitted: Vec<Fitted>) -> Option<Candidate> {
         let part_nodes: Vec<NodeId> = head.part_nodes.iter().map(|&n| NodeId(n)).collect();
-        let nominal_part = model.part(&part_nodes);
+        Self::from_part(model.part(&part_nodes), head, edit, fitted)
+    }
+
+    /// As [`Self::new`], with the part cut through an index of the model
+    /// (for the many candidates of one generation).
+    pub(crate) fn indexed(
+        model: &Model,
+        index: &PartIndex,
+        head: Head,
+        edit: Edit,
+        fitted: Vec<Fitted>,
+    ) -> Option<Candidate> {
+        let part_nodes: Vec<NodeId> = head.part_nodes.iter().map(|&n| NodeId(n)).collect();
+        Self::from_part(model.part_indexed(index, &part_nodes), head, edit, fitted)
+    }
+
+    /// A candidate from the nominal part on its `head.part_nodes`.
+    fn from_part(nominal_part: Model, head: Head, edit: Edit, fitted: Vec<Fitted>) -> Option<Candidate> {
         let mut part = nominal_part.clone();
         edit.apply(&mut part).ok()?;
         if fitted.is_empty() || fitted.iter().any(|f| part.parameter(&f.name).is_err()) {
