@@ -204,9 +204,13 @@ impl PartIndex {
         };
         PartIndex {
             beams: lists(&mut model.beams.iter().enumerate().flat_map(|(i, b)| b.nodes.map(|n| (i, n)))),
-            springs: lists(&mut model.springs.iter().enumerate().flat_map(|(i, s)| {
-                std::iter::once((i, s.a)).chain(s.b.map(|b| (i, b)))
-            })),
+            springs: lists(
+                &mut model
+                    .springs
+                    .iter()
+                    .enumerate()
+                    .flat_map(|(i, s)| std::iter::once((i, s.a)).chain(s.b.map(|b| (i, b)))),
+            ),
             masses: lists(&mut model.masses.iter().enumerate().map(|(i, m)| (i, m.node))),
             supports: lists(&mut model.supports.iter().enumerate().map(|(i, s)| (i, s.node))),
             ties: lists(&mut model.ties.iter().enumerate().flat_map(|(i, t)| t.nodes.map(|n| (i, n)))),

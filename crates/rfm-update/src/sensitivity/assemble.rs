@@ -12,7 +12,6 @@ use frf::{Workspace, ZSolver};
 use num_complex::Complex64 as C64;
 use rayon::prelude::*;
 
-use super::cache::ZCache;
 use super::kernels::BucketProducts;
 use super::plan::ChannelPlan;
 use super::terms::{Coefficients, TermTable};
@@ -84,14 +83,13 @@ pub fn assemble_one(
     line: usize,
     scratch: &mut Scratch,
 ) -> Result<FrequencyBlock, UpdateError> {
-    assemble_line(sys, None, None, Strategy::Auto, solver, plan, params, freq_hz, hybrid, line, scratch)
+    assemble_line(sys, None, Strategy::Auto, solver, plan, params, freq_hz, hybrid, line, scratch)
 }
 
-/// [`assemble_one`] with optional prepared parts: a Z cache, and a term
-/// table (made here for this line when absent or when it does not fit).
+/// [`assemble_one`] with an optional term table (made here for this line
+/// when absent or when it does not fit).
 pub(super) fn assemble_line(
     sys: &DampedSystem,
-    cache: Option<&ZCache>,
     table: Option<&TermTable>,
     strategy: Strategy,
     solver: &ZSolver,
@@ -135,10 +133,7 @@ pub(super) fn assemble_line(
 
     // 1: one factorisation
     scratch.z.resize(sys.assembly().pattern().nnz(), ZERO);
-    match cache {
-        None => sys.z_values_into(omega, &mut scratch.z),
-        Some(cache) => cache.values_into(&sys.coefficients(omega), &mut scratch.z),
-    }
+    sys.z_values_into(omega, &mut scratch.z);
     solver.factorize(&mut scratch.ws, &scratch.z, freq_hz)?;
 
     // class sums as right-hand sides need n_ref (1 + classes) solves in two
@@ -296,8 +291,7 @@ pub fn assemble(
     // frequency-independent preparation, shared by the threads (and made by
     // both at once): it pays for itself from a few lines on
     let omega = 2.0 * std::f64::consts::PI * first;
-    let (table, cache) =
-        rayon::join(|| TermTable::new(sys, solver, params, omega), || (freqs_hz.len() >= 3).then(|| ZCache::new(sys)));
+    let table = TermTable::new(sys, solver, params, omega);
     // rayon's `map_init` would make a scratch per work split, not per thread;
     // a pool makes at most one per concurrently running task
     let pool = Mutex::new(Vec::new());
@@ -307,19 +301,8 @@ pub fn assemble(
         .map(|(k, &f)| {
             let popped = pool.lock().unwrap_or_else(PoisonError::into_inner).pop();
             let mut scratch = popped.unwrap_or_else(|| Scratch::new(solver));
-            let block = assemble_line(
-                sys,
-                cache.as_ref(),
-                Some(&table),
-                Strategy::Auto,
-                solver,
-                plan,
-                params,
-                f,
-                hybrid,
-                k,
-                &mut scratch,
-            );
+            let block =
+                assemble_line(sys, Some(&table), Strategy::Auto, solver, plan, params, f, hybrid, k, &mut scratch);
             pool.lock().unwrap_or_else(PoisonError::into_inner).push(scratch);
             block
         })
