@@ -59,8 +59,21 @@ impl LineSet {
         n_lines: usize,
         gains: bool,
     ) -> Result<Self, UpdateError> {
-        let data = measured.at_frequencies(&informative_lines(measured, n_lines))?;
-        let mut model = frf::synthesize(nominal, data.channels(), data.frequencies_hz())?;
+        let lines = informative_lines(measured, n_lines);
+        Self::with_model(measured, n_lines, gains, &frf::synthesize(nominal, measured.channels(), &lines)?)
+    }
+
+    /// As [`Self::new`], with the nominal model's FRFs given at (at least)
+    /// the set's lines.
+    pub(crate) fn with_model(
+        measured: &FrfSet,
+        n_lines: usize,
+        gains: bool,
+        nominal: &FrfSet,
+    ) -> Result<Self, UpdateError> {
+        let lines = informative_lines(measured, n_lines);
+        let data = measured.at_frequencies(&lines)?;
+        let mut model = nominal.at_frequencies(&lines)?;
         if gains {
             // the closed-form gains of the nominal model: its misfit is what no gain removes
             let model_kind = model.converted(data.kind());
@@ -131,6 +144,8 @@ fn fit(
         tolerance: 1e-6,
         bounds,
         gains: lines.gains,
+        // the ranking reads the plain covariance only
+        jackknife: false,
         ..OeOptions::default()
     };
     let data = OeData { measured: &lines.data, weights: None };
@@ -242,9 +257,31 @@ impl<'a> Pool<'a> {
         which: &[usize],
         starts: &[Option<Vec<f64>>],
     ) -> Result<Vec<Result<Fit, String>>, UpdateError> {
+        let data = self.local_data(lines, which)?;
+        Ok(self.fit_on(stage, lines, &data, iterations, which, starts))
+    }
+
+    /// The nominal model's low-rank data on `lines` for the candidates of
+    /// `which`: a factorisation per line, the cost of a fit stage on a
+    /// large model, so that fits of the same candidates from several
+    /// starts share it.
+    fn local_data(&self, lines: &LineSet, which: &[usize]) -> Result<LocalData, UpdateError> {
         let forms: Vec<_> = which.iter().filter_map(|&i| self.locals[i].as_ref().map(|l| &l.form)).collect();
-        let data = LocalData::new(self.nominal, lines.data.channels(), lines.data.frequencies_hz(), &forms)?;
-        Ok(which
+        LocalData::new(self.nominal, lines.data.channels(), lines.data.frequencies_hz(), &forms)
+    }
+
+    /// Fits `which` on `lines` by `data` (from [`Self::local_data`] for
+    /// these candidates), each from its start where given.
+    fn fit_on(
+        &self,
+        stage: FitStage,
+        lines: &LineSet,
+        data: &LocalData,
+        iterations: usize,
+        which: &[usize],
+        starts: &[Option<Vec<f64>>],
+    ) -> Vec<Result<Fit, String>> {
+        which
             .par_iter()
             .zip(starts)
             .map(|(&i, start)| {
@@ -255,7 +292,7 @@ impl<'a> Pool<'a> {
                 }
                 #[cfg(not(test))]
                 let _ = stage;
-                let local = self.locals[i].as_ref().map(|l| (&data, l));
+                let local = self.locals[i].as_ref().map(|l| (data, l));
                 let start = start.as_deref();
                 // a low-rank update that cannot be evaluated (a singular
                 // local system at some line) falls back to the whole model
@@ -264,7 +301,7 @@ impl<'a> Pool<'a> {
                     .or_else(|e| if local.is_some() { attempt(None, start) } else { Err(e) })
                     .or_else(|e| if start.is_some() { attempt(None, None) } else { Err(e) })
             })
-            .collect())
+            .collect()
     }
 
     /// Screens `which` (at `stage`, pre-screening or screening): a short fit
@@ -325,6 +362,7 @@ impl<'a> Pool<'a> {
                 .map(|&k| starts[k].clone().unwrap_or_else(|| self.candidates[which[k]].start_values()))
                 .collect();
             let mut best: Vec<Option<Fit>> = vec![None; with_mu.len()];
+            let data = self.local_data(coarse, &subset)?;
             for m in std::iter::once(None).chain(self.mu_starts.clone().into_iter().map(Some)) {
                 let tries: Vec<Option<Vec<f64>>> = with_mu
                     .iter()
@@ -338,7 +376,7 @@ impl<'a> Pool<'a> {
                         Some(s)
                     })
                     .collect();
-                let fits = self.fit_all(FitStage::FullFit, coarse, short_iterations, &subset, &tries)?;
+                let fits = self.fit_on(FitStage::FullFit, coarse, &data, short_iterations, &subset, &tries);
                 for (slot, f) in best.iter_mut().zip(fits) {
                     if let Ok(f) = f
                         && slot.as_ref().is_none_or(|b| f.cost < b.cost)
@@ -386,12 +424,13 @@ impl<'a> Pool<'a> {
             return Ok(best);
         }
         let rounds = others.iter().map(Vec::len).max().unwrap_or(0);
+        let data = self.local_data(lines, &with.iter().map(|&k| which[k]).collect::<Vec<_>>())?;
         // round 0 from each candidate's own start, then its alternatives
         for r in 0..=rounds {
             let ks: Vec<usize> = with.iter().copied().filter(|&k| r <= others[k].len()).collect();
             let subset: Vec<usize> = ks.iter().map(|&k| which[k]).collect();
             let tries: Vec<Option<Vec<f64>>> = ks.iter().map(|&k| (r > 0).then(|| others[k][r - 1].clone())).collect();
-            for (&k, f) in ks.iter().zip(self.fit_all(stage, lines, iterations, &subset, &tries)?) {
+            for (&k, f) in ks.iter().zip(self.fit_on(stage, lines, &data, iterations, &subset, &tries)) {
                 if let Ok(f) = f
                     && best[k].as_ref().is_none_or(|b| f.cost < b.cost)
                 {
@@ -565,19 +604,21 @@ impl<'a> Pool<'a> {
 
 /// The pre-screening, screening and full fits of a first pass of
 /// candidates, then the refinement and the holding; see the module docs of
-/// [`super`].
+/// [`super`]. `nominal` holds the nominal model's FRFs at every line of the
+/// line sets.
 pub(crate) fn search(
     pool: &mut Pool<'_>,
     measured: &FrfSet,
+    nominal: &FrfSet,
     full: &LineSet,
     opts: &DiagnoseOptions,
     copts: &CandidateOptions,
     trace: &mut dyn FnMut(&str),
 ) -> Result<(), UpdateError> {
-    let coarse = LineSet::new(pool.nominal, measured, opts.screen_lines, opts.gains)?;
+    let coarse = LineSet::with_model(measured, opts.screen_lines, opts.gains, nominal)?;
     let all = pool.add(candidates::generate(pool.model, copts));
     let to_screen = if all.len() > opts.prescreen_above {
-        let pre = LineSet::new(pool.nominal, measured, opts.prescreen_lines, opts.gains)?;
+        let pre = LineSet::with_model(measured, opts.prescreen_lines, opts.gains, nominal)?;
         pool.screen(FitStage::PreScreening, &pre, opts.prescreen_iterations, &all, false)?;
         trace(&format!("pre-screened {} candidates on {} lines", all.len(), pre.data.n_freq()));
         let mut best = pool.by_screening(&all);

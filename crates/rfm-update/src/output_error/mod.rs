@@ -127,6 +127,10 @@ pub struct OeOptions {
     /// without converging (see [`crate::study::Study::run_output_error`]);
     /// 0: none.
     pub restarts: usize,
+    /// Compute [`OeResult::jackknife`] (a solve per left-out block of
+    /// lines); off where only the fit and its plain covariance are read,
+    /// as in the diagnosis's tens of thousands of candidate fits.
+    pub jackknife: bool,
 }
 
 impl Default for OeOptions {
@@ -141,6 +145,7 @@ impl Default for OeOptions {
             rcond: 1e-12,
             stop_within_noise: true,
             restarts: 6,
+            jackknife: true,
         }
     }
 }
@@ -204,7 +209,8 @@ pub struct OeResult {
     pub sigma2: f64,
     /// Covariance of `(theta, gain parameters)` by the delete-a-block
     /// jackknife over the lines ([`crate::jackknife`]): the spread that
-    /// model error gives the estimates. `None` with regularisation or too
+    /// model error gives the estimates. `None` when not asked for
+    /// ([`OeOptions::jackknife`]), with regularisation, or with too
     /// few lines.
     pub jackknife: Option<Mat<f64>>,
     /// Singular values of the column-scaled Jacobian at the solution.
@@ -435,7 +441,7 @@ pub(crate) fn run_with(
     let covariance = covariance(&sol, sigma2);
     let residual_correlation =
         adjacent_correlation(&final_point.residual, measured.n_freq(), measured.channels().len());
-    let jackknife = if opts.regularization == 0.0 {
+    let jackknife = if opts.jackknife && opts.regularization == 0.0 {
         let fixed: Vec<bool> = (0..jac.ncols()).map(|j| j < n && at_bound[j]).collect();
         crate::jackknife::block_covariance(
             jac,
