@@ -333,7 +333,8 @@ fn update_case(
         oe_opts.restarts = 0;
     }
     let outcome = study.run_output_error(&oe_opts, |_| {})?;
-    let misfit_updated = diagnose::log_misfit_with(&outcome.system, measured, lines, d.gains)?;
+    let weights = opts.diagnose.weights.as_deref();
+    let misfit_updated = diagnose::log_misfit_with(&outcome.system, measured, lines, d.gains, weights)?;
     let values = crate::params::quantity_values(study.parameters(), outcome.system.model());
     editor.set_values(&values, &format!("updated by rfm fix, step {step}"))?;
     editor.push_history(&HistoryEntry {

@@ -82,7 +82,7 @@ pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
     let bar = if args.json { ProgressBar::hidden() } else { ProgressBar::new_spinner() };
     bar.enable_steady_tick(std::time::Duration::from_millis(120));
     let start = std::time::Instant::now();
-    let opts = study.diagnose_options()?;
+    let opts = study.diagnose_options(&measured)?;
     let d = diagnose_with(&study.case().model, &measured, &opts, |stage| {
         let line = format!("{stage} ({:.2} s)", start.elapsed().as_secs_f64());
         if args.verbose {

@@ -54,7 +54,7 @@ pub(crate) fn fix(args: &FixArgs<'_>) -> Result<Exit> {
     }
     let opts = FixOptions {
         max_steps: args.steps,
-        diagnose: study.diagnose_options()?,
+        diagnose: study.diagnose_options(study.measured())?,
         data: synthesised.then(|| output.path(DATA_FILE)),
         ..FixOptions::default()
     };

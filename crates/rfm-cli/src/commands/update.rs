@@ -115,12 +115,16 @@ pub(crate) fn update(
         }
     };
     bar.finish_and_clear();
-    // the misfit the case's history speaks of, after this update
-    let noise = rfm_update::diagnose::estimate_noise_against(&outcome.system, study.measured())?;
+    // the misfit the case's history speaks of, after this update, weighted
+    // as the diagnosis weighs it (the fit's line weights)
+    let weights = study.line_weights(study.measured())?;
+    let (measured, weights) = (study.measured(), weights.as_deref());
+    let noise = rfm_update::diagnose::estimate_noise_against_weighted(&outcome.system, measured, weights)?;
     let gains = study.gains() != fe_model::case::Gains::None;
-    let misfit = rfm_update::diagnose::log_misfit_with(&outcome.system, study.measured(), HISTORY_LINES, gains)?;
+    let misfit = rfm_update::diagnose::log_misfit_with(&outcome.system, measured, HISTORY_LINES, gains, weights)?;
     // worse than the start over the whole band, not only at the fitted lines
-    let misfit_initial = rfm_update::diagnose::log_misfit_with(study.system(), study.measured(), HISTORY_LINES, gains)?;
+    let misfit_initial =
+        rfm_update::diagnose::log_misfit_with(study.system(), measured, HISTORY_LINES, gains, weights)?;
     if misfit > WORSE_BY * misfit_initial && !outcome.worse_than_start {
         outcome.worse_than_start = true;
         outcome.warnings.push(format!(
@@ -138,8 +142,8 @@ pub(crate) fn update(
             print_history(&[study.case().history.clone(), vec![step.clone()]].concat())?;
             if let (Some(ratio), true) = (outcome.noise_ratio, outcome.residual_noise != outcome.noise_estimate) {
                 outln!(
-                    "(misfits over the band, unweighted; the status weighs the fit's residual and the noise alike: \
-                     {ratio:.2} times the noise)"
+                    "(misfits over the band, weighted as the fit weighs its lines; the status, from the fit's \
+                     residual on its own lines: {ratio:.2} times the noise)"
                 );
             }
         }

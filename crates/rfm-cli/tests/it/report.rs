@@ -360,11 +360,14 @@ fn compare_refuses_bad_bands_and_missing_files_with_a_message() {
 #[test]
 fn the_xml_check_rejects_what_it_should() {
     assert!(check_xml("<svg><g><text>a &amp; b</text></g></svg>", "svg").is_ok());
-    assert!(check_xml("<svg><g></svg>", "svg").is_err());
-    assert!(check_xml("<svg><text>a & b</text></svg>", "svg").is_err());
-    assert!(check_xml("<svg a=\"1></svg>", "svg").is_err());
-    assert!(check_xml("<html></html>", "svg").is_err());
-    assert!(check_xml("<svg/><svg/>", "svg").is_err());
+    let refused = |doc: &str| check_xml(doc, "svg").unwrap_err();
+    assert_eq!(refused("<svg><g></svg>"), "</svg> closes <g>");
+    assert_eq!(refused("<svg><text>a & b</text></svg>"), "an unescaped `&` in \"a & b\"");
+    assert_eq!(refused("<svg a=\"1></svg>"), "unbalanced quotes in <svg a=\"1>");
+    assert_eq!(refused("<html></html>"), "the root is <html>, not <svg>");
+    assert_eq!(refused("<svg/><svg/>"), "a second root element <svg>");
+    assert_eq!(refused("<svg><g>"), "<g> is never closed");
+    assert_eq!(refused("<svg></svg>tail"), "text after the root element: \"tail\"");
 }
 
 /// Case 1's initial model differs from its truth only in damping: every

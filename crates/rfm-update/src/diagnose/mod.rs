@@ -258,6 +258,11 @@ pub struct DiagnoseOptions {
     /// with the nominal model (voltage-referenced data, see [`crate::gain`]):
     /// a level offset common to a reference's channels is then no symptom.
     pub gains: bool,
+    /// Residual weights at the measured lines, channel-major, as
+    /// [`crate::Study::line_weights`] gives them (the measured coherence's
+    /// and the case's band weights); `None`: all 1. The noise level is read
+    /// from the values weighted the same way.
+    pub weights: Option<Vec<f64>>,
 }
 
 impl Default for DiagnoseOptions {
@@ -275,6 +280,7 @@ impl Default for DiagnoseOptions {
             significance: -10.0,
             candidates: CandidateOptions::default(),
             gains: false,
+            weights: None,
         }
     }
 }
@@ -491,13 +497,23 @@ pub fn informative_lines(measured: &FrfSet, n: usize) -> Vec<f64> {
 /// RMS of `ln(H / M)` per complex value of a system's receptances `H`
 /// against measured ones `M`, on `lines` lines spread over the measured band.
 pub fn log_misfit(sys: &DampedSystem, measured: &FrfSet, lines: usize) -> Result<f64, UpdateError> {
-    log_misfit_with(sys, measured, lines, false)
+    log_misfit_with(sys, measured, lines, false, None)
 }
 
 /// As [`log_misfit`], after the model's FRFs are multiplied by the gain per
-/// reference that fits them best when `gains` (see [`crate::gain`]).
-pub fn log_misfit_with(sys: &DampedSystem, measured: &FrfSet, lines: usize, gains: bool) -> Result<f64, UpdateError> {
-    let set = LineSet::new(sys, measured, lines, gains)?;
+/// reference that fits them best when `gains` (see [`crate::gain`]), each
+/// value weighted by `weights` (at the lines of `measured`, channel-major,
+/// as [`DiagnoseOptions::weights`]; the diagnosis's misfits are weighted so).
+pub fn log_misfit_with(
+    sys: &DampedSystem,
+    measured: &FrfSet,
+    lines: usize,
+    gains: bool,
+    weights: Option<&[f64]>,
+) -> Result<f64, UpdateError> {
+    let at = informative_lines(measured, lines);
+    let model = frf::synthesize(sys, measured.channels(), &at)?;
+    let set = LineSet::with_model(measured, lines, gains, &model, weights)?;
     Ok((set.cost0 / (set.n as f64 / 2.0)).sqrt())
 }
 
@@ -534,6 +550,17 @@ fn diagnose_in(
             lines.len()
         )));
     }
+    let weights = opts.weights.as_deref();
+    if let Some(w) = weights
+        && w.len() != measured.channels().len() * lines.len()
+    {
+        return Err(UpdateError::Data(format!(
+            "the diagnosis has {} weights for {} channels x {} lines",
+            w.len(),
+            measured.channels().len(),
+            lines.len()
+        )));
+    }
     let nominal = DampedSystem::new(model.clone())?;
     // the nominal model at every line read below, in one synthesis (on a
     // 96k-DOF frame, 2 s saved against one per line set)
@@ -544,11 +571,11 @@ fn diagnose_in(
     read.sort_by(f64::total_cmp);
     read.dedup();
     let at_lines = frf::synthesize(&nominal, measured.channels(), &read)?;
-    let noise = noise_against(measured, None, &at_lines)
+    let noise = noise_against(measured, weights, &at_lines)
         .ok_or_else(|| UpdateError::Data("too few usable measured values to estimate the noise level".into()))?;
     // a noise floor for noise-free data keeps the criterion finite
     let s2 = (noise * noise / 2.0).max(1e-20);
-    let full = LineSet::with_model(measured, opts.lines, opts.gains, &at_lines)?;
+    let full = LineSet::with_model(measured, opts.lines, opts.gains, &at_lines, weights)?;
     let mut copts = opts.candidates.clone();
     copts.band_hz = (lines[0], lines[lines.len() - 1]);
     let mut pool = Pool::new(model, &nominal, s2, copts.band_hz);

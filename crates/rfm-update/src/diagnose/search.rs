@@ -50,47 +50,48 @@ pub(crate) struct LineSet {
     /// Whether every fit on these lines fits a gain per reference (and
     /// `cost0` is the nominal model's after its best gains).
     pub(crate) gains: bool,
+    /// Residual weights at these lines, channel-major (`None`: all 1).
+    pub(crate) weights: Option<Vec<f64>>,
 }
 
 impl LineSet {
-    pub(crate) fn new(
-        nominal: &DampedSystem,
-        measured: &FrfSet,
-        n_lines: usize,
-        gains: bool,
-    ) -> Result<Self, UpdateError> {
-        let lines = informative_lines(measured, n_lines);
-        Self::with_model(measured, n_lines, gains, &frf::synthesize(nominal, measured.channels(), &lines)?)
-    }
-
-    /// As [`Self::new`], with the nominal model's FRFs given at (at least)
-    /// the set's lines.
+    /// The `n_lines` most informative lines of `measured` with the nominal
+    /// model's cost there; `nominal` holds the nominal model's FRFs at (at
+    /// least) those lines, `weights` the residual weights at the lines of
+    /// `measured` (channel-major; `None`: all 1).
     pub(crate) fn with_model(
         measured: &FrfSet,
         n_lines: usize,
         gains: bool,
         nominal: &FrfSet,
+        weights: Option<&[f64]>,
     ) -> Result<Self, UpdateError> {
         let lines = informative_lines(measured, n_lines);
         let data = measured.at_frequencies(&lines)?;
         let mut model = nominal.at_frequencies(&lines)?;
+        let weights: Option<Vec<f64>> = weights.map(|w| {
+            let (nf, at): (usize, Vec<usize>) =
+                (measured.n_freq(), lines.iter().map(|&f| measured.line_of(f).expect("a measured line")).collect());
+            (0..data.channels().len()).flat_map(|c| at.iter().map(move |&k| w[c * nf + k])).collect()
+        });
         if gains {
             // the closed-form gains of the nominal model: its misfit is what no gain removes
             let model_kind = model.converted(data.kind());
-            let fitted = crate::gain::fit_gains(&model_kind, &data, None, Gains::PerReference)?;
+            let fitted = crate::gain::fit_gains(&model_kind, &data, weights.as_deref(), Gains::PerReference)?;
             fitted.apply(&mut model);
         }
         let (mut cost, mut n) = (0.0, 0);
-        for (h, m) in model.values().iter().zip(data.values()) {
-            if m.norm() > 0.0 {
-                cost += (h / m).ln().norm_sqr();
+        for (i, (h, m)) in model.values().iter().zip(data.values()).enumerate() {
+            let w = weights.as_ref().map_or(1.0, |w| w[i]);
+            if m.norm() > 0.0 && w > 0.0 {
+                cost += w * w * (h / m).ln().norm_sqr();
                 n += 2;
             }
         }
         if !cost.is_finite() {
             return Err(UpdateError::Data("the nominal model's misfit is not finite at the measured lines".into()));
         }
-        Ok(LineSet { data, cost0: cost, n, gains })
+        Ok(LineSet { data, cost0: cost, n, gains, weights })
     }
 }
 
@@ -148,7 +149,7 @@ fn fit(
         jackknife: false,
         ..OeOptions::default()
     };
-    let data = OeData { measured: &lines.data, weights: None };
+    let data = OeData { measured: &lines.data, weights: lines.weights.as_deref() };
     let r = match local {
         Some((ld, lc)) => {
             let mut response = ld.response(lc, sys);
@@ -615,10 +616,11 @@ pub(crate) fn search(
     copts: &CandidateOptions,
     trace: &mut dyn FnMut(&str),
 ) -> Result<(), UpdateError> {
-    let coarse = LineSet::with_model(measured, opts.screen_lines, opts.gains, nominal)?;
+    let weights = opts.weights.as_deref();
+    let coarse = LineSet::with_model(measured, opts.screen_lines, opts.gains, nominal, weights)?;
     let all = pool.add(candidates::generate(pool.model, copts));
     let to_screen = if all.len() > opts.prescreen_above {
-        let pre = LineSet::with_model(measured, opts.prescreen_lines, opts.gains, nominal)?;
+        let pre = LineSet::with_model(measured, opts.prescreen_lines, opts.gains, nominal, weights)?;
         pool.screen(FitStage::PreScreening, &pre, opts.prescreen_iterations, &all, false)?;
         trace(&format!("pre-screened {} candidates on {} lines", all.len(), pre.data.n_freq()));
         let mut best = pool.by_screening(&all);

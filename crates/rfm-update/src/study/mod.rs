@@ -422,10 +422,13 @@ impl Study {
         Ok(())
     }
 
-    /// The diagnosis options of this study: the defaults, with a gain per
-    /// reference fitted with every candidate when the study has gains. A
+    /// The diagnosis options of this study for `measured` (its data, or
+    /// other data on its channels): the defaults, with a gain per reference
+    /// fitted with every candidate when the study has gains, and the
+    /// residual weights of [`Study::line_weights`] at the lines of
+    /// `measured` (the coherence's, by default when the data carry it). A
     /// gain per channel is refused: the diagnosis fits them per reference.
-    pub fn diagnose_options(&self) -> Result<crate::diagnose::DiagnoseOptions, UpdateError> {
+    pub fn diagnose_options(&self, measured: &FrfSet) -> Result<crate::diagnose::DiagnoseOptions, UpdateError> {
         let gains = match self.gains {
             Gains::None => false,
             Gains::PerReference => true,
@@ -437,7 +440,8 @@ impl Study {
                 ));
             }
         };
-        Ok(crate::diagnose::DiagnoseOptions { gains, ..Default::default() })
+        let weights = self.line_weights(measured)?;
+        Ok(crate::diagnose::DiagnoseOptions { gains, weights, ..Default::default() })
     }
 
     /// The measured FRFs in the kind they were measured in (`measured` is
