@@ -14,58 +14,23 @@ impl Model {
     /// whole, at the same indices; beams, springs and masses keep their ids
     /// and names but not their indices. A part usually floats free, so it is
     /// assembled with [`crate::Assembly::of_part`], not [`crate::Assembly::new`].
+    /// Each call indexes the whole model; for many parts of one model, see
+    /// [`Self::part_indexed`].
     pub fn part(&self, nodes: &[NodeId]) -> Model {
-        let mut keep = vec![false; self.nodes.len()];
-        for id in nodes {
-            if let Some(&i) = self.node_index.get(id) {
-                keep[i] = true;
-            }
-        }
-        // closure over ties: a tie chain can reach further than one step
-        loop {
-            let mut grew = false;
-            for t in &self.ties {
-                let [a, b] = t.nodes.map(|n| self.node_index[&n]);
-                if keep[a] != keep[b] {
-                    keep[a] = true;
-                    keep[b] = true;
-                    grew = true;
-                }
-            }
-            if !grew {
-                break;
-            }
-        }
-        let kept = |id: &NodeId| keep[self.node_index[id]];
-        let nodes: Vec<Node> = self.nodes.iter().filter(|n| kept(&n.id)).cloned().collect();
-        let node_index = nodes.iter().enumerate().map(|(i, n)| (n.id, i)).collect();
-        Model {
-            title: self.title.clone(),
-            dimension: self.dimension,
-            nodes,
-            node_index,
-            materials: self.materials.clone(),
-            sections: self.sections.clone(),
-            beams: self.beams.iter().filter(|b| b.nodes.iter().all(kept)).cloned().collect(),
-            springs: self.springs.iter().filter(|s| kept(&s.a) && s.b.as_ref().is_none_or(kept)).cloned().collect(),
-            masses: self.masses.iter().filter(|m| kept(&m.node)).cloned().collect(),
-            supports: self.supports.iter().filter(|s| kept(&s.node)).cloned().collect(),
-            ties: self.ties.iter().filter(|t| t.nodes.iter().all(kept)).cloned().collect(),
-            groups: self.groups.clone(),
-            imported: self.imported.iter().filter(|b| b.nodes.iter().all(kept)).cloned().collect(),
-        }
+        self.part_indexed(&PartIndex::new(self), nodes)
     }
 
-    /// The same part as [`Self::part`], cut with an index of the items at
-    /// each node: it touches only what lies on the part's nodes, where
-    /// `part` looks through the whole model. A diagnosis cuts one part per
-    /// candidate (60,000 on a 100k-DOF frame, where the whole-model scan
-    /// took 40 s of CPU); build the index once with [`PartIndex::new`].
+    /// [`Self::part`], cut through an index of the items at each node made
+    /// beforehand ([`PartIndex::new`]): it touches only what lies on the
+    /// part's nodes. A diagnosis cuts one part per candidate (60,000 on a
+    /// 100k-DOF frame, where a scan of the whole model for each took 40 s of
+    /// CPU); it builds the index once.
     pub fn part_indexed(&self, index: &PartIndex, nodes: &[NodeId]) -> Model {
         let mut keep: Vec<usize> = nodes.iter().filter_map(|id| self.node_index.get(id).copied()).collect();
         keep.sort_unstable();
         keep.dedup();
-        // closure over ties, as in `part`, by a walk along the ties at kept nodes
+        // closure over ties (a chain can reach further than one step), by a
+        // walk along the ties at kept nodes
         let mut queue = keep.clone();
         while let Some(i) = queue.pop() {
             for &t in &index.ties[i] {
