@@ -60,33 +60,13 @@ impl Model {
             node_index,
             materials: self.materials.clone(),
             sections: self.sections.clone(),
-            beams: at(&index.beams)
-                .into_iter()
-                .map(|i| &self.beams[i])
-                .filter(|b| b.nodes.iter().all(kept))
-                .cloned()
-                .collect(),
-            springs: at(&index.springs)
-                .into_iter()
-                .map(|i| &self.springs[i])
-                .filter(|s| kept(&s.a) && s.b.as_ref().is_none_or(kept))
-                .cloned()
-                .collect(),
-            masses: at(&index.masses).into_iter().map(|i| self.masses[i].clone()).collect(),
-            supports: at(&index.supports).into_iter().map(|i| self.supports[i].clone()).collect(),
-            ties: at(&index.ties)
-                .into_iter()
-                .map(|i| &self.ties[i])
-                .filter(|t| t.nodes.iter().all(kept))
-                .cloned()
-                .collect(),
+            beams: cut(&self.beams, at(&index.beams), |b| b.nodes.iter().all(kept)),
+            springs: cut(&self.springs, at(&index.springs), |s| kept(&s.a) && s.b.as_ref().is_none_or(kept)),
+            masses: cut(&self.masses, at(&index.masses), |_| true),
+            supports: cut(&self.supports, at(&index.supports), |_| true),
+            ties: cut(&self.ties, at(&index.ties), |t| t.nodes.iter().all(kept)),
             groups: self.groups.clone(),
-            imported: at(&index.imported)
-                .into_iter()
-                .map(|i| &self.imported[i])
-                .filter(|b| b.nodes.iter().all(kept))
-                .cloned()
-                .collect(),
+            imported: cut(&self.imported, at(&index.imported), |b| b.nodes.iter().all(kept)),
         }
     }
 
@@ -139,6 +119,11 @@ impl Model {
         let lumped: f64 = self.masses.iter().map(|m| m.m * self.groups[m.group].mass).sum();
         beams + lumped + self.imported_mass()
     }
+}
+
+/// The items of `items` at the indices `at` that `keep` keeps, in order.
+fn cut<T: Clone>(items: &[T], at: Vec<usize>, keep: impl Fn(&T) -> bool) -> Vec<T> {
+    at.into_iter().map(|i| &items[i]).filter(|x| keep(x)).cloned().collect()
 }
 
 /// The items at each node of a model (by node index), for
