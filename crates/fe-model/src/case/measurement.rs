@@ -349,32 +349,14 @@ mod tests {
     use crate::CaseFile;
     use crate::dof::Dof;
 
-    const BEAM: &str = r#"
-title = "beam"
-[materials.steel]
-E = 2e11
-rho = 7800
-[sections.bar]
-b = 0.05
-h = 0.01
-[groups.beam]
-alpha = 1e-5
-[[lines]]
-from = [0.0, 0.0]
-to = [1.0, 0.0]
-elements = 4
-material = "steel"
-section = "bar"
-group = "beam"
-[[supports]]
-node = 1
-[measurement]
+    /// The tests' beam, measured at its tip.
+    const MEASUREMENT: &str = r#"[measurement]
 references = ["5:uy"]
 responses = ["2..5:uy"]
 "#;
 
     fn parse(extra: &str) -> Result<MeasurementSpec, CaseError> {
-        let text = format!("{BEAM}{extra}");
+        let text = format!("{}{MEASUREMENT}{extra}", crate::case::tests::BEAM);
         CaseFile::parse(Path::new("/lab/case.toml"), &text).map(|c| c.measurement.unwrap())
     }
 

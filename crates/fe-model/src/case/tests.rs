@@ -11,7 +11,8 @@ fn parse(text: &str) -> Result<CaseFile, CaseError> {
     CaseFile::parse(Path::new("test.toml"), text)
 }
 
-const BEAM: &str = r#"
+/// A clamped beam of four elements, the case tests' model.
+pub(super) const BEAM: &str = r#"
 title = "beam"
 [materials.steel]
 E = 2e11
