@@ -154,10 +154,16 @@ fn unfitted_lines(d: &Diagnosis) -> Vec<String> {
 
 fn print_diagnosis(d: &Diagnosis, top: usize) -> Result<()> {
     outln!(
-        "noise level estimated from the data: {:.2} %; nominal model misfit: {:.2} % (RMS relative)\n",
+        "noise level estimated from the data: {:.2} %; nominal model misfit: {:.2} % (RMS relative)",
         100.0 * d.noise,
         100.0 * d.nominal_misfit
     );
+    if d.weighted {
+        outln!(
+            "(both, and every fit, weigh the lines as the update does: by the measured coherence and any band weights)"
+        );
+    }
+    outln!("");
     if d.gains {
         outln!("every fit includes an unknown complex gain per reference; the leader's:");
         if let Some(l) = d.ranking.first() {
@@ -279,6 +285,7 @@ mod tests {
             tried: 40,
             superseded: 2,
             gains: false,
+            weighted: false,
             unfitted,
             candidates: Vec::new(),
         }

@@ -413,6 +413,9 @@ pub struct Diagnosis {
     /// Whether every fit (and the nominal misfit) fitted an unknown gain
     /// per reference.
     pub gains: bool,
+    /// Whether the fits, the misfits and the noise level weigh the lines
+    /// ([`DiagnoseOptions::weights`]: the coherence's, or band weights).
+    pub weighted: bool,
     /// Candidates whose last fit failed, with the stage and the reason:
     /// every candidate tried is ranked, superseded by a variant that holds
     /// what the data do not determine, or here (or both, when it is ranked
@@ -649,6 +652,7 @@ fn rank(pool: Pool<'_>, noise: f64, full: &LineSet, opts: &DiagnoseOptions) -> D
         tried: pool.candidates.len(),
         superseded: pool.superseded.iter().filter(|&&s| s).count(),
         gains: full.gains,
+        weighted: full.weights.is_some(),
         unfitted,
         candidates: pool.candidates,
     }
