@@ -53,6 +53,17 @@ impl GroupCoefficients {
     }
 }
 
+/// The place of a matrix kind's coefficient among a group's (stiffness,
+/// mass, damping): the slot `3 group + kind_slot(kind)` of a table of every
+/// group's coefficients, as `Z(w)` and the sensitivity assembly keep them.
+pub fn kind_slot(kind: MatrixKind) -> u32 {
+    match kind {
+        MatrixKind::Stiffness => 0,
+        MatrixKind::Mass => 1,
+        MatrixKind::Damping => 2,
+    }
+}
+
 /// Coefficients of the damping-parameter derivatives of one group, already
 /// multiplied by the parameter (relative form `(dZ/dp) p`), per matrix kind.
 /// None of alpha, beta and mu acts on an imported damping matrix.

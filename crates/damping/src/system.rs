@@ -47,6 +47,7 @@ impl Layout {
     fn new(assembly: &Assembly) -> Option<Layout> {
         let mut units: Vec<f64> = Vec::new();
         let mut stored: HashMap<Vec<u64>, u32> = HashMap::new();
+        let mut key: Vec<u64> = Vec::new();
         let (mut blocks, mut positions, mut terms) = (Vec::new(), Vec::new(), Vec::new());
         for b in assembly.blocks() {
             let p0 = u32::try_from(positions.len()).ok()?;
@@ -56,17 +57,19 @@ impl Layout {
             let t0 = u32::try_from(terms.len()).ok()?;
             // Assembly::accumulate skips terms whose value is zero
             for t in b.terms().iter().filter(|t| t.value() != 0.0) {
-                let key: Vec<u64> = t.unit().iter().map(|u| u.to_bits()).collect();
-                let at = match stored.get(&key) {
+                // the key is built in one buffer, and kept only for a new matrix
+                key.clear();
+                key.extend(t.unit().iter().map(|u| u.to_bits()));
+                let at = match stored.get(key.as_slice()) {
                     Some(&at) => at,
                     None => {
                         let at = u32::try_from(units.len()).ok()?;
                         units.extend_from_slice(t.unit());
-                        stored.insert(key, at);
+                        stored.insert(key.clone(), at);
                         at
                     }
                 };
-                let slot = 3 * u32::try_from(b.group()).ok()? + kind_slot(t.kind());
+                let slot = 3 * u32::try_from(b.group()).ok()? + kernel::kind_slot(t.kind());
                 terms.push((slot, t.value(), at));
             }
             let len = u32::try_from(b.positions().len()).ok()?;
@@ -91,15 +94,6 @@ impl Layout {
                 }
             }
         }
-    }
-}
-
-/// A term's place among its group's coefficients (stiffness, mass, damping).
-fn kind_slot(kind: MatrixKind) -> u32 {
-    match kind {
-        MatrixKind::Stiffness => 0,
-        MatrixKind::Mass => 1,
-        MatrixKind::Damping => 2,
     }
 }
 

@@ -2,19 +2,7 @@
 
 use std::hash::Hasher;
 
-use fe_model::MatrixKind;
-
 use super::hash::{FxHasher, FxMap};
-
-/// 0, 1, 2 for a stiffness, mass or damping term: its place among its
-/// group's coefficients.
-pub(super) fn kind_index(kind: MatrixKind) -> u32 {
-    match kind {
-        MatrixKind::Stiffness => 0,
-        MatrixKind::Mass => 1,
-        MatrixKind::Damping => 2,
-    }
-}
 
 /// Unit matrices stored once each: identical elements (the common case in
 /// a mesh) share one copy, so that the hot loops read them from cache.

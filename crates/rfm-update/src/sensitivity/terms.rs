@@ -218,7 +218,7 @@ impl TermTable {
                 let class = if rules_hold {
                     let mut h = FxHasher::default();
                     h.write_usize(block.group());
-                    h.write_u32(super::cache::kind_index(term.kind()));
+                    h.write_u32(damping::kernel::kind_slot(term.kind()));
                     for &i in who {
                         h.write_u32(i);
                     }
