@@ -164,13 +164,14 @@ fn print_diagnosis(d: &Diagnosis, top: usize) -> Result<()> {
         );
     }
     outln!("");
-    if d.gains {
-        outln!("every fit includes an unknown complex gain per reference; the leader's:");
+    if d.gains != Gains::None {
+        let per = if d.gains == Gains::PerChannel { "channel" } else { "reference" };
+        outln!("every fit includes an unknown complex gain per {per}; the leader's:");
         if let Some(l) = d.ranking.first() {
             for g in &l.gains {
                 outln!(
                     "    {}: x{} ({:+.1} dB), {:+.1} deg",
-                    g.reference,
+                    g.key,
                     num(g.magnitude),
                     20.0 * g.magnitude.log10(),
                     g.phase_deg
@@ -284,7 +285,7 @@ mod tests {
             recommended: None,
             tried: 40,
             superseded: 2,
-            gains: false,
+            gains: Gains::None,
             weighted: false,
             unfitted,
             candidates: Vec::new(),

@@ -120,7 +120,7 @@ pub(crate) fn update(
     let weights = study.line_weights(study.measured())?;
     let (measured, weights) = (study.measured(), weights.as_deref());
     let noise = rfm_update::diagnose::estimate_noise_against_weighted(&outcome.system, measured, weights)?;
-    let gains = study.gains() != fe_model::case::Gains::None;
+    let gains = study.gains();
     let misfit = rfm_update::diagnose::log_misfit_with(&outcome.system, measured, HISTORY_LINES, gains, weights)?;
     // worse than the start over the whole band, not only at the fitted lines
     let misfit_initial =
@@ -194,11 +194,7 @@ fn write_updated_model(
         let fitted: Vec<fe_model::case::FittedGain> = outcome
             .gains
             .iter()
-            .map(|g| fe_model::case::FittedGain {
-                key: fe_model::case::GainKey::Reference(g.reference),
-                magnitude: g.magnitude,
-                phase_deg: g.phase_deg,
-            })
+            .map(|g| fe_model::case::FittedGain { key: g.key, magnitude: g.magnitude, phase_deg: g.phase_deg })
             .collect();
         editor.set_gains(study.gains(), &fitted)?;
     }
@@ -361,7 +357,8 @@ fn print_outcome(outcome: &UpdateOutcome) -> Result<()> {
         }
     }
     for g in &outcome.gains {
-        outln!("gain of reference {}: {:.4} at {:+.2} deg", g.reference, g.magnitude, g.phase_deg);
+        let of = if matches!(g.key, fe_model::case::GainKey::Channel(..)) { "channel" } else { "reference" };
+        outln!("gain of {of} {}: {:.4} at {:+.2} deg", g.key, g.magnitude, g.phase_deg);
     }
     let nf = &outcome.natural_frequencies_hz;
     if nf.kind == "none" {

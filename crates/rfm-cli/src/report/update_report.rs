@@ -6,8 +6,9 @@
 
 use std::path::{Path, PathBuf};
 
+use fe_model::case::GainKey;
 use frf::correlation::{BandSpec, correlate};
-use frf::{C64, synthesize_regular};
+use frf::synthesize_regular;
 use rfm_update::output_error::Gain;
 use rfm_update::status::Status;
 use rfm_update::study::FrequencyTable;
@@ -145,10 +146,12 @@ pub(crate) fn write(
         }
     }
     if !outcome.gains.is_empty() {
-        let mut t = Table::new(&["reference", "gain magnitude", "gain phase (deg)"])
-            .caption("Fitted gain per reference (the model FRFs are multiplied by it before comparison).");
+        let per =
+            if outcome.gains.iter().any(|g| matches!(g.key, GainKey::Channel(..))) { "channel" } else { "reference" };
+        let mut t = Table::new(&[per, "gain magnitude", "gain phase (deg)"])
+            .caption(format!("Fitted gain per {per} (the model FRFs are multiplied by it before comparison)."));
         for g in &outcome.gains {
-            t.row(vec![g.reference.to_string(), sig(g.magnitude, 4), sig(g.phase_deg, 3)]);
+            t.row(vec![g.key.to_string(), sig(g.magnitude, 4), sig(g.phase_deg, 3)]);
         }
         ps.push(Block::Table(t));
     }
@@ -163,8 +166,7 @@ pub(crate) fn write(
     )];
     report.sections.push(super::correlation_section(measured, &models, opts, out, notes)?);
     let comparison = super::modes::compare_modes(&outcome.system, measured, |c| {
-        let reference = measured.channels()[c].reference;
-        outcome.gains.iter().find(|g| g.reference == reference).map_or(C64::new(1.0, 0.0), Gain::factor)
+        Gain::factor_of(&outcome.gains, &measured.channels()[c])
     });
     report.sections.push(super::modes::section(
         comparison.as_ref(),

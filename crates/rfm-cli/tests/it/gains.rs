@@ -1,5 +1,5 @@
-//! Voltage-referenced data: an unknown complex gain per reference in
-//! compare, diagnose and update, whichever way the data arrive.
+//! Voltage-referenced data: an unknown complex gain per reference (or per
+//! channel) in compare, diagnose and update, whichever way the data arrive.
 //!
 //! The truth is independent of rfm's gain fit: the tutorial's measured
 //! receptances (per newton) are turned into accelerances per volt here, by
@@ -20,8 +20,13 @@ fn tutorial() -> PathBuf {
 /// The tutorial's receptances as accelerances per volt, times `gain`
 /// (magnitude, phase in degrees).
 fn per_volt_accelerance(gain: (f64, f64)) -> String {
+    per_volt_accelerance_each(|_| gain)
+}
+
+/// As [`per_volt_accelerance`], channel `c` (in the file's order) times
+/// `gain(c)`: an amplifier's gain and each accelerometer's own error.
+fn per_volt_accelerance_each(gain: impl Fn(usize) -> (f64, f64)) -> String {
     let text = std::fs::read_to_string(tutorial().join("l-frame-measured.csv")).unwrap();
-    let (gr, gi) = (gain.0 * gain.1.to_radians().cos(), gain.0 * gain.1.to_radians().sin());
     let mut out = String::from("# kind = accelerance\n# units = (m/s^2)/V\n");
     for line in text.lines().filter(|l| !l.starts_with('#')) {
         if line.starts_with("frequency") {
@@ -32,7 +37,9 @@ fn per_volt_accelerance(gain: (f64, f64)) -> String {
         let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
         let w2 = (2.0 * std::f64::consts::PI * v[0]).powi(2);
         let mut row = vec![v[0].to_string()];
-        for p in v[1..].chunks(2) {
+        for (c, p) in v[1..].chunks(2).enumerate() {
+            let (m, deg) = gain(c);
+            let (gr, gi) = (m * deg.to_radians().cos(), m * deg.to_radians().sin());
             // (re + j im) (gr + j gi) (-w^2)
             let (re, im) = (p[0] * gr - p[1] * gi, p[0] * gi + p[1] * gr);
             row.push(format!("{:e}", -w2 * re));
@@ -129,7 +136,7 @@ fn diagnosis_of_per_volt_data_names_the_joint_whatever_the_gain_and_keeps_the_ga
     let v2 = dir.path().join("v2.csv");
     let b = json(&rfm(&["diagnose", case.to_str().unwrap(), "--json", "--measured", v2.to_str().unwrap()]));
     for (d, g) in [(&a, g1), (&b, g2)] {
-        assert_eq!(d["gains"], true);
+        assert_eq!(d["gains"], "per-reference");
         let top = &d["ranking"][0];
         // the hidden joint (l-frame-truth.toml): kr = 2e4 at node 13
         assert_eq!((top["kind"].as_str().unwrap(), &top["nodes"]), ("flexible_joint", &serde_json::json!([13])));
@@ -151,6 +158,55 @@ fn diagnosis_of_per_volt_data_names_the_joint_whatever_the_gain_and_keeps_the_ga
     assert!((mag / g1.0 - 1.0).abs() < 0.01, "{line}");
     // written paths are relative to the written file: it can be moved with its data
     assert!(updated.contains("data = \"../v1.csv\""), "{updated}");
+}
+
+/// Every accelerometer with its own unknown sensitivity on top of the
+/// amplifier's gain: with `gains = "per-channel"` the diagnosis still names
+/// the hidden joint, the same whatever the constants, and the update
+/// recovers each channel's gain; the applied and updated cases keep them.
+#[test]
+fn per_channel_gains_are_fitted_by_diagnose_and_update() {
+    let dir = tempfile::tempdir().unwrap();
+    // amplifier 150 at 40 deg; sensors within +-30 % and +-8 deg of nominal
+    let gain = |c: usize| (150.0 * (0.7 + 0.075 * c as f64), 40.0 + 2.0 * c as f64 - 8.0);
+    let other = |c: usize| (0.02 * (1.3 - 0.07 * c as f64), -120.0 - 1.5 * c as f64);
+    std::fs::write(dir.path().join("v1.csv"), per_volt_accelerance_each(gain)).unwrap();
+    std::fs::write(dir.path().join("v2.csv"), per_volt_accelerance_each(other)).unwrap();
+    let case = case_with(dir.path(), "v1.toml", "v1.csv", "gains = \"per-channel\"");
+    let applied = dir.path().join("applied.toml");
+    let a =
+        json(&rfm(&["diagnose", case.to_str().unwrap(), "--json", "--apply", "1", "--out", applied.to_str().unwrap()]));
+    let v2 = dir.path().join("v2.csv");
+    let b = json(&rfm(&["diagnose", case.to_str().unwrap(), "--json", "--measured", v2.to_str().unwrap()]));
+    for (d, g) in [(&a, &gain as &dyn Fn(usize) -> (f64, f64)), (&b, &other)] {
+        assert_eq!(d["gains"], "per-channel");
+        let top = &d["ranking"][0];
+        assert_eq!((top["kind"].as_str().unwrap(), &top["nodes"]), ("flexible_joint", &serde_json::json!([13])));
+        let gains = top["gains"].as_array().unwrap();
+        assert_eq!(gains.len(), 8, "{gains:?}");
+        assert_eq!(gains[0]["key"], "H(15:uy,23:uy)");
+        for (c, fitted) in gains.iter().enumerate() {
+            let (m, deg) = g(c);
+            assert!((f(&fitted["magnitude"]) / m - 1.0).abs() < 0.01, "channel {c}: {fitted} vs {m}");
+            let dphase = (f(&fitted["phase_deg"]) - deg).rem_euclid(360.0);
+            assert!(dphase.min(360.0 - dphase) < 1.0, "channel {c}: {fitted} vs {deg}");
+        }
+    }
+    let (ka, kb) = (f(&a["ranking"][0]["parameters"][0]["value"]), f(&b["ranking"][0]["parameters"][0]["value"]));
+    assert!((ka / kb - 1.0).abs() < 1e-3, "{ka} vs {kb}");
+    let text = std::fs::read_to_string(&applied).unwrap();
+    assert!(text.contains("gains = \"per-channel\"") && text.contains("\"H(13:ux,23:uy)\" = ["), "{text}");
+    let out_dir = dir.path().join("up");
+    let u = json(&rfm(&["update", applied.to_str().unwrap(), "--json", "--out", out_dir.to_str().unwrap()]));
+    assert!(u["gain_setting"].as_str().unwrap().starts_with("per-channel"), "{u}");
+    let fitted = u["gains"].as_array().unwrap();
+    assert_eq!(fitted.len(), 8);
+    for (c, fitted) in fitted.iter().enumerate() {
+        assert!((f(&fitted["magnitude"]) / gain(c).0 - 1.0).abs() < 0.01, "channel {c}: {fitted}");
+    }
+    let updated = std::fs::read_to_string(out_dir.join("updated.toml")).unwrap();
+    let line = updated.lines().find(|l| l.starts_with("fitted_gains")).expect("fitted_gains in updated.toml");
+    assert_eq!(line.matches("\"H(").count(), 8, "{line}");
 }
 
 /// Lines of poor coherence hardly move the fitted gain: the gain is the

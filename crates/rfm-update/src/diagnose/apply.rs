@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use fe_model::case::{FittedGain, GainKey, Gains};
+use fe_model::case::{FittedGain, Gains};
 use fe_model::{CaseEditor, CaseFile, HistoryEntry};
 
 use super::Diagnosis;
@@ -104,18 +104,14 @@ impl Diagnosis {
         if !names.is_empty() {
             editor.set_update(&names, method)?;
         }
-        if self.gains {
+        if self.gains != Gains::None {
             // the next run fits the gains too; their values are kept for reading
             let fitted: Vec<FittedGain> = r
                 .gains
                 .iter()
-                .map(|g| FittedGain {
-                    key: GainKey::Reference(g.reference),
-                    magnitude: g.magnitude,
-                    phase_deg: g.phase_deg,
-                })
+                .map(|g| FittedGain { key: g.key, magnitude: g.magnitude, phase_deg: g.phase_deg })
                 .collect();
-            editor.set_gains(Gains::PerReference, &fitted)?;
+            editor.set_gains(self.gains, &fitted)?;
         }
         if case.history.is_empty() {
             editor.push_history(&HistoryEntry {

@@ -79,6 +79,7 @@ mod local;
 mod search;
 
 use damping::DampedSystem;
+use fe_model::case::Gains;
 use frf::FrfSet;
 
 pub use candidates::{Candidate, CandidateOptions, EffectKind, Role};
@@ -254,10 +255,11 @@ pub struct DiagnoseOptions {
     pub significance: f64,
     /// Candidate generation options (the band is taken from the data).
     pub candidates: CandidateOptions,
-    /// Fit an unknown complex gain per reference with every candidate and
-    /// with the nominal model (voltage-referenced data, see [`crate::gain`]):
-    /// a level offset common to a reference's channels is then no symptom.
-    pub gains: bool,
+    /// Fit unknown complex gains (one per reference, or one per channel)
+    /// with every candidate and with the nominal model (voltage-referenced
+    /// data, uncalibrated sensors; see [`crate::gain`]): a level offset
+    /// common to a gain's channels is then no symptom.
+    pub gains: Gains,
     /// Residual weights at the measured lines, channel-major, as
     /// [`crate::Study::line_weights`] gives them (the measured coherence's
     /// and the case's band weights); `None`: all 1. The noise level is read
@@ -279,7 +281,7 @@ impl Default for DiagnoseOptions {
             iterations: 40,
             significance: -10.0,
             candidates: CandidateOptions::default(),
-            gains: false,
+            gains: Gains::None,
             weights: None,
         }
     }
@@ -308,8 +310,8 @@ pub struct FittedParameter {
 pub struct Ranked {
     /// Kind.
     pub kind: EffectKind,
-    /// The unknown gains fitted with it, per reference (empty unless the
-    /// diagnosis fits gains: [`DiagnoseOptions::gains`]).
+    /// The unknown gains fitted with it (empty unless the diagnosis fits
+    /// gains: [`DiagnoseOptions::gains`]).
     pub gains: Vec<crate::output_error::Gain>,
     /// Plain-language description with location.
     pub description: String,
@@ -410,9 +412,9 @@ pub struct Diagnosis {
     /// How many of them gave way to a variant: one that holds what the data
     /// do not determine, or a twin that did not beat its original.
     pub superseded: usize,
-    /// Whether every fit (and the nominal misfit) fitted an unknown gain
-    /// per reference.
-    pub gains: bool,
+    /// The unknown gains every fit (and the nominal misfit) fitted.
+    #[cfg_attr(feature = "serde", serde(serialize_with = "crate::serialize_display"))]
+    pub gains: Gains,
     /// Whether the fits, the misfits and the noise level weigh the lines
     /// ([`DiagnoseOptions::weights`]: the coherence's, or band weights).
     pub weighted: bool,
@@ -500,18 +502,19 @@ pub fn informative_lines(measured: &FrfSet, n: usize) -> Vec<f64> {
 /// RMS of `ln(H / M)` per complex value of a system's receptances `H`
 /// against measured ones `M`, on `lines` lines spread over the measured band.
 pub fn log_misfit(sys: &DampedSystem, measured: &FrfSet, lines: usize) -> Result<f64, UpdateError> {
-    log_misfit_with(sys, measured, lines, false, None)
+    log_misfit_with(sys, measured, lines, Gains::None, None)
 }
 
-/// As [`log_misfit`], after the model's FRFs are multiplied by the gain per
-/// reference that fits them best when `gains` (see [`crate::gain`]), each
-/// value weighted by `weights` (at the lines of `measured`, channel-major,
-/// as [`DiagnoseOptions::weights`]; the diagnosis's misfits are weighted so).
+/// As [`log_misfit`], after the model's FRFs are multiplied by the gains
+/// (`gains`: per reference or per channel) that fit them best (see
+/// [`crate::gain`]), each value weighted by `weights` (at the lines of
+/// `measured`, channel-major, as [`DiagnoseOptions::weights`]; the
+/// diagnosis's misfits are weighted so).
 pub fn log_misfit_with(
     sys: &DampedSystem,
     measured: &FrfSet,
     lines: usize,
-    gains: bool,
+    gains: Gains,
     weights: Option<&[f64]>,
 ) -> Result<f64, UpdateError> {
     let at = informative_lines(measured, lines);

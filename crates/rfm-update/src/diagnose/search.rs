@@ -47,9 +47,9 @@ pub(crate) struct LineSet {
     pub(crate) cost0: f64,
     /// Real residuals.
     pub(crate) n: usize,
-    /// Whether every fit on these lines fits a gain per reference (and
-    /// `cost0` is the nominal model's after its best gains).
-    pub(crate) gains: bool,
+    /// The gains every fit on these lines fits (and `cost0` is the nominal
+    /// model's after its best gains).
+    pub(crate) gains: Gains,
     /// Residual weights at these lines, channel-major (`None`: all 1).
     pub(crate) weights: Option<Vec<f64>>,
 }
@@ -62,7 +62,7 @@ impl LineSet {
     pub(crate) fn with_model(
         measured: &FrfSet,
         n_lines: usize,
-        gains: bool,
+        gains: Gains,
         nominal: &FrfSet,
         weights: Option<&[f64]>,
     ) -> Result<Self, UpdateError> {
@@ -74,10 +74,10 @@ impl LineSet {
                 (measured.n_freq(), lines.iter().map(|&f| measured.line_of(f).expect("a measured line")).collect());
             (0..data.channels().len()).flat_map(|c| at.iter().map(move |&k| w[c * nf + k])).collect()
         });
-        if gains {
+        if gains != Gains::None {
             // the closed-form gains of the nominal model: its misfit is what no gain removes
             let model_kind = model.converted(data.kind());
-            let fitted = crate::gain::fit_gains(&model_kind, &data, weights.as_deref(), Gains::PerReference)?;
+            let fitted = crate::gain::fit_gains(&model_kind, &data, weights.as_deref(), gains)?;
             fitted.apply(&mut model);
         }
         let (mut cost, mut n) = (0.0, 0);

@@ -14,8 +14,9 @@
 //!
 //! with `H` the model receptance, `M` the measured one, `w_kc >= 0` line
 //! weights (band weights, coherence; 0 masks a line) and `g_v = exp(a_v + j b_v)`
-//! an optional unknown complex gain per reference `v` (FRFs referenced to a
-//! shaker amplifier's voltage carry one). For multiplicative noise of
+//! an optional unknown complex gain per reference or per channel `v` (FRFs
+//! referenced to a shaker amplifier's voltage carry one per reference; an
+//! accelerometer of unknown sensitivity one per channel). For multiplicative noise of
 //! relative level `s`, both forms give residuals of standard deviation about
 //! `s` per complex value, so the weighting is the maximum-likelihood one.
 //!
@@ -60,8 +61,8 @@ mod response;
 
 use damping::DampedSystem;
 use faer::Mat;
-use fe_model::DofRef;
-use frf::{FrfSet, ZSolver};
+use fe_model::case::{GainKey, Gains};
+use frf::{Channel, FrfSet, ZSolver};
 use num_complex::Complex64 as C64;
 
 pub(crate) use response::{Evaluated, Response};
@@ -115,8 +116,9 @@ pub struct OeOptions {
     pub regularization: f64,
     /// Bounds per parameter in physical units (`None`: unbounded).
     pub bounds: Vec<Option<(f64, f64)>>,
-    /// Estimate a complex gain per reference.
-    pub gains: bool,
+    /// Unknown complex gains to estimate: none, one per reference or one
+    /// per channel ([`crate::gain`]).
+    pub gains: Gains,
     /// Relative singular-value cut-off.
     pub rcond: f64,
     /// Stop when the last steps gain less than the noise can show
@@ -141,7 +143,7 @@ impl Default for OeOptions {
             tolerance: 1e-8,
             regularization: 0.0,
             bounds: Vec::new(),
-            gains: false,
+            gains: Gains::None,
             rcond: 1e-12,
             stop_within_noise: true,
             restarts: 6,
@@ -150,13 +152,14 @@ impl Default for OeOptions {
     }
 }
 
-/// A fitted gain of one reference.
+/// A fitted gain of one reference or one channel.
 #[derive(Clone, Copy, Debug)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Gain {
-    /// The reference DOF.
+    /// What it multiplies: a reference's channels (`1:uy`) or one channel
+    /// (`H(31:uy,1:uy)`).
     #[cfg_attr(feature = "serde", serde(serialize_with = "crate::serialize_display"))]
-    pub reference: DofRef,
+    pub key: GainKey,
     /// Magnitude of the gain.
     pub magnitude: f64,
     /// Phase of the gain (degrees).
@@ -169,14 +172,28 @@ impl Gain {
         C64::from_polar(self.magnitude, self.phase_deg.to_radians())
     }
 
-    /// Multiplies every channel of `frfs` driven at this gain's reference by
-    /// it (what the fit compared with the data).
+    /// Whether this gain multiplies `channel`: every channel of its
+    /// reference, or its one channel.
+    pub fn applies_to(&self, channel: &Channel) -> bool {
+        match self.key {
+            GainKey::Reference(r) => channel.reference == r,
+            GainKey::Channel(response, reference) => channel.response == response && channel.reference == reference,
+        }
+    }
+
+    /// The product of the gains in `gains` that multiply `channel` (1 when
+    /// none does).
+    pub fn factor_of(gains: &[Gain], channel: &Channel) -> C64 {
+        gains.iter().filter(|g| g.applies_to(channel)).map(Gain::factor).product()
+    }
+
+    /// Multiplies every channel of `frfs` by the gains that apply to it
+    /// (what the fit compared with the data).
     pub fn apply_all(gains: &[Gain], frfs: &mut FrfSet) {
-        for g in gains {
-            for c in 0..frfs.channels().len() {
-                if frfs.channels()[c].reference == g.reference {
-                    frfs.channel_mut(c).iter_mut().for_each(|v| *v *= g.factor());
-                }
+        for c in 0..frfs.channels().len() {
+            let g = Gain::factor_of(gains, &frfs.channels()[c]);
+            if g != C64::new(1.0, 0.0) {
+                frfs.channel_mut(c).iter_mut().for_each(|v| *v *= g);
             }
         }
     }
@@ -275,9 +292,8 @@ pub(crate) fn run_with(
     {
         return Err(UpdateError::Method(format!("{} weights for {} data values", w.len(), measured.values().len())));
     }
-    let refs = measured.references();
-    let ref_of = measured.channels().iter().map(|c| refs.iter().position(|&r| r == c.reference).unwrap()).collect();
-    let ev = Evaluator { data, opts, ref_of, refs, p0 };
+    let (group_of, keys) = crate::gain::gain_groups(measured.channels(), opts.gains);
+    let ev = Evaluator { data, opts, group_of, keys, p0 };
     let (n, ng) = (ev.n_params(), ev.n_gain());
     let n_data = ev.n_data();
     let m_free = n + ng;
@@ -300,7 +316,7 @@ pub(crate) fn run_with(
         }
     }
     let mut x = vec![0.0; n + ng];
-    if opts.gains {
+    if opts.gains != Gains::None {
         // start each gain at its least-squares value for the initial model
         ev.apply(src, &x)?;
         let (model, _) = src.evaluate(measured.frequencies_hz(), false).ok_or_else(|| {
@@ -310,9 +326,9 @@ pub(crate) fn run_with(
                     .into(),
             )
         })?;
-        for v in 0..ev.refs.len() {
+        for v in 0..ev.keys.len() {
             let (mut num, mut den) = (C64::new(0.0, 0.0), 0.0);
-            for c in (0..measured.channels().len()).filter(|&c| ev.ref_of[c] == v) {
+            for c in (0..measured.channels().len()).filter(|&c| ev.group_of[c] == v) {
                 for k in 0..measured.n_freq() {
                     let (h, m) = (model[k][c], measured.get(c, k));
                     let w = ev.weight(c, k) / m.norm().max(1e-300);
@@ -454,11 +470,11 @@ pub(crate) fn run_with(
     } else {
         None
     };
-    let gains = (0..ev.refs.len())
-        .filter(|_| opts.gains)
+    let gains = (0..ev.keys.len())
+        .filter(|_| opts.gains != Gains::None)
         .map(|v| {
             let g = ev.gain(&x, v);
-            Gain { reference: ev.refs[v], magnitude: g.norm(), phase_deg: g.arg().to_degrees() }
+            Gain { key: ev.keys[v], magnitude: g.norm(), phase_deg: g.arg().to_degrees() }
         })
         .collect();
     Ok(OeResult {
@@ -504,14 +520,14 @@ mod tests {
     /// magnitude and phase.
     #[test]
     fn a_gain_multiplies_the_channels_of_its_reference_only() {
-        use fe_model::Dof;
+        use fe_model::{Dof, DofRef};
         let (a, b) = (DofRef::new(3, Dof::Uy), DofRef::new(5, Dof::Uy));
         let channels = vec![frf::Channel::new(a, a), frf::Channel::new(b, a), frf::Channel::new(a, b)];
         let mut set = FrfSet::zeros(vec![10.0, 20.0], channels, frf::FrfKind::Receptance).unwrap();
         for c in 0..3 {
             set.channel_mut(c).iter_mut().for_each(|v| *v = C64::new(1.0, 0.0));
         }
-        Gain::apply_all(&[Gain { reference: a, magnitude: 2.0, phase_deg: 90.0 }], &mut set);
+        Gain::apply_all(&[Gain { key: GainKey::Reference(a), magnitude: 2.0, phase_deg: 90.0 }], &mut set);
         for c in 0..2 {
             for v in set.channel(c) {
                 assert!((v - C64::new(0.0, 2.0)).norm() < 1e-15, "{v}");

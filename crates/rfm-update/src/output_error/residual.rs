@@ -1,9 +1,9 @@
 //! The residuals of the output-error fit and their Jacobian at a point:
-//! weighted, relative or complex-log, with a gain per reference; and the
-//! correlation of adjacent residuals.
+//! weighted, relative or complex-log, with a gain per reference or per
+//! channel; and the correlation of adjacent residuals.
 
 use faer::Mat;
-use fe_model::DofRef;
+use fe_model::case::{GainKey, Gains};
 use num_complex::Complex64 as C64;
 
 use super::{Misfit, OeData, OeOptions, Response};
@@ -21,9 +21,10 @@ fn ln(z: C64) -> C64 {
 pub(super) struct Evaluator<'a> {
     pub(super) data: &'a OeData<'a>,
     pub(super) opts: &'a OeOptions,
-    /// Reference index of each channel.
-    pub(super) ref_of: Vec<usize>,
-    pub(super) refs: Vec<DofRef>,
+    /// Gain index of each channel ([`crate::gain::gain_groups`]).
+    pub(super) group_of: Vec<usize>,
+    /// What each gain belongs to.
+    pub(super) keys: Vec<GainKey>,
     pub(super) p0: Vec<f64>,
 }
 
@@ -40,7 +41,7 @@ impl Evaluator<'_> {
     }
 
     pub(super) fn n_gain(&self) -> usize {
-        if self.opts.gains { 2 * self.refs.len() } else { 0 }
+        if self.opts.gains != Gains::None { 2 * self.keys.len() } else { 0 }
     }
 
     pub(super) fn weight(&self, c: usize, k: usize) -> f64 {
@@ -63,7 +64,7 @@ impl Evaluator<'_> {
     }
 
     pub(super) fn gain(&self, x: &[f64], v: usize) -> C64 {
-        if self.opts.gains {
+        if self.opts.gains != Gains::None {
             let n = self.n_params();
             C64::new(x[n + 2 * v], x[n + 2 * v + 1]).exp()
         } else {
@@ -96,7 +97,7 @@ impl Evaluator<'_> {
                     continue;
                 }
                 let r = k * nc + c;
-                let v = self.ref_of[c];
+                let v = self.group_of[c];
                 let g = self.gain(x, v);
                 let h = model[k][c];
                 let meas = m.get(c, k);
@@ -119,7 +120,7 @@ impl Evaluator<'_> {
                         j[(r, i)] = d.re;
                         j[(rows + r, i)] = d.im;
                     }
-                    if self.opts.gains {
+                    if self.opts.gains != Gains::None {
                         let da = match self.opts.misfit {
                             Misfit::Relative => w * g * h / meas.norm(),
                             Misfit::Log => C64::new(w, 0.0),

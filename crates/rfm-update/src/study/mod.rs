@@ -423,25 +423,13 @@ impl Study {
     }
 
     /// The diagnosis options of this study for `measured` (its data, or
-    /// other data on its channels): the defaults, with a gain per reference
-    /// fitted with every candidate when the study has gains, and the
+    /// other data on its channels): the defaults, with the study's gains
+    /// (per reference or per channel) fitted with every candidate, and the
     /// residual weights of [`Study::line_weights`] at the lines of
-    /// `measured` (the coherence's, by default when the data carry it). A
-    /// gain per channel is refused: the diagnosis fits them per reference.
+    /// `measured` (the coherence's, by default when the data carry it).
     pub fn diagnose_options(&self, measured: &FrfSet) -> Result<crate::diagnose::DiagnoseOptions, UpdateError> {
-        let gains = match self.gains {
-            Gains::None => false,
-            Gains::PerReference => true,
-            Gains::PerChannel => {
-                return Err(UpdateError::Method(
-                    "`gains = \"per-channel\"`: the diagnosis and the output-error update fit one gain per \
-                     reference (compare fits them per channel); diagnose with `gains = \"per-reference\"`"
-                        .into(),
-                ));
-            }
-        };
         let weights = self.line_weights(measured)?;
-        Ok(crate::diagnose::DiagnoseOptions { gains, weights, ..Default::default() })
+        Ok(crate::diagnose::DiagnoseOptions { gains: self.gains, weights, ..Default::default() })
     }
 
     /// The measured FRFs in the kind they were measured in (`measured` is

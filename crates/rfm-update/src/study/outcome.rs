@@ -50,7 +50,7 @@ pub struct UpdateOutcome {
     pub natural_frequencies_hz: FrequencyTable,
     /// Parameter uncertainty and identifiability (output-error method).
     pub uncertainty: Option<UncertaintyReport>,
-    /// Fitted gain per reference, when requested.
+    /// Fitted gains (per reference or per channel), when requested.
     pub gains: Vec<Gain>,
     /// Relative noise level of the measured data, estimated from their
     /// roughness and that of their residual against the updated model (see

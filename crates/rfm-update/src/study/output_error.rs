@@ -1,8 +1,6 @@
 //! The output-error estimator on a study: its options from the case and a
 //! run that restarts from spread starts when the fit ends above the noise.
 
-use fe_model::case::Gains;
-
 use super::{Method, Restart, Study, UpdateOutcome, describe_masked};
 use crate::error::UpdateError;
 use crate::output_error::{self, Misfit, OeData, OeOptions};
@@ -19,20 +17,9 @@ const RESTART_SPREAD: f64 = 10.0;
 
 impl Study {
     /// Output-error options from the case's `[update]` section, with the
-    /// study's gains ([`Study::gains`]; the estimator fits them per reference).
+    /// study's gains ([`Study::gains`]: per reference or per channel).
     pub fn output_error_options(&self) -> Result<OeOptions, UpdateError> {
-        let gains = match self.gains {
-            Gains::None => false,
-            Gains::PerReference => true,
-            Gains::PerChannel => {
-                return Err(UpdateError::Method(
-                    "`gains = \"per-channel\"`: the output-error update fits one gain per reference (compare fits \
-                     them per channel); update with `gains = \"per-reference\"`"
-                        .into(),
-                ));
-            }
-        };
-        let mut opts = OeOptions { gains, ..OeOptions::default() };
+        let mut opts = OeOptions { gains: self.gains, ..OeOptions::default() };
         if let Some(spec) = self.case.update.as_ref() {
             if let Some(n) = spec.max_iterations {
                 opts.max_iterations = n as usize;
