@@ -166,7 +166,14 @@ impl CaseFile {
                 if bad(r.misfit) || r.noise.is_some_and(bad) {
                     return Err(ctx.err(h.span(), "a history entry's misfit and noise must be finite and not negative"));
                 }
-                Ok(HistoryEntry { step: r.step.clone(), misfit: r.misfit, noise: r.noise })
+                Ok(HistoryEntry {
+                    step: r.step.clone(),
+                    misfit: r.misfit,
+                    noise: r.noise,
+                    effect: r.effect.clone(),
+                    nodes: r.nodes.clone(),
+                    elements: r.elements.clone(),
+                })
             })
             .collect::<Result<Vec<_>, CaseError>>()?;
         let check =

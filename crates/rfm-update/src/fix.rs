@@ -341,6 +341,7 @@ fn update_case(
         step: format!("updated after step {step}"),
         misfit: misfit_updated,
         noise: Some(d.noise),
+        ..HistoryEntry::default()
     })?;
     let case = CaseFile::parse(&current.path, &editor.text_at(&current.path)?)?;
     Ok((editor, case, misfit_updated, outcome))

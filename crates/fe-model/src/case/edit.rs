@@ -176,6 +176,14 @@ impl CaseEditor {
         if let Some(noise) = entry.noise {
             t.insert("noise", value(noise));
         }
+        if let Some(effect) = &entry.effect {
+            t.insert("effect", value(effect.as_str()));
+        }
+        for (key, ids) in [("nodes", &entry.nodes), ("elements", &entry.elements)] {
+            if !ids.is_empty() {
+                t.insert(key, value(ids.iter().map(|&i| i64::from(i)).collect::<toml_edit::Array>()));
+            }
+        }
         match self.doc.entry("history").or_insert(Item::ArrayOfTables(ArrayOfTables::new())) {
             Item::ArrayOfTables(a) => {
                 if a.is_empty() {
@@ -441,14 +449,26 @@ data = \"data/measured.csv\"   # from the lab
         let c = case(Path::new("/tmp"));
         let mut e = c.editor().unwrap();
         e.set_update(&["group.beam.alpha".to_string()], "output-error").unwrap();
-        e.push_history(&HistoryEntry { step: "nominal".into(), misfit: 1.25, noise: Some(0.01) }).unwrap();
-        e.push_history(&HistoryEntry { step: "+ a joint".into(), misfit: 0.0125, noise: None }).unwrap();
+        e.push_history(&HistoryEntry { step: "nominal".into(), misfit: 1.25, noise: Some(0.01), ..Default::default() })
+            .unwrap();
+        let joint = HistoryEntry {
+            step: "+ a joint".into(),
+            misfit: 0.0125,
+            noise: None,
+            effect: Some("flexible_joint".into()),
+            nodes: vec![13],
+            elements: vec![12, 13],
+        };
+        e.push_history(&joint).unwrap();
         let out = e.text_at(Path::new("/tmp/x.toml")).unwrap();
         let back = CaseFile::parse(Path::new("/tmp/x.toml"), &out).unwrap();
         assert_eq!(back.update.unwrap().parameters[0].name, "group.beam.alpha");
         assert_eq!(back.history.len(), 2);
         assert_eq!((back.history[0].step.as_str(), back.history[0].misfit), ("nominal", 1.25));
         assert_eq!((back.history[1].misfit, back.history[1].noise), (0.0125, None));
+        // where the effect sits comes back; a step without one has none
+        assert_eq!(back.history[1], joint);
+        assert_eq!((back.history[0].effect.as_ref(), back.history[0].nodes.len()), (None, 0));
     }
 
     #[test]

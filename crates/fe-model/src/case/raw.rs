@@ -347,6 +347,11 @@ pub(super) struct RawHistory {
     pub(super) step: String,
     pub(super) misfit: f64,
     pub(super) noise: Option<f64>,
+    pub(super) effect: Option<String>,
+    #[serde(default)]
+    pub(super) nodes: Vec<u32>,
+    #[serde(default)]
+    pub(super) elements: Vec<u32>,
 }
 
 #[derive(Deserialize)]

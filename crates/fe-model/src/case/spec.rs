@@ -93,7 +93,7 @@ pub struct PaperSpec {
 /// updates (`[[history]]`): what the model was and how far it was from the
 /// data, so that a later run can show the fall of the misfit from the
 /// nominal model.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct HistoryEntry {
     /// What the step did (`nominal`, `+ flexible, lossy joint at node 13`, `updated`).
     pub step: String,
@@ -101,6 +101,14 @@ pub struct HistoryEntry {
     pub misfit: f64,
     /// The data's estimated relative noise level, when known.
     pub noise: Option<f64>,
+    /// The kind of effect the step added (`flexible_joint`, `lumped_mass`,
+    /// `stiffness_change`, ...), for a step that added one: reports mark
+    /// it on the structure.
+    pub effect: Option<String>,
+    /// The nodes where the added effect acts.
+    pub nodes: Vec<u32>,
+    /// The elements where the added effect acts.
+    pub elements: Vec<u32>,
 }
 
 /// How an updating run may end, as its results name it (the statuses of

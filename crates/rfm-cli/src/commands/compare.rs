@@ -109,7 +109,7 @@ fn measured_data(case: CaseFile, system: &DampedSystem, files: &[PathBuf]) -> Re
     if files.is_empty() {
         let study = Study::from_case(case)?;
         let source = match (study.case().measurement.as_ref().and_then(|m| m.data.as_ref()), &study.case().truth) {
-            (Some(p), _) => format!("measured file {} (from the case)", p.display()),
+            (Some(p), _) => format!("measured file {} (from the case)", report::shown_path(p)),
             (None, Some(t)) if t.noise > 0.0 => format!(
                 "synthesised from the case's truth model ({} % noise, seed {})",
                 report::short(100.0 * t.noise),
@@ -299,7 +299,18 @@ fn report_sections(
 ) -> Result<Vec<Section>> {
     let c = &model.correlation;
     let mut first = summary(case, measured, source, c);
-    first.push(report::structure_figure(&case.model, measured, &[], "The case's model.", out)?);
+    // the loop so far, when the case was written by an earlier step
+    if let Some(fall) = report::loop_story::fall_figure(&case.history, false, out)? {
+        first.push(fall);
+    }
+    let added = report::loop_story::highlights(&case.history);
+    let caption = if added.is_empty() {
+        "The case's model."
+    } else {
+        "The case's model, each effect its history records as added numbered and marked where it sits (a ring at a \
+         joint, a support or a mass, a broad band along the elements of a changed region)."
+    };
+    first.push(report::structure_figure(&case.model, measured, &added, caption, out)?);
     let mut sections = vec![first];
     let mut notes = vec!["The case's model with its initial parameter values against the measured FRFs.".to_string()];
     if !doc.gains.is_empty() {

@@ -132,7 +132,12 @@ pub(crate) fn update(
              {misfit:.3e}): the updated model is not an improvement"
         ));
     }
-    let step = fe_model::HistoryEntry { step: format!("updated ({})", outcome.method), misfit, noise };
+    let step = fe_model::HistoryEntry {
+        step: format!("updated ({})", outcome.method),
+        misfit,
+        noise,
+        ..fe_model::HistoryEntry::default()
+    };
     if json {
         outln!("{}", serde_json::to_string_pretty(&outcome)?);
     } else {
@@ -151,8 +156,14 @@ pub(crate) fn update(
     if let Some(mut output) = output.take() {
         let path = output.write("results.json", serde_json::to_string_pretty(&outcome)?.as_bytes())?;
         let updated = write_updated_model(&study, &outcome, &step, &mut output)?;
-        let report =
-            crate::report::update_report::write(&study, &outcome, &mut output, case, &report.for_case(study.case()))?;
+        let report = crate::report::update_report::write(
+            &study,
+            &outcome,
+            &step,
+            &mut output,
+            case,
+            &report.for_case(study.case()),
+        )?;
         output.commit()?;
         if !json {
             outln!("\nwrote {} and {}", path.display(), updated.display());

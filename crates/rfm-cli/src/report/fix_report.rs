@@ -9,12 +9,12 @@ use std::path::PathBuf;
 use frf::correlation::{BandSpec, correlate};
 use frf::synthesize;
 use rfm_update::Study;
-use rfm_update::diagnose::{EffectKind, Ranked};
+use rfm_update::diagnose::Ranked;
 use rfm_update::fix::{CONSISTENT, FixOutcome};
 
 use super::html::{Block, Report, Section, Table, Tone};
-use super::plot::structure::{Highlight, HighlightKind};
-use super::{ModelFrfs, ReportOptions, Result, plot, sig};
+use super::plot::structure::Highlight;
+use super::{ModelFrfs, ReportOptions, Result, loop_story, plot, sig};
 use crate::output::Outputs;
 use crate::table::{num, percent};
 
@@ -25,49 +25,15 @@ pub(crate) fn step_file(k: usize) -> String {
     format!("step-{k}.toml")
 }
 
-/// How an effect is marked on the structure: at its nodes for a joint, a
-/// support or a mass, along its elements for a change over a region.
+/// How an effect is marked on the structure (see [`loop_story::highlight_kind`]).
 fn highlight(e: &Ranked) -> Highlight {
-    let kind = match e.kind {
-        EffectKind::FlexibleSupport => HighlightKind::Support,
-        EffectKind::FlexibleJoint => HighlightKind::Joint,
-        EffectKind::LumpedMass => HighlightKind::Mass,
-        EffectKind::StiffnessChange
-        | EffectKind::MassChange
-        | EffectKind::ViscousDamping
-        | EffectKind::NonViscousDamping => HighlightKind::Patch,
-    };
-    // a region change without elements can only be pointed at by its nodes
-    let kind = if kind == HighlightKind::Patch && e.elements.is_empty() { HighlightKind::Joint } else { kind };
+    let kind = loop_story::highlight_kind(Some(e.kind), !e.elements.is_empty());
     Highlight { label: e.description.clone(), kind, nodes: e.nodes.clone(), elements: e.elements.clone() }
 }
 
-/// An effect in a few words for an axis label, numbered elsewhere as on
-/// the structure: what it is and where (`joint at node 13`, `stiffness of
-/// elements 4-7`).
+/// An effect in a few words for an axis label (see [`loop_story::short_effect`]).
 fn short_effect(e: &Ranked) -> String {
-    let what = match e.kind {
-        EffectKind::FlexibleSupport => "support",
-        EffectKind::FlexibleJoint => "joint",
-        EffectKind::LumpedMass => "mass",
-        EffectKind::StiffnessChange => "stiffness",
-        EffectKind::MassChange => "mass change",
-        EffectKind::ViscousDamping | EffectKind::NonViscousDamping => "damping",
-    };
-    let span = |ids: &[u32], one: &str, many: &str| match (ids.iter().min(), ids.iter().max()) {
-        (Some(a), Some(b)) if a == b => format!("{one} {a}"),
-        (Some(a), Some(b)) => format!("{many} {a}-{b}"),
-        _ => String::new(),
-    };
-    let place = match e.kind {
-        EffectKind::FlexibleSupport | EffectKind::FlexibleJoint | EffectKind::LumpedMass if !e.nodes.is_empty() => {
-            format!("at {}", span(&e.nodes, "node", "nodes"))
-        }
-        _ if !e.elements.is_empty() => format!("of {}", span(&e.elements, "element", "elements")),
-        _ if !e.nodes.is_empty() => format!("at {}", span(&e.nodes, "node", "nodes")),
-        _ => String::new(),
-    };
-    if place.is_empty() { what.to_string() } else { format!("{what} {place}") }
+    loop_story::short_effect(Some(e.kind), &e.nodes, &e.elements)
 }
 
 /// Writes the report files of the loop through `out` and returns where
@@ -168,10 +134,10 @@ pub(crate) fn write(study: &Study, outcome: &FixOutcome, opts: &ReportOptions, o
             (
                 "after the update".into(),
                 format!(
-                    "{} ({:.1} x noise), {:?}",
+                    "{} ({:.1} x noise), {}",
                     sig(s.misfit_updated, 4),
                     s.misfit_updated / outcome.noise,
-                    s.status
+                    s.status.name()
                 ),
             ),
             ("case file".into(), step_file(k + 1)),

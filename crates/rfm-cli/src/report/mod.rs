@@ -10,9 +10,12 @@
 
 pub(crate) mod fix_report;
 pub(crate) mod html;
+pub(crate) mod loop_story;
 pub(crate) mod modes;
 pub(crate) mod plot;
 pub(crate) mod update_report;
+
+use std::path::{Path, PathBuf};
 
 use fe_model::{DofRef, Model};
 use frf::correlation::Correlation;
@@ -485,6 +488,25 @@ fn sensor_dofs(set: &FrfSet) -> (Vec<DofRef>, Vec<DofRef>) {
     (responses, references)
 }
 
+/// `path` for reading: `name/..` pairs taken out (`fix/../../data.csv` is
+/// `../data.csv`). Only for display: through a symbolic link the two can
+/// name different files, so files are opened by the path as given.
+pub(crate) fn shown_path(path: &Path) -> String {
+    use std::path::Component;
+    let mut parts: Vec<Component<'_>> = Vec::new();
+    for c in path.components() {
+        match (c, parts.last()) {
+            (Component::CurDir, _) if !parts.is_empty() => {}
+            (Component::ParentDir, Some(Component::Normal(_))) => {
+                parts.pop();
+            }
+            (Component::ParentDir, Some(Component::RootDir)) => {}
+            _ => parts.push(c),
+        }
+    }
+    if parts.is_empty() { ".".to_string() } else { parts.iter().collect::<PathBuf>().display().to_string() }
+}
+
 /// A drawing of the structure with the measured DOFs of `measured` and the
 /// `highlights`, as a report block.
 pub(crate) fn structure_figure(
@@ -561,6 +583,22 @@ pub(crate) fn definitions_section() -> Section {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A folder and the `..` after it cancel; leading `..`, a root and the
+    /// file name stay.
+    #[test]
+    fn shown_paths_drop_a_folder_and_the_dotdot_after_it() {
+        for (given, shown) in [
+            ("fix/../../../work/main/m.csv", "../../work/main/m.csv"),
+            ("a/./b/../c.csv", "a/c.csv"),
+            ("../x.uff", "../x.uff"),
+            ("/tmp/a/../b.uff", "/tmp/b.uff"),
+            ("/../b.uff", "/b.uff"),
+            ("a/..", "."),
+        ] {
+            assert_eq!(shown_path(Path::new(given)), shown, "{given}");
+        }
+    }
     use fe_model::{Dof, DofRef};
     use frf::FrfKind;
 

@@ -15,15 +15,17 @@ use rfm_update::study::FrequencyTable;
 use rfm_update::{Study, UpdateOutcome};
 
 use super::html::{Block, Report, Section, Table, Tone};
-use super::{ModelFrfs, ReportOptions, Result, plot, sig};
+use super::{ModelFrfs, ReportOptions, Result, loop_story, plot, sig};
 use crate::output::Outputs;
 use crate::table::num;
 
 /// Writes the report files of an updating run into the run's outputs and
-/// returns where `report.html` will be.
+/// returns where `report.html` will be; `step` is this run's entry in the
+/// case's history (the updated model's misfit over the band).
 pub(crate) fn write(
     study: &Study,
     outcome: &UpdateOutcome,
+    step: &fe_model::HistoryEntry,
     out: &mut Outputs,
     case_path: &Path,
     opts: &ReportOptions,
@@ -85,11 +87,26 @@ pub(crate) fn write(
     for text in singular {
         first.push(Block::Text(text));
     }
+    // the loop so far, when the case was written by an earlier step
+    let history = &study.case().history;
+    if !history.is_empty() {
+        let steps = [history.clone(), vec![step.clone()]].concat();
+        if let Some(fall) = loop_story::fall_figure(&steps, true, out)? {
+            first.push(fall);
+        }
+    }
+    let added = loop_story::highlights(history);
     first.push(super::structure_figure(
         outcome.system.model(),
         measured,
-        &[],
-        "The updated model (its geometry is the initial model's).",
+        &added,
+        if added.is_empty() {
+            "The updated model (its geometry is the initial model's)."
+        } else {
+            "The updated model (its geometry is the initial model's), each effect its history records as added \
+             numbered and marked where it sits (a ring at a joint, a support or a mass, a broad band along the \
+             elements of a changed region)."
+        },
         out,
     )?);
     report.sections.push(first);
@@ -205,7 +222,7 @@ fn summary(study: &Study, outcome: &UpdateOutcome, models: &[ModelFrfs; 2]) -> S
     let measured = &study.measured_as_read();
     let f = measured.frequencies_hz();
     let source = match (&study.case().measurement.as_ref().and_then(|m| m.data.clone()), &study.case().truth) {
-        (Some(path), _) => format!("measured file {}", path.display()),
+        (Some(path), _) => format!("measured file {}", super::shown_path(path)),
         (None, Some(t)) if t.noise > 0.0 => {
             format!(
                 "synthesised from the case's truth model with {} % noise (seed {})",

@@ -18,7 +18,9 @@ use std::time::{Duration, Instant};
 use serde_json::{Value, json};
 use tungstenite::{Message, WebSocket};
 
-use super::fixtures::{clamp_update, svg_files, text, tutorial_compare, tutorial_fix, tutorial_update};
+use super::fixtures::{
+    clamp_update, svg_files, text, tutorial_applied_update, tutorial_compare, tutorial_fix, tutorial_update,
+};
 
 /// The Chromium binary: `RFM_CHROMIUM`, else the first of the usual names on `PATH`.
 fn chromium() -> Option<PathBuf> {
@@ -284,10 +286,17 @@ fn every_report_kind_loads_offline_in_chromium_without_console_errors() {
     for h in ["The fall of the misfit", "Modes", "FRF overlays"] {
         assert!(headings.iter().any(|x| x == h), "fix lacks {h}: {headings:?}");
     }
-    // a stalled update (the clamp) and a converged one (the walkthrough's)
+    // a stalled update (the clamp), a converged one (the walkthrough's) and
+    // one of a case with a history (the tutorial with the joint applied)
     let converged = tutorial_update();
     assert!(converged.output.status.success(), "{}", text(&converged.output.stderr));
-    for (dir, what) in [(&update.dir, "the stalled update report"), (&converged.dir, "the converged update report")] {
+    let applied = tutorial_applied_update();
+    assert!(applied.output.status.success(), "{}", text(&applied.output.stderr));
+    for (dir, what) in [
+        (&update.dir, "the stalled update report"),
+        (&converged.dir, "the converged update report"),
+        (&applied.dir, "the update report of an applied case"),
+    ] {
         let headings = check_report(&mut b, dir, what);
         for h in ["Summary", "Convergence", "Parameters", "Modes", "FRF overlays"] {
             assert!(headings.iter().any(|x| x == h), "{what} lacks {h}: {headings:?}");

@@ -85,6 +85,35 @@ pub(crate) fn tutorial_update() -> &'static Written {
     })
 }
 
+/// The tutorial case with the diagnosis's leader (the corner joint) added
+/// by `rfm diagnose --apply 1`: a case whose history holds the nominal
+/// model and the added joint.
+fn tutorial_applied() -> &'static PathBuf {
+    static P: OnceLock<PathBuf> = OnceLock::new();
+    P.get_or_init(|| {
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("reports");
+        std::fs::create_dir_all(&dir).expect("the reports folder");
+        let applied = dir.join("l-frame-applied.toml");
+        let _ = std::fs::remove_file(&applied);
+        let case = case("tutorial/l-frame");
+        let out = rfm(&["diagnose", case.to_str().unwrap(), "--apply", "1", "--out", applied.to_str().unwrap()]);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        applied
+    })
+}
+
+/// `rfm update` of the case `rfm diagnose --apply 1` wrote from the tutorial.
+pub(crate) fn tutorial_applied_update() -> &'static Written {
+    static W: OnceLock<Written> = OnceLock::new();
+    W.get_or_init(|| write_case("tutorial-applied-update", "update", tutorial_applied(), &[]))
+}
+
+/// `rfm compare` of the case `rfm diagnose --apply 1` wrote from the tutorial.
+pub(crate) fn tutorial_applied_compare() -> &'static Written {
+    static W: OnceLock<Written> = OnceLock::new();
+    W.get_or_init(|| write_case("tutorial-applied-compare", "compare", tutorial_applied(), &[]))
+}
+
 /// `rfm update` of the flexible-clamp cantilever (it stalls short of the
 /// tolerance, exit code 5, and writes its report all the same).
 pub(crate) fn clamp_update() -> &'static Written {

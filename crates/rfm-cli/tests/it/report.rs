@@ -10,7 +10,10 @@ use damping::DampedSystem;
 use frf::correlation::{BandSpec, correlate};
 use rfm_update::Study;
 
-use super::fixtures::{case, clamp_update, rfm, svg_files, text, tutorial_compare, tutorial_fix, tutorial_update};
+use super::fixtures::{
+    case, clamp_update, rfm, svg_files, text, tutorial_applied_compare, tutorial_applied_update, tutorial_compare,
+    tutorial_fix, tutorial_update,
+};
 
 fn read(path: &Path) -> String {
     std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
@@ -503,6 +506,38 @@ fn the_tutorial_fix_report_marks_the_added_joint_where_it_sits() {
     for heading in ["The fall of the misfit", "Modes", "FRF overlays"] {
         assert!(html.contains(&format!("<h2>{heading}</h2>")), "report.html lacks the section {heading}");
     }
+}
+
+/// The reports of a case written by `rfm diagnose --apply` tell the loop so
+/// far from the case's history: the misfit per step (and, for the update,
+/// after it) and the structure with the added joint marked at the corner;
+/// with every channel, the MAC matrix and the stabilisation diagram.
+#[test]
+fn the_reports_of_an_applied_case_show_the_loop_so_far() {
+    for (w, steps, kind) in [
+        (tutorial_applied_update(), &["nominal", "+ 1: joint at node 13", "updated"][..], "update"),
+        (tutorial_applied_compare(), &["nominal", "+ 1: joint at node 13"][..], "compare"),
+    ] {
+        assert!(w.output.status.success(), "{kind}: {}", text(&w.output.stderr));
+        let d = w.dir.as_path();
+        let fall = check_svg(&d.join("misfit-steps.svg"), steps);
+        // the compare report draws the history alone, the update's adds itself
+        assert_eq!(fall.contains(">\nupdated\n<"), kind == "update", "{kind}");
+        let structure = check_figure(&d.join("structure.svg"), &["The structure and what was added"]);
+        assert!(structure.contains("1: flexible, lossy joint at node 13"), "{kind}: the legend names the joint");
+        assert!(structure.contains(&format!("stroke=\"{}\"", hex(204, 37, 41))), "{kind}: no ring for the joint");
+        let all = check_svg(&d.join("frf-channels.svg"), &["measured"]);
+        assert_eq!(panel_titles(&all).len(), 8, "{kind}");
+        check_figure(&d.join("mac-matrix.svg"), &["measured modes"]);
+        check_figure(&d.join("stabilisation.svg"), &["Model order"]);
+        let html = read(&d.join("report.html"));
+        check_self_contained(&html);
+        assert!(html.contains("as its [[history]] records them"), "{kind}: the fall's caption");
+    }
+    // a case without a history draws neither
+    let plain = tutorial_compare();
+    assert!(!plain.dir.join("misfit-steps.svg").exists());
+    assert!(read(&plain.dir.join("structure.svg")).contains("The structure and its measured DOFs"));
 }
 
 /// The walkthrough's update: every channel before and after, its 200

@@ -118,12 +118,17 @@ impl Diagnosis {
                 step: "nominal".into(),
                 misfit: self.nominal_misfit,
                 noise: Some(self.noise),
+                ..HistoryEntry::default()
             })?;
         }
+        // where it sits too, for the reports' drawing of the structure
         editor.push_history(&HistoryEntry {
             step: format!("+ {}", r.description),
             misfit: r.misfit,
             noise: Some(self.noise),
+            effect: Some(r.kind.name().to_string()),
+            nodes: r.nodes.clone(),
+            elements: r.elements.clone(),
         })?;
         // the new case loads and reads back the fitted values
         let text = editor.text_at(&case.path)?;

@@ -65,6 +65,35 @@ pub enum EffectKind {
 }
 
 impl EffectKind {
+    /// Every kind.
+    pub const ALL: [EffectKind; 7] = [
+        EffectKind::FlexibleSupport,
+        EffectKind::FlexibleJoint,
+        EffectKind::LumpedMass,
+        EffectKind::StiffnessChange,
+        EffectKind::MassChange,
+        EffectKind::ViscousDamping,
+        EffectKind::NonViscousDamping,
+    ];
+
+    /// The name in JSON and in a case's `[[history]]` (`flexible_joint`).
+    pub fn name(self) -> &'static str {
+        match self {
+            EffectKind::FlexibleSupport => "flexible_support",
+            EffectKind::FlexibleJoint => "flexible_joint",
+            EffectKind::LumpedMass => "lumped_mass",
+            EffectKind::StiffnessChange => "stiffness_change",
+            EffectKind::MassChange => "mass_change",
+            EffectKind::ViscousDamping => "viscous_damping",
+            EffectKind::NonViscousDamping => "non_viscous_damping",
+        }
+    }
+
+    /// The kind of a [`EffectKind::name`].
+    pub fn from_name(name: &str) -> Option<EffectKind> {
+        EffectKind::ALL.into_iter().find(|k| k.name() == name)
+    }
+
     /// Plain-language name.
     pub fn label(self) -> &'static str {
         match self {

@@ -215,3 +215,17 @@ fn a_damper_beside_a_spring_may_dominate_it_at_the_top_of_the_band() {
     let e = judge(region, alpha).expect("a material above 1 in the band");
     assert!(e.contains("a loss factor of 1.20 (above 1) in the band"), "{e}");
 }
+
+/// A kind's name is its JSON name (the reports read the one a case's
+/// history keeps as the other) and names its kind back; every kind has one
+/// of its own.
+#[test]
+fn effect_kind_names_are_their_json_names_and_read_back() {
+    let mut seen = std::collections::HashSet::new();
+    for k in EffectKind::ALL {
+        assert_eq!(serde_json::to_value(k).unwrap(), serde_json::Value::from(k.name()), "{k:?}");
+        assert_eq!(EffectKind::from_name(k.name()), Some(k));
+        assert!(seen.insert(k.name()), "{k:?}");
+    }
+    assert_eq!(EffectKind::from_name("flexible joint"), None);
+}
