@@ -75,6 +75,7 @@
 
 mod apply;
 pub mod candidates;
+mod lines;
 mod local;
 mod search;
 
@@ -84,7 +85,9 @@ use frf::FrfSet;
 
 pub use candidates::{Candidate, CandidateOptions, EffectKind, Role};
 
-use self::search::{LineSet, Pool};
+use self::lines::LineSet;
+pub use self::lines::informative_lines;
+use self::search::Pool;
 use crate::error::UpdateError;
 
 /// Relative noise level of measured FRFs (RMS of the relative error per
@@ -438,64 +441,6 @@ impl Diagnosis {
     pub fn consistent(&self) -> bool {
         !self.ranking.iter().any(|r| r.fully_fitted && r.significant)
     }
-}
-
-/// `n` lines of a measured set that carry most of what the data can tell
-/// (the lines the diagnosis fits and [`log_misfit`] measures on):
-/// up to half of them at and around the resonance peaks (where damping
-/// and small frequency shifts show, on a line grid that an even spread
-/// would step across), the rest spread evenly over the band. Peaks are
-/// local maxima of the sum over channels of `ln |M|`, ranked by prominence.
-pub fn informative_lines(measured: &FrfSet, n: usize) -> Vec<f64> {
-    let lines = measured.frequencies_hz();
-    if n >= lines.len() {
-        return lines.to_vec();
-    }
-    let nl = lines.len();
-    let level: Vec<f64> = (0..nl)
-        .map(|k| {
-            (0..measured.channels().len()).map(|c| measured.get(c, k).norm().max(f64::MIN_POSITIVE).ln()).sum::<f64>()
-                / measured.channels().len().max(1) as f64
-        })
-        .collect();
-    // prominence: the height above the lowest level within a few peak widths
-    const REACH: usize = 8;
-    let mut peaks: Vec<(f64, usize)> = (1..nl - 1)
-        .filter(|&k| level[k] > level[k - 1] && level[k] >= level[k + 1])
-        .map(|k| {
-            let lo = k.saturating_sub(REACH);
-            let hi = (k + REACH + 1).min(nl);
-            let floor = level[lo..hi].iter().copied().fold(f64::INFINITY, f64::min);
-            (level[k] - floor, k)
-        })
-        .filter(|&(p, _)| p > 1.0)
-        .collect();
-    peaks.sort_by(|a, b| b.0.total_cmp(&a.0));
-    let mut idx: Vec<usize> = Vec::new();
-    'peaks: for &(_, k) in &peaks {
-        for j in k.saturating_sub(2)..=(k + 2).min(nl - 1) {
-            if idx.len() >= n / 2 {
-                break 'peaks;
-            }
-            idx.push(j);
-        }
-    }
-    idx.sort_unstable();
-    idx.dedup();
-    let rest = n - idx.len();
-    let mut m = rest;
-    // enough evenly spread lines that, with the peaks', n are distinct
-    while m <= nl {
-        let mut all = idx.clone();
-        all.extend((0..m).map(|i| (i as f64 * (nl - 1) as f64 / (m - 1).max(1) as f64).round() as usize));
-        all.sort_unstable();
-        all.dedup();
-        if all.len() >= n || m == nl {
-            return all.into_iter().map(|k| lines[k]).collect();
-        }
-        m += (n - all.len()).max(1);
-    }
-    lines.to_vec()
 }
 
 /// The misfit the diagnosis, `rfm fix` and the case history speak of: the

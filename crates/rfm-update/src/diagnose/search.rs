@@ -11,12 +11,12 @@ use frf::FrfSet;
 use rayon::prelude::*;
 
 use super::candidates::{self, Candidate, CandidateOptions, EffectKind, Role};
+use super::lines::LineSet;
 use super::local::{LocalCandidate, LocalData};
-use super::{DiagnoseOptions, FitStage, informative_lines};
+use super::{DiagnoseOptions, FitStage};
 use crate::error::UpdateError;
 use crate::output_error::{self, Misfit, OeData, OeOptions};
 use crate::params::ParameterSet;
-use fe_model::case::Gains;
 
 /// The relative standard deviation (of the log-parameter) above which a
 /// fitted value is not determined by the data: it could as well be e times
@@ -39,60 +39,6 @@ pub(crate) struct Fit {
     pub(crate) determined: Vec<bool>,
     /// The gains fitted with it (empty unless the line set fits gains).
     pub(crate) gains: Vec<output_error::Gain>,
-}
-
-/// A line set with the nominal model's cost on it.
-pub(crate) struct LineSet {
-    pub(crate) data: FrfSet,
-    pub(crate) cost0: f64,
-    /// Real residuals.
-    pub(crate) n: usize,
-    /// The gains every fit on these lines fits (and `cost0` is the nominal
-    /// model's after its best gains).
-    pub(crate) gains: Gains,
-    /// Residual weights at these lines, channel-major (`None`: all 1).
-    pub(crate) weights: Option<Vec<f64>>,
-}
-
-impl LineSet {
-    /// The `n_lines` most informative lines of `measured` with the nominal
-    /// model's cost there; `nominal` holds the nominal model's FRFs at (at
-    /// least) those lines, `weights` the residual weights at the lines of
-    /// `measured` (channel-major; `None`: all 1).
-    pub(crate) fn with_model(
-        measured: &FrfSet,
-        n_lines: usize,
-        gains: Gains,
-        nominal: &FrfSet,
-        weights: Option<&[f64]>,
-    ) -> Result<Self, UpdateError> {
-        let lines = informative_lines(measured, n_lines);
-        let data = measured.at_frequencies(&lines)?;
-        let mut model = nominal.at_frequencies(&lines)?;
-        let weights: Option<Vec<f64>> = weights.map(|w| {
-            let (nf, at): (usize, Vec<usize>) =
-                (measured.n_freq(), lines.iter().map(|&f| measured.line_of(f).expect("a measured line")).collect());
-            (0..data.channels().len()).flat_map(|c| at.iter().map(move |&k| w[c * nf + k])).collect()
-        });
-        if gains != Gains::None {
-            // the closed-form gains of the nominal model: its misfit is what no gain removes
-            let model_kind = model.converted(data.kind());
-            let fitted = crate::gain::fit_gains(&model_kind, &data, weights.as_deref(), gains)?;
-            fitted.apply(&mut model);
-        }
-        let (mut cost, mut n) = (0.0, 0);
-        for (i, (h, m)) in model.values().iter().zip(data.values()).enumerate() {
-            let w = weights.as_ref().map_or(1.0, |w| w[i]);
-            if m.norm() > 0.0 && w > 0.0 {
-                cost += w * w * (h / m).ln().norm_sqr();
-                n += 2;
-            }
-        }
-        if !cost.is_finite() {
-            return Err(UpdateError::Data("the nominal model's misfit is not finite at the measured lines".into()));
-        }
-        Ok(LineSet { data, cost0: cost, n, gains, weights })
-    }
 }
 
 /// Per parameter, whether the data determine it: a finite relative standard
