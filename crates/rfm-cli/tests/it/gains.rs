@@ -70,6 +70,26 @@ fn f(v: &serde_json::Value) -> f64 {
     v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
 }
 
+/// `rfm diagnose --json` of `case` twice: on its own data (`v1.csv`),
+/// applying the leader to `applied.toml` in `dir`, and on `v2.csv` in `dir`
+/// (`--measured`); the two documents and the applied case.
+fn diagnose_twice(dir: &Path, case: &Path) -> (serde_json::Value, serde_json::Value, PathBuf) {
+    let applied = dir.join("applied.toml");
+    let a =
+        json(&rfm(&["diagnose", case.to_str().unwrap(), "--json", "--apply", "1", "--out", applied.to_str().unwrap()]));
+    let v2 = dir.join("v2.csv");
+    let b = json(&rfm(&["diagnose", case.to_str().unwrap(), "--json", "--measured", v2.to_str().unwrap()]));
+    (a, b, applied)
+}
+
+/// A fitted gain of a JSON document within 1 % and 1 degree of `want`
+/// (magnitude, phase in degrees; phases compared modulo a turn).
+fn assert_gain_near(fitted: &serde_json::Value, want: (f64, f64), what: &str) {
+    assert!((f(&fitted["magnitude"]) / want.0 - 1.0).abs() < 0.01, "{what}: {fitted} vs {want:?}");
+    let dphase = (f(&fitted["phase_deg"]) - want.1).rem_euclid(360.0);
+    assert!(dphase.min(360.0 - dphase) < 1.0, "{what}: {fitted} vs {want:?}");
+}
+
 #[test]
 fn compare_fits_the_gain_of_per_volt_data_the_same_from_the_case_and_from_measured() {
     let dir = tempfile::tempdir().unwrap();
@@ -130,20 +150,14 @@ fn diagnosis_of_per_volt_data_names_the_joint_whatever_the_gain_and_keeps_the_ga
     std::fs::write(dir.path().join("v1.csv"), per_volt_accelerance(g1)).unwrap();
     std::fs::write(dir.path().join("v2.csv"), per_volt_accelerance(g2)).unwrap();
     let case = case_with(dir.path(), "v1.toml", "v1.csv", "");
-    let applied = dir.path().join("applied.toml");
-    let a =
-        json(&rfm(&["diagnose", case.to_str().unwrap(), "--json", "--apply", "1", "--out", applied.to_str().unwrap()]));
-    let v2 = dir.path().join("v2.csv");
-    let b = json(&rfm(&["diagnose", case.to_str().unwrap(), "--json", "--measured", v2.to_str().unwrap()]));
+    let (a, b, applied) = diagnose_twice(dir.path(), &case);
     for (d, g) in [(&a, g1), (&b, g2)] {
         assert_eq!(d["gains"], "per-reference");
         let top = &d["ranking"][0];
         // the hidden joint (l-frame-truth.toml): kr = 2e4 at node 13
         assert_eq!((top["kind"].as_str().unwrap(), &top["nodes"]), ("flexible_joint", &serde_json::json!([13])));
         let gain = &top["gains"][0];
-        assert!((f(&gain["magnitude"]) / g.0 - 1.0).abs() < 0.01, "{gain} vs {g:?}");
-        let dphase = (f(&gain["phase_deg"]) - g.1).rem_euclid(360.0);
-        assert!(dphase.min(360.0 - dphase) < 1.0, "{gain} vs {g:?}");
+        assert_gain_near(gain, g, "the reference");
     }
     let (ka, kb) = (f(&a["ranking"][0]["parameters"][0]["value"]), f(&b["ranking"][0]["parameters"][0]["value"]));
     assert!((ka / kb - 1.0).abs() < 1e-3, "{ka} vs {kb}");
@@ -173,11 +187,7 @@ fn per_channel_gains_are_fitted_by_diagnose_and_update() {
     std::fs::write(dir.path().join("v1.csv"), per_volt_accelerance_each(gain)).unwrap();
     std::fs::write(dir.path().join("v2.csv"), per_volt_accelerance_each(other)).unwrap();
     let case = case_with(dir.path(), "v1.toml", "v1.csv", "gains = \"per-channel\"");
-    let applied = dir.path().join("applied.toml");
-    let a =
-        json(&rfm(&["diagnose", case.to_str().unwrap(), "--json", "--apply", "1", "--out", applied.to_str().unwrap()]));
-    let v2 = dir.path().join("v2.csv");
-    let b = json(&rfm(&["diagnose", case.to_str().unwrap(), "--json", "--measured", v2.to_str().unwrap()]));
+    let (a, b, applied) = diagnose_twice(dir.path(), &case);
     for (d, g) in [(&a, &gain as &dyn Fn(usize) -> (f64, f64)), (&b, &other)] {
         assert_eq!(d["gains"], "per-channel");
         let top = &d["ranking"][0];
@@ -186,10 +196,7 @@ fn per_channel_gains_are_fitted_by_diagnose_and_update() {
         assert_eq!(gains.len(), 8, "{gains:?}");
         assert_eq!(gains[0]["key"], "H(15:uy,23:uy)");
         for (c, fitted) in gains.iter().enumerate() {
-            let (m, deg) = g(c);
-            assert!((f(&fitted["magnitude"]) / m - 1.0).abs() < 0.01, "channel {c}: {fitted} vs {m}");
-            let dphase = (f(&fitted["phase_deg"]) - deg).rem_euclid(360.0);
-            assert!(dphase.min(360.0 - dphase) < 1.0, "channel {c}: {fitted} vs {deg}");
+            assert_gain_near(fitted, g(c), &format!("channel {c}"));
         }
     }
     let (ka, kb) = (f(&a["ranking"][0]["parameters"][0]["value"]), f(&b["ranking"][0]["parameters"][0]["value"]));

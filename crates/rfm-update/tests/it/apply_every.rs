@@ -224,15 +224,7 @@ fn every_ranked_effect_applies_to_the_tutorial_the_papers_cases_and_samples() {
     for kind in ["FlexibleSupport per direction", "FlexibleJoint per direction", "undetermined damping updated"] {
         assert!(kinds.contains(kind), "no {kind} was applied");
     }
-    for kind in [
-        EffectKind::FlexibleSupport,
-        EffectKind::FlexibleJoint,
-        EffectKind::LumpedMass,
-        EffectKind::StiffnessChange,
-        EffectKind::MassChange,
-        EffectKind::ViscousDamping,
-        EffectKind::NonViscousDamping,
-    ] {
+    for kind in EffectKind::ALL {
         assert!(kinds.contains(&format!("{kind:?}")), "no {kind:?} was applied");
     }
 }
