@@ -82,6 +82,25 @@ fn diagnose_twice(dir: &Path, case: &Path) -> (serde_json::Value, serde_json::Va
     (a, b, applied)
 }
 
+/// The leader's first value is the same from both diagnoses; the applied
+/// case keeps the gain `setting`, and its update (into `up` beside it) fits
+/// them: the update's document and `updated.toml`.
+fn same_leader_then_update(
+    a: &serde_json::Value,
+    b: &serde_json::Value,
+    applied: &Path,
+    setting: &str,
+) -> (serde_json::Value, String) {
+    let (ka, kb) = (f(&a["ranking"][0]["parameters"][0]["value"]), f(&b["ranking"][0]["parameters"][0]["value"]));
+    assert!((ka / kb - 1.0).abs() < 1e-3, "{ka} vs {kb}");
+    let text = std::fs::read_to_string(applied).unwrap();
+    assert!(text.contains(&format!("gains = \"{setting}\"")), "{text}");
+    let out_dir = applied.parent().unwrap().join("up");
+    let u = json(&rfm(&["update", applied.to_str().unwrap(), "--json", "--out", out_dir.to_str().unwrap()]));
+    assert!(u["gain_setting"].as_str().unwrap().starts_with(setting), "{u}");
+    (u, std::fs::read_to_string(out_dir.join("updated.toml")).unwrap())
+}
+
 /// A fitted gain of a JSON document within 1 % and 1 degree of `want`
 /// (magnitude, phase in degrees; phases compared modulo a turn).
 fn assert_gain_near(fitted: &serde_json::Value, want: (f64, f64), what: &str) {
@@ -159,14 +178,9 @@ fn diagnosis_of_per_volt_data_names_the_joint_whatever_the_gain_and_keeps_the_ga
         let gain = &top["gains"][0];
         assert_gain_near(gain, g, "the reference");
     }
-    let (ka, kb) = (f(&a["ranking"][0]["parameters"][0]["value"]), f(&b["ranking"][0]["parameters"][0]["value"]));
-    assert!((ka / kb - 1.0).abs() < 1e-3, "{ka} vs {kb}");
     let text = std::fs::read_to_string(&applied).unwrap();
-    assert!(text.contains("gains = \"per-reference\"") && text.contains("fitted_gains = { \"23:uy\" = ["), "{text}");
-    let out_dir = dir.path().join("up");
-    let u = json(&rfm(&["update", applied.to_str().unwrap(), "--json", "--out", out_dir.to_str().unwrap()]));
-    assert!(u["gain_setting"].as_str().unwrap().starts_with("per-reference"), "{u}");
-    let updated = std::fs::read_to_string(out_dir.join("updated.toml")).unwrap();
+    assert!(text.contains("fitted_gains = { \"23:uy\" = ["), "{text}");
+    let (_, updated) = same_leader_then_update(&a, &b, &applied, "per-reference");
     let line = updated.lines().find(|l| l.starts_with("fitted_gains")).expect("fitted_gains in updated.toml");
     let mag: f64 = line.split('[').nth(1).unwrap().split(',').next().unwrap().trim().parse().unwrap();
     assert!((mag / g1.0 - 1.0).abs() < 0.01, "{line}");
@@ -199,19 +213,14 @@ fn per_channel_gains_are_fitted_by_diagnose_and_update() {
             assert_gain_near(fitted, g(c), &format!("channel {c}"));
         }
     }
-    let (ka, kb) = (f(&a["ranking"][0]["parameters"][0]["value"]), f(&b["ranking"][0]["parameters"][0]["value"]));
-    assert!((ka / kb - 1.0).abs() < 1e-3, "{ka} vs {kb}");
     let text = std::fs::read_to_string(&applied).unwrap();
-    assert!(text.contains("gains = \"per-channel\"") && text.contains("\"H(13:ux,23:uy)\" = ["), "{text}");
-    let out_dir = dir.path().join("up");
-    let u = json(&rfm(&["update", applied.to_str().unwrap(), "--json", "--out", out_dir.to_str().unwrap()]));
-    assert!(u["gain_setting"].as_str().unwrap().starts_with("per-channel"), "{u}");
+    assert!(text.contains("\"H(13:ux,23:uy)\" = ["), "{text}");
+    let (u, updated) = same_leader_then_update(&a, &b, &applied, "per-channel");
     let fitted = u["gains"].as_array().unwrap();
     assert_eq!(fitted.len(), 8);
     for (c, fitted) in fitted.iter().enumerate() {
         assert!((f(&fitted["magnitude"]) / gain(c).0 - 1.0).abs() < 0.01, "channel {c}: {fitted}");
     }
-    let updated = std::fs::read_to_string(out_dir.join("updated.toml")).unwrap();
     let line = updated.lines().find(|l| l.starts_with("fitted_gains")).expect("fitted_gains in updated.toml");
     assert_eq!(line.matches("\"H(").count(), 8, "{line}");
 }
