@@ -16,9 +16,10 @@
 //! weights (band weights, coherence; 0 masks a line) and `g_v = exp(a_v + j b_v)`
 //! an optional unknown complex gain per reference or per channel `v` (FRFs
 //! referenced to a shaker amplifier's voltage carry one per reference; an
-//! accelerometer of unknown sensitivity one per channel). For multiplicative noise of
-//! relative level `s`, both forms give residuals of standard deviation about
-//! `s` per complex value, so the weighting is the maximum-likelihood one.
+//! accelerometer of unknown sensitivity one per channel). For
+//! multiplicative noise of relative level `s`, both forms give residuals of
+//! standard deviation about `s` per complex value, so the weighting is the
+//! maximum-likelihood one.
 //!
 //! The log form is the default: far from the solution, where the model's
 //! resonances sit where the data have none, the relative residual is
