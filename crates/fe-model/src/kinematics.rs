@@ -1,5 +1,5 @@
 //! Zero-energy motions found from the model's kinematics: the check behind
-//! [`ModelError::Mechanism`](crate::ModelError::Mechanism).
+//! [`crate::ModelError::Mechanism`].
 //!
 //! A singular stiffness matrix cannot be told from a badly conditioned one by
 //! its pivots: a free 3,000-element beam leaves pivots of `1e-6 K_ii` where a

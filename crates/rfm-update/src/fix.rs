@@ -20,12 +20,12 @@
 //! lower the misfit, or after the given number of steps. When it then
 //! leaves more than 1.5 times the noise, the form of each effect is revised
 //! with the others in place (its other variants, a kind that stands in for
-//! it, or nothing; [`revise`]), and if the misfit still stays above that,
+//! it, or nothing; `fix/revise.rs`), and if the misfit still stays above that,
 //! each effect but the last, and each
 //! pair of effects, is left out in turn and the data diagnosed again
 //! without them, adding as many effects as were left out: an effect added
 //! early may only have mimicked the missing one, and another added later
-//! may only have made up for it ([`swap`]). The best replacement is kept
+//! may only have made up for it (`fix/swap.rs`). The best replacement is kept
 //! when it lowers the misfit (last steps that name what they replaced).
 //! A last diagnosis of the final model says what, if anything, still stands
 //! out.
@@ -91,7 +91,7 @@ pub struct FixStep {
     /// when it did: their descriptions joined by " and ".
     pub replaced: Option<String>,
     /// The effect was taken out again, not added: with the others revised
-    /// it no longer paid for its parameters ([`revise`]); `misfit_added`
+    /// it no longer paid for its parameters (`fix/revise.rs`); `misfit_added`
     /// and `misfit_updated` are both the misfit without it, updated.
     pub removed: bool,
     /// The case after this step (write it with [`CaseEditor::text_at`]).
@@ -392,7 +392,7 @@ fn distinct_leaders(d: &Diagnosis, model: &fe_model::Model, width: usize) -> Vec
 /// When the best single effect would leave more than three times the noise
 /// (two effects may hide at once, and a single candidate that mimics both
 /// may lead), every pair of a few distinct leaders is added and updated
-/// jointly ([`pairs`]); unless the best pair reaches the noise, the first
+/// jointly (`fix/pairs.rs`); unless the best pair reaches the noise, the first
 /// effect is also sought by looking one step ahead: each of a few distinct
 /// leaders is added and updated, the data diagnosed again, and its best
 /// follower added and everything updated jointly. The best pair is added as

@@ -19,7 +19,7 @@ pub const MAX_ITERATIONS_EVALUATED: usize = 30;
 const DOF_LINE_BUDGET: f64 = 1e8;
 
 /// Every how many lines to evaluate `iterates` models of `dofs` DOFs within
-/// [`DOF_LINE_BUDGET`], keeping at least 20 lines per iterate.
+/// `DOF_LINE_BUDGET`, keeping at least 20 lines per iterate.
 pub fn line_stride(dofs: usize, iterates: usize, lines: usize) -> usize {
     let per_iterate = (DOF_LINE_BUDGET / dofs.max(1) as f64 / iterates.max(1) as f64).max(20.0);
     (lines as f64 / per_iterate).ceil().max(1.0) as usize

@@ -143,11 +143,11 @@ pub struct Beam {
     pub id: ElementId,
     /// End nodes.
     pub nodes: [NodeId; 2],
-    /// Index into [`Model::materials`].
+    /// Index into [`Model::materials`](crate::Model::materials).
     pub material: usize,
-    /// Index into [`Model::sections`].
+    /// Index into [`Model::sections`](crate::Model::sections).
     pub section: usize,
-    /// Index into [`Model::groups`].
+    /// Index into [`Model::groups`](crate::Model::groups).
     pub group: usize,
     /// Non-structural transverse mass per unit length (kg/m), lumped at the
     /// ends, for example the added mass of surrounding water.
@@ -183,10 +183,10 @@ pub struct Spring {
     /// the spring's own axes when it has them); zero in the DOFs the spring
     /// does not join.
     pub k: PerDof,
-    /// Index into [`Model::groups`].
+    /// Index into [`Model::groups`](crate::Model::groups).
     pub group: usize,
     /// The spring's own axes (rows: local x, y, z in global components) in
-    /// a 3D model, set by [`Model::orient_spring`]; `None`: the global axes.
+    /// a 3D model, set by [`Model::orient_spring`](crate::Model::orient_spring); `None`: the global axes.
     pub axes: Option<[[f64; 3]; 3]>,
 }
 
@@ -202,7 +202,7 @@ pub struct LumpedMass {
     /// Rotary inertias about the global x, y and z axes (kg m^2), acting on
     /// `rx`, `ry`, `rz`; a planar model has only the last.
     pub j: [f64; 3],
-    /// Index into [`Model::groups`].
+    /// Index into [`Model::groups`](crate::Model::groups).
     pub group: usize,
 }
 
@@ -314,7 +314,7 @@ impl ImportedKind {
 /// or between the DOFs of two nodes.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ImportedBlock {
-    /// Index into [`Model::groups`](super::Model::groups).
+    /// Index into [`Model::groups`](crate::Model::groups)(super::Model::groups).
     pub group: usize,
     /// Stiffness, mass or damping.
     pub kind: ImportedKind,

@@ -66,8 +66,8 @@
 //! per mode region. A line belongs to the band `[lo, hi)` (the last band
 //! includes its upper edge).
 //!
-//! The measures of one value or one FRF are in [`measure`], the bands in
-//! [`band`]; this file holds the result types and [`correlate`].
+//! The measures of one value or one FRF are in `measure.rs`, the bands in
+//! `band.rs`; this file holds the result types and [`correlate`].
 //!
 //! # JSON
 //!

@@ -77,10 +77,10 @@
 //! that `l_i = psi_i`, which makes it comparable with the model's shape
 //! including its scale.
 //!
-//! The estimator's steps have a file each: [`poles`] (lag sums, reduced
-//! normal equations and the companion matrix, per order), [`stabilisation`]
+//! The estimator's steps have a file each: `poles.rs` (lag sums, reduced
+//! normal equations and the companion matrix, per order), `stabilisation.rs`
 //! (status of each pole against the previous order, selection of the
-//! modes) and [`lsfd`] (residues, residuals and shapes).
+//! modes) and `lsfd.rs` (residues, residuals and shapes).
 
 use std::ops::RangeInclusive;
 

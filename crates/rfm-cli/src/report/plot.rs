@@ -13,7 +13,7 @@
 //! curves.
 //!
 //! What every figure shares has a file each: [`style`] (colours and line
-//! styles), [`frame`] (the SVG backend, title and legend), [`axes`] (log
+//! styles), [`frame`](mod@frame) (the SVG backend, title and legend), [`axes`] (log
 //! axes, ticks, the frequency axis and the continuous phase); the figures
 //! of the correlation are in [`correlation`], those of the iteration in
 //! [`history`]. Curves with more points than pixel columns are thinned to

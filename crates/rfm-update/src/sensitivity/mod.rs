@@ -22,7 +22,7 @@
 //! # How it is made fast
 //!
 //! - **Solves.** `Z` is factorised as a sparse complex-symmetric `L D L^T`
-//!   ([`ZSolver`]), its symbolic analysis shared by every line and iteration.
+//!   ([`frf::ZSolver`]), its symbolic analysis shared by every line and iteration.
 //!   The `(references + measured)` unit right-hand sides are solved together,
 //!   row-interleaved (the values of one equation for every right-hand side
 //!   are contiguous, so each elimination step is one vectorised update).
@@ -35,7 +35,7 @@
 //!   class sums times their coefficients (a group's `alpha`, `mu` and
 //!   stiffness factor share one sum). The coefficients come from the group
 //!   data by the rules of `damping::kernel`; this is checked against
-//!   [`DampedSystem::derivative`] when the table is made, and the assembly
+//!   [`damping::DampedSystem::derivative`] when the table is made, and the assembly
 //!   falls back to calling it at every line (one class per term) otherwise.
 //! - **One sweep.** The products of a block are taken as soon as its rows of
 //!   the solution are final in the backward substitution, while they are in
@@ -53,7 +53,7 @@
 //!   row, distinct unit matrices stored once) is made once per [`assemble`]
 //!   call and shared by the threads, which take the lines in parallel, each
 //!   with its own [`Scratch`]. `Z(w)` is the system's own
-//!   ([`DampedSystem::z_values_into`]), so the model FRFs here equal those of
+//!   ([`damping::DampedSystem::z_values_into`]), so the model FRFs here equal those of
 //!   [`frf::synthesize_with`] bitwise, which the response function method's
 //!   step control relies on near convergence.
 //!

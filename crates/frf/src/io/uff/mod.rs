@@ -40,7 +40,7 @@
 //! # Errors
 //!
 //! Nothing here panics on bad input. A malformed or truncated file gives
-//! [`FileError::Parse`](crate::FileError::Parse) with the line (ASCII) or, for binary data, the byte
+//! [`crate::FileError::Parse`] with the line (ASCII) or, for binary data, the byte
 //! offset in the `line` field and the message, and says what was expected.
 
 mod frfs;

@@ -19,13 +19,13 @@
 //! no engineer would accept, and the ranking says so.
 //!
 //! What the data cannot determine is held rather than fitted to a bound
-//! ([`Candidate::holding`]): a support or joint spring the measured
+//! (`Candidate::holding`): a support or joint spring the measured
 //! directions do not see (the axial spring of a clamp measured in bending)
 //! is made rigid again, and the candidate is fitted without it (with one
 //! group per direction, without that spring's group either).
 //!
 //! A candidate does not carry a copy of the whole model: a large model has
-//! thousands of candidates. It carries the recipe of its change ([`Edit`]),
+//! thousands of candidates. It carries the recipe of its change (`Edit`),
 //! applied to the whole model on demand ([`Candidate::model`]), and the part
 //! of the model where it acts with the change applied ([`Model::part`]),
 //! which is all the diagnosis needs to fit it (module `local`).
