@@ -90,7 +90,10 @@ fn synthesize_lines(
         .iter()
         .map(|c| Ok((equation_of(sys, c.response)?, refs.iter().position(|&r| r == c.reference).unwrap())))
         .collect::<Result<_, FrfError>>()?;
-    let lines: Vec<Option<Vec<C64>>> = freqs_hz
+    // collected per line and then read in order: a parallel collect into
+    // one `Result` keeps whichever thread's error came first, so the line a
+    // failure names would change from run to run
+    let lines: Vec<Result<Option<Vec<C64>>, FrfError>> = freqs_hz
         .par_iter()
         .map_init(
             || (solver.workspace(), Vec::new()),
@@ -100,7 +103,8 @@ fn synthesize_lines(
                 Err(e) => Err(e),
             },
         )
-        .collect::<Result<_, FrfError>>()?;
+        .collect();
+    let lines: Vec<Option<Vec<C64>>> = lines.into_iter().collect::<Result<_, FrfError>>()?;
     let mut singular = Vec::new();
     for (k, line) in lines.iter().enumerate() {
         match line {
@@ -118,6 +122,26 @@ fn synthesize_lines(
 mod tests {
     use super::*;
     use fe_model::{Dof, samples};
+
+    /// A dynamic stiffness that overflows at every line is refused at the
+    /// first line, whichever thread meets its line first.
+    #[test]
+    fn a_failure_names_the_first_failing_line_every_time() {
+        let mut sys = DampedSystem::new(samples::cantilever(4)).unwrap();
+        let alpha = sys.model().quantity("group.beam.alpha").unwrap();
+        sys.set(alpha, 1e300).unwrap();
+        let tip = DofRef::new(5, Dof::Uy);
+        let lines: Vec<f64> = (1..=400).map(f64::from).collect();
+        // more threads than cores, so that the chunks of later lines often
+        // fail before the first one
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(8).build().unwrap();
+        for _ in 0..50 {
+            match pool.install(|| synthesize(&sys, &[Channel::new(tip, tip)], &lines)).unwrap_err() {
+                FrfError::NonFiniteZ { freq_hz, .. } => assert_eq!(freq_hz, 1.0),
+                e => panic!("{e}"),
+            }
+        }
+    }
 
     #[test]
     fn fixed_and_unknown_dofs_are_refused_by_name() {
