@@ -16,8 +16,9 @@
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
+use crate::dof::NodeId;
 use crate::error::{CaseError, ModelError};
-use crate::model::Model;
+use crate::model::{ElementId, Model};
 
 mod build;
 mod check;
@@ -43,8 +44,8 @@ pub use measurement::{
     MeasurementSpec, PairingSpec,
 };
 pub use spec::{
-    BandWeight, CheckSpec, DiagnosisCheck, FrequencyChoice, HistoryEntry, PaperSpec, RUN_STATUSES, RunCheck, TruthSpec,
-    UpdateSpec,
+    BandWeight, CheckSpec, DiagnosisCheck, EFFECT_KINDS, FrequencyChoice, HistoryEntry, PaperSpec, RUN_STATUSES,
+    RunCheck, TruthSpec, UpdateSpec,
 };
 
 use dof_list::parse_dof_refs;
@@ -165,6 +166,16 @@ impl CaseFile {
                 let bad = |v: f64| !(v.is_finite() && v >= 0.0);
                 if bad(r.misfit) || r.noise.is_some_and(bad) {
                     return Err(ctx.err(h.span(), "a history entry's misfit and noise must be finite and not negative"));
+                }
+                if let Some(e) = r.effect.as_deref().filter(|e| !EFFECT_KINDS.contains(e)) {
+                    let hint = hint(e, &EFFECT_KINDS, "effects");
+                    return Err(ctx.err(h.span(), format!("a history entry names the unknown effect `{e}`{hint}")));
+                }
+                if let Some(n) = r.nodes.iter().find(|&&n| model.node(NodeId(n)).is_none()) {
+                    return Err(ctx.err(h.span(), format!("a history entry names node {n}, which the model lacks")));
+                }
+                if let Some(e) = r.elements.iter().find(|&&e| model.beam_index(ElementId(e)).is_none()) {
+                    return Err(ctx.err(h.span(), format!("a history entry names element {e}, which the model lacks")));
                 }
                 Ok(HistoryEntry {
                     step: r.step.clone(),

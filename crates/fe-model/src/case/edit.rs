@@ -444,6 +444,27 @@ data = \"data/measured.csv\"   # from the lab
         assert!(out.contains("# updated by rfm\n[set]"), "{out}");
     }
 
+    /// A history entry may name only effects, nodes and elements there are:
+    /// anything else is refused with the file, the entry's place and a hint.
+    #[test]
+    fn a_history_entry_naming_what_is_not_there_is_refused_where_it_stands() {
+        let c = case(Path::new("/tmp"));
+        let base = c.editor().unwrap().text_at(Path::new("/tmp/x.toml")).unwrap();
+        for (entry, says) in [
+            ("effect = \"flexible joint\"", "the unknown effect `flexible joint`; did you mean `flexible_joint`?"),
+            ("effect = \"crack\"", "the unknown effect `crack` (effects: flexible_support, flexible_joint,"),
+            ("nodes = [1, 999]", "names node 999, which the model lacks"),
+            ("elements = [999]", "names element 999, which the model lacks"),
+        ] {
+            let text = format!("{base}\n[[history]]\nstep = \"+ x\"\nmisfit = 0.1\n{entry}\n");
+            // the entry's place: its `[[history]]` line (1-based)
+            let line = text.lines().position(|l| l == "[[history]]").unwrap() + 1;
+            let e = CaseFile::parse(Path::new("/tmp/x.toml"), &text).unwrap_err().to_string();
+            assert!(e.contains(says), "{entry}: {e}");
+            assert!(e.contains(&format!("x.toml:{line}:")), "{entry}: not located at line {line}: {e}");
+        }
+    }
+
     #[test]
     fn update_and_history_tables_are_written_and_parsed() {
         let c = case(Path::new("/tmp"));
@@ -456,8 +477,8 @@ data = \"data/measured.csv\"   # from the lab
             misfit: 0.0125,
             noise: None,
             effect: Some("flexible_joint".into()),
-            nodes: vec![13],
-            elements: vec![12, 13],
+            nodes: vec![3],
+            elements: vec![2, 3],
         };
         e.push_history(&joint).unwrap();
         let out = e.text_at(Path::new("/tmp/x.toml")).unwrap();

@@ -101,15 +101,26 @@ pub struct HistoryEntry {
     pub misfit: f64,
     /// The data's estimated relative noise level, when known.
     pub noise: Option<f64>,
-    /// The kind of effect the step added (`flexible_joint`, `lumped_mass`,
-    /// `stiffness_change`, ...), for a step that added one: reports mark
-    /// it on the structure.
+    /// The kind of effect the step added (one of [`EFFECT_KINDS`]), for a
+    /// step that added one: reports mark it on the structure.
     pub effect: Option<String>,
-    /// The nodes where the added effect acts.
+    /// The nodes where the added effect acts (nodes of the model).
     pub nodes: Vec<u32>,
-    /// The elements where the added effect acts.
+    /// The elements where the added effect acts (beams of the model).
     pub elements: Vec<u32>,
 }
+
+/// The kinds of effect a history entry may name (the names of
+/// `rfm_update::diagnose::EffectKind`, whose tests keep the two lists equal).
+pub const EFFECT_KINDS: [&str; 7] = [
+    "flexible_support",
+    "flexible_joint",
+    "lumped_mass",
+    "stiffness_change",
+    "mass_change",
+    "viscous_damping",
+    "non_viscous_damping",
+];
 
 /// How an updating run may end, as its results name it (the statuses of
 /// `rfm_update::status::Status`, whose tests keep the two lists equal).

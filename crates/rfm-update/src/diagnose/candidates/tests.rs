@@ -217,8 +217,8 @@ fn a_damper_beside_a_spring_may_dominate_it_at_the_top_of_the_band() {
 }
 
 /// A kind's name is its JSON name (the reports read the one a case's
-/// history keeps as the other) and names its kind back; every kind has one
-/// of its own.
+/// history keeps as the other), names its kind back and is one of the
+/// names fe-model accepts in a history; every kind has one of its own.
 #[test]
 fn effect_kind_names_are_their_json_names_and_read_back() {
     let mut seen = std::collections::HashSet::new();
@@ -228,4 +228,6 @@ fn effect_kind_names_are_their_json_names_and_read_back() {
         assert!(seen.insert(k.name()), "{k:?}");
     }
     assert_eq!(EffectKind::from_name("flexible joint"), None);
+    // the names a case's history may use are these, in this order
+    assert_eq!(EffectKind::ALL.map(EffectKind::name), fe_model::case::EFFECT_KINDS);
 }
