@@ -202,11 +202,7 @@ fn write_updated_model(
     editor.set_values(&values, &comment)?;
     if study.gains() != fe_model::case::Gains::None {
         // the next run (diagnose, compare, update) fits the gains too; their values are kept
-        let fitted: Vec<fe_model::case::FittedGain> = outcome
-            .gains
-            .iter()
-            .map(|g| fe_model::case::FittedGain { key: g.key, magnitude: g.magnitude, phase_deg: g.phase_deg })
-            .collect();
+        let fitted: Vec<fe_model::case::FittedGain> = outcome.gains.iter().map(|g| g.fitted()).collect();
         editor.set_gains(study.gains(), &fitted)?;
     }
     editor.push_history(step)?;
@@ -368,8 +364,7 @@ fn print_outcome(outcome: &UpdateOutcome) -> Result<()> {
         }
     }
     for g in &outcome.gains {
-        let of = if matches!(g.key, fe_model::case::GainKey::Channel(..)) { "channel" } else { "reference" };
-        outln!("gain of {of} {}: {:.4} at {:+.2} deg", g.key, g.magnitude, g.phase_deg);
+        outln!("gain of {} {}: {:.4} at {:+.2} deg", g.key.noun(), g.key, g.magnitude, g.phase_deg);
     }
     let nf = &outcome.natural_frequencies_hz;
     if nf.kind == "none" {

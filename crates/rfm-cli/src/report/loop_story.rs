@@ -65,15 +65,17 @@ pub(crate) fn short_effect(kind: Option<EffectKind>, nodes: &[u32], elements: &[
     if place.is_empty() { what.to_string() } else { format!("{what} {place}") }
 }
 
-/// The steps of a history that added an effect with a place (`+ ...` with
-/// nodes or elements), in order: the numbering of the structure figure.
-fn added(history: &[HistoryEntry]) -> impl Iterator<Item = &HistoryEntry> {
-    history.iter().filter(|h| h.step.starts_with('+') && !(h.nodes.is_empty() && h.elements.is_empty()))
+/// Whether a step added an effect with a place (`+ ...` with nodes or
+/// elements): the steps the structure figure numbers.
+fn adds_a_placed_effect(h: &HistoryEntry) -> bool {
+    h.step.starts_with('+') && !(h.nodes.is_empty() && h.elements.is_empty())
 }
 
 /// The effects the history says were added, marked where they sit.
 pub(crate) fn highlights(history: &[HistoryEntry]) -> Vec<Highlight> {
-    added(history)
+    history
+        .iter()
+        .filter(|h| adds_a_placed_effect(h))
         .map(|h| {
             let kind = h.effect.as_deref().and_then(EffectKind::from_name);
             Highlight {
@@ -93,8 +95,7 @@ fn labels(history: &[HistoryEntry]) -> Vec<String> {
     history
         .iter()
         .map(|h| {
-            let placed = !(h.nodes.is_empty() && h.elements.is_empty());
-            if h.step.starts_with('+') && placed {
+            if adds_a_placed_effect(h) {
                 k += 1;
                 let kind = h.effect.as_deref().and_then(EffectKind::from_name);
                 format!("+ {k}: {}", short_effect(kind, &h.nodes, &h.elements))

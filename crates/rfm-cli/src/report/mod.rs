@@ -583,6 +583,8 @@ pub(crate) fn definitions_section() -> Section {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use fe_model::{Dof, DofRef};
+    use frf::FrfKind;
 
     /// A folder and the `..` after it cancel; leading `..`, a root and the
     /// file name stay.
@@ -599,8 +601,6 @@ mod tests {
             assert_eq!(shown_path(Path::new(given)), shown, "{given}");
         }
     }
-    use fe_model::{Dof, DofRef};
-    use frf::FrfKind;
 
     #[test]
     fn driving_points_come_once_per_reference() {

@@ -6,7 +6,6 @@
 
 use std::path::{Path, PathBuf};
 
-use fe_model::case::GainKey;
 use frf::correlation::{BandSpec, correlate};
 use frf::synthesize_regular;
 use rfm_update::output_error::Gain;
@@ -163,8 +162,8 @@ pub(crate) fn write(
         }
     }
     if !outcome.gains.is_empty() {
-        let per =
-            if outcome.gains.iter().any(|g| matches!(g.key, GainKey::Channel(..))) { "channel" } else { "reference" };
+        // one setting per run: every gain is of a reference, or of a channel
+        let per = outcome.gains[0].key.noun();
         let mut t = Table::new(&[per, "gain magnitude", "gain phase (deg)"])
             .caption(format!("Fitted gain per {per} (the model FRFs are multiplied by it before comparison)."));
         for g in &outcome.gains {

@@ -106,11 +106,7 @@ impl Diagnosis {
         }
         if self.gains != Gains::None {
             // the next run fits the gains too; their values are kept for reading
-            let fitted: Vec<FittedGain> = r
-                .gains
-                .iter()
-                .map(|g| FittedGain { key: g.key, magnitude: g.magnitude, phase_deg: g.phase_deg })
-                .collect();
+            let fitted: Vec<FittedGain> = r.gains.iter().map(|g| g.fitted()).collect();
             editor.set_gains(self.gains, &fitted)?;
         }
         if case.history.is_empty() {

@@ -62,7 +62,7 @@ mod response;
 
 use damping::DampedSystem;
 use faer::Mat;
-use fe_model::case::{GainKey, Gains};
+use fe_model::case::{FittedGain, GainKey, Gains};
 use frf::{Channel, FrfSet, ZSolver};
 use num_complex::Complex64 as C64;
 
@@ -171,6 +171,11 @@ impl Gain {
     /// The complex factor.
     pub fn factor(&self) -> C64 {
         C64::from_polar(self.magnitude, self.phase_deg.to_radians())
+    }
+
+    /// The gain as a case file keeps it (`fitted_gains`).
+    pub fn fitted(&self) -> FittedGain {
+        FittedGain { key: self.key, magnitude: self.magnitude, phase_deg: self.phase_deg }
     }
 
     /// Whether this gain multiplies `channel`: every channel of its

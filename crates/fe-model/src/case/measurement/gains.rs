@@ -50,6 +50,16 @@ pub enum GainKey {
     Channel(DofRef, DofRef),
 }
 
+impl GainKey {
+    /// What it belongs to, in a word: `reference` or `channel`.
+    pub fn noun(&self) -> &'static str {
+        match self {
+            GainKey::Reference(_) => "reference",
+            GainKey::Channel(..) => "channel",
+        }
+    }
+}
+
 impl std::fmt::Display for GainKey {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
@@ -82,4 +92,18 @@ pub struct FittedGain {
     pub magnitude: f64,
     /// Phase (degrees).
     pub phase_deg: f64,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A key reads back from what it writes, and says what it belongs to.
+    #[test]
+    fn a_gain_key_reads_back_and_names_what_it_belongs_to() {
+        for (text, noun) in [("1:uy", "reference"), ("H(31:uy,1:uy)", "channel")] {
+            let key: GainKey = text.parse().unwrap();
+            assert_eq!((key.to_string().as_str(), key.noun()), (text, noun));
+        }
+    }
 }
