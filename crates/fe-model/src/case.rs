@@ -16,9 +16,8 @@
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
-use crate::dof::NodeId;
 use crate::error::{CaseError, ModelError};
-use crate::model::{ElementId, Model};
+use crate::model::Model;
 
 mod build;
 mod check;
@@ -170,12 +169,6 @@ impl CaseFile {
                 if let Some(e) = r.effect.as_deref().filter(|e| !EFFECT_KINDS.contains(e)) {
                     let hint = hint(e, &EFFECT_KINDS, "effects");
                     return Err(ctx.err(h.span(), format!("a history entry names the unknown effect `{e}`{hint}")));
-                }
-                if let Some(n) = r.nodes.iter().find(|&&n| model.node(NodeId(n)).is_none()) {
-                    return Err(ctx.err(h.span(), format!("a history entry names node {n}, which the model lacks")));
-                }
-                if let Some(e) = r.elements.iter().find(|&&e| model.beam_index(ElementId(e)).is_none()) {
-                    return Err(ctx.err(h.span(), format!("a history entry names element {e}, which the model lacks")));
                 }
                 Ok(HistoryEntry {
                     step: r.step.clone(),

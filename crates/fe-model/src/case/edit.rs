@@ -444,25 +444,30 @@ data = \"data/measured.csv\"   # from the lab
         assert!(out.contains("# updated by rfm\n[set]"), "{out}");
     }
 
-    /// A history entry may name only effects, nodes and elements there are:
-    /// anything else is refused with the file, the entry's place and a hint.
+    /// A history entry may name only the effects there are: another name is
+    /// refused with the file, the entry's place and a hint. Its nodes and
+    /// elements record where an effect was put when it was added, and the
+    /// model may have lost them since (the effect taken out again by hand or
+    /// by `rfm fix`'s revision): the case loads with them as written.
     #[test]
-    fn a_history_entry_naming_what_is_not_there_is_refused_where_it_stands() {
+    fn a_history_entry_is_checked_for_its_effect_not_for_places_since_gone() {
         let c = case(Path::new("/tmp"));
         let base = c.editor().unwrap().text_at(Path::new("/tmp/x.toml")).unwrap();
+        let with = |entry: &str| format!("{base}\n[[history]]\nstep = \"+ x\"\nmisfit = 0.1\n{entry}\n");
         for (entry, says) in [
             ("effect = \"flexible joint\"", "the unknown effect `flexible joint`; did you mean `flexible_joint`?"),
             ("effect = \"crack\"", "the unknown effect `crack` (effects: flexible_support, flexible_joint,"),
-            ("nodes = [1, 999]", "names node 999, which the model lacks"),
-            ("elements = [999]", "names element 999, which the model lacks"),
         ] {
-            let text = format!("{base}\n[[history]]\nstep = \"+ x\"\nmisfit = 0.1\n{entry}\n");
+            let text = with(entry);
             // the entry's place: its `[[history]]` line (1-based)
             let line = text.lines().position(|l| l == "[[history]]").unwrap() + 1;
             let e = CaseFile::parse(Path::new("/tmp/x.toml"), &text).unwrap_err().to_string();
             assert!(e.contains(says), "{entry}: {e}");
             assert!(e.contains(&format!("x.toml:{line}:")), "{entry}: not located at line {line}: {e}");
         }
+        let gone = CaseFile::parse(Path::new("/tmp/x.toml"), &with("nodes = [1, 999]\nelements = [999]")).unwrap();
+        let h = gone.history.last().unwrap();
+        assert_eq!((&h.nodes[..], &h.elements[..]), (&[1, 999][..], &[999][..]));
     }
 
     #[test]

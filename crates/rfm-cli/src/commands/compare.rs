@@ -303,7 +303,7 @@ fn report_sections(
     if let Some(fall) = report::loop_story::fall_figure(&case.history, false, out)? {
         first.push(fall);
     }
-    let added = report::loop_story::highlights(&case.history);
+    let added = report::loop_story::highlights(&case.history, &case.model);
     let caption = if added.is_empty() {
         "The case's model."
     } else {

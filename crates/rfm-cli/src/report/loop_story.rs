@@ -5,7 +5,7 @@
 //! case written by `rfm diagnose --apply` shows what was added and how far
 //! the misfit fell.
 
-use fe_model::HistoryEntry;
+use fe_model::{ElementId, HistoryEntry, Model, NodeId};
 use rfm_update::diagnose::EffectKind;
 use rfm_update::fix::CONSISTENT;
 
@@ -71,19 +71,25 @@ fn adds_a_placed_effect(h: &HistoryEntry) -> bool {
     h.step.starts_with('+') && !(h.nodes.is_empty() && h.elements.is_empty())
 }
 
-/// The effects the history says were added, marked where they sit.
-pub(crate) fn highlights(history: &[HistoryEntry]) -> Vec<Highlight> {
+/// The effects the history says were added, marked where they sit in
+/// `model`. A history records where each effect was put when it was added:
+/// a node or element that `model` no longer has (the effect was later
+/// taken out, or the model edited) is not marked, and an effect with
+/// nothing left to mark says so in its legend.
+pub(crate) fn highlights(history: &[HistoryEntry], model: &Model) -> Vec<Highlight> {
     history
         .iter()
         .filter(|h| adds_a_placed_effect(h))
         .map(|h| {
             let kind = h.effect.as_deref().and_then(EffectKind::from_name);
-            Highlight {
-                label: h.step.trim_start_matches('+').trim().to_string(),
-                kind: highlight_kind(kind, !h.elements.is_empty()),
-                nodes: h.nodes.clone(),
-                elements: h.elements.clone(),
+            let nodes: Vec<u32> = h.nodes.iter().copied().filter(|&n| model.node(NodeId(n)).is_some()).collect();
+            let elements: Vec<u32> =
+                h.elements.iter().copied().filter(|&e| model.beam_index(ElementId(e)).is_some()).collect();
+            let mut label = h.step.trim_start_matches('+').trim().to_string();
+            if nodes.is_empty() && elements.is_empty() {
+                label.push_str(" (no longer in the model)");
             }
+            Highlight { label, kind: highlight_kind(kind, !h.elements.is_empty()), nodes, elements }
         })
         .collect()
 }
@@ -164,7 +170,7 @@ mod tests {
             entry("+ stiffness change of elements 4..7", 0.02, Some("stiffness_change"), &[4, 5, 6, 7, 8], &[4, 7]),
             entry("+ lumped mass at node 9", 0.011, Some("lumped_mass"), &[9], &[]),
         ];
-        let h = highlights(&history);
+        let h = highlights(&history, &fe_model::samples::cantilever(20));
         let kinds: Vec<HighlightKind> = h.iter().map(|h| h.kind).collect();
         assert_eq!(kinds, [HighlightKind::Joint, HighlightKind::Patch, HighlightKind::Mass]);
         assert_eq!(h[0].label, "flexible, lossy joint at node 13");
@@ -178,6 +184,24 @@ mod tests {
                 "+ 2: stiffness of elements 4-7",
                 "+ 3: mass at node 9"
             ]
+        );
+    }
+
+    /// A place the model no longer has (the effect was taken out later, or
+    /// the model edited) is not marked, and an effect with nothing left to
+    /// mark says so; the case loads all the same.
+    #[test]
+    fn a_place_the_model_no_longer_has_is_left_unmarked_and_said() {
+        let history = [
+            entry("+ in-line joint at node 30", 0.1, Some("flexible_joint"), &[30], &[30]),
+            entry("+ damping in elements 19..22", 0.05, Some("viscous_damping"), &[19, 20, 21, 22, 23], &[19, 22]),
+        ];
+        let h = highlights(&history, &fe_model::samples::cantilever(20));
+        assert_eq!(h[0].label, "in-line joint at node 30 (no longer in the model)");
+        assert!(h[0].nodes.is_empty() && h[0].elements.is_empty(), "{:?}", h[0].nodes);
+        assert_eq!(
+            (h[1].label.as_str(), &h[1].nodes[..], &h[1].elements[..]),
+            ("damping in elements 19..22", &[19, 20, 21][..], &[19][..])
         );
     }
 

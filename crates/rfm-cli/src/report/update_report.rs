@@ -94,7 +94,7 @@ pub(crate) fn write(
             first.push(fall);
         }
     }
-    let added = loop_story::highlights(history);
+    let added = loop_story::highlights(history, outcome.system.model());
     first.push(super::structure_figure(
         outcome.system.model(),
         measured,

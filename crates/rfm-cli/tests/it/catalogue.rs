@@ -199,11 +199,6 @@ fn catalogue() -> Vec<Entry> {
             vec!["@cat.toml:[[history]]", "unknown effect `flexible-joint`", "did you mean `flexible_joint`?"],
         ),
         bad_case(
-            "a history entry naming a node the model lacks",
-            format!("{BEAM}\n[[history]]\nstep = \"+ a mass\"\nmisfit = 0.1\nnodes = [9]\n"),
-            vec!["@cat.toml:[[history]]", "names node 9, which the model lacks"],
-        ),
-        bad_case(
             "unknown key in a group",
             replaced("alpha = 1e-5", "alpah = 1e-5"),
             vec!["@cat.toml:alpah", "did you mean `alpha`?"],
