@@ -7,8 +7,9 @@
 //! a mass on the column and a non-viscous corner joint, the joint is
 //! chosen viscous while the mass is missing, and with the mass added the
 //! viscous joint leaves 6.8 times the noise where the non-viscous one
-//! reaches it (held-out trial 25 of the reduced set). The joint update of
-//! every parameter cannot mend that: it changes values, not forms.
+//! reaches it (held-out trial 25 of a study at 4 trials per family and 6
+//! pairs). The joint update of every parameter cannot mend that: it changes
+//! values, not forms.
 //!
 //! So, when the loop leaves more than the noise, each effect in turn is
 //! replaced by each of the few best other candidates of the diagnosis it

@@ -19,13 +19,16 @@
 //! - in pair trials both effects are found in at least 80 %;
 //! - in null trials (2 % noise) nothing is significant in at least 95 %.
 //!
-//! The reduced set is 4 trials per family, 6 pairs and 10 null trials (a
-//! few minutes), and CI runs it: 28/30 right first, 29/30 within 1.5 times
-//! the noise, true values within 3 sd 22/25, both effects of a pair 6/6,
-//! null trials clean 10/10. `cargo xtask heldout` runs the full study (12
-//! per family, 16 pairs, 20 null trials) with the same criteria. `HELD_OUT_SINGLE` (per
-//! family), `HELD_OUT_PAIRS` and `HELD_OUT_NULL` set the numbers of trials;
-//! `HELD_OUT_ONLY=i,j,...` runs those trials alone and `HELD_OUT_DUMP=DIR` writes
+//! CI runs the study at the size the criteria ask for: 12 trials per family
+//! (72), 8 pairs and 20 null trials (about 12 minutes in the test profile on
+//! two cores). On the code of today: right kind and place first 77/80,
+//! within 1.5 times the noise 78/80, true values within 3 sd 59/67, both
+//! effects of a pair 8/8, null trials clean 20/20. `cargo xtask heldout`
+//! runs it with 16 pairs (the first 8 are CI's) in the release profile:
+//! 85/88, 84/88, 65/74, 16/16 and 20/20. `HELD_OUT_SINGLE` (per family),
+//! `HELD_OUT_PAIRS` and `HELD_OUT_NULL` set the numbers of trials (a smaller
+//! study checks the rates but not the counts); `HELD_OUT_ONLY=i,j,...` runs
+//! those trials alone and `HELD_OUT_DUMP=DIR` writes
 //! each trial as a case with its data.
 
 use std::collections::BTreeMap;
@@ -204,7 +207,7 @@ fn trial_of(singles: usize, pairs: usize, index: usize) -> Trial {
     run(&draws(singles, pairs)[index], 7000 + index as u64, &opts)
 }
 
-/// Trial 25 of the reduced set: a non-viscous corner joint and a mass with
+/// Trial 25 of a study at 4 trials per family and 6 pairs: a non-viscous corner joint and a mass with
 /// rotary inertia on the column of an L-frame. With the mass missing, the
 /// joint is chosen viscous, and the mass is then added without its rotary
 /// inertia: the loop's three steps leave 3.9 times the noise. Revised with
@@ -292,8 +295,8 @@ fn two_effects_that_mislead_one_at_a_time_are_fitted_together() {
 
 #[test]
 fn the_loop_finds_and_fixes_held_out_effects() {
-    let singles = count("HELD_OUT_SINGLE", 4);
-    let pairs = count("HELD_OUT_PAIRS", 6);
+    let singles = count("HELD_OUT_SINGLE", 12);
+    let pairs = count("HELD_OUT_PAIRS", 8);
     let opts = FixOptions { max_steps: 3, ..FixOptions::default() };
     let mut trials: Vec<Trial> = Vec::new();
     let draws = draws(singles, pairs);
@@ -356,7 +359,8 @@ fn the_loop_finds_and_fixes_held_out_effects() {
     if only.is_some() {
         return;
     }
-    assert!(n >= 26 || std::env::var("HELD_OUT_SINGLE").is_ok(), "at least 26 trials with effects");
+    let resized = std::env::var("HELD_OUT_SINGLE").is_ok() || std::env::var("HELD_OUT_PAIRS").is_ok();
+    assert!(n >= 80 || resized, "at least 80 trials with effects, not {n}");
     assert!(rate(first_ok, n) >= 0.90, "right kind and place first in {first_ok}/{n}");
     assert!(rate(fixed, n) >= 0.85, "misfit within 1.5 x noise in {fixed}/{n}");
     assert!(rate(values_ok, with_values.len()) >= 0.85, "values within 3 sd in {values_ok}/{}", with_values.len());
@@ -365,7 +369,8 @@ fn the_loop_finds_and_fixes_held_out_effects() {
 
 #[test]
 fn null_trials_find_nothing_significant() {
-    let trials = count("HELD_OUT_NULL", 10);
+    let trials = count("HELD_OUT_NULL", 20);
+    assert!(trials >= 20 || std::env::var("HELD_OUT_NULL").is_ok(), "at least 20 null trials, not {trials}");
     let mut rng = ChaCha8Rng::seed_from_u64(2612);
     let mut quiet = 0;
     for i in 0..trials {
