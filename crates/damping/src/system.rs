@@ -284,6 +284,8 @@ mod tests {
     use fe_model::samples;
 
     fn max_rel_diff(a: &[C64], b: &[C64]) -> f64 {
+        // a zip would pass over a missing vector (an empty G or Z) as equal
+        assert_eq!(a.len(), b.len(), "the vectors compared differ in length");
         let scale = b.iter().map(|v| v.norm()).fold(0.0, f64::max);
         a.iter().zip(b).map(|(x, y)| (x - y).norm()).fold(0.0, f64::max) / scale
     }
@@ -401,6 +403,34 @@ mod tests {
             let after = sys.z_values(900.0);
             assert!(max_rel_diff(&after, &before) > 1e-3, "{name}: Z did not change");
             assert_eq!(after, blockwise(&sys, 900.0), "{name}");
+        }
+    }
+
+    /// `Z(w) - j w G(w)` is `K - w^2 M`: real, and on a straight line in
+    /// `w^2` through three frequencies, for non-viscous groups (the beam's
+    /// and the frame's joint, where `G` depends on `w`) and viscous ones.
+    #[test]
+    fn z_less_its_damping_is_k_minus_w2_m() {
+        for model in [samples::two_material_cantilever(), samples::frame_with_joint(), samples::space_portal()] {
+            let sys = DampedSystem::new(model).unwrap();
+            let undamped = |omega: f64| -> Vec<C64> {
+                let (z, g) = (sys.z_values(omega), sys.g_values(omega));
+                assert_eq!(z.len(), g.len());
+                z.iter().zip(&g).map(|(z, g)| z - C64::new(0.0, omega) * g).collect()
+            };
+            let (w1, w2, w3) = (100.0, 700.0, 3000.0);
+            let (a, b, c) = (undamped(w1), undamped(w2), undamped(w3));
+            // the damping is not nothing: j w G moves Z by more than round-off
+            let z = sys.z_values(w2);
+            assert!(max_rel_diff(&b, &z) > 1e-6, "{}: G(w) is missing", sys.model().title);
+            let scale = c.iter().map(|v| v.norm()).fold(0.0, f64::max);
+            for ((a, b), c) in a.iter().zip(&b).zip(&c) {
+                // b on the line through a and c in w^2
+                let t = (w2 * w2 - w1 * w1) / (w3 * w3 - w1 * w1);
+                let line = a + (c - a) * t;
+                assert!((b - line).norm() < 1e-10 * scale, "{}: {b} off the line {line}", sys.model().title);
+                assert!(b.im.abs() < 1e-10 * scale, "{}: K - w^2 M has an imaginary part {b}", sys.model().title);
+            }
         }
     }
 
