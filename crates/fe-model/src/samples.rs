@@ -5,7 +5,7 @@
 //! default API. Enable it where they are used, as a dev-dependency:
 //! `fe-model = { workspace = true, features = ["samples"] }`.
 
-use crate::dof::{Dimension, Dof};
+use crate::dof::{Dimension, Dof, DofRef};
 use crate::model::{Group, Model, Section};
 
 /// A uniform steel cantilever, 1 m long, 50 x 10 mm, clamped at node 1,
@@ -291,6 +291,103 @@ pub fn space_portal() -> Model {
     m
 }
 
+/// The sparsity of a shell mesh, imported: a square 1 m plate of `n x n`
+/// cells, its `(n + 1)^2` nodes in the x-y plane with all six DOFs,
+/// clamped along x = 0, each node coupled to its four neighbours by full
+/// 6 x 6 blocks (30 non-zeros in an inner row of `K` and `M`, as in a
+/// shell model exported from another code). The matrices are imported
+/// ([`Model::add_imported`]), one stiffness and one mass per group; the
+/// plate is cut into `strips` groups along x (a cell edge belongs to the
+/// strip of its midpoint), each non-viscous with its own relaxation
+/// parameter.
+///
+/// It has the sparsity of a shell, not its physics: the couplings are
+/// springs along the grid lines (a membrane for every DOF), scaled so that
+/// the lowest modes lie near 20 Hz and the band 5-400 Hz holds many.
+pub fn imported_plate(n: usize, strips: usize) -> Model {
+    use crate::imported::{ImportedKind, SymmetricCoo};
+    use std::collections::BTreeMap;
+
+    let mut m = Model::with_dimension("plate-like imported model", Dimension::Spatial);
+    let groups: Vec<usize> = (0..strips)
+        .map(|g| {
+            let group = Group::new(&format!("strip{}", g + 1)).rayleigh(1e-5, 0.5).relaxation(400.0 + 100.0 * g as f64);
+            m.add_group(group).unwrap()
+        })
+        .collect();
+    let side = n + 1;
+    let h = 1.0 / n as f64;
+    for j in 0..side {
+        for i in 0..side {
+            m.add_node_at((j * side + i + 1) as u32, [i as f64 * h, j as f64 * h, 0.0]).unwrap();
+        }
+    }
+    for j in 0..side {
+        m.add_support((j * side + 1) as u32, &Dof::SPATIAL).unwrap();
+    }
+    // a node's block: the six DOFs coupled (I + c J, J the all-ones matrix
+    // over 6, positive definite), the rotations scaled by h^2 so that every
+    // DOF has the same stiffness-to-mass ratio
+    let scale = |d: usize| if d < 3 { 1.0 } else { h };
+    let block = |c: f64| {
+        let mut b = [[0.0; 6]; 6];
+        for (r, row) in b.iter_mut().enumerate() {
+            for (col, v) in row.iter_mut().enumerate() {
+                *v = scale(r) * scale(col) * (f64::from(u8::from(r == col)) + c / 6.0);
+            }
+        }
+        b
+    };
+    let (plate_mass, c) = (10.0, 80.0); // kg; wave speed (m/s), lowest mode c / 4 m
+    let (kb, mb) = (block(0.2), block(0.1));
+    // each of the 2 n (n + 1) edges carries the same share of the mass; an
+    // inner node has 4/3 of an edge's, and a chain of nodes m apart joined
+    // by springs k carries waves at h sqrt(k / m)
+    let m_edge = plate_mass / (2 * n * side) as f64 / mb[0][0];
+    let k_edge = 4.0 / 3.0 * m_edge * (c / h).powi(2);
+    let table: Vec<DofRef> =
+        (0..side * side).flat_map(|node| Dof::SPATIAL.map(|d| DofRef::new((node + 1) as u32, d))).collect();
+    let mut stiffness = vec![BTreeMap::<(usize, usize), f64>::new(); strips];
+    let mut mass = stiffness.clone();
+    let add = |map: &mut BTreeMap<(usize, usize), f64>, a: usize, b: usize, f: f64, blk: &[[f64; 6]; 6]| {
+        for (r, row) in blk.iter().enumerate() {
+            for (col, v) in row.iter().enumerate() {
+                let (i, j) = (6 * a + r, 6 * b + col);
+                if i >= j {
+                    *map.entry((i, j)).or_default() += f * v;
+                }
+            }
+        }
+    };
+    for j in 0..side {
+        for i in 0..side {
+            let a = j * side + i;
+            for (b, x_mid) in [
+                (i + 1 < side).then(|| (a + 1, (i as f64 + 0.5) * h)),
+                (j + 1 < side).then(|| (a + side, i as f64 * h)),
+            ]
+            .into_iter()
+            .flatten()
+            {
+                let g = ((x_mid * strips as f64) as usize).min(strips - 1);
+                for (x, y, sign) in [(a, a, 1.0), (b, b, 1.0), (b, a, -1.0), (a, b, -1.0)] {
+                    add(&mut stiffness[g], x, y, sign * k_edge, &kb);
+                    // consistent, as a bar's: 2/6 on the nodes, 1/6 between
+                    add(&mut mass[g], x, y, m_edge * if x == y { 2.0 } else { 1.0 } / 6.0, &mb);
+                }
+            }
+        }
+    }
+    for (g, (k, mm)) in groups.into_iter().zip(stiffness.into_iter().zip(mass)) {
+        for (kind, map) in [(ImportedKind::Stiffness, k), (ImportedKind::Mass, mm)] {
+            let mut entries: Vec<_> = map.into_iter().map(|((i, j), v)| (i, j, v)).collect();
+            entries.sort_by_key(|&(i, j, _)| (j, i));
+            m.add_imported(g, kind, &table, &SymmetricCoo { n: table.len(), entries }).unwrap();
+        }
+    }
+    m
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -307,5 +404,26 @@ mod tests {
         let members = (2 * bays + 1) * storeys;
         assert_eq!(a.n(), 3 * ((bays + 1) * storeys + members * (per - 1)));
         assert_eq!(frame_grid(bays, storeys, per).beams().len(), members * per);
+    }
+
+    #[test]
+    fn the_imported_plate_has_the_sparsity_of_a_shell() {
+        let (n, strips) = (4, 3);
+        let model = imported_plate(n, strips);
+        let a = Assembly::new(&model).unwrap();
+        // six DOFs at each node but the clamped column's
+        assert_eq!(a.n(), 6 * (n + 1) * n);
+        assert_eq!(model.groups().len(), strips);
+        // an inner node's row couples its own six DOFs and its four
+        // neighbours' (an edge node's fewer)
+        let p = a.pattern();
+        let per_row: Vec<usize> = (0..a.n()).map(|c| p.rows(c).len()).collect();
+        assert_eq!(per_row.iter().max(), Some(&30));
+        assert!(per_row.iter().all(|&k| (12..=30).contains(&k)), "{per_row:?}");
+        let dofs = a.dofs();
+        let inner = (0..a.n()).find(|&eq| dofs.dof_of(eq).node.0 == (2 * (n + 1) + 3) as u32).unwrap();
+        assert_eq!(p.rows(inner).len(), 30);
+        // the mass is the plate's 10 kg, the clamped column's share included
+        assert!((model.imported_mass() - 10.0).abs() < 1e-9, "{}", model.imported_mass());
     }
 }

@@ -155,6 +155,14 @@ impl ZSolver {
         self.ldlt.nnz_l()
     }
 
+    /// Complex multiply-adds of one numeric `L D L^T` factorisation: the
+    /// part of a line's cost that grows with the square of the factor's
+    /// column counts (a shell's factor has columns tens of times fuller
+    /// than a beam's), where the solves grow with [`Self::factor_nnz`].
+    pub fn factor_multiply_adds(&self) -> u64 {
+        self.ldlt.multiply_adds()
+    }
+
     /// Row of equation `eq` in the solver's internal order (the layout of
     /// [`Self::solve_ordered`]).
     pub fn position(&self, eq: usize) -> usize {

@@ -5,12 +5,14 @@
 //!     --model beam:34483 --params 30 --measured 20 --freqs 10 [--naive] [--repeat 3]
 //! ```
 //!
-//! Models: `paper`, `beam:<elements>`, `frame:<bays>x<storeys>x<per>` (see
+//! Models: `paper`, `beam:<elements>`, `frame:<bays>x<storeys>x<per>`, `shell:<n>` (see
 //! `benches/common`). Assembles the sensitivities (`Hybrid::Model`) over all
-//! lines `--repeat` times and prints one JSON line: sizes, the best wall
+//! lines `--repeat` times and prints one JSON line: sizes (with the
+//! factor's entries and the multiply-adds of one factorisation), the best wall
 //! time per frequency line and the CPU time of that run (all threads), the
-//! setup time and the process's peak resident memory (VmHWM), so that each
-//! configuration's memory is its own.
+//! best wall time per line of the numeric factorisations of `Z` alone (over
+//! the same lines and threads), the setup time and the process's peak
+//! resident memory (VmHWM), so that each configuration's memory is its own.
 
 #[path = "../benches/common/mod.rs"]
 mod common;
@@ -20,6 +22,7 @@ mod point;
 use std::time::Instant;
 
 use point::{arg, peak_kib};
+use rayon::prelude::*;
 use rfm_update::sensitivity::{self, ChannelPlan, Hybrid};
 
 /// CPU time used so far by all threads of this process (s), from
@@ -69,17 +72,40 @@ fn main() {
         }
         std::hint::black_box(blocks);
     }
+    // the numeric factorisations alone, over the same lines and threads:
+    // the part of a line's cost that grows with the factor's flops, not
+    // only with its entries (a shell's columns are 30 times fuller than a
+    // beam's)
+    let factor = if naive {
+        f64::NAN
+    } else {
+        let mut best = f64::INFINITY;
+        for _ in 0..repeat.max(1) {
+            let t = Instant::now();
+            w.freqs.par_iter().for_each_init(
+                || (solver.workspace(), Vec::new()),
+                |(ws, z), &f| {
+                    z.resize(w.sys.assembly().pattern().nnz(), num_complex::Complex64::ZERO);
+                    w.sys.z_values_into(2.0 * std::f64::consts::PI * f, z);
+                    solver.factorize(ws, z, f).expect("Z factorises");
+                },
+            );
+            best = best.min(t.elapsed().as_secs_f64());
+        }
+        best
+    };
     // one JSON object per line; labels never contain quotes or backslashes
     let json = format!(
         concat!(
-            "{{\"label\":\"{}\",\"method\":\"{}\",\"dofs\":{},\"factor_nnz\":{},\"params\":{},",
+            "{{\"label\":\"{}\",\"method\":\"{}\",\"dofs\":{},\"factor_nnz\":{},\"factor_madds\":{},\"params\":{},",
             "\"measured\":{},\"freqs\":{},\"threads\":{},\"seconds\":{:e},\"ms_per_freq\":{:e},",
-            "\"cpu_ms_per_freq\":{},\"setup_s\":{:e},\"peak_kib\":{}}}"
+            "\"cpu_ms_per_freq\":{},\"factor_ms_per_freq\":{},\"setup_s\":{:e},\"peak_kib\":{}}}"
         ),
         w.label,
         if naive { "dense" } else { "sparse" },
         w.sys.n(),
         solver.factor_nnz(),
+        solver.factor_multiply_adds(),
         w.params.len(),
         w.channels.len(),
         w.freqs.len(),
@@ -87,6 +113,7 @@ fn main() {
         best,
         1e3 * best / w.freqs.len() as f64,
         if best_cpu.is_finite() { format!("{:e}", 1e3 * best_cpu / w.freqs.len() as f64) } else { "null".into() },
+        if factor.is_finite() { format!("{:e}", 1e3 * factor / w.freqs.len() as f64) } else { "null".into() },
         setup,
         peak_kib().map_or("null".to_string(), |k| k.to_string()),
     );

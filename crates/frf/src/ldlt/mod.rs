@@ -112,6 +112,15 @@ impl SymbolicLdlt {
         self.l_row_idx.len()
     }
 
+    /// Complex multiply-adds of one numeric factorisation: column `j` of
+    /// `L`, with `c` entries below the diagonal, is scaled by its pivot (`c`)
+    /// and updates the `c (c + 1) / 2` entries of the trailing matrix its
+    /// rows pair up (`c (c + 3) / 2` in all). It grows with the square of the
+    /// column counts, where [`Self::nnz_l`] grows with their sum.
+    pub(crate) fn multiply_adds(&self) -> u64 {
+        self.l_col_ptr.windows(2).map(|w| (w[1] - w[0]) as u64).map(|c| c * (c + 3) / 2).sum()
+    }
+
     /// `perm[new] = old`.
     pub(crate) fn perm(&self) -> &[usize] {
         &self.perm
@@ -217,6 +226,59 @@ mod tests {
         assert_eq!(got, expected.into_iter().collect::<Vec<_>>(), "sorted by column, then row, without repeats");
         let e = with_clique_pairs(&pat, &[vec![2, 9]]).unwrap_err();
         assert!(e.contains(&format!("clique equation 9 is not below {}", pat.n())), "{e}");
+    }
+
+    /// The fill and the multiply-adds of the analysis against a dense
+    /// elimination in the same order: on a 7 x 6 five-point grid, whose
+    /// factor fills in (unlike a band's).
+    #[test]
+    fn fill_and_multiply_adds_equal_a_dense_elimination() {
+        let (nx, ny) = (7, 6);
+        let n = nx * ny;
+        let (mut col_ptr, mut row_idx) = (vec![0], Vec::new());
+        for c in 0..n {
+            let (x, y) = (c % nx, c / nx);
+            let mut rows = vec![c];
+            if x > 0 {
+                rows.push(c - 1);
+            }
+            if x + 1 < nx {
+                rows.push(c + 1);
+            }
+            if y > 0 {
+                rows.push(c - nx);
+            }
+            if y + 1 < ny {
+                rows.push(c + nx);
+            }
+            rows.sort_unstable();
+            row_idx.extend(rows);
+            col_ptr.push(row_idx.len());
+        }
+        let pat = Pattern::new(n, col_ptr, row_idx).unwrap();
+        let sym = SymbolicLdlt::new(&pat, &[]).unwrap();
+        // the pattern in the analysis's order, eliminated densely
+        let mut filled = vec![vec![false; n]; n];
+        for c in 0..n {
+            for &r in pat.rows(c) {
+                filled[sym.perm_inv()[r]][sym.perm_inv()[c]] = true;
+            }
+        }
+        let (mut nnz, mut madds) = (0, 0u64);
+        for j in 0..n {
+            let below: Vec<usize> = (j + 1..n).filter(|&i| filled[i][j]).collect();
+            for &a in &below {
+                for &b in &below {
+                    filled[a][b] = true;
+                }
+            }
+            let c = below.len() as u64;
+            nnz += below.len();
+            madds += c * (c + 3) / 2;
+        }
+        assert!(nnz > 2 * n, "the grid fills in: {nnz} entries below the diagonal");
+        assert_eq!(sym.nnz_l(), nnz);
+        assert_eq!(sym.multiply_adds(), madds);
     }
 
     #[test]

@@ -41,10 +41,16 @@ pub(crate) enum Family {
         /// Elements per member.
         per: usize,
     },
+    /// `samples::imported_plate(n, 6)`: imported matrices with the sparsity
+    /// of a shell mesh, six groups.
+    Shell {
+        /// Cells along each side.
+        n: usize,
+    },
 }
 
 impl Family {
-    /// Parses `paper`, `beam:<elements>` or `frame:<bays>x<storeys>x<per>`.
+    /// Parses `paper`, `beam:<elements>`, `frame:<bays>x<storeys>x<per>` or `shell:<n>`.
     #[allow(dead_code)]
     pub(crate) fn parse(s: &str) -> Option<Family> {
         if s == "paper" {
@@ -53,6 +59,7 @@ impl Family {
         let (kind, size) = s.split_once(':')?;
         match kind {
             "beam" => Some(Family::Beam { elements: size.parse().ok()? }),
+            "shell" => Some(Family::Shell { n: size.parse().ok()? }),
             "frame" => {
                 let v: Vec<usize> = size.split('x').map(str::parse).collect::<Result<_, _>>().ok()?;
                 match v[..] {
@@ -71,13 +78,14 @@ fn spread(len: usize, count: usize) -> impl Iterator<Item = usize> {
     (0..count).map(move |i| (2 * i + 1) * len / (2 * count))
 }
 
-/// Builds a workload. For the beam and frame families the parameters are
-/// first the groups' (alpha, beta, mu, stiffness and mass factors of each
-/// group: they touch every element of the group), then stiffness and mass
-/// factors of evenly spaced elements (one element each, the diagnosis kind),
-/// up to `params`; the measured DOFs are `measured` evenly spaced uy DOFs, the
-/// reference the middle one; the lines are `freqs` evenly spaced in 5-400 Hz.
-/// `Paper` ignores the counts.
+/// Builds a workload. For the beam, frame and shell families the
+/// parameters are first the groups' (alpha, beta, mu, stiffness and mass
+/// factors of each group: they touch every element of the group), then
+/// stiffness and mass factors of evenly spaced elements (one element each,
+/// the diagnosis kind; the shell has none), up to `params`; the measured
+/// DOFs are `measured` evenly spaced uy DOFs (uz on the shell), the
+/// reference the middle one; the lines are `freqs` evenly spaced in 5-400
+/// Hz. `Paper` ignores the counts.
 pub(crate) fn workload(family: Family, params: usize, measured: usize, freqs: usize) -> Workload {
     let (model, label) = match family {
         Family::Paper => (samples::two_material_cantilever(), "paper beam".to_string()),
@@ -85,6 +93,7 @@ pub(crate) fn workload(family: Family, params: usize, measured: usize, freqs: us
         Family::Frame { bays, storeys, per } => {
             (samples::frame_grid(bays, storeys, per), format!("frame {bays}x{storeys}x{per}"))
         }
+        Family::Shell { n } => (samples::imported_plate(n, 6), format!("imported shell {n}x{n}")),
     };
     let sys = DampedSystem::new(model).expect("sample models assemble");
     let m = sys.model();
@@ -117,7 +126,9 @@ pub(crate) fn workload(family: Family, params: usize, measured: usize, freqs: us
     }
     qs.truncate(params);
     let dofs = sys.assembly().dofs();
-    let uy: Vec<_> = (0..sys.n()).map(|eq| dofs.dof_of(eq)).filter(|d| d.dof == Dof::Uy).collect();
+    // the plate's normal, the beams' and frames' transverse direction
+    let across = if let Family::Shell { .. } = family { Dof::Uz } else { Dof::Uy };
+    let uy: Vec<_> = (0..sys.n()).map(|eq| dofs.dof_of(eq)).filter(|d| d.dof == across).collect();
     let meas: Vec<_> = spread(uy.len(), measured).map(|i| uy[i]).collect();
     let reference = meas[meas.len() / 2];
     let channels = meas.iter().map(|&r| Channel::new(r, reference)).collect();
