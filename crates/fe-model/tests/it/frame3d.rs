@@ -230,6 +230,10 @@ fn local_axes_are_right_handed_and_follow_the_reference_and_the_angle() {
         Err(frame3d::AxesError::Reference)
     );
     assert_eq!(frame3d::axes([0.0; 3], [1.0, 0.0, 0.0], Some([0.0; 3]), 0.0), Err(frame3d::AxesError::Reference));
+    // a beam without length, or with one that is not a number, has no axes
+    for q in [[0.0; 3], [f64::INFINITY, 0.0, 0.0], [f64::NAN, 1.0, 0.0]] {
+        assert_eq!(frame3d::axes([0.0; 3], q, None, 0.0), Err(frame3d::AxesError::ZeroLength), "{q:?}");
+    }
 }
 
 /// `J / (a b^3)` of a solid `a x b` rectangle (`a >= b`), as tabulated by
