@@ -230,6 +230,19 @@ fn local_axes_are_right_handed_and_follow_the_reference_and_the_angle() {
         Err(frame3d::AxesError::Reference)
     );
     assert_eq!(frame3d::axes([0.0; 3], [1.0, 0.0, 0.0], Some([0.0; 3]), 0.0), Err(frame3d::AxesError::Reference));
+    // a reference that is not a number says nothing either
+    for r in [[0.0, f64::INFINITY, 0.0], [f64::NAN, 1.0, 0.0]] {
+        assert_eq!(frame3d::axes([0.0; 3], [1.0, 0.0, 0.0], Some(r), 0.0), Err(frame3d::AxesError::Reference), "{r:?}");
+    }
+    // along the beam is an angle, whatever the reference's length: a long
+    // reference within the angle is refused, a short one beyond it taken
+    let sine = frame3d::PARALLEL / 10.0;
+    let near = frame3d::axes([0.0; 3], [1.0, 0.0, 0.0], Some([1e3, 1e3 * sine, 0.0]), 0.0);
+    assert_eq!(near, Err(frame3d::AxesError::Reference));
+    let sine = frame3d::PARALLEL * 10.0;
+    let off = frame3d::axes([0.0; 3], [1.0, 0.0, 0.0], Some([1e-3, 1e-3 * sine, 0.0]), 0.0).unwrap();
+    check(off);
+    assert!((off[2][1] - 1.0).abs() < 1e-12, "{off:?}");
     // a beam without length, or with one that is not a number, has no axes
     for q in [[0.0; 3], [f64::INFINITY, 0.0, 0.0], [f64::NAN, 1.0, 0.0]] {
         assert_eq!(frame3d::axes([0.0; 3], q, None, 0.0), Err(frame3d::AxesError::ZeroLength), "{q:?}");
