@@ -607,6 +607,29 @@ mod tests {
         assert!(e.contains("expected displacement, velocity or acceleration per moment"), "{e}");
         let e = kind("m*s", "N").unwrap_err();
         assert!(e.contains("are not those of an FRF"), "{e}");
+        // per volt (the reference a drive signal, not a force): any length
+        // over V or mV, with no force in it; a volt has no length, so a
+        // rotational reference takes none
+        let u = kind("m/s^2", "mV").unwrap();
+        assert_eq!((u.kind, u.per_volt, u.assumed_si), (FrfKind::Accelerance, true, false));
+        assert!((u.scale - 1e3).abs() < 1e-12, "{}", u.scale);
+        let u = kind("mm", "V").unwrap();
+        assert_eq!((u.kind, u.per_volt), (FrfKind::Receptance, true));
+        assert!(!kind("m/s^2", "N").unwrap().per_volt);
+        let u = frf_units(&header(
+            y,
+            rz,
+            DataAxis::new(18, "f", "Hz"),
+            DataAxis::new(0, "r", "m/s"),
+            DataAxis::new(0, "e", "V"),
+        ))
+        .unwrap();
+        assert_eq!((u.kind, u.per_volt), (FrfKind::Mobility, true));
+        // a force and a volt together, or a volt squared, are no FRF
+        for den in ["N*V", "V^2"] {
+            let e = kind("m/s^2", den).unwrap_err();
+            assert!(e.contains("are not those of an FRF"), "{den}: {e}");
+        }
     }
 
     #[test]
