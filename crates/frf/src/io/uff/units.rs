@@ -531,6 +531,9 @@ mod tests {
         assert_eq!(unit("g"), Some(Dim { l: 1, f: 0, t: -2, v: 0, scale: G0 }));
         assert_eq!(unit("deg"), Some(Dim { l: 0, f: 0, t: 0, v: 0, scale: PI / 180.0 }));
         assert_eq!(unit("Hz"), Some(Dim { l: 0, f: 0, t: -1, v: 0, scale: 1.0 }));
+        for (name, scale) in [("V", 1.0), ("mV", 1e-3), ("uV", 1e-6), ("µV", 1e-6), ("μV", 1e-6)] {
+            assert_eq!(unit(name), Some(Dim { l: 0, f: 0, t: 0, v: 1, scale }), "{name}");
+        }
         assert_eq!(unit("furlong"), None);
     }
 
@@ -625,6 +628,11 @@ mod tests {
         ))
         .unwrap();
         assert_eq!((u.kind, u.per_volt), (FrfKind::Mobility, true));
+        // a response over neither a force nor a volt, or over a force squared
+        for (num, den) in [("m", "s"), ("m/s", "N^2")] {
+            let e = kind(num, den).unwrap_err();
+            assert!(e.contains("are not those of an FRF"), "{num} / {den}: {e}");
+        }
         // a force and a volt together, or a volt squared, are no FRF
         for den in ["N*V", "V^2"] {
             let e = kind("m/s^2", den).unwrap_err();
