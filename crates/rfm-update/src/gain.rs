@@ -49,13 +49,21 @@ pub fn log_gain(values: impl IntoIterator<Item = (C64, C64, f64)>) -> Option<C64
     let mut logs: Vec<(C64, f64)> = Vec::new();
     for (h, m, w) in values {
         if usable(h) && usable(m) && w > 0.0 && w.is_finite() {
-            logs.push(((m / h).ln(), w * w));
+            logs.push(((m / h).ln(), w));
         }
     }
-    let total: f64 = logs.iter().map(|(_, w2)| w2).sum();
-    if logs.is_empty() || !(total > 0.0) {
+    // the weights relative to the largest, squared: the gain does not
+    // depend on their scale, and squares of weights near the ends of the
+    // f64 range would underflow to a total of zero or overflow to infinity
+    let largest = logs.iter().map(|&(_, w)| w).fold(0.0, f64::max);
+    for (_, w) in &mut logs {
+        *w = (*w / largest).powi(2);
+    }
+    if logs.is_empty() {
         return None;
     }
+    // at least 1: the largest weight's own square
+    let total: f64 = logs.iter().map(|(_, w2)| w2).sum();
     let magnitude = logs.iter().map(|(z, w2)| w2 * z.re).sum::<f64>() / total;
     let phasor: C64 = logs.iter().map(|(z, w2)| C64::from_polar(*w2, z.im)).sum();
     let mut phase = if phasor.norm() > 0.0 { phasor.arg() } else { 0.0 };
@@ -326,6 +334,43 @@ mod tests {
         }
         assert_eq!(log_gain([(C64::new(0.0, 0.0), C64::new(1.0, 0.0), 1.0)]), None);
         assert_eq!(log_gain([(C64::new(1.0, 0.0), C64::new(1.0, 0.0), 0.0)]), None);
+    }
+
+    /// The gain does not change when every weight is scaled, down to
+    /// weights whose squares underflow and up to ones whose squares
+    /// overflow; triples that cannot count are left out, not averaged in.
+    #[test]
+    fn the_gain_is_the_same_whatever_the_scale_of_the_weights() {
+        let t = noisy(40, C64::from_polar(3.0, 0.7), 3);
+        let one = log_gain(t.iter().copied()).unwrap();
+        for scale in [1e-170, 1e-3, 1e3, 1e170] {
+            let scaled = log_gain(t.iter().map(|&(h, m, w)| (h, m, w * scale))).unwrap();
+            assert!((scaled - one).norm() < 1e-13, "weights x {scale:e}: {scaled} vs {one}");
+        }
+        let zero = C64::new(0.0, 0.0);
+        let spoilt = [(zero, C64::new(1.0, 0.0), 1.0), (C64::new(1.0, 0.0), C64::new(f64::NAN, 0.0), 1.0)];
+        let with = log_gain(t.iter().copied().chain(spoilt).chain([(t[0].0, t[0].1, 0.0)])).unwrap();
+        assert_eq!(with, one);
+    }
+
+    /// Residual phases on both sides of half a turn: their mean on the
+    /// circle is half a turn, where their plain mean (from a start at zero
+    /// phase) would be zero.
+    #[test]
+    fn phases_either_side_of_half_a_turn_give_half_a_turn() {
+        let pi = std::f64::consts::PI;
+        let t: Vec<(C64, C64, f64)> = (0..20)
+            .map(|k| {
+                let h = C64::from_polar(1.0 + k as f64, 0.2 * k as f64);
+                let side = if k % 2 == 0 { pi - 0.05 } else { -pi + 0.05 };
+                (h, h * C64::from_polar(2.0, side), 1.0)
+            })
+            .collect();
+        let g = log_gain(t.iter().copied()).unwrap();
+        assert!((g.im.abs() - pi).abs() < 1e-12, "phase {} rad", g.im);
+        assert!((g.re - 2f64.ln()).abs() < 1e-12);
+        let brute = brute_force(&t);
+        assert!((C64::new(0.0, g.im).exp() - C64::new(0.0, brute.im).exp()).norm() < 1e-6, "{g} vs {brute}");
     }
 
     #[test]
