@@ -203,6 +203,31 @@ pub enum MismatchError {
         /// The channel.
         channel: Channel,
     },
+    /// [`FrfSet::merge_channels`](crate::FrfSet::merge_channels) was given no set.
+    #[error("no FRF set to merge")]
+    NothingToMerge,
+    /// A set to merge on other lines than the first set's.
+    #[error(
+        "set {set} has {lines} lines that differ from the {first} lines of set 0; merged sets must share their lines"
+    )]
+    SetLinesDiffer {
+        /// Index of the set in the list.
+        set: usize,
+        /// Its number of lines.
+        lines: usize,
+        /// The first set's number of lines.
+        first: usize,
+    },
+    /// A channel in two of the sets to merge.
+    #[error("channel {channel} of set {set} is in set {earlier} too")]
+    ChannelInTwoSets {
+        /// The channel.
+        channel: Channel,
+        /// The first set that holds it.
+        earlier: usize,
+        /// The set that holds it again.
+        set: usize,
+    },
 }
 
 fn held_factors(held: &Option<FactorKind>) -> &'static str {

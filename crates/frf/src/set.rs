@@ -9,6 +9,8 @@ use num_complex::Complex64 as C64;
 pub use crate::channel::Channel;
 use crate::error::{FrfError, MismatchError};
 
+mod merge;
+
 /// What an FRF relates: displacement, velocity or acceleration to force.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum FrfKind {

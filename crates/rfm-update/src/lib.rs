@@ -88,6 +88,7 @@
 //! assert!(after.total.log_misfit < 0.1 * before.total.log_misfit);
 //! ```
 
+pub mod comparison;
 pub mod diagnose;
 pub mod error;
 pub mod fix;

@@ -11,10 +11,11 @@ use std::path::{Path, PathBuf};
 use damping::DampedSystem;
 use fe_model::CaseFile;
 use fe_model::case::Gains;
-use frf::correlation::{BandSpec, Correlation, correlate};
-use frf::{FrfSet, synthesize};
+use frf::correlation::{BandSpec, Correlation};
+use frf::{FrfError, FrfSet, MismatchError};
 use rfm_update::Study;
-use rfm_update::gain::{self, GainReport};
+use rfm_update::comparison::{self, GainSource};
+use rfm_update::gain::{self, FittedGains, GainReport};
 use rfm_update::study::{describe_masked, read_measured_for};
 use serde::Serialize;
 
@@ -22,7 +23,7 @@ use super::{Result, load_case, print_masked, print_notes};
 use crate::exit::Exit;
 use crate::output::Outputs;
 use crate::report::html::{Block, Report, Section};
-use crate::report::modes::{ModesJson, compare_modes, mode_table_rows, rows};
+use crate::report::modes::{MIN_MAC, ModesJson, mode_table_rows, rows};
 use crate::report::{self, ModelFrfs, ReportOptions, plot, sig, signed};
 use crate::table::Table;
 
@@ -148,49 +149,23 @@ fn measured_data(case: CaseFile, system: &DampedSystem, files: &[PathBuf]) -> Re
 }
 
 /// Joins the channels of several measured files on the same lines, in the
-/// first file's FRF kind.
+/// first file's FRF kind ([`FrfSet::merge_channels`]); a refusal names the
+/// files.
 fn merge(sets: Vec<(PathBuf, FrfSet)>) -> Result<FrfSet> {
-    let mut it = sets.into_iter();
-    let Some((first_path, first)) = it.next() else {
-        return Err("no measured file given".into());
-    };
-    let rest: Vec<(PathBuf, FrfSet)> = it.collect();
-    if rest.is_empty() {
-        return Ok(first);
-    }
-    let f = first.frequencies_hz().to_vec();
-    let mut channels = first.channels().to_vec();
-    let mut seen: std::collections::HashSet<frf::Channel> = channels.iter().copied().collect();
-    for (path, set) in &rest {
-        let same = set.n_freq() == f.len()
-            && set.frequencies_hz().iter().zip(&f).all(|(a, b)| (a - b).abs() <= 1e-6 * b.abs());
-        if !same {
-            return Err(format!(
-                "{}: its {} lines differ from the {} lines of {}; files compared together must share their lines",
-                path.display(),
-                set.n_freq(),
-                f.len(),
-                first_path.display()
-            )
-            .into());
+    let (paths, sets): (Vec<PathBuf>, Vec<FrfSet>) = sets.into_iter().unzip();
+    FrfSet::merge_channels(&sets).map_err(|e| match e {
+        FrfError::Mismatch(MismatchError::NothingToMerge) => "no measured file given".into(),
+        FrfError::Mismatch(MismatchError::SetLinesDiffer { set, lines, first }) => format!(
+            "{}: its {lines} lines differ from the {first} lines of {}; files compared together must share their lines",
+            paths[set].display(),
+            paths[0].display()
+        )
+        .into(),
+        FrfError::Mismatch(MismatchError::ChannelInTwoSets { channel, set, .. }) => {
+            format!("{}: channel {channel} appears in an earlier file too", paths[set].display()).into()
         }
-        for c in set.channels() {
-            if !seen.insert(*c) {
-                return Err(format!("{}: channel {c} appears in an earlier file too", path.display()).into());
-            }
-            channels.push(*c);
-        }
-    }
-    let mut out = FrfSet::zeros(f, channels, first.kind())?;
-    let mut c_out = 0;
-    for set in std::iter::once(&first).chain(rest.iter().map(|(_, s)| s)) {
-        let set = set.converted(first.kind());
-        for c in 0..set.channels().len() {
-            out.channel_mut(c_out).copy_from_slice(set.channel(c));
-            c_out += 1;
-        }
-    }
-    Ok(out)
+        other => other.into(),
+    })
 }
 
 pub(crate) fn compare(
@@ -211,21 +186,31 @@ pub(crate) fn compare(
         measured_data(case, &system, measured_files)?;
     print_notes(&notes, json)?;
     print_masked(&masked, json)?;
-    // the model's FRFs in the data's kind: what the tables, the gains and the overlays compare
-    let mut frfs = synthesize(&system, measured.channels(), measured.frequencies_hz())?.converted(measured.kind());
-    // the gains that bring the model closest to the data (closed form),
-    // weighted as the fits weight them: by the measured coherence when the data carry it
+    // the model's FRFs in the data's kind, times the gains that bring them
+    // closest to the data (closed form), weighted as the fits weight them:
+    // by the measured coherence when the data carry it
     let weights = rfm_update::study::line_weights_for(&case, &measured)?;
-    let fitted = gain::fit_gains(&frfs, &measured, weights.as_deref(), gains.0)?;
-    fitted.apply(&mut frfs);
+    let source_of_gains = GainSource::Fit { setting: gains.0, weights: weights.as_deref() };
+    let compared = comparison::compare(&system, &measured, source_of_gains, &spec)?;
+    // a model singular at a line cannot be compared there: refused, as
+    // before the comparison moved into the library
+    if let Some(&freq_hz) = compared.model.singular_hz.first() {
+        return Err(FrfError::Singular { freq_hz }.into());
+    }
+    let fitted = compared.model.fitted.clone().unwrap_or_else(|| FittedGains::none(measured.channels()));
     let coherent = (0..measured.channels().len()).any(|c| measured.coherence(c).is_some());
     let mut notes = notes;
     if coherent && gains.0 != Gains::None && weights.is_some() {
         notes.push("the gains are fitted with each line weighted by its measured coherence".into());
     }
-    let correlation = correlate(&measured, &frfs, &spec)?;
-    let model = ModelFrfs { label: "model".into(), colour: plot::UPDATED, frfs, correlation };
-    let comparison = compare_modes(&system, &measured, |c| fitted.of_channel(c));
+    let comparison =
+        comparison::compare_modes(&system, &measured, &compared.model.gains, MIN_MAC).map_err(|e| e.to_string());
+    let model = ModelFrfs {
+        label: "model".into(),
+        colour: plot::UPDATED,
+        frfs: compared.model.frfs,
+        correlation: compared.correlation,
+    };
     let (modes, modes_error) = match comparison.as_ref().map(rows) {
         Ok(m) => (Some(m), None),
         Err(e) => (None, Some(e.clone())),

@@ -6,9 +6,9 @@
 
 use std::path::PathBuf;
 
-use frf::correlation::{BandSpec, correlate};
-use frf::synthesize;
+use frf::correlation::BandSpec;
 use rfm_update::Study;
+use rfm_update::comparison::{self, GainSource};
 use rfm_update::diagnose::Ranked;
 use rfm_update::fix::{CONSISTENT, FixOutcome};
 
@@ -205,30 +205,38 @@ pub(crate) fn write(study: &Study, outcome: &FixOutcome, opts: &ReportOptions, o
     rest.push(Block::Table(t));
     report.sections.push(rest);
 
-    // the nominal and the final model against the data
+    // the nominal and the final model against the data, each times the
+    // gains that bring it closest to them when the case fits gains
     let measured = study.measured();
-    let model = |label: &str, colour, sys: &damping::DampedSystem| -> Result<ModelFrfs> {
-        let frfs = synthesize(sys, measured.channels(), measured.frequencies_hz())?;
-        let correlation = correlate(measured, &frfs, &BandSpec::Auto)?;
-        Ok(ModelFrfs { label: label.into(), colour, frfs, correlation })
+    let weights = study.line_weights(measured)?;
+    let gains = match study.gains() {
+        fe_model::case::Gains::None => GainSource::None,
+        setting => GainSource::Fit { setting, weights: weights.as_deref() },
     };
-    let mut models = vec![model("nominal model", plot::INITIAL, study.system())?];
+    let model = |label: &str, colour, sys: &damping::DampedSystem| -> Result<(ModelFrfs, Vec<frf::C64>)> {
+        let compared = comparison::compare(sys, measured, gains, &BandSpec::Auto)?;
+        if let Some(&freq_hz) = compared.model.singular_hz.first() {
+            return Err(frf::FrfError::Singular { freq_hz }.into());
+        }
+        let frfs =
+            ModelFrfs { label: label.into(), colour, frfs: compared.model.frfs, correlation: compared.correlation };
+        Ok((frfs, compared.model.gains))
+    };
+    let (nominal, mut last_gains) = model("nominal model", plot::INITIAL, study.system())?;
+    let mut models = vec![nominal];
     if let Some(f) = &fixed {
-        models.push(model("fixed model", plot::UPDATED, f)?);
+        let (fixed_frfs, gains) = model("fixed model", plot::UPDATED, f)?;
+        models.push(fixed_frfs);
+        last_gains = gains;
     }
-    let notes = vec!["The nominal model and the model after the last step against the measured FRFs.".to_string()];
+    let mut notes = vec!["The nominal model and the model after the last step against the measured FRFs.".to_string()];
+    if !matches!(gains, GainSource::None) {
+        notes.push("Each model's FRFs are multiplied by the unknown complex gains that fit it best.".to_string());
+    }
     report.sections.push(super::correlation_section(measured, &models, opts, out, notes)?);
     let last_system = fixed.as_ref().unwrap_or(study.system());
-    // the gains that bring the final model closest to the data, when the case fits gains
-    let gains = match study.gains() {
-        fe_model::case::Gains::None => None,
-        _ => {
-            Some(study.fit_gains(&synthesize(last_system, measured.channels(), measured.frequencies_hz())?, measured)?)
-        }
-    };
-    let comparison = super::modes::compare_modes(last_system, measured, |c| {
-        gains.as_ref().map_or(frf::C64::new(1.0, 0.0), |g| g.of_channel(c))
-    });
+    let comparison =
+        comparison::compare_modes(last_system, measured, &last_gains, super::modes::MIN_MAC).map_err(|e| e.to_string());
     let against = if fixed.is_some() { "the fixed model" } else { "the nominal model" };
     report.sections.push(super::modes::section(
         comparison.as_ref(),

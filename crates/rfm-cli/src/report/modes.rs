@@ -4,15 +4,14 @@
 //! MAC matrix, the stabilisation diagram and the paired mode shapes drawn
 //! on the structure.
 //!
-//! The comparison itself is [`frf::compare_modes`]; this file turns it
+//! The comparison itself is [`rfm_update::comparison::compare_modes`]; this file turns it
 //! into the table, the JSON and the figures.
 
 use std::collections::HashMap;
 
-use damping::DampedSystem;
 use fe_model::{Model, PerDof};
 use frf::comparison::{measured_on_model, real_shape};
-use frf::{C64, FrfSet, ModalComparison};
+use frf::{FrfSet, ModalComparison};
 use serde::Serialize;
 
 use super::html::{Block, Section, Table, Tone};
@@ -21,32 +20,7 @@ use super::{ReportOptions, Result, short};
 use crate::output::Outputs;
 
 /// Least MAC of a pair.
-const MIN_MAC: f64 = 0.5;
-
-/// The measured modes paired with `system`'s ([`frf::compare_modes`]), the
-/// error as the text the report and `--json` show. `gain_of(c)` is the gain
-/// the model's FRFs of channel `c` are multiplied by to match the data (1
-/// without gains): the data are divided by it first, so that the modal
-/// estimator sees FRFs per newton. An amplifier's phase in FRFs per volt
-/// is a constant complex factor that no rational function with real
-/// coefficients fits: the estimator bends its poles to make up for it,
-/// and a weak mode's drifts in damping from order to order until it is
-/// not seen (the lap joint's 7.4 Hz mode). The measured shapes come on the
-/// model's scale too.
-pub(crate) fn compare_modes(
-    system: &DampedSystem,
-    measured: &FrfSet,
-    gain_of: impl Fn(usize) -> C64,
-) -> std::result::Result<ModalComparison, String> {
-    let mut per_newton = measured.clone();
-    for c in 0..per_newton.channels().len() {
-        let g = gain_of(c);
-        if g != C64::new(1.0, 0.0) {
-            per_newton.channel_mut(c).iter_mut().for_each(|v| *v /= g);
-        }
-    }
-    frf::compare_modes(system, &per_newton, MIN_MAC).map_err(|e| e.to_string())
-}
+pub(crate) const MIN_MAC: f64 = 0.5;
 
 /// One measured mode and its model partner.
 #[derive(Serialize)]

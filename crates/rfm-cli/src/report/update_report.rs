@@ -6,8 +6,8 @@
 
 use std::path::{Path, PathBuf};
 
-use frf::correlation::{BandSpec, correlate};
-use frf::synthesize_regular;
+use frf::correlation::BandSpec;
+use rfm_update::comparison::{self, GainSource};
 use rfm_update::output_error::Gain;
 use rfm_update::status::Status;
 use rfm_update::study::FrequencyTable;
@@ -33,31 +33,29 @@ pub(crate) fn write(
     // model's FRFs are converted to: what the overlays show
     let as_read = study.measured_as_read();
     let measured = &as_read;
-    let channels = measured.channels();
     let freqs = measured.frequencies_hz();
     // a model singular at a line (an RFM run that wandered off, an undamped
     // model on a resonance) is shown everywhere else, and the report says where
     let mut singular = Vec::new();
-    let mut model = |label: &str, colour, sys: &damping::DampedSystem, gains: Option<&[Gain]>| -> Result<ModelFrfs> {
-        let (frfs, lines) = synthesize_regular(sys, channels, freqs)?;
-        let mut frfs = frfs.converted(measured.kind());
-        if !lines.is_empty() {
+    let weights = study.line_weights(measured)?;
+    let mut model = |label: &str, colour, sys: &damping::DampedSystem, gains: GainSource<'_>| -> Result<ModelFrfs> {
+        let compared = comparison::compare(sys, measured, gains, &BandSpec::Auto)?;
+        if !compared.model.singular_hz.is_empty() {
             singular.push(format!(
                 "The {label}'s dynamic stiffness is singular to working precision at {} Hz: its FRFs there are left \
                  out of the figures and errors.",
-                lines.iter().map(|&f| super::short(f)).collect::<Vec<_>>().join(", ")
+                compared.model.singular_hz.iter().map(|&f| super::short(f)).collect::<Vec<_>>().join(", ")
             ));
         }
-        match gains {
-            Some(gains) => Gain::apply_all(gains, &mut frfs),
-            // the initial model with the gains that fit it best, when the
-            // study fits gains: without them it would sit the data's
-            // unknown level (tens of dB on data per volt) off the curves
-            None if !outcome.gains.is_empty() => study.fit_gains(&frfs, measured)?.apply(&mut frfs),
-            None => {}
-        }
-        let correlation = correlate(measured, &frfs, &BandSpec::Auto)?;
-        Ok(ModelFrfs { label: label.into(), colour, frfs, correlation })
+        Ok(ModelFrfs { label: label.into(), colour, frfs: compared.model.frfs, correlation: compared.correlation })
+    };
+    // the initial model with the gains that fit it best, when the study
+    // fits gains: without them it would sit the data's unknown level (tens
+    // of dB on data per volt) off the curves
+    let initial_gains = if outcome.gains.is_empty() {
+        GainSource::None
+    } else {
+        GainSource::Fit { setting: study.gains(), weights: weights.as_deref() }
     };
     let (initial_label, updated_label) = if outcome.gains.is_empty() {
         ("initial model", "updated model")
@@ -65,8 +63,8 @@ pub(crate) fn write(
         ("initial model (with the gains that fit it)", "updated model (with fitted gains)")
     };
     let models = [
-        model(initial_label, plot::INITIAL, study.system(), None)?,
-        model(updated_label, plot::UPDATED, &outcome.system, Some(&outcome.gains))?,
+        model(initial_label, plot::INITIAL, study.system(), initial_gains)?,
+        model(updated_label, plot::UPDATED, &outcome.system, GainSource::Estimated(&outcome.gains))?,
     ];
     let (all_lines_db, stride) = rfm_update::history::rms_db_per_iteration(study, outcome, measured);
     let mut which_lines = if stride == 1 {
@@ -181,9 +179,9 @@ pub(crate) fn write(
         outcome.frequencies_hz.len()
     )];
     report.sections.push(super::correlation_section(measured, &models, opts, out, notes)?);
-    let comparison = super::modes::compare_modes(&outcome.system, measured, |c| {
-        Gain::factor_of(&outcome.gains, &measured.channels()[c])
-    });
+    let gains: Vec<_> = measured.channels().iter().map(|c| Gain::factor_of(&outcome.gains, c)).collect();
+    let comparison =
+        comparison::compare_modes(&outcome.system, measured, &gains, super::modes::MIN_MAC).map_err(|e| e.to_string());
     report.sections.push(super::modes::section(
         comparison.as_ref(),
         "the updated model",
