@@ -76,11 +76,13 @@ pub mod eigen;
 pub mod kernel;
 pub mod modal;
 pub mod system;
+pub mod units;
 
 pub use complex_modes::{ComplexMode, ComplexModes, RealMode, complex_modes};
 pub use kernel::{GroupCoefficients, relaxation_factor};
 pub use modal::{ModalError, NormalModes, normal_modes};
 pub use system::{DampedSystem, Derivative};
+pub use units::UnitStore;
 
 /// Complex double, the scalar of every frequency-domain quantity.
 pub use num_complex::Complex64 as C64;

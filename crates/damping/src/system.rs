@@ -5,7 +5,7 @@ use num_complex::Complex64 as C64;
 use std::sync::{Arc, OnceLock};
 
 use crate::kernel::{self, GroupCoefficients};
-use std::collections::HashMap;
+use crate::units::UnitStore;
 
 /// A model together with its assembly, kept consistent when quantities change.
 ///
@@ -45,9 +45,7 @@ impl Layout {
     /// The layout of an assembly, or `None` when it does not fit `u32`
     /// indices (`z_values_into` then walks the assembly).
     fn new(assembly: &Assembly) -> Option<Layout> {
-        let mut units: Vec<f64> = Vec::new();
-        let mut stored: HashMap<Vec<u64>, u32> = HashMap::new();
-        let mut key: Vec<u64> = Vec::new();
+        let mut units = UnitStore::default();
         let (mut blocks, mut positions, mut terms) = (Vec::new(), Vec::new(), Vec::new());
         for b in assembly.blocks() {
             let p0 = u32::try_from(positions.len()).ok()?;
@@ -57,25 +55,14 @@ impl Layout {
             let t0 = u32::try_from(terms.len()).ok()?;
             // Assembly::accumulate skips terms whose value is zero
             for t in b.terms().iter().filter(|t| t.value() != 0.0) {
-                // the key is built in one buffer, and kept only for a new matrix
-                key.clear();
-                key.extend(t.unit().iter().map(|u| u.to_bits()));
-                let at = match stored.get(key.as_slice()) {
-                    Some(&at) => at,
-                    None => {
-                        let at = u32::try_from(units.len()).ok()?;
-                        units.extend_from_slice(t.unit());
-                        stored.insert(key.clone(), at);
-                        at
-                    }
-                };
+                let at = units.offset_of(t.unit())?;
                 let slot = 3 * u32::try_from(b.group()).ok()? + kernel::kind_slot(t.kind());
                 terms.push((slot, t.value(), at));
             }
             let len = u32::try_from(b.positions().len()).ok()?;
             blocks.push([p0, len, t0, u32::try_from(terms.len()).ok()?]);
         }
-        Some(Layout { blocks, positions, terms, units })
+        Some(Layout { blocks, positions, terms, units: units.into_values() })
     }
 
     /// `Z(w)` added into `out` (cleared), given each group's coefficients.
@@ -288,96 +275,6 @@ mod tests {
         assert_eq!(a.len(), b.len(), "the vectors compared differ in length");
         let scale = b.iter().map(|v| v.norm()).fold(0.0, f64::max);
         a.iter().zip(b).map(|(x, y)| (x - y).norm()).fold(0.0, f64::max) / scale
-    }
-
-    /// Every kind of quantity, on a model that has all of them, against a
-    /// central finite difference of Z; the damping parameters also on the
-    /// two-material beam, whose groups are non-viscous with both alpha and
-    /// beta (the frame's only beta is viscous, where the kernel factor is 1
-    /// and a wrong use of it would pass).
-    #[test]
-    fn every_parameter_derivative_matches_central_finite_difference() {
-        let mut model = samples::frame_with_joint();
-        let beam = model.quantity("element.2.added_mass").unwrap();
-        model.set(beam, 3.0).unwrap();
-        let frame = DampedSystem::new(model).unwrap();
-        let beam = DampedSystem::new(samples::two_material_cantilever()).unwrap();
-        let frame_names = [
-            "group.joint.alpha",
-            "group.frame.beta",
-            "group.frame.alpha",
-            "group.joint.mu",
-            "group.frame.stiffness",
-            "group.frame.mass",
-            "group.joint.stiffness",
-            "material.steel.E",
-            "material.steel.rho",
-            "element.1.stiffness",
-            "element.2.mass",
-            "element.2.added_mass",
-            "spring.joint.kr",
-            "mass.tip.m",
-            "mass.tip.j",
-        ];
-        let beam_names = ["group.steel.beta", "group.aluminium.beta", "group.steel.alpha", "group.aluminium.mu"];
-        // a frame in space: torsion through E, springs and inertias about three axes
-        let mut model = samples::space_portal();
-        let arm = model.quantity("element.5.added_mass").unwrap();
-        model.set(arm, 2.0).unwrap();
-        let portal = DampedSystem::new(model).unwrap();
-        let portal_names = [
-            "group.joint.alpha",
-            "group.joint.mu",
-            "group.frame.beta",
-            "material.steel.E",
-            "material.steel.rho",
-            "element.5.stiffness",
-            "element.5.added_mass",
-            "spring.joint.krx",
-            "spring.joint.kry",
-            "spring.joint.krz",
-            "spring.foot.kz",
-            "mass.tip.m",
-            "mass.tip.jx",
-            "mass.tip.jy",
-            "mass.tip.jz",
-        ];
-        // On the slender beam the damping terms are 1e-7 of Z and less, below
-        // what a difference of Z resolves; they enter Z only as j w G(w), so
-        // there the differences are taken of j w G, without the stiffness
-        // and mass beside them.
-        let cases =
-            [(&frame, &frame_names[..], false), (&beam, &beam_names[..], true), (&portal, &portal_names[..], false)];
-        for &(sys, names, via_g) in &cases {
-            for (omega, name) in [30.0, 900.0, 5000.0].iter().flat_map(|&w| names.iter().map(move |&n| (w, n))) {
-                let q = sys.model().quantity(name).unwrap();
-                let p = sys.get(q);
-                let analytic = sys.derivative(q, omega).values(sys.assembly());
-                // Richardson-extrapolated central differences: a large step keeps
-                // round-off small even where the derivative is tiny beside Z
-                // (a rotary inertia at low frequency), and extrapolation removes
-                // the step's truncation error.
-                let central = |h: f64| -> Vec<C64> {
-                    let mut plus = sys.clone();
-                    plus.set(q, p + h).unwrap();
-                    let mut minus = sys.clone();
-                    minus.set(q, p - h).unwrap();
-                    let of = |s: &DampedSystem| -> Vec<C64> {
-                        if via_g {
-                            s.g_values(omega).iter().map(|g| C64::new(0.0, omega) * g).collect()
-                        } else {
-                            s.z_values(omega)
-                        }
-                    };
-                    let (zp, zm) = (of(&plus), of(&minus));
-                    zp.iter().zip(&zm).map(|(a, b)| (a - b) / (2.0 * h) * p).collect()
-                };
-                let (d1, d2) = (central(0.02 * p), central(0.01 * p));
-                let fd: Vec<C64> = d1.iter().zip(&d2).map(|(a, b)| (4.0 * b - a) / 3.0).collect();
-                let err = max_rel_diff(&fd, &analytic);
-                assert!(err < 1e-6, "{name} at w = {omega}: relative error {err:e}");
-            }
-        }
     }
 
     /// `Z` from the layout is bitwise `Z` added up block by block, and

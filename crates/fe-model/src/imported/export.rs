@@ -35,19 +35,7 @@ pub struct ExportedGroup {
 
 /// Exports the group matrices of `model`, assembled as `assembly`.
 pub fn export(model: &Model, assembly: &Assembly) -> Exported {
-    let p = assembly.pattern();
-    let lower = |values: Vec<f64>| {
-        let mut entries = Vec::new();
-        for c in 0..p.n() {
-            for k in p.col_ptr()[c]..p.col_ptr()[c + 1] {
-                let r = p.row_idx()[k];
-                if r >= c && values[k] != 0.0 {
-                    entries.push((r, c, values[k]));
-                }
-            }
-        }
-        SymmetricCoo { n: p.n(), entries }
-    };
+    let lower = |values: Vec<f64>| SymmetricCoo::lower_of(assembly.pattern(), &values);
     let groups = (0..model.groups().len())
         .map(|g| ExportedGroup {
             name: model.groups()[g].name.clone(),

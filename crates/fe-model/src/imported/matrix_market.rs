@@ -18,6 +18,8 @@
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
+use crate::assembly::Pattern;
+
 /// A square symmetric matrix as coordinate entries of its lower triangle
 /// (`row >= col`, 0-based), each position once.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -26,6 +28,24 @@ pub struct SymmetricCoo {
     pub n: usize,
     /// `(row, col, value)` with `row >= col`, sorted by `(col, row)`.
     pub entries: Vec<(usize, usize, f64)>,
+}
+
+impl SymmetricCoo {
+    /// The lower triangle of a matrix given as values on `pattern` (in its
+    /// column-major order, as [`Assembly`](crate::Assembly) keeps them),
+    /// zeros left out.
+    pub fn lower_of(pattern: &Pattern, values: &[f64]) -> SymmetricCoo {
+        let mut entries = Vec::new();
+        for c in 0..pattern.n() {
+            for k in pattern.col_ptr()[c]..pattern.col_ptr()[c + 1] {
+                let r = pattern.row_idx()[k];
+                if r >= c && values[k] != 0.0 {
+                    entries.push((r, c, values[k]));
+                }
+            }
+        }
+        SymmetricCoo { n: pattern.n(), entries }
+    }
 }
 
 /// A place in a text file and what is wrong there.

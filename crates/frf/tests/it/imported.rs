@@ -194,20 +194,6 @@ fn assert_same_receptances(a: &DampedSystem, b: &DampedSystem, dofs: &[(u32, Dof
     worst
 }
 
-/// The lower triangle of a values array on `a`'s pattern.
-fn lower(a: &Assembly, values: &[f64]) -> SymmetricCoo {
-    let p = a.pattern();
-    let mut entries = Vec::new();
-    for c in 0..p.n() {
-        for k in p.col_ptr()[c]..p.col_ptr()[c + 1] {
-            if p.row_idx()[k] >= c && values[k] != 0.0 {
-                entries.push((p.row_idx()[k], c, values[k]));
-            }
-        }
-    }
-    SymmetricCoo { n: p.n(), entries }
-}
-
 /// A viscous damping matrix that no group's `alpha K_g + beta M_g` can
 /// give: the portal's frame and joint damped in their own proportions,
 /// imported as one group whose stiffness, mass and damping are the sums.
@@ -231,7 +217,7 @@ fn an_imported_damping_matrix_gives_the_native_non_proportional_viscous_damping(
             let (k, m) = (a.group_values(g, MatrixKind::Stiffness), a.group_values(g, MatrixKind::Mass));
             v.iter_mut().zip(k.iter().zip(&m)).for_each(|(s, (k, m))| *s += c[0] * k + c[1] * m);
         }
-        lower(&a, &v)
+        SymmetricCoo::lower_of(a.pattern(), &v)
     };
     let (k, m, c) = (sum(MatrixKind::Stiffness), sum(MatrixKind::Mass), sum(MatrixKind::Damping));
     let entries = [Entry { group: fe_model::Group::new("all"), stiffness: &k, mass: &m, damping: Some(&c) }];
@@ -268,7 +254,7 @@ fn an_imported_damping_matrix_adds_to_the_group_damping_and_its_factor_scales_it
         let exported = export::export(&native, &a);
         let f = native.group_index("frame").unwrap();
         let kf = a.group_values(f, MatrixKind::Stiffness);
-        let c = lower(&a, &kf.iter().map(|k| frame_alpha * k).collect::<Vec<_>>());
+        let c = SymmetricCoo::lower_of(a.pattern(), &kf.iter().map(|k| frame_alpha * k).collect::<Vec<_>>());
         let entries: Vec<Entry<'_>> = exported
             .groups
             .iter()

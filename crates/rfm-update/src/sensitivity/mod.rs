@@ -70,16 +70,14 @@
 //!
 //! [`ChannelPlan`] (`plan.rs`) resolves channels to equations; the
 //! frequency-independent preparation is the term table (`terms.rs`, classes
-//! and coefficient rules, with the unit matrix store of `cache.rs` and the
-//! small hasher of `hash.rs`); `assemble.rs` takes the
+//! and coefficient rules, the unit matrices stored once in
+//! [`damping::UnitStore`]); `assemble.rs` takes the
 //! lines, one factorisation and one sweep each, with the vectorised
 //! products of step 4 in `kernels.rs`.
 
 pub mod naive;
 
 mod assemble;
-mod cache;
-mod hash;
 mod kernels;
 mod plan;
 mod terms;

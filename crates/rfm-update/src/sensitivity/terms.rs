@@ -5,13 +5,13 @@
 
 use std::hash::Hasher;
 
-use damping::{DampedSystem, Derivative, GroupCoefficients, kernel};
+use damping::{DampedSystem, Derivative, GroupCoefficients, UnitStore, kernel};
 use fe_model::{Group, MatrixKind, Quantity};
 use frf::ZSolver;
 use num_complex::Complex64 as C64;
 
-use super::cache::UnitStore;
-use super::hash::{FxHasher, FxMap};
+use rustc_hash::{FxHashMap, FxHasher};
+
 use super::{MAX_BLOCK, NONE, ZERO};
 
 /// A block that some parameter touches, as step 4 reads it.
@@ -185,7 +185,7 @@ impl TermTable {
         let mut units = UnitStore::default();
         // classes by hash of (group, kind, users), checked against the first
         // term of the class: (group, kind, its users' range in `users`)
-        let mut class_of: FxMap<u64, u32> = FxMap::default();
+        let mut class_of: FxHashMap<u64, u32> = FxHashMap::default();
         let mut classes: Vec<(usize, MatrixKind, usize)> = Vec::new();
         let mut class_of_term = vec![NONE; total];
         let mut pairs: Vec<(u32, u32)> = Vec::new();
@@ -204,7 +204,7 @@ impl TermTable {
                 if !used(f) {
                     continue;
                 }
-                let unit = units.offset_of(term.unit());
+                let unit = units.offset_of(term.unit()).expect("unit matrices within u32 offsets");
                 let who = &users[users_ptr[f] as usize..users_ptr[f + 1] as usize];
                 let mut new_class = || {
                     let class = if rules_hold { classes.len() } else { terms.len() } as u32;
@@ -250,7 +250,7 @@ impl TermTable {
             Coefficients::Rules(pair_rules)
         } else {
             // one class per term, so each (parameter, term) is one pair
-            let mut pair_at: FxMap<(u32, u32), u32> = FxMap::default();
+            let mut pair_at: FxHashMap<(u32, u32), u32> = FxHashMap::default();
             for (p, &pair) in pairs.iter().enumerate() {
                 pair_at.insert(pair, p as u32);
             }
@@ -270,7 +270,7 @@ impl TermTable {
                     .collect(),
             )
         };
-        TermTable { bucket, items, terms, units: units.values, n_classes, pairs, coefficients }
+        TermTable { bucket, items, terms, units: units.into_values(), n_classes, pairs, coefficients }
     }
 
     /// Each pair's coefficient at `omega` into `coef`. `None` when the
