@@ -368,6 +368,16 @@ mod tests {
         assert!(d("group.joint.beta").values(sys.assembly()).iter().all(|v| *v == C64::new(0.0, 0.0)));
         assert!(!d("group.joint.alpha").is_zero());
         assert!(!d("mass.tip.m").is_zero());
+        // only the terms a quantity changes are listed (the sensitivity
+        // assembly loops over them): none for the joint's beta, and the
+        // frame's alpha lists its stiffness terms, not its mass terms
+        assert!(d("group.joint.beta").terms.is_empty());
+        let alpha = d("group.frame.alpha");
+        assert!(!alpha.terms.is_empty());
+        for &(b, t, c) in &alpha.terms {
+            let term = &sys.assembly().blocks()[b].terms()[t];
+            assert!(c != C64::new(0.0, 0.0) && term.value() != 0.0, "{:?} term listed", term.kind());
+        }
     }
 
     #[test]
