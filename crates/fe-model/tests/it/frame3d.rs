@@ -8,7 +8,7 @@ use fe_model::model::rectangle_torsion;
 use fe_model::{Assembly, Dimension, Dof, DofRef, Group, Model, Section};
 use nalgebra::{DMatrix, SVector, Vector3};
 
-use super::elements::integrate;
+use super::elements::{assert_assembled, integrate};
 
 /// The element's shape functions at `x` along it, as rows over the local
 /// DOFs `[u1, v1, w1, tx1, ty1, tz1, u2, v2, w2, tx2, ty2, tz2]`: the axial
@@ -348,24 +348,7 @@ fn assembled_3d_matrices_equal_an_independent_assembly_of_every_item_type() {
         let p = eq(3, dof).unwrap();
         m[(p, p)] += v;
     }
-    let (ka, ma) = (a.stiffness_dense(), a.mass_dense());
-    for r in 0..n {
-        for col in 0..n {
-            let (ks, ms) = (k[(r, r)].abs().max(k[(col, col)].abs()), m[(r, r)].abs().max(m[(col, col)].abs()));
-            assert!(
-                (ka[(r, col)] - k[(r, col)]).abs() <= 1e-12 * ks,
-                "K[{r}][{col}]: {} vs {}",
-                ka[(r, col)],
-                k[(r, col)]
-            );
-            assert!(
-                (ma[(r, col)] - m[(r, col)]).abs() <= 1e-12 * ms,
-                "M[{r}][{col}]: {} vs {}",
-                ma[(r, col)],
-                m[(r, col)]
-            );
-        }
-    }
+    assert_assembled(&a, &k, &m);
 }
 
 #[test]

@@ -18,7 +18,9 @@ use fe_model::{Assembly, CaseFile, Dof};
 /// (nodes 1-4) to the top corners (5-8), four rails of three elements
 /// between them (nodes 17-24 inside the rails: 17 and 18 on 5-6, 19 and 20
 /// on 6-7, 21 and 22 on 7-8, 23 and 24 on 8-5).
-const NATIVE: &str = r#"
+fn native() -> String {
+    let mut text = String::from(
+        r#"
 title = "stand"
 nodes = [[1, 0.0, 0.0, 0.0], [2, 0.8, 0.0, 0.0], [3, 0.8, 0.5, 0.0], [4, 0.0, 0.5, 0.0],
          [5, 0.0, 0.0, 0.6], [6, 0.8, 0.0, 0.6], [7, 0.8, 0.5, 0.6], [8, 0.0, 0.5, 0.6]]
@@ -29,71 +31,19 @@ steel = { E = 2.1e11, rho = 7850, nu = 0.3 }
 [sections]
 bar = { b = 0.03, h = 0.02 }
 [groups.frame]
-[[lines]]
-from = 1
-to = 5
-elements = 3
-material = "steel"
-section = "bar"
-group = "frame"
-[[lines]]
-from = 2
-to = 6
-elements = 3
-material = "steel"
-section = "bar"
-group = "frame"
-[[lines]]
-from = 3
-to = 7
-elements = 3
-material = "steel"
-section = "bar"
-group = "frame"
-[[lines]]
-from = 4
-to = 8
-elements = 3
-material = "steel"
-section = "bar"
-group = "frame"
-[[lines]]
-from = 5
-to = 6
-elements = 3
-material = "steel"
-section = "bar"
-group = "frame"
-[[lines]]
-from = 6
-to = 7
-elements = 3
-material = "steel"
-section = "bar"
-group = "frame"
-[[lines]]
-from = 7
-to = 8
-elements = 3
-material = "steel"
-section = "bar"
-group = "frame"
-[[lines]]
-from = 8
-to = 5
-elements = 3
-material = "steel"
-section = "bar"
-group = "frame"
-[[supports]]
-node = 1
-[[supports]]
-node = 2
-[[supports]]
-node = 3
-[[supports]]
-node = 4
-"#;
+"#,
+    );
+    for (from, to) in [(1, 5), (2, 6), (3, 7), (4, 8), (5, 6), (6, 7), (7, 8), (8, 5)] {
+        let _ = write!(
+            text,
+            "[[lines]]\nfrom = {from}\nto = {to}\nelements = 3\nmaterial = \"steel\"\nsection = \"bar\"\ngroup = \"frame\"\n"
+        );
+    }
+    for node in 1..=4 {
+        let _ = writeln!(text, "[[supports]]\nnode = {node}");
+    }
+    text
+}
 
 /// The nominal imported case: the matrices, its feet held in translation
 /// (rfm holds the rotations no table lists), measured at the top.
@@ -139,7 +89,7 @@ fn rfm(args: &[&str]) -> std::process::Output {
 /// feet too: the supports are the case's), its DOF table and node file
 /// into `dir`.
 fn write_matrices(dir: &Path) {
-    let native = CaseFile::parse(Path::new("stand.toml"), NATIVE).unwrap().model;
+    let native = CaseFile::parse(Path::new("stand.toml"), &native()).unwrap().model;
     let mut free = native.clone();
     for n in 1..=4 {
         free.remove_support(n);

@@ -158,12 +158,7 @@ fn fast_assembly_equals_dense_formulation_in_space() {
         "mass.tip.jz",
     ];
     let responses = [(7, Dof::Ux), (7, Dof::Uy), (7, Dof::Uz), (7, Dof::Rx), (5, Dof::Uz), (4, Dof::Ry), (2, Dof::Ux)];
-    let mut channels = Vec::new();
-    for reference in [DofRef::new(7, Dof::Uy), DofRef::new(5, Dof::Uz)] {
-        for &(node, dof) in &responses {
-            channels.push(Channel::new(DofRef::new(node, dof), reference));
-        }
-    }
+    let channels = portal_channels(&responses);
     // Lines from near the first mode up: at 9 Hz, nearly static, Z is close
     // to K, whose axial terms lie 1e4 above the joint's and torsion's, and
     // the two formulations differ by 1e-9, the round-off of a dense inverse
@@ -203,13 +198,15 @@ fn fast_assembly_equals_dense_formulation_with_an_imported_damping_matrix() {
         "group.joint.stiffness",
     ];
     let responses = [(7, Dof::Ux), (7, Dof::Uy), (7, Dof::Uz), (5, Dof::Uz), (4, Dof::Ry), (2, Dof::Ux)];
-    let mut channels = Vec::new();
-    for reference in [DofRef::new(7, Dof::Uy), DofRef::new(5, Dof::Uz)] {
-        for &(node, dof) in &responses {
-            channels.push(Channel::new(DofRef::new(node, dof), reference));
-        }
-    }
+    let channels = portal_channels(&responses);
     let freqs = [23.0, 61.0, 173.0, 420.0];
     let measured = synthesize(&truth, &channels, &freqs).unwrap();
     check(&sys, &names, &channels, &freqs, &measured);
+}
+
+/// Every response of `responses` per each of the portal's two references
+/// (the top's uy and a column's uz).
+fn portal_channels(responses: &[(u32, Dof)]) -> Vec<Channel> {
+    let references = [DofRef::new(7, Dof::Uy), DofRef::new(5, Dof::Uz)];
+    references.iter().flat_map(|&r| responses.iter().map(move |&(n, d)| Channel::new(DofRef::new(n, d), r))).collect()
 }
