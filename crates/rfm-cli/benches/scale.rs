@@ -70,34 +70,7 @@ fn many_lines(lines: usize) -> String {
 /// at every line of the data (no `frequencies`: with `frequencies = [1.0]`
 /// a compare used one line whatever the size, and failed where 1 Hz was not
 /// a line).
-const CASE: &str = r#"title = "scale"
-
-[materials]
-steel = { E = 2.0e11, rho = 7800 }
-
-[sections]
-bar = { b = 0.05, h = 0.01 }
-
-[groups.beam]
-alpha = 1e-5
-beta = 0.5
-
-[[lines]]
-from = [0.0, 0.0]
-to = [1.0, 0.0]
-elements = 10
-material = "steel"
-section = "bar"
-group = "beam"
-
-[[supports]]
-node = 1
-
-[measurement]
-references = ["11:uy"]
-responses = ["2..11:uy"]
-data = "lines.csv"
-"#;
+const CASE: &str = include_str!("scale-case.toml");
 
 /// What one run of `rfm` took.
 struct Run {

@@ -338,32 +338,7 @@ fn resolved(path: &Path) -> PathBuf {
 mod tests {
     use super::*;
 
-    const CASE: &str = "\
-title = \"edit me\"   # the user's comment
-[materials]
-steel = { E = 2e11, rho = 7800 }
-[sections]
-bar = { b = 0.04, h = 0.008 }
-[groups.beam]
-alpha = 1e-5
-[[lines]]
-from = [0.0, 0.0]
-to = [1.0, 0.0]
-elements = 4
-material = \"steel\"
-section = \"bar\"
-group = \"beam\"
-[[supports]]
-node = 1
-[[supports]]
-node = 5
-dofs = [\"uy\"]
-[measurement]
-frequencies = [10.0, 20.0]
-references = [\"5:ux\"]
-responses = [\"2..5:ux\"]
-data = \"data/measured.csv\"   # from the lab
-";
+    const CASE: &str = include_str!("../../tests/cases/edit-me.toml");
 
     fn case(dir: &Path) -> CaseFile {
         CaseFile::parse(&dir.join("case.toml"), CASE).unwrap()

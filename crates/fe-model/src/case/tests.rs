@@ -12,26 +12,7 @@ fn parse(text: &str) -> Result<CaseFile, CaseError> {
 }
 
 /// A clamped beam of four elements, the case tests' model.
-pub(super) const BEAM: &str = r#"
-title = "beam"
-[materials.steel]
-E = 2e11
-rho = 7800
-[sections.bar]
-b = 0.05
-h = 0.01
-[groups.beam]
-alpha = 1e-5
-[[lines]]
-from = [0.0, 0.0]
-to = [1.0, 0.0]
-elements = 4
-material = "steel"
-section = "bar"
-group = "beam"
-[[supports]]
-node = 1
-"#;
+pub(super) const BEAM: &str = include_str!("../../tests/cases/beam.toml");
 
 #[test]
 fn a_line_generates_nodes_and_elements() {

@@ -11,36 +11,7 @@ use fe_model::{CaseFile, Dof, DofRef};
 use frf::Channel;
 
 /// A 4-element steel cantilever along x, nodes 1-5, clamped at node 1.
-const BEAM: &str = r#"title = "catalogue beam"
-
-[materials]
-steel = { E = 2.0e11, rho = 7800 }
-
-[sections]
-bar = { b = 0.05, h = 0.01 }
-
-[groups.beam]
-alpha = 1e-5
-beta = 0.5
-
-[[lines]]
-from = [0.0, 0.0]
-to = [1.0, 0.0]
-elements = 4
-material = "steel"
-section = "bar"
-group = "beam"
-
-[[supports]]
-node = 1
-
-[truth]
-
-[measurement]
-frequencies = { from = 10.0, to = 100.0, step = 10.0 }
-references = ["5:uy"]
-responses = ["3:uy", "5:uy"]
-"#;
+const BEAM: &str = include_str!("cases/catalogue-beam.toml");
 
 /// One malformed input.
 struct Entry {

@@ -11,29 +11,7 @@ fn rfm(args: &[&str]) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_rfm")).args(args).output().expect("rfm runs")
 }
 
-const BEAM: &str = r#"title = "beam"
-[materials.steel]
-E = 2e11
-rho = 7800
-[sections.bar]
-b = 0.05
-h = 0.01
-[groups.beam]
-alpha = 1e-5
-[[lines]]
-from = [0.0, 0.0]
-to = [1.0, 0.0]
-elements = 4
-material = "steel"
-section = "bar"
-group = "beam"
-[[supports]]
-node = 1
-[measurement]
-frequencies = { from = 5.0, to = 200.0, step = 5.0 }
-references = ["5:uy"]
-responses = ["3:uy", "5:uy"]
-"#;
+const BEAM: &str = include_str!("cases/pairing-beam.toml");
 
 /// The model's FRFs as a universal file whose test nodes are 100 + the
 /// model's, with their coordinates (dataset 15, in metres, 10 mm off the

@@ -23,29 +23,9 @@ use rfm_update::diagnose::{DiagnoseOptions, Diagnosis, Ranked, Role, diagnose};
 
 /// A 1 m steel cantilever of 20 elements (nodes 1..21), measured in uy at
 /// every other node with the tip's uy as reference, 1 to 400 Hz.
-const BEAM: &str = r#"
-[materials]
-steel = { E = 2.0e11, rho = 7800 }
-[sections]
-bar = { b = 0.04, h = 0.008 }
-[groups.beam]
-alpha = 1e-5
-beta = 0.5
-[[lines]]
-from = [0.0, 0.0]
-to = [1.0, 0.0]
-elements = 20
-material = "steel"
-section = "bar"
-group = "beam"
-"#;
+const BEAM: &str = include_str!("cases/per-direction-beam.toml");
 
-const MEASUREMENT: &str = r#"
-[measurement]
-frequencies = { from = 1.0, to = 400.0, step = 0.5 }
-references = ["21:uy"]
-responses = ["3:uy", "5:uy", "7:uy", "9:uy", "11:uy", "13:uy", "15:uy", "17:uy", "19:uy", "21:uy"]
-"#;
+const MEASUREMENT: &str = include_str!("cases/per-direction-measurement.toml");
 
 /// The true support springs: ky and kr to ground at node 1, which stays
 /// fixed in ux, with viscous damping: each spring in a group of its own, or
