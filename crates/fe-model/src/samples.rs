@@ -54,15 +54,21 @@ pub fn two_material_cantilever() -> Model {
 /// spring `joint` (kr = 2e5 N m/rad) in group `joint` (alpha = 1e-3,
 /// mu = 300 rad/s). The members are in group `frame` (viscous Rayleigh).
 pub fn frame_with_joint() -> Model {
+    frame_with_joint_turned(0.0)
+}
+
+/// [`frame_with_joint`] with every node turned by `theta` (radians) about
+/// the origin, in the plane: the same structure in another orientation.
+pub fn frame_with_joint_turned(theta: f64) -> Model {
+    let (c, s) = (theta.cos(), theta.sin());
     let mut m = Model::new("L-frame with a lossy joint");
     let frame = m.add_group(Group::new("frame").rayleigh(2e-5, 0.3)).unwrap();
     let joint = m.add_group(Group::new("joint").rayleigh(1e-3, 0.0).relaxation(300.0)).unwrap();
     let steel = m.add_material("steel", 2.0e11, 7800.0).unwrap();
     let sec = m.add_section(Section::rectangle("square", 0.03, 0.03)).unwrap();
-    m.add_node(1, 0.0, 0.0).unwrap();
-    m.add_node(2, 0.0, 1.0).unwrap();
-    m.add_node(3, 0.0, 1.0).unwrap();
-    m.add_node(4, 1.0, 1.0).unwrap();
+    for (id, x, y) in [(1, 0.0, 0.0), (2, 0.0, 1.0), (3, 0.0, 1.0), (4, 1.0, 1.0)] {
+        m.add_node(id, c * x - s * y, s * x + c * y).unwrap();
+    }
     m.add_beam(1, [1, 2], steel, sec, frame).unwrap();
     m.add_beam(2, [3, 4], steel, sec, frame).unwrap();
     m.add_spring("joint", 2, Some(3), [0.0, 0.0, 2.0e5], joint).unwrap();
