@@ -403,9 +403,48 @@ mod tests {
         assert_eq!(per.as_fitted()[2].key, GainKey::Channel(d(3), d(4)));
         let none = fit_gains(&model, &measured, None, Gains::None).unwrap();
         assert_eq!(none.of_channel(1), C64::new(1.0, 0.0));
-        let other = model.converted(frf::FrfKind::Receptance);
-        let e = fit_gains(&other, &measured, None, Gains::PerReference).unwrap_err();
-        assert!(matches!(&e, UpdateError::Data(m) if m.contains("gains are fitted between sets of one kind")), "{e}");
+        // sets that differ in any one of kind, channels and lines are refused
+        let refused = |other: &FrfSet| {
+            let e = fit_gains(other, &measured, None, Gains::PerReference).unwrap_err();
+            assert!(
+                matches!(&e, UpdateError::Data(m) if m.contains("gains are fitted between sets of one kind")),
+                "{e}"
+            );
+        };
+        refused(&model.converted(frf::FrfKind::Receptance));
+        refused(&model.select_channels(&[0, 1]));
+        refused(&model.select_lines(&[0, 2]).unwrap());
+    }
+
+    /// The weights are read per channel and line: values of weight zero
+    /// take no part, so a gain fitted where a second gain hides in the
+    /// zero-weighted values is the first one exactly.
+    #[test]
+    fn weights_are_read_at_their_channel_and_line() {
+        let d = |n: u32| DofRef::new(n, Dof::Uy);
+        let channels = vec![Channel::new(d(2), d(1)), Channel::new(d(3), d(1))];
+        let lines = vec![10.0, 20.0, 30.0, 40.0];
+        let mut model = FrfSet::zeros(lines, channels, frf::FrfKind::Receptance).unwrap();
+        for c in 0..2 {
+            for k in 0..4 {
+                model.set(c, k, C64::new(1.0 + c as f64, 0.5 * k as f64 - 1.0));
+            }
+        }
+        let (g, other) = (C64::new(3.0, -1.0), C64::new(0.2, 0.7));
+        // channel-major weights: channel 0's last two lines and channel 1's first line carry `other`
+        let weights = [1.0, 2.0, 0.0, 0.0, 0.0, 0.5, 1.0, 3.0];
+        let mut measured = model.clone();
+        for c in 0..2 {
+            for k in 0..4 {
+                let gain = if weights[c * 4 + k] > 0.0 { g } else { other };
+                measured.set(c, k, model.get(c, k) * gain);
+            }
+        }
+        let f = fit_gains(&model, &measured, Some(&weights), Gains::PerReference).unwrap();
+        assert!((f.values[0] / g - 1.0).norm() < 1e-12, "{} against {g}", f.values[0]);
+        // equally weighted, the hidden gain pulls the fit away
+        let equal = fit_gains(&model, &measured, None, Gains::PerReference).unwrap();
+        assert!((equal.values[0] / g - 1.0).norm() > 0.1);
     }
 
     #[test]
