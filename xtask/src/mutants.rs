@@ -6,11 +6,15 @@
 //!   matrices, the damping kernel, `Z` and its derivatives, the
 //!   sensitivities, the low-rank (Woodbury) update of the diagnosis, the FRF
 //!   kind and unit conversions, the least squares and the covariance), each
-//!   mutant tested by its own crate's unit and integration tests. Results go
-//!   to `<target>/mutants.out` (`missed.txt` lists the survivors). Further
-//!   arguments go to cargo-mutants: `--list` to see the mutants, `--iterate`
-//!   to retest only those not caught last time, `-f FILE` to narrow the run.
-//!   A whole run takes hours on two cores.
+//!   mutant tested by its own crate's unit and integration tests. Where
+//!   cargo-nextest is installed it runs in two passes: every mutant against
+//!   the quick tests, stopping at the first failure, then the mutants that
+//!   pass missed against the full suites (`--iterate`). Results go to
+//!   `<target>/mutants.out` (`missed.txt` lists the survivors). Further
+//!   arguments make it one plain run of cargo-mutants with them: `--list` to
+//!   see the mutants, `--iterate` to retest only those not caught last time,
+//!   `-f FILE` to narrow the run. A whole run takes three to four hours on
+//!   two cores (`docs/mutation-testing.md` has the last one's results).
 //! - `cargo xtask mutants --classic` plants the classic equation bugs that
 //!   cargo-mutants does not generate (it changes operators and return
 //!   values, not coefficients), one at a time in a copy of the workspace,
@@ -83,6 +87,15 @@ const CLASSIC: [Bug; 5] = [
     },
 ];
 
+/// Tests of rfm-update that take seconds to minutes and that the quick
+/// first pass leaves out beside [`SLOW_TESTS`] (the second pass runs them
+/// on the mutants the first pass missed), as nextest name patterns.
+const QUICK_PASS_SKIPS: [&str; 3] = [
+    "apply_every::",
+    "hidden_effects::diagnosis_finds_nothing_significant_when_nothing_is_hidden",
+    "hidden_effects::pre_screening_keeps_the_leader",
+];
+
 pub(crate) fn mutants(args: &[String]) -> Result<(), String> {
     if args.iter().any(|a| a == "--classic") {
         return classic();
@@ -92,11 +105,40 @@ pub(crate) fn mutants(args: &[String]) -> Result<(), String> {
         return Err("cargo-mutants is not installed: cargo install cargo-mutants".into());
     }
     let target = crate::target_dir()?;
-    // the filters and the test that is skipped are in .cargo/mutants.toml,
-    // so that a plain `cargo mutants` does the same
-    let mut cmd = crate::cargo();
-    cmd.current_dir(crate::root()).arg("mutants").arg("--output").arg(&target).args(args);
-    let status = cmd.status().map_err(|e| format!("cannot run cargo mutants: {e}"))?;
+    let run = |extra: &[String]| -> Result<std::process::ExitStatus, String> {
+        let mut cmd = crate::cargo();
+        cmd.current_dir(crate::root()).arg("mutants").arg("--output").arg(&target).args(extra).args(args);
+        cmd.status().map_err(|e| format!("cannot run cargo mutants: {e}"))
+    };
+    let nextest = crate::cargo().args(["nextest", "--version"]).stdout(Stdio::null()).stderr(Stdio::null()).status();
+    // with arguments of their own (--list, -f FILE, --iterate) or without
+    // nextest: one run with .cargo/mutants.toml, as a plain `cargo mutants`
+    let status = if !args.is_empty() || !nextest.is_ok_and(|s| s.success()) {
+        run(&[])?
+    } else {
+        // A mutant caught by a quick test costs its build and a second of
+        // testing when the run stops at the first failure (nextest's
+        // fail-fast); the full suite of rfm-update takes minutes whatever
+        // fails. So a first pass tests every mutant with the quick tests,
+        // and a second retests only those it missed with the full suites.
+        let quick = target.join("mutants-quick.toml");
+        std::fs::write(
+            &quick,
+            quick_config(
+                &std::fs::read_to_string(crate::root().join(".cargo/mutants.toml"))
+                    .map_err(|e| format!(".cargo/mutants.toml: {e}"))?,
+            )?,
+        )
+        .map_err(|e| format!("{}: {e}", quick.display()))?;
+        println!("first pass: every mutant against the quick tests (nextest, stopping at the first failure)");
+        if run(&["--config".into(), quick.display().to_string()])?.success() {
+            println!("the first pass caught every mutant");
+            std::process::ExitStatus::default()
+        } else {
+            println!("second pass: the mutants the first pass missed against the full test suites");
+            run(&["--iterate".into()])?
+        }
+    };
     println!("results: {}", target.join("mutants.out").display());
     // cargo-mutants exits non-zero when a mutant survived: pass that on
     if status.success() {
@@ -104,6 +146,25 @@ pub(crate) fn mutants(args: &[String]) -> Result<(), String> {
     } else {
         Err(format!("cargo mutants: {status} (survivors in mutants.out/missed.txt)"))
     }
+}
+
+/// The first pass's configuration: `.cargo/mutants.toml` (its text
+/// `config`) with nextest for the test tool and [`SLOW_TESTS`] and
+/// [`QUICK_PASS_SKIPS`] left out by a filter expression.
+fn quick_config(config: &str) -> Result<String, String> {
+    let at = config
+        .find("test_workspace")
+        .ok_or(".cargo/mutants.toml: no `test_workspace` line, where the test settings begin")?;
+    let filter = SLOW_TESTS
+        .iter()
+        .chain(&QUICK_PASS_SKIPS)
+        .map(|t| format!("test(/{}/)", t.trim_end_matches("::")))
+        .collect::<Vec<_>>()
+        .join(" | ");
+    Ok(format!(
+        "{}test_workspace = false\ntest_tool = \"nextest\"\nadditional_cargo_test_args = [\"--lib\", \"--tests\", \"-E\", \"not ({filter})\"]\nminimum_test_timeout = 120\n",
+        &config[..at]
+    ))
 }
 
 /// Every file a test may read, copied into `dest` (not `target/`, `.git/`
@@ -245,5 +306,13 @@ mod tests {
             .filter_map(|r| r.strip_prefix('"')?.split('"').next().map(str::to_string))
             .collect();
         assert_eq!(skips, SLOW_TESTS.map(str::to_string));
+        // the first pass examines the same files with the quick tests
+        let quick = quick_config(&text).unwrap();
+        let examined = |t: &str| t.lines().filter_map(quoted).filter(|q| q.starts_with("crates/")).count();
+        assert_eq!(examined(&quick), files.len());
+        for t in SLOW_TESTS.iter().chain(&QUICK_PASS_SKIPS) {
+            assert!(quick.contains(&format!("test(/{}/)", t.trim_end_matches("::"))), "{t}");
+        }
+        assert!(quick.contains("test_tool = \"nextest\""));
     }
 }
