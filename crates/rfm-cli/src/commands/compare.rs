@@ -192,8 +192,8 @@ pub(crate) fn compare(
     let weights = rfm_update::study::line_weights_for(&case, &measured)?;
     let source_of_gains = GainSource::Fit { setting: gains.0, weights: weights.as_deref() };
     let compared = comparison::compare(&system, &measured, source_of_gains, &spec)?;
-    // a model singular at a line cannot be compared there: refused, as
-    // before the comparison moved into the library
+    // a model singular at a line has no FRF there: the comparison is
+    // refused, naming the line (the reports of updates draw around it)
     if let Some(&freq_hz) = compared.model.singular_hz.first() {
         return Err(FrfError::Singular { freq_hz }.into());
     }
