@@ -251,5 +251,116 @@ mod tests {
         assert!((f - 10.0 * 19f64.sqrt()).abs() < 1e-9, "{f}");
         // unknown noise: the correlation alone
         assert!((model_error_inflation(0.1, None, 0.6, 400) - 2.0).abs() < 1e-12);
+        // a noise level of zero is no noise level: the correlation alone
+        assert!((model_error_inflation(0.1, Some(0.0), 0.6, 400) - 2.0).abs() < 1e-12);
+        // a correlation within white noise's spread 2 / sqrt(n), at its edge too, adds nothing
+        assert_eq!(model_error_inflation(0.1, None, 0.5, 16), 1.0);
+        assert!(model_error_inflation(0.1, None, 0.51, 16) > 1.7);
+    }
+
+    /// An output-error result with the given covariance of the
+    /// log-parameters, residual RMS `r` over `n_data` real residuals,
+    /// lag-one correlation `rho` and jackknife covariance.
+    fn fit(values: [f64; 2], cov: [[f64; 2]; 2], r: f64, n_data: usize, rho: f64, jack: Option<[f64; 2]>) -> OeResult {
+        use faer::Mat;
+        OeResult {
+            status: crate::status::Status::Converged,
+            flat_valley: false,
+            values: values.to_vec(),
+            gains: Vec::new(),
+            history: Vec::new(),
+            cost: 0.0,
+            n_data,
+            covariance: Mat::from_fn(2, 2, |i, j| cov[i][j]),
+            sigma2: r * r / 2.0,
+            jackknife: jack.map(|d| Mat::from_fn(2, 2, |i, j| if i == j { d[i] } else { 0.0 })),
+            singular_values: Vec::new(),
+            v: Mat::zeros(2, 0),
+            at_bound: vec![false, true],
+            residual_correlation: rho,
+        }
+    }
+
+    /// The standard deviations, intervals, correlations and flags of
+    /// `analyse` against the module docs' formulas, worked by hand.
+    #[test]
+    fn analyse_scales_to_the_noise_inflates_for_model_error_and_flags_as_documented() {
+        let sys = damping::DampedSystem::new(fe_model::samples::two_material_cantilever()).unwrap();
+        let q = |n: &str| sys.model().quantity(n).unwrap();
+        let params = ParameterSet::of_quantities(&sys, &[q("group.steel.mu"), q("group.steel.alpha")]);
+        // the band 1..100 Hz: w_min = 2 pi, w_max = 200 pi rad/s
+        let band = (1.0, 100.0);
+        let w_max = 200.0 * std::f64::consts::PI;
+        // relative sd 0.02 and 0.1 at the residual's variance, correlated 0.98
+        let cov = [[4e-4, 1.96e-3], [1.96e-3, 1e-2]];
+        let values = [5.0 * w_max, 2e-5];
+        let close = |a: f64, b: f64| (a / b - 1.0).abs() < 1e-12;
+
+        // the residual twice the noise, white: noise-only sd half the
+        // residual's, shown sd twice that (the lack of fit)
+        let rep = analyse(&params, &fit(values, cov, 0.02, 200, 0.0, None), band, Some(0.01));
+        let p = &rep.parameters;
+        assert!(close(p[0].relative_std_noise, 0.01) && close(p[1].relative_std_noise, 0.05), "{p:?}");
+        assert!(close(p[0].relative_std, 0.02) && close(p[1].relative_std, 0.1));
+        assert!(close(p[0].std, values[0] * 0.02) && close(p[1].std_noise, values[1] * 0.05));
+        assert!(close(rep.inflation, 2.0) && close(rep.chi2_per_dof.unwrap(), 4.0));
+        let (lo, hi) = p[1].interval95;
+        assert!(close(lo, 2e-5 * (-0.196f64).exp()) && close(hi, 2e-5 * 0.196f64.exp()));
+        assert!(close(rep.correlation[0][1], 0.98) && close(rep.correlation[1][0], 0.98));
+        assert_eq!((rep.correlation[0][0], rep.correlation[1][1]), (1.0, 1.0));
+        assert!(rep.warnings.iter().any(|w| w.contains("strongly correlated (rho = +0.980)")), "{:?}", rep.warnings);
+        // the second parameter ended on its bound; the first is within the band's reach
+        assert!(p[0].warnings.is_empty() && p[0].well_determined, "{:?}", p[0].warnings);
+        assert!(p[1].warnings.iter().any(|w| w.contains("ended on its bound")) && !p[1].well_determined);
+
+        // noise above the residual: the residual's variance is the noise's, nothing inflated
+        for noise in [Some(0.04), None, Some(0.0)] {
+            let rep = analyse(&params, &fit(values, cov, 0.02, 200, 0.0, None), band, noise);
+            let p = &rep.parameters;
+            assert!(close(p[0].relative_std_noise, 0.02) && close(p[0].relative_std, 0.02), "{noise:?}: {p:?}");
+            assert_eq!(rep.inflation, 1.0, "{noise:?}");
+        }
+
+        // correlated residuals over n_data / 2 = 100 complex values (spread
+        // 0.2): 0.15 adds nothing, 0.3 adds sqrt(1.3 / 0.7)
+        let quiet = analyse(&params, &fit(values, cov, 0.02, 200, 0.15, None), band, None);
+        assert_eq!(quiet.inflation, 1.0);
+        let loud = analyse(&params, &fit(values, cov, 0.02, 200, 0.3, None), band, None);
+        assert!(close(loud.inflation, (1.3f64 / 0.7).sqrt()));
+
+        // the jackknife's spread counts only where model error shows
+        let jack = Some([0.09, 0.09]);
+        let white = analyse(&params, &fit(values, cov, 0.02, 200, 0.0, jack), band, None);
+        assert!(close(white.parameters[0].relative_std, 0.02));
+        let off = analyse(&params, &fit(values, cov, 0.02, 200, 0.3, jack), band, None);
+        assert!(close(off.parameters[0].relative_std, 0.3) && close(off.parameters[1].relative_std, 0.3));
+
+        // how well determined: 0.5 poorly, 20 unbounded, infinite not at all
+        for (var, words) in [
+            (0.25, "poorly determined by the data (+-50 %"),
+            (400.0, "its standard deviation is unbounded"),
+            (f64::INFINITY, "the FRFs do not depend on it"),
+        ] {
+            let rep = analyse(&params, &fit(values, [[var, 0.0], [0.0, 1e-2]], 0.02, 200, 0.0, None), band, None);
+            assert!(rep.parameters[0].warnings.iter().any(|w| w.contains(words)), "{words}: {:?}", rep.parameters[0]);
+        }
+        let rep = analyse(&params, &fit(values, [[f64::INFINITY, 0.0], [0.0, 1e-2]], 0.02, 200, 0.0, None), band, None);
+        assert_eq!(rep.parameters[0].interval95, (0.0, f64::INFINITY));
+
+        // mu beyond ten times the band's top, or below a tenth of its bottom
+        let w_min = 2.0 * std::f64::consts::PI;
+        for (mu, words) in [
+            (10.01 * w_max, Some("lies far above the measured band")),
+            (9.99 * w_max, None),
+            (0.0999 * w_min, Some("lies far below the measured band")),
+            (0.1001 * w_min, None),
+        ] {
+            let rep = analyse(&params, &fit([mu, 2e-5], cov, 0.02, 200, 0.0, None), band, None);
+            let w = &rep.parameters[0].warnings;
+            match words {
+                Some(words) => assert!(w.iter().any(|x| x.contains(words)), "mu {mu}: {w:?}"),
+                None => assert!(w.is_empty(), "mu {mu}: {w:?}"),
+            }
+        }
     }
 }

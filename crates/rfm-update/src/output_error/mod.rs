@@ -522,6 +522,28 @@ fn covariance(sol: &lstsq::LstsqSolution, sigma2: f64) -> Mat<f64> {
 mod tests {
     use super::*;
 
+    /// Columns `c`, `c` again (the data see only the sum of the first two
+    /// unknowns) and `d`, not orthogonal to `c`: the first two have
+    /// unbounded variance and no covariance with anything, the third the
+    /// variance of the problem with columns `c` and `d`, `sigma2 |c|^2 /
+    /// (|c|^2 |d|^2 - (c.d)^2)`.
+    #[test]
+    fn covariance_is_unbounded_where_the_data_cannot_resolve_and_sigma2_times_the_inverse_elsewhere() {
+        let (c, d) = ([1.0, 2.0, 0.0, 1.0], [1.0e3, 0.0, 3.0e3, 2.0e3]);
+        let a = Mat::from_fn(4, 3, |i, j| if j < 2 { c[i] } else { d[i] });
+        let sol = lstsq::solve(&a, &[1.0, -1.0, 0.5, 2.0], 1e-10);
+        assert_eq!(sol.undetermined(), vec![true, true, false]);
+        let sigma2 = 0.3;
+        let cov = covariance(&sol, sigma2);
+        assert_eq!((cov[(0, 0)], cov[(1, 1)]), (f64::INFINITY, f64::INFINITY));
+        for (i, j) in [(0, 1), (1, 0), (0, 2), (2, 0), (1, 2), (2, 1)] {
+            assert_eq!(cov[(i, j)], 0.0, "({i}, {j})");
+        }
+        let dot = |x: &[f64; 4], y: &[f64; 4]| x.iter().zip(y).map(|(a, b)| a * b).sum::<f64>();
+        let want = sigma2 * dot(&c, &c) / (dot(&c, &c) * dot(&d, &d) - dot(&c, &d).powi(2));
+        assert!((cov[(2, 2)] / want - 1.0).abs() < 1e-10, "{} against {want}", cov[(2, 2)]);
+    }
+
     /// A gain multiplies exactly the channels of its reference, by its
     /// magnitude and phase.
     #[test]
