@@ -57,7 +57,8 @@
 //!
 //! ```
 //! use fe_model::CaseFile;
-//! use frf::correlation::{BandSpec, correlate};
+//! use frf::correlation::BandSpec;
+//! use rfm_update::comparison::{self, GainSource};
 //! use rfm_update::diagnose::{self, DiagnoseOptions};
 //! use rfm_update::Study;
 //! use rfm_update::status::Status;
@@ -67,9 +68,8 @@
 //! let measured = study.measured().to_receptance();
 //!
 //! // compare: FRF errors per channel and band, and the modes paired by MAC
-//! let model = frf::synthesize(study.system(), measured.channels(), measured.frequencies_hz()).unwrap();
-//! let before = correlate(&measured, &model, &BandSpec::Auto).unwrap();
-//! let modes = frf::compare_modes(study.system(), &measured, 0.5).unwrap();
+//! let before = comparison::compare(study.system(), &measured, GainSource::None, &BandSpec::Auto).unwrap();
+//! let modes = comparison::compare_modes(study.system(), &measured, &before.model.gains, 0.5).unwrap();
 //! assert!(!modes.pairing.pairs.is_empty());
 //!
 //! // diagnose: every candidate effect fitted and ranked against the noise
@@ -83,9 +83,8 @@
 //! let updated = next.run_output_error(&next.output_error_options().unwrap(), |_| {}).unwrap();
 //! assert_eq!(updated.status, Status::Converged);
 //!
-//! let fitted = frf::synthesize(&updated.system, measured.channels(), measured.frequencies_hz()).unwrap();
-//! let after = correlate(&measured, &fitted, &BandSpec::Auto).unwrap();
-//! assert!(after.total.log_misfit < 0.1 * before.total.log_misfit);
+//! let after = comparison::compare(&updated.system, &measured, GainSource::None, &BandSpec::Auto).unwrap();
+//! assert!(after.correlation.total.log_misfit < 0.1 * before.correlation.total.log_misfit);
 //! ```
 
 pub mod comparison;
