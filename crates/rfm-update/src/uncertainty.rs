@@ -346,14 +346,25 @@ mod tests {
         }
         let rep = analyse(&params, &fit(values, [[f64::INFINITY, 0.0], [0.0, 1e-2]], 0.02, 200, 0.0, None), band, None);
         assert_eq!(rep.parameters[0].interval95, (0.0, f64::INFINITY));
+        // a standard deviation of exactly 10 is still a number, +-1000 %
+        let rep = analyse(&params, &fit(values, [[100.0, 0.0], [0.0, 1e-2]], 0.02, 200, 0.0, None), band, None);
+        assert!(rep.parameters[0].warnings.iter().any(|w| w.contains("+-1000 %")), "{:?}", rep.parameters[0]);
+
+        // a parameter the fit pins exactly (zero variance) correlates with
+        // nothing and fully with itself, not 0 / 0
+        let rep = analyse(&params, &fit(values, [[0.0, 0.0], [0.0, 1e-2]], 0.02, 200, 0.0, None), band, None);
+        assert_eq!(rep.correlation, vec![vec![1.0, 0.0], vec![0.0, 1.0]]);
 
         // mu beyond ten times the band's top, or below a tenth of its bottom
+        // (at those limits exactly, within reach)
         let w_min = 4.0 * std::f64::consts::PI;
         for (mu, words) in [
             (10.01 * w_max, Some("lies far above the measured band")),
             (9.99 * w_max, None),
+            (10.0 * w_max, None),
             (0.0999 * w_min, Some("lies far below the measured band")),
             (0.1001 * w_min, None),
+            (w_min / 10.0, None),
         ] {
             let rep = analyse(&params, &fit([mu, 2e-5], cov, 0.02, 200, 0.0, None), band, None);
             let w = &rep.parameters[0].warnings;
