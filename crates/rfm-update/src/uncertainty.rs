@@ -304,6 +304,13 @@ mod tests {
         assert!(close(p[0].relative_std, 0.02) && close(p[1].relative_std, 0.1));
         assert!(close(p[0].std, values[0] * 0.02) && close(p[1].std_noise, values[1] * 0.05));
         assert!(close(rep.inflation, 2.0) && close(rep.chi2_per_dof.unwrap(), 4.0));
+        assert!(
+            rep.shown_first.starts_with(
+                "with model error: the noise-only standard deviation times 2.00 (the fit leaves 2.00 times"
+            ),
+            "{}",
+            rep.shown_first
+        );
         let (lo, hi) = p[1].interval95;
         assert!(close(lo, 2e-5 * (-0.196f64).exp()) && close(hi, 2e-5 * 0.196f64.exp()));
         assert!(close(rep.correlation[0][1], 0.98) && close(rep.correlation[1][0], 0.98));
@@ -321,6 +328,9 @@ mod tests {
             let p = &rep.parameters;
             assert!(close(p[0].relative_std_noise, 0.02) && close(p[0].relative_std, 0.02), "{noise:?}: {p:?}");
             assert_eq!(rep.inflation, 1.0, "{noise:?}");
+            assert!(rep.shown_first.contains("which adds nothing here"), "{noise:?}: {}", rep.shown_first);
+            // a noise level of zero is no noise level: no chi2
+            assert_eq!(rep.chi2_per_dof.is_some(), noise == Some(0.04), "{noise:?}");
         }
 
         // correlated residuals over n_data / 2 = 100 complex values (spread
