@@ -200,6 +200,28 @@ mod tests {
         }
     }
 
+    /// A fallback table made at one line serves the others, with the
+    /// coefficients of a table made there, and refuses parameters whose
+    /// derivatives list other terms (the assembly then makes its own).
+    #[test]
+    fn a_derivative_table_fits_other_lines_and_refuses_other_terms() {
+        let (sys, params) = every_kind();
+        let solver = ZSolver::new(sys.assembly().pattern()).unwrap();
+        let omega = |f: f64| 2.0 * std::f64::consts::PI * f;
+        let table = TermTable::build(&sys, &solver, &params, omega(60.0), false);
+        let (mut coef, mut own) = (Vec::new(), Vec::new());
+        for f in [3.0, 400.0] {
+            assert!(table.coefficients(&sys, &params, omega(f), &mut coef).is_some(), "at {f} Hz");
+            let there = TermTable::build(&sys, &solver, &params, omega(f), false);
+            there.coefficients(&sys, &params, omega(f), &mut own).unwrap();
+            assert_eq!(coef, own, "at {f} Hz");
+        }
+        // the joint's mu and the frame's beta touch other blocks
+        let mut swapped = params.clone();
+        swapped.swap(0, 2);
+        assert!(table.coefficients(&sys, &swapped, omega(60.0), &mut coef).is_none());
+    }
+
     /// Solving for each class sum and reading the measured rows gives what
     /// the unit solves at the measured rows give, for both hybrid modes.
     #[test]
