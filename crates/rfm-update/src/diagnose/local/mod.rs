@@ -133,7 +133,9 @@ mod tests {
         let nominal = DampedSystem::new(model.clone()).unwrap();
         let uy: Vec<DofRef> =
             (0..nominal.n()).map(|eq| nominal.assembly().dofs().dof_of(eq)).filter(|d| d.dof == Dof::Uy).collect();
-        let channels: Vec<Channel> = uy.iter().step_by(2).map(|&r| Channel::new(r, uy[uy.len() - 1])).collect();
+        // two references, so that the update's columns per reference are seen
+        let mut channels: Vec<Channel> = uy.iter().step_by(2).map(|&r| Channel::new(r, uy[uy.len() - 1])).collect();
+        channels.push(Channel::new(uy[uy.len() - 1], uy[0]));
         let lines = [3.0, 17.0, 41.0, 88.0];
         let opts = CandidateOptions { band_hz: (1.0, 100.0), ..CandidateOptions::default() };
         let mut all = candidates::generate(model, &opts);
