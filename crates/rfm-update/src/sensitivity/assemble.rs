@@ -72,6 +72,21 @@ pub(super) enum Strategy {
     ClassSums,
 }
 
+impl Strategy {
+    /// Whether to solve for the class sums, with the coefficient rules or
+    /// not, `n_classes` classes, `n_ref` references and `n_resp` measured
+    /// rows. `Auto` takes the fewer solves: the class sums need `n_ref (1 +
+    /// n_classes)` in two rounds, the measured rows `n_ref + n_resp` in one;
+    /// without the rules (the fallback's class per term) the measured rows.
+    fn class_sums(self, rules: bool, n_classes: usize, n_ref: usize, n_resp: usize) -> bool {
+        match self {
+            Strategy::Auto => rules && n_ref * (1 + n_classes) < n_ref + n_resp,
+            Strategy::MeasuredRows => false,
+            Strategy::ClassSums => true,
+        }
+    }
+}
+
 /// Model FRFs and sensitivities at one line; see the module docs.
 pub fn assemble_one(
     sys: &DampedSystem,
@@ -136,16 +151,8 @@ pub(super) fn assemble_line(
     sys.z_values_into(omega, &mut scratch.z);
     solver.factorize(&mut scratch.ws, &scratch.z, freq_hz)?;
 
-    // class sums as right-hand sides need n_ref (1 + classes) solves in two
-    // rounds, the measured rows n_ref + n_resp in one
-    let class_sums = match strategy {
-        Strategy::Auto => {
-            matches!(table.coefficients, Coefficients::Rules(_)) && n_ref * (1 + table.n_classes) < n_ref + n_resp
-        }
-        Strategy::MeasuredRows => false,
-        Strategy::ClassSums => true,
-    };
-    let model = if class_sums {
+    let rules = matches!(table.coefficients, Coefficients::Rules(_));
+    let model = if strategy.class_sums(rules, table.n_classes, n_ref, n_resp) {
         by_class_sums(table, solver, plan, freq_hz, scratch)?
     } else {
         by_measured_rows(table, solver, plan, freq_hz, scratch)?
@@ -307,4 +314,29 @@ pub fn assemble(
             block
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Strategy;
+
+    /// `Auto` takes the class sums exactly when they need fewer solves and
+    /// the rules hold; the forced strategies ignore the counts.
+    #[test]
+    fn auto_takes_the_fewer_solves() {
+        let auto = |rules, classes, refs, rows| Strategy::Auto.class_sums(rules, classes, refs, rows);
+        // one reference, three classes: 4 solves against 1 + rows
+        assert!(auto(true, 3, 1, 4));
+        assert!(!auto(true, 3, 1, 3), "a tie keeps the single round");
+        assert!(!auto(true, 3, 1, 2));
+        // two references: 8 against 2 + rows
+        assert!(auto(true, 3, 2, 7));
+        assert!(!auto(true, 3, 2, 6));
+        // the fallback measures rows however many
+        assert!(!auto(false, 3, 1, 100));
+        for (rules, rows) in [(true, 1), (true, 100), (false, 100)] {
+            assert!(Strategy::ClassSums.class_sums(rules, 3, 1, rows));
+            assert!(!Strategy::MeasuredRows.class_sums(rules, 3, 1, rows));
+        }
+    }
 }
