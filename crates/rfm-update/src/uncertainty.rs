@@ -358,6 +358,10 @@ mod tests {
         }
         let rep = analyse(&params, &fit(values, [[f64::INFINITY, 0.0], [0.0, 1e-2]], 0.02, 200, 0.0, None), band, None);
         assert_eq!(rep.parameters[0].interval95, (0.0, f64::INFINITY));
+        // exactly 0.3 (sqrt(0.09) is 0.3 in floating point) is not yet poor
+        let rep = analyse(&params, &fit(values, [[0.09, 0.0], [0.0, 1e-2]], 0.02, 200, 0.0, None), band, None);
+        assert_eq!(rep.parameters[0].relative_std, 0.3);
+        assert!(rep.parameters[0].warnings.is_empty(), "{:?}", rep.parameters[0]);
         // a standard deviation of exactly 10 is still a number, +-1000 %
         let rep = analyse(&params, &fit(values, [[100.0, 0.0], [0.0, 1e-2]], 0.02, 200, 0.0, None), band, None);
         assert!(rep.parameters[0].warnings.iter().any(|w| w.contains("+-1000 %")), "{:?}", rep.parameters[0]);
