@@ -347,31 +347,33 @@ mod tests {
         let off = analyse(&params, &fit(values, cov, 0.02, 200, 0.3, jack), band, None);
         assert!(close(off.parameters[0].relative_std, 0.3) && close(off.parameters[1].relative_std, 0.3));
 
+        // the first fit with another covariance, white residuals and no noise level
+        let with_cov = |cov: [[f64; 2]; 2]| analyse(&params, &fit(values, cov, 0.02, 200, 0.0, None), band, None);
         // how well determined: 0.5 poorly, 20 unbounded, infinite not at all
         for (var, words) in [
             (0.25, "poorly determined by the data (+-50 %"),
             (400.0, "its standard deviation is unbounded"),
             (f64::INFINITY, "the FRFs do not depend on it"),
         ] {
-            let rep = analyse(&params, &fit(values, [[var, 0.0], [0.0, 1e-2]], 0.02, 200, 0.0, None), band, None);
+            let rep = with_cov([[var, 0.0], [0.0, 1e-2]]);
             assert!(rep.parameters[0].warnings.iter().any(|w| w.contains(words)), "{words}: {:?}", rep.parameters[0]);
         }
-        let rep = analyse(&params, &fit(values, [[f64::INFINITY, 0.0], [0.0, 1e-2]], 0.02, 200, 0.0, None), band, None);
+        let rep = with_cov([[f64::INFINITY, 0.0], [0.0, 1e-2]]);
         assert_eq!(rep.parameters[0].interval95, (0.0, f64::INFINITY));
         // exactly 0.3 (sqrt(0.09) is 0.3 in floating point) is not yet poor
-        let rep = analyse(&params, &fit(values, [[0.09, 0.0], [0.0, 1e-2]], 0.02, 200, 0.0, None), band, None);
+        let rep = with_cov([[0.09, 0.0], [0.0, 1e-2]]);
         assert_eq!(rep.parameters[0].relative_std, 0.3);
         assert!(rep.parameters[0].warnings.is_empty(), "{:?}", rep.parameters[0]);
         // a standard deviation of exactly 10 is still a number, +-1000 %
-        let rep = analyse(&params, &fit(values, [[100.0, 0.0], [0.0, 1e-2]], 0.02, 200, 0.0, None), band, None);
+        let rep = with_cov([[100.0, 0.0], [0.0, 1e-2]]);
         assert!(rep.parameters[0].warnings.iter().any(|w| w.contains("+-1000 %")), "{:?}", rep.parameters[0]);
 
         // a parameter the fit pins exactly (zero variance) correlates with
         // nothing and fully with itself, not 0 / 0
-        let rep = analyse(&params, &fit(values, [[0.0, 0.0], [0.0, 1e-2]], 0.02, 200, 0.0, None), band, None);
+        let rep = with_cov([[0.0, 0.0], [0.0, 1e-2]]);
         assert_eq!(rep.correlation, vec![vec![1.0, 0.0], vec![0.0, 1.0]]);
         // correlated 0.95 exactly is not yet "strongly"
-        let rep = analyse(&params, &fit(values, [[1.0, 0.95], [0.95, 1.0]], 0.02, 200, 0.0, None), band, None);
+        let rep = with_cov([[1.0, 0.95], [0.95, 1.0]]);
         assert_eq!(rep.correlation[0][1], 0.95);
         assert!(!rep.warnings.iter().any(|w| w.contains("strongly correlated")), "{:?}", rep.warnings);
 
