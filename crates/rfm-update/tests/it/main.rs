@@ -14,6 +14,7 @@ mod output_error;
 mod paper_cases;
 mod per_direction;
 mod sensitivity;
+mod setup_checks;
 mod study;
 mod trust;
 mod truths;
