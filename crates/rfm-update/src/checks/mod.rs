@@ -182,6 +182,9 @@ pub struct Finding {
     pub misfit_after: f64,
     /// The frequency of a measured mode the model lacks (Hz).
     pub frequency_hz: Option<f64>,
+    /// How many steps of `rfm fix` were kept before it was found (0: found
+    /// against the model as given).
+    pub found_after_step: usize,
 }
 
 impl Finding {
@@ -536,6 +539,7 @@ fn judge(fits: &[ChannelFit], opts: &CheckOptions) -> Vec<Finding> {
                 misfit_before: rms(before, weight),
                 misfit_after: rms(ca + cb, weight),
                 frequency_hz: None,
+                found_after_step: 0,
             });
             done.extend([fa.channel, fb.channel]);
         }
@@ -619,6 +623,7 @@ fn judge(fits: &[ChannelFit], opts: &CheckOptions) -> Vec<Finding> {
                 misfit_before: rms(plus, weight),
                 misfit_after: rms(cost, weight),
                 frequency_hz: None,
+                found_after_step: 0,
             });
             continue;
         }
@@ -651,6 +656,7 @@ fn judge(fits: &[ChannelFit], opts: &CheckOptions) -> Vec<Finding> {
                 misfit_before: rms(plus, weight),
                 misfit_after: rms(minus, weight),
                 frequency_hz: None,
+                found_after_step: 0,
             });
             continue;
         }
@@ -693,6 +699,7 @@ fn judge(fits: &[ChannelFit], opts: &CheckOptions) -> Vec<Finding> {
                 misfit_before: rms(plus, weight),
                 misfit_after: rms((plus - explained).max(0.0), weight),
                 frequency_hz: None,
+                found_after_step: 0,
             });
         }
     }

@@ -63,6 +63,7 @@ pub fn extra_modes(sys: &DampedSystem, measured: &FrfSet) -> Result<Vec<Finding>
             misfit_before: f64::NAN,
             misfit_after: f64::NAN,
             frequency_hz: Some(f),
+            found_after_step: 0,
         });
     }
     Ok(out)

@@ -183,11 +183,14 @@ pub struct CandidateOptions {
     pub per_element_limit: usize,
     /// Band of the data (Hz), to scale damping starting values.
     pub band_hz: (f64, f64),
+    /// Frequencies (Hz) of measured modes the model lacks: resonators tuned
+    /// to them are candidates (none when empty).
+    pub resonator_hz: Vec<f64>,
 }
 
 impl Default for CandidateOptions {
     fn default() -> Self {
-        CandidateOptions { region_size: 4, per_element_limit: 40, band_hz: (1.0, 1000.0) }
+        CandidateOptions { region_size: 4, per_element_limit: 40, band_hz: (1.0, 1000.0), resonator_hz: Vec::new() }
     }
 }
 
