@@ -5,7 +5,8 @@ use std::path::{Path, PathBuf};
 use fe_model::case::Gains;
 use indicatif::ProgressBar;
 use rfm_update::Study;
-use rfm_update::diagnose::{Diagnosis, diagnose_with};
+use rfm_update::diagnose::Diagnosis;
+use rfm_update::fix::{CheckedDiagnosis, FixOptions, FixProgress, Prepared, diagnose_prepared};
 use rfm_update::study::{describe_masked, read_measured_for};
 
 use super::{Result, WithNotes, print_masked, print_notes};
@@ -82,24 +83,50 @@ pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
     let bar = if args.json { ProgressBar::hidden() } else { ProgressBar::new_spinner() };
     bar.enable_steady_tick(std::time::Duration::from_millis(120));
     let start = std::time::Instant::now();
-    let opts = study.diagnose_options(&measured)?;
-    let d = diagnose_with(&study.case().model, &measured, &opts, |stage| {
-        let line = format!("{stage} ({:.2} s)", start.elapsed().as_secs_f64());
-        if args.verbose {
-            bar.suspend(|| eprintln!("{line}"));
-        }
-        bar.set_message(line);
-    })?;
+    let fix_opts = FixOptions {
+        diagnose: study.diagnose_options(&measured)?,
+        data: data_output.as_ref().map(|(_, path)| path.clone()),
+        ..FixOptions::default()
+    };
+    let json = args.json;
+    let (prepared, d) = diagnose_prepared(
+        study.case(),
+        &measured,
+        &fix_opts,
+        &mut |p| match p {
+            FixProgress::Declared { step } => {
+                let line = format!(
+                    "step 0: updated the case's own [update] parameters first ({}); misfit {:.4e} -> {:.4e}",
+                    step.status.name(),
+                    step.misfit_before,
+                    step.misfit_updated
+                );
+                if !json {
+                    bar.suspend(|| eprintln!("{line}"));
+                }
+            }
+            _ => {}
+        },
+        |stage| {
+            let line = format!("{stage} ({:.2} s)", start.elapsed().as_secs_f64());
+            if args.verbose {
+                bar.suspend(|| eprintln!("{line}"));
+            }
+            bar.set_message(line);
+        },
+    )?;
     bar.finish_and_clear();
+    let report = CheckedDiagnosis { findings: &prepared.findings, declared: prepared.declared.as_ref(), diagnosis: &d };
     if args.json {
-        outln!("{}", serde_json::to_string_pretty(&WithNotes { notes: &notes, result: &d })?);
+        outln!("{}", serde_json::to_string_pretty(&WithNotes { notes: &notes, result: &report })?);
     } else {
+        print_checks(&prepared)?;
         print_diagnosis(&d, args.top)?;
     }
     if let Some(rank) = args.apply {
         let out = args.out.ok_or("--apply needs --out FILE for the new case file")?;
         let data = data_output.as_ref().map(|(_, path)| path.clone());
-        let editor = d.apply_with_data(study.case(), rank, data.as_deref())?;
+        let editor = d.apply_with_data(&prepared.case, rank, data.as_deref())?;
         if let Some((mut data, path)) = data_output.take() {
             data.write_file(frf::io::csv::to_csv_string(study.measured()).as_bytes())?;
             data.commit()?;
@@ -152,6 +179,29 @@ fn unfitted_lines(d: &Diagnosis) -> Vec<String> {
     out
 }
 
+/// What was found about the data and corrected, and step 0, before the ranking.
+fn print_checks(p: &Prepared) -> Result<()> {
+    if !p.findings.is_empty() {
+        outln!("findings about the data (corrected before the diagnosis when a correction is given):");
+        for f in &p.findings {
+            let fix = if f.corrections.is_empty() { "" } else { " [corrected]" };
+            outln!("  - {}{fix}\n    {}", f.summary, f.evidence);
+        }
+        outln!("");
+    }
+    if let Some(d) = &p.declared {
+        outln!(
+            "the case's own [update] parameters were updated first (step 0, {}): misfit {:.2} % -> {:.2} % (RMS relative); \
+             the diagnosis below is of the updated model",
+            d.status.name(),
+            100.0 * d.misfit_before,
+            100.0 * d.misfit_updated
+        );
+        outln!("");
+    }
+    Ok(())
+}
+
 fn print_diagnosis(d: &Diagnosis, top: usize) -> Result<()> {
     outln!(
         "noise level estimated from the data: {:.2} %; nominal model misfit: {:.2} % (RMS relative)",
@@ -162,6 +212,10 @@ fn print_diagnosis(d: &Diagnosis, top: usize) -> Result<()> {
         outln!(
             "(both, and every fit, weigh the lines as the update does: by the measured coherence and any band weights)"
         );
+    }
+    if !d.singular_hz.is_empty() {
+        let list = d.singular_hz.iter().map(|f| format!("{f} Hz")).collect::<Vec<_>>().join(", ");
+        outln!("left out: {list}, where the model's dynamic stiffness is singular (an undamped mode on the line)");
     }
     outln!("");
     if d.gains != Gains::None {
@@ -288,6 +342,7 @@ mod tests {
             gains: Gains::None,
             weighted: false,
             unfitted,
+            singular_hz: Vec::new(),
             candidates: Vec::new(),
         }
     }

@@ -31,8 +31,9 @@ pub(crate) fn fix(args: &FixArgs<'_>) -> Result<Exit> {
     // the data every written case reads: the case's own file, or the data
     // synthesised from its [truth], written once beside the steps
     let synthesised = study.case().measurement.as_ref().and_then(|m| m.data.as_ref()).is_none();
-    // one more than the steps: the loop may end by replacing an early effect
-    let mut names: Vec<String> = (1..=args.steps + 1).map(step_file).collect();
+    // step 0 (the case's own parameters), and one more than the steps: the
+    // loop may end by replacing an early effect
+    let mut names: Vec<String> = (0..=args.steps + 1).map(step_file).collect();
     names.extend(["results.json", "report.html"].map(String::from));
     if synthesised {
         names.push(DATA_FILE.into());
@@ -63,30 +64,49 @@ pub(crate) fn fix(args: &FixArgs<'_>) -> Result<Exit> {
         if json {
             return;
         }
-        let line = match p {
-            FixProgress::Diagnosed { step, diagnosis } => match diagnosis.leader() {
+        let lines: Vec<String> = match p {
+            FixProgress::Checked { findings } if findings.is_empty() => {
+                vec!["checked the data for set-up errors: none found".into()]
+            }
+            FixProgress::Checked { findings } => std::iter::once("checked the data for set-up errors:".to_string())
+                .chain(findings.iter().map(|f| {
+                    let fix = if f.corrections.is_empty() { "" } else { " (corrected)" };
+                    format!("  {}{fix}", f.summary)
+                }))
+                .collect(),
+            FixProgress::Declared { step } => vec![format!(
+                "step 0: updated the case's own parameters ({}); misfit {:.4e} -> {:.4e}",
+                step.status.name(),
+                step.misfit_before,
+                step.misfit_updated
+            )],
+            FixProgress::Diagnosed { step, diagnosis } => vec![match diagnosis.leader() {
                 Some(l) => format!("diagnosis {}: {} stands out (dBIC {:.1})", step + 1, l.description, l.delta_bic),
                 None if diagnosis.consistent() => format!("diagnosis {}: nothing significant", step + 1),
                 None => format!("diagnosis {}: significant effects, none at plausible values", step + 1),
-            },
-            FixProgress::LookedAhead { ahead, .. } => match (&ahead.failed, &ahead.with) {
-                (Some(why), _) => format!("  looking one step ahead from {}: could not add it ({why})", ahead.effect),
-                (None, Some(with)) => format!(
-                    "  the best pair fitted together: {} with {with}: misfit {:.4e}",
-                    ahead.effect, ahead.misfit_ahead
-                ),
-                (None, None) => format!(
-                    "  looking one step ahead from {}: misfit {:.4e} after it and its best follower",
-                    ahead.effect, ahead.misfit_ahead
-                ),
-            },
+            }],
+            FixProgress::LookedAhead { ahead, .. } => {
+                let what = match &ahead.with {
+                    Some(with) => format!("{} with {with} (fitted together)", ahead.effect),
+                    None => ahead.effect.clone(),
+                };
+                vec![match &ahead.rejected {
+                    _ if ahead.misfit_ahead.is_nan() => {
+                        format!("  tried {what}: {}", ahead.failed.as_deref().unwrap_or("failed"))
+                    }
+                    Some(why) => format!("  tried {what}: misfit {:.4e}, not kept: {why}", ahead.misfit_ahead),
+                    None => format!("  tried {what}: misfit {:.4e}, dBIC {:.1}", ahead.misfit_ahead, ahead.delta_bic),
+                }]
+            }
             FixProgress::Updated { step, effect, removed, misfit, status } => {
                 let verb = if removed { "took out" } else { "added" };
-                format!("step {}: {verb} {effect} and updated ({}); misfit {misfit:.4e}", step + 1, status.name())
+                vec![format!("step {}: {verb} {effect} and updated ({}); misfit {misfit:.4e}", step + 1, status.name())]
             }
         };
-        // an error here would be the same as at the next print, which reports it
-        let _ = crate::print_line(format_args!("{line}"));
+        for line in lines {
+            // an error here would be the same as at the next print, which reports it
+            let _ = crate::print_line(format_args!("{line}"));
+        }
     })?;
     if json {
         outln!("{}", serde_json::to_string_pretty(&outcome)?);
@@ -98,9 +118,14 @@ pub(crate) fn fix(args: &FixArgs<'_>) -> Result<Exit> {
     if synthesised {
         output.write(DATA_FILE, frf::io::csv::to_csv_string(study.measured()).as_bytes())?;
     }
-    for (k, s) in outcome.steps.iter().enumerate() {
-        let name = step_file(k + 1);
-        let mut editor = s.case.clone();
+    let cases = outcome
+        .declared
+        .iter()
+        .map(|d| (0, &d.case))
+        .chain(outcome.steps.iter().enumerate().map(|(k, s)| (k + 1, &s.case)));
+    for (k, case) in cases {
+        let name = step_file(k);
+        let mut editor = case.clone();
         if let Some(data) = &data_file {
             editor.use_data(data);
         }
@@ -112,49 +137,83 @@ pub(crate) fn fix(args: &FixArgs<'_>) -> Result<Exit> {
     let written = output.commit()?;
     if !json {
         outln!("\nwrote {} files into {}", written.len(), args.out.display());
-        if let Some(last) = outcome.steps.len().checked_sub(1) {
-            outln!("the fixed model: {}", args.out.join(step_file(last + 1)).display());
+        if outcome.final_case().is_some() {
+            let last = if outcome.steps.is_empty() { 0 } else { outcome.steps.len() };
+            outln!("the fixed model: {}", args.out.join(step_file(last)).display());
         }
     }
-    // success only when the loop ended with the data explained down to their noise
-    let explained = outcome.stop == FixStop::NothingSignificant && outcome.final_misfit() <= CONSISTENT * outcome.noise;
-    Ok(if explained { Exit::Success } else { Exit::NotConverged })
+    // success only when the loop ended with the data explained down to their
+    // noise; a model that stays above it with nothing the evidence singles
+    // out (or several effects it cannot tell apart) is inadequate
+    Ok(match outcome.stop {
+        _ if outcome.explained() => Exit::Success,
+        FixStop::ModelInadequate | FixStop::Ambiguous => Exit::ModelInadequate,
+        _ => Exit::NotConverged,
+    })
 }
 
 fn print_outcome(o: &FixOutcome) -> Result<()> {
+    let corrected: Vec<_> = o.findings.iter().filter(|f| !f.corrections.is_empty()).collect();
+    if !o.findings.is_empty() {
+        outln!("\nfindings about the data (set-up errors are corrected before the model is fitted):");
+        for f in &o.findings {
+            let fix = if f.corrections.is_empty() { "" } else { " [corrected in the case]" };
+            outln!("  - {}{fix}\n    {}", f.summary, f.evidence);
+        }
+    }
+    if !corrected.is_empty() {
+        outln!("  the corrections are written under [[measurement.corrections]] in every step's case");
+    }
     outln!("\nthe misfit after each step (RMS of ln(model/measured) per value):");
-    let mut t = Table::new(&["step", "misfit", "(dB)", "x noise"]);
-    for (label, m) in o.stages() {
-        t.row(vec![label, format!("{m:.4e}"), format!("{:.1}", 20.0 * m.log10()), format!("{:.1}", m / o.noise)]);
+    let mut t = Table::new(&["step", "misfit", "(dB)", "x noise", "dBIC of the step"]);
+    let mut bics: Vec<String> = vec![String::new(); 1];
+    if o.findings.iter().any(|f| !f.corrections.is_empty()) {
+        bics.push(String::new());
+    }
+    if let Some(d) = &o.declared {
+        bics.push(format!("{:.1}", d.delta_bic));
+    }
+    for s in &o.steps {
+        bics.push(String::new());
+        bics.push(format!("{:.1}", s.delta_bic));
+    }
+    for ((label, m), bic) in o.stages().into_iter().zip(bics) {
+        t.row(vec![label, format!("{m:.4e}"), format!("{:.1}", 20.0 * m.log10()), format!("{:.1}", m / o.noise), bic]);
     }
     outln!("{}", t.render());
     outln!("noise level estimated from the data: {:.3e}", o.noise);
-    outln!("\nstopped: {}", o.stop.describe());
+    outln!("\nstopped: {}", o.stop_reason);
     let last = o.final_misfit();
-    if last <= CONSISTENT * o.noise {
+    if o.explained() {
         outln!(
             "the final misfit is {:.2} times the noise: the model explains the data down to their noise",
             last / o.noise
         );
+    } else if last <= CONSISTENT * o.noise {
+        outln!("the final misfit is {:.2} times the noise", last / o.noise);
     } else {
-        outln!(
-            "the final misfit is {:.1} times the noise: something the candidates cannot represent remains",
-            last / o.noise
-        );
+        outln!("the final misfit is {:.1} times the noise; what remains unexplained:", last / o.noise);
+        for r in &o.remains {
+            outln!("  - {r}");
+        }
     }
-    if let Some(s) = o.steps.last() {
+    let last_update = match (o.steps.last(), &o.declared) {
+        (Some(s), _) => Some((&s.parameters, &s.uncertainty)),
+        (None, Some(d)) => Some((&d.parameters, &d.uncertainty)),
+        (None, None) => None,
+    };
+    if let Some((parameters, uncertainty)) = last_update {
         // the standard deviation shown is the one that includes model error
         // (the residual beyond the noise), which equals the noise's alone when
         // the fit reaches the noise
-        let inflated = s.uncertainty.as_ref().is_some_and(|u| u.inflation > 1.0);
+        let inflated = uncertainty.as_ref().is_some_and(|u| u.inflation > 1.0);
         outln!(
             "\nparameters after the last update (relative standard deviation{}):",
             if inflated { ", widened for the misfit beyond the noise" } else { " from the noise" }
         );
         let mut t = Table::new(&["parameter", "value", "+-1 sd"]);
-        for (i, p) in s.parameters.iter().enumerate() {
-            let sd = s
-                .uncertainty
+        for (i, p) in parameters.iter().enumerate() {
+            let sd = uncertainty
                 .as_ref()
                 .and_then(|u| u.parameters.get(i))
                 .map_or("-".to_string(), |u| crate::table::percent(u.relative_std));
