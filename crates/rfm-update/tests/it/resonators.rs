@@ -85,6 +85,7 @@ fn a_tuned_mass_damper_at_the_tip_is_found_with_its_values() {
     let mut opts = DiagnoseOptions::default();
     opts.candidates.resonator_hz = vec![extra];
     let d = diagnose(&nominal.model, &measured, &opts).unwrap();
+    println!("extra mode at {extra:.2} Hz; {} candidates tried", d.tried);
     for r in d.ranking.iter().take(5) {
         println!("{:<55} dBIC {:>10.1} misfit {:.4}", r.description, r.delta_bic, r.misfit);
     }
