@@ -1,6 +1,8 @@
 //! Diagnosis: which physical effect is missing from the model.
 //!
-//! Every candidate effect ([`candidates`]) is fitted to the measured FRFs by
+//! Every candidate effect ([`candidates`]; attached resonators only where
+//! [`CandidateOptions::resonator_hz`] names the frequencies of measured
+//! modes the model lacks) is fitted to the measured FRFs by
 //! the output-error estimator on the complex-log misfit `ln(H / M)`, which
 //! stays well behaved when a resonance is shifted by more than its width
 //! (one linearised step from the nominal model does not: it ranks a 40 %
@@ -587,6 +589,9 @@ fn diagnose_in(
             lines.len()
         )));
     }
+    if let Some(&f) = opts.candidates.resonator_hz.iter().find(|f| !(f.is_finite() && **f > 0.0)) {
+        return Err(UpdateError::Data(format!("a resonator's frequency must be positive and finite, got {f} Hz")));
+    }
     let nominal = DampedSystem::new(model.clone())?;
     // the nominal model at every line read below, in one synthesis (on a
     // 96k-DOF frame, 2 s saved against one per line set)
@@ -644,7 +649,8 @@ fn rank(pool: Pool<'_>, noise: f64, full: &LineSet, opts: &DiagnoseOptions) -> D
         Ranked {
             kind: c.kind,
             gains: f.gains.clone(),
-            description: c.description.clone(),
+            // at its fitted values: a resonator's names its fitted tuning
+            description: c.description_at(&f.values),
             nodes: c.nodes.clone(),
             elements: c.elements.clone(),
             dof: c.dofs.iter().map(|d| d.to_string()).collect(),
@@ -681,15 +687,17 @@ fn rank(pool: Pool<'_>, noise: f64, full: &LineSet, opts: &DiagnoseOptions) -> D
         pool.by_screening(&rest).into_iter().map(|i| ranked(i, pool.screened[i].as_ref().expect("screened"), false)),
     );
     let recommended = ranking.iter().position(|r| r.fully_fitted && r.significant && r.plausible).map(|r| r + 1);
-    let ranked: std::collections::HashSet<usize> = ranking.iter().map(|r| r.candidate).collect();
+    // a ranked candidate is listed under the description it is ranked with
+    let ranked: std::collections::HashMap<usize, &str> =
+        ranking.iter().map(|r| (r.candidate, r.description.as_str())).collect();
     let unfitted = (0..pool.candidates.len())
         .filter_map(|i| {
             let (stage, reason) = pool.failure[i].clone()?;
             Some(Unfitted {
-                description: pool.candidates[i].description.clone(),
+                description: ranked.get(&i).map_or_else(|| pool.candidates[i].description.clone(), |d| d.to_string()),
                 reason,
                 stage,
-                ranked: ranked.contains(&i),
+                ranked: ranked.contains_key(&i),
             })
         })
         .collect();

@@ -55,6 +55,8 @@ fn family(kind: EffectKind) -> u8 {
         EffectKind::LumpedMass | EffectKind::MassChange => 1,
         EffectKind::ViscousDamping | EffectKind::NonViscousDamping => 2,
         EffectKind::FlexibleSupport => 3,
+        // a mode of its own: nothing else stands in for it
+        EffectKind::Resonator => 4,
     }
 }
 

@@ -13,6 +13,7 @@ mod numerics;
 mod output_error;
 mod paper_cases;
 mod per_direction;
+mod resonators;
 mod sensitivity;
 mod setup_checks;
 mod study;
