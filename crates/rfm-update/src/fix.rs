@@ -731,7 +731,7 @@ pub fn fix(
     let mut fl = Loop { data: p.data, opts, evidence: Evidence { noise, significance: d_opts.significance } };
     let (nominal, corrected) = (p.nominal_misfit, p.corrected_misfit);
     let mut findings = p.findings;
-    let extra_hz = p.extra_modes_hz;
+    let mut extra_hz = p.extra_modes_hz;
     let declared = p.declared;
     let mut current = p.case;
     let mut state = p.state;
@@ -893,9 +893,11 @@ pub fn fix(
         }
         // the data's own errors again, against the model the evidence now
         // prefers: a large model error can hide a misplaced or miscalibrated
-        // sensor from the first check
+        // sensor from the first check; and the modes it still lacks (a
+        // resonator added explains its mode, which is not offered again)
         if opts.check_data {
             let sys = damping::DampedSystem::new(current.model.clone())?;
+            extra_hz = checks::extra_modes(&sys, &fl.data)?.iter().filter_map(|f| f.frequency_hz).collect();
             let late: Vec<Finding> = checks::check_channels(&sys, &fl.data, &check_options(opts, noise))?
                 .into_iter()
                 .filter(|f| !f.corrections.is_empty())
