@@ -3,6 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use fe_model::case::Gains;
+use frf::FrfSet;
 use indicatif::ProgressBar;
 use rfm_update::Study;
 use rfm_update::diagnose::{Diagnosis, diagnose_with};
@@ -14,60 +15,34 @@ use crate::output::Outputs;
 use crate::table::{Table, num, percent};
 
 /// Options of the diagnose command.
-pub(crate) struct DiagnoseArgs<'a> {
-    pub(crate) case: &'a Path,
-    pub(crate) measured: Option<&'a Path>,
-    pub(crate) json: bool,
-    pub(crate) apply: Option<usize>,
-    pub(crate) out: Option<&'a Path>,
-    pub(crate) top: usize,
-    pub(crate) verbose: bool,
+pub struct DiagnoseArgs<'a> {
+    /// The case file.
+    pub case: &'a Path,
+    /// Measured FRFs instead of the case's.
+    pub measured: Option<&'a Path>,
+    /// Print JSON instead of tables.
+    pub json: bool,
+    /// Write the case with the effect of this rank added.
+    pub apply: Option<usize>,
+    /// The new case file of `apply`.
+    pub out: Option<&'a Path>,
+    /// Rows of the ranking to print.
+    pub top: usize,
+    /// Print each stage with its time.
+    pub verbose: bool,
 }
 
-pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
+/// `rfm diagnose`: prints the ranking (or `--json`) and with `--apply`
+/// writes the case with an effect added.
+pub fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
     let mut study = Study::load(args.case)?;
-    let mut inputs = study.case().inputs();
-    inputs.extend(args.measured.map(Path::to_path_buf));
-    let mut output = match (args.apply, args.out) {
-        (Some(_), Some(out)) => Some(Outputs::file(out, &inputs)?),
+    let mut outputs = match (args.apply, args.out) {
+        (Some(_), Some(out)) => Some(apply_outputs(&study, args.measured, out)?),
         _ => None,
     };
-    // A case whose data come from its [truth] cannot keep the truth once an
-    // effect is added: a truth that adds the same joint or mass would add
-    // it twice. The new case gets the synthesised data beside it instead
-    // (as every step of `rfm fix` does), written before the case.
-    let synthesised = args.measured.is_none()
-        && study.case().measurement.as_ref().is_some_and(|m| m.data.is_none())
-        && study.case().truth.is_some();
-    let mut data_output = match (args.apply, args.out) {
-        (Some(_), Some(out)) if synthesised => {
-            let path = data_beside(out);
-            Some((Outputs::file(&path, &inputs)?, path))
-        }
-        _ => None,
-    };
-    let (measured, notes) = match args.measured {
-        Some(path) => {
-            let read = read_measured_for(study.system(), path, study.case().measurement.as_ref())?;
-            study.set_gains_for(&read)?;
-            let mut notes = read.notes.clone();
-            if study.gains() != Gains::None {
-                notes.push(format!(
-                    "model FRFs are multiplied by fitted gains ({}): {}",
-                    study.gains(),
-                    study.gains_reason()
-                ));
-            }
-            print_notes(&notes, args.json)?;
-            print_masked(&describe_masked(&read.masked), args.json)?;
-            (read.set.to_receptance(), notes)
-        }
-        None => {
-            print_notes(study.notes(), args.json)?;
-            print_masked(&describe_masked(study.masked()), args.json)?;
-            (study.measured().clone(), study.notes().to_vec())
-        }
-    };
+    let (measured, notes, masked) = diagnosis_data(&mut study, args.measured)?;
+    print_notes(&notes, args.json)?;
+    print_masked(&masked, args.json)?;
     if !args.json {
         outln!("{}", study.case().model.title);
         outln!(
@@ -98,24 +73,100 @@ pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
     }
     if let Some(rank) = args.apply {
         let out = args.out.ok_or("--apply needs --out FILE for the new case file")?;
-        let data = data_output.as_ref().map(|(_, path)| path.clone());
-        let editor = d.apply_with_data(study.case(), rank, data.as_deref())?;
-        if let Some((mut data, path)) = data_output.take() {
-            data.write_file(frf::io::csv::to_csv_string(study.measured()).as_bytes())?;
-            data.commit()?;
-            if !args.json {
+        let outputs = outputs.take().ok_or("--apply needs --out FILE for the new case file")?;
+        let data = write_apply(&study, &d, rank, out, outputs)?;
+        if !args.json {
+            if let Some(path) = data {
                 outln!("\nwrote {} with the data synthesised from the case's [truth]", path.display());
             }
-        }
-        let text = editor.text_at(out)?;
-        let mut output = output.take().ok_or("--apply needs --out FILE for the new case file")?;
-        output.write_file(text.as_bytes())?;
-        output.commit()?;
-        if !args.json {
             outln!("\nwrote {} with effect {rank} added", out.display());
         }
     }
     Ok(Exit::Success)
+}
+
+/// The measured receptances `rfm diagnose` fits: the file `measured` as
+/// `--measured` reads it (the study's gains decided again for it), or the
+/// study's own data; with the notes on reading them and what the case's
+/// mask left out.
+pub fn diagnosis_data(study: &mut Study, measured: Option<&Path>) -> Result<(FrfSet, Vec<String>, Vec<String>)> {
+    Ok(match measured {
+        Some(path) => {
+            let read = read_measured_for(study.system(), path, study.case().measurement.as_ref())?;
+            study.set_gains_for(&read)?;
+            let mut notes = read.notes.clone();
+            if study.gains() != Gains::None {
+                notes.push(format!(
+                    "model FRFs are multiplied by fitted gains ({}): {}",
+                    study.gains(),
+                    study.gains_reason()
+                ));
+            }
+            (read.set.to_receptance(), notes, describe_masked(&read.masked))
+        }
+        None => (study.measured().clone(), study.notes().to_vec(), describe_masked(study.masked())),
+    })
+}
+
+/// The outputs of `--apply` into `out`, opened before the diagnosis: the
+/// case, and where the study's data come from its `[truth]` (and not from
+/// `measured`), the data beside it.
+fn apply_outputs(study: &Study, measured: Option<&Path>, out: &Path) -> Result<(Outputs, Option<(Outputs, PathBuf)>)> {
+    let mut inputs = study.case().inputs();
+    inputs.extend(measured.map(Path::to_path_buf));
+    let output = Outputs::file(out, &inputs)?;
+    // A case whose data come from its [truth] cannot keep the truth once an
+    // effect is added: a truth that adds the same joint or mass would add
+    // it twice. The new case gets the synthesised data beside it instead
+    // (as every step of `rfm fix` does), written before the case.
+    let synthesised = measured.is_none()
+        && study.case().measurement.as_ref().is_some_and(|m| m.data.is_none())
+        && study.case().truth.is_some();
+    let data = if synthesised {
+        let path = data_beside(out);
+        Some((Outputs::file(&path, &inputs)?, path))
+    } else {
+        None
+    };
+    Ok((output, data))
+}
+
+/// Writes the case with the effect of `rank` added as `out`, and the
+/// synthesised data beside it when it needs them; returns their path.
+fn write_apply(
+    study: &Study,
+    d: &Diagnosis,
+    rank: usize,
+    out: &Path,
+    (mut output, data_output): (Outputs, Option<(Outputs, PathBuf)>),
+) -> Result<Option<PathBuf>> {
+    let data = data_output.as_ref().map(|(_, path)| path.clone());
+    let editor = d.apply_with_data(study.case(), rank, data.as_deref())?;
+    if let Some((mut data, _)) = data_output {
+        data.write_file(frf::io::csv::to_csv_string(study.measured()).as_bytes())?;
+        data.commit()?;
+    }
+    let text = editor.text_at(out)?;
+    output.write_file(text.as_bytes())?;
+    output.commit()?;
+    Ok(data)
+}
+
+/// Writes what `rfm diagnose --apply RANK --out CASE` writes for the
+/// diagnosis `d` of `study` (made from the study's own data when `measured`
+/// is `None`, else from that file): the case with the effect of rank
+/// `rank` added, and when the study's data come from its `[truth]`, those
+/// data beside it (`CASE-measured.csv`, whose path is returned), each file
+/// all or nothing.
+pub fn write_applied(
+    study: &Study,
+    d: &Diagnosis,
+    rank: usize,
+    measured: Option<&Path>,
+    out: &Path,
+) -> Result<Option<PathBuf>> {
+    let outputs = apply_outputs(study, measured, out)?;
+    write_apply(study, d, rank, out, outputs)
 }
 
 /// `NEW-measured.csv` beside the new case `NEW.toml`.
