@@ -224,7 +224,7 @@ impl From<OutputError> for Failure {
 }
 
 /// A failed print: standard output is full or broken (a closed pipe is
-/// handled before, see [`crate::print_line`]).
+/// handled before, see `print_line` in `lib.rs`).
 impl From<std::io::Error> for Failure {
     fn from(e: std::io::Error) -> Self {
         Failure::new(Exit::Output, format!("standard output: cannot write: {e}"))

@@ -45,7 +45,7 @@ pub struct ReportOptions {
     /// Scale of every frequency axis.
     pub frequency_scale: FrequencyScale,
     /// Lines of measured coherence below it are shaded in the FRF figures
-    /// (the case's `[measurement] coherence_threshold`, see [`Self::for_case`]).
+    /// (the case's `[measurement] coherence_threshold`, see `ReportOptions::for_case`).
     pub coherence_threshold: f64,
 }
 

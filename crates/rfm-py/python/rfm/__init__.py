@@ -9,7 +9,7 @@ result serialises as the command's ``--json`` and saves the command's files.
 >>> case = rfm.load_case("cases/tutorial/l-frame.toml")
 >>> d = rfm.diagnose(case)              # doctest: +SKIP
 >>> d.leader.description                # doctest: +SKIP
-'joint at node 13 (...)'
+'flexible, lossy joint at node 13 (element 13; kr; viscous)'
 >>> result = rfm.fix(case, steps=3)     # doctest: +SKIP
 >>> result.save("out/fix")              # doctest: +SKIP
 
@@ -63,7 +63,10 @@ __all__ = [
 
 logger = logging.getLogger("rfm")
 
+#: What ``progress=`` takes: None, a callable given each stage's message,
+#: or True for a tqdm bar.
 Progress = Union[None, bool, Callable[[str], Any]]
+#: What ``measured=`` takes: None (the case's own data), a file, or FRFs.
 Measured = Union[None, str, "os.PathLike[str]", FrfData]
 
 
