@@ -144,6 +144,10 @@ def test_a_wrong_shape_is_a_data_error() -> None:
 
 
 def test_to_sdynpy_needs_sdynpy_or_gives_its_array() -> None:
+    import os
+
+    # SDynPy imports Qt, which needs no display this way
+    os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
     data = rfm.Case.from_toml(SPRING_MASS).simulate()
     try:
         import sdynpy  # noqa: F401
@@ -152,4 +156,9 @@ def test_to_sdynpy_needs_sdynpy_or_gives_its_array() -> None:
             data.to_sdynpy()
     else:
         tf = data.to_sdynpy()
-        np.testing.assert_array_equal(tf.ordinate[0, 0], data.h[:, 0, 0])
+        assert tf.shape == (3, 1)
+        for o in range(3):
+            np.testing.assert_array_equal(tf.ordinate[o, 0], data.h[:, o, 0])
+            np.testing.assert_array_equal(tf.abscissa[o, 0], data.freq)
+        assert "1X+" in str(tf.coordinate[1, 0]) and "1Y+" in str(tf.coordinate[1, 0])
+        assert "1RZ+" in str(tf.coordinate[2, 0])
