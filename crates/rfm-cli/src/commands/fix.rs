@@ -2,7 +2,7 @@
 //! until nothing significant remains; the case after every step, and a
 //! report whose headline is the fall of the misfit.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use rfm_update::Study;
 use rfm_update::fix::{CONSISTENT, FixOptions, FixOutcome, FixProgress, FixStop, fix as run_fix};
@@ -17,29 +17,56 @@ use crate::table::{Table, num};
 const DATA_FILE: &str = "measured.csv";
 
 /// Options of the fix command.
-pub(crate) struct FixArgs<'a> {
-    pub(crate) case: &'a Path,
-    pub(crate) out: &'a Path,
-    pub(crate) steps: usize,
-    pub(crate) json: bool,
-    pub(crate) report: crate::report::ReportOptions,
+pub struct FixArgs<'a> {
+    /// The case file.
+    pub case: &'a Path,
+    /// The output folder.
+    pub out: &'a Path,
+    /// Most effects to add.
+    pub steps: usize,
+    /// Print JSON instead of tables.
+    pub json: bool,
+    /// How the report draws.
+    pub report: crate::report::ReportOptions,
 }
 
-pub(crate) fn fix(args: &FixArgs<'_>) -> Result<Exit> {
-    let study = Study::load(args.case)?;
-    let inputs = study.case().inputs();
-    // the data every written case reads: the case's own file, or the data
-    // synthesised from its [truth], written once beside the steps
-    let synthesised = study.case().measurement.as_ref().and_then(|m| m.data.as_ref()).is_none();
-    // step 0 (the case's own parameters), and one more than the steps: the
-    // loop may end by replacing an early effect
-    let mut names: Vec<String> = (0..=args.steps + 1).map(step_file).collect();
+/// Whether the study's data are synthesised from its case's `[truth]`:
+/// then `rfm fix` writes them once beside the steps, which read them there.
+fn synthesises(study: &Study) -> bool {
+    study.case().measurement.as_ref().and_then(|m| m.data.as_ref()).is_none()
+}
+
+/// Opens the outputs of `rfm fix` in `dir` for `steps` steps at most.
+fn fix_outputs(study: &Study, steps: usize, dir: &Path) -> Result<Outputs> {
+    // one more than the steps: the loop may end by replacing an early effect
+    let mut names: Vec<String> = (0..=steps + 1).map(step_file).collect();
     names.extend(["results.json", "report.html"].map(String::from));
-    if synthesised {
+    if synthesises(study) {
         names.push(DATA_FILE.into());
     }
     let known: Vec<&str> = names.iter().map(String::as_str).collect();
-    let mut output = Outputs::folder(args.out, &inputs, &known)?;
+    Ok(Outputs::folder(dir, &study.case().inputs(), &known)?)
+}
+
+/// The options of `rfm fix` on `study`: at most `steps` effects, each
+/// diagnosis with the study's options, and where the study's data are
+/// synthesised from its `[truth]`, `data` for the file the cases of the
+/// steps read them from (written by [`save_fix`], which points the cases
+/// at the file it writes).
+pub fn fix_options(study: &Study, steps: usize, data: PathBuf) -> Result<FixOptions> {
+    Ok(FixOptions {
+        max_steps: steps,
+        diagnose: study.diagnose_options(study.measured())?,
+        data: synthesises(study).then_some(data),
+        ..FixOptions::default()
+    })
+}
+
+/// `rfm fix`: prints each step and the outcome (or `--json`) and writes the
+/// cases of the steps, the results and the report.
+pub fn fix(args: &FixArgs<'_>) -> Result<Exit> {
+    let study = Study::load(args.case)?;
+    let mut output = fix_outputs(&study, args.steps, args.out)?;
     print_notes(study.notes(), args.json)?;
     print_masked(&rfm_update::study::describe_masked(study.masked()), args.json)?;
     if !args.json {
@@ -53,57 +80,13 @@ pub(crate) fn fix(args: &FixArgs<'_>) -> Result<Exit> {
             args.steps
         );
     }
-    let opts = FixOptions {
-        max_steps: args.steps,
-        diagnose: study.diagnose_options(study.measured())?,
-        data: synthesised.then(|| output.path(DATA_FILE)),
-        ..FixOptions::default()
-    };
+    let opts = fix_options(&study, args.steps, output.path(DATA_FILE))?;
     let json = args.json;
     let outcome = run_fix(study.case(), study.measured(), &opts, |p| {
         if json {
             return;
         }
-        let lines: Vec<String> = match p {
-            FixProgress::Checked { findings } if findings.is_empty() => {
-                vec!["checked the data for set-up errors: none found".into()]
-            }
-            FixProgress::Checked { findings } => std::iter::once("checked the data for set-up errors:".to_string())
-                .chain(findings.iter().map(|f| {
-                    let fix = if f.corrections.is_empty() { "" } else { " (corrected)" };
-                    format!("  {}{fix}", f.summary)
-                }))
-                .collect(),
-            FixProgress::Declared { step } => vec![format!(
-                "step 0: updated the case's own parameters ({}); misfit {:.4e} -> {:.4e}",
-                step.status.name(),
-                step.misfit_before,
-                step.misfit_updated
-            )],
-            FixProgress::Diagnosed { step, diagnosis } => vec![match diagnosis.leader() {
-                Some(l) => format!("diagnosis {}: {} stands out (dBIC {:.1})", step + 1, l.description, l.delta_bic),
-                None if diagnosis.consistent() => format!("diagnosis {}: nothing significant", step + 1),
-                None => format!("diagnosis {}: significant effects, none at plausible values", step + 1),
-            }],
-            FixProgress::LookedAhead { ahead, .. } => {
-                let what = match &ahead.with {
-                    Some(with) => format!("{} with {with} (fitted together)", ahead.effect),
-                    None => ahead.effect.clone(),
-                };
-                vec![match &ahead.rejected {
-                    _ if ahead.misfit_ahead.is_nan() => {
-                        format!("  tried {what}: {}", ahead.failed.as_deref().unwrap_or("failed"))
-                    }
-                    Some(why) => format!("  tried {what}: misfit {:.4e}, not kept: {why}", ahead.misfit_ahead),
-                    None => format!("  tried {what}: misfit {:.4e}, dBIC {:.1}", ahead.misfit_ahead, ahead.delta_bic),
-                }]
-            }
-            FixProgress::Updated { step, effect, removed, misfit, status } => {
-                let verb = if removed { "took out" } else { "added" };
-                vec![format!("step {}: {verb} {effect} and updated ({}); misfit {misfit:.4e}", step + 1, status.name())]
-            }
-        };
-        for line in lines {
+        for line in progress_lines(&p) {
             // an error here would be the same as at the next print, which reports it
             let _ = crate::print_line(format_args!("{line}"));
         }
@@ -114,6 +97,82 @@ pub(crate) fn fix(args: &FixArgs<'_>) -> Result<Exit> {
         print_outcome(&outcome)?;
     }
 
+    write_fix(&study, &outcome, &args.report, &mut output)?;
+    let written = output.commit()?;
+    if !json {
+        outln!("\nwrote {} files into {}", written.len(), args.out.display());
+        if outcome.final_case().is_some() {
+            let last = if outcome.steps.is_empty() { 0 } else { outcome.steps.len() };
+            outln!("the fixed model: {}", args.out.join(step_file(last)).display());
+        }
+    }
+    Ok(fix_exit(&outcome))
+}
+
+/// What `rfm fix` prints as the loop goes, one line each (the Python
+/// package's progress says the same).
+pub fn progress_lines(p: &FixProgress<'_>) -> Vec<String> {
+    match p {
+        FixProgress::Checked { findings } if findings.is_empty() => {
+            vec!["checked the data for set-up errors: none found".into()]
+        }
+        FixProgress::Checked { findings } => std::iter::once("checked the data for set-up errors:".to_string())
+            .chain(findings.iter().map(|f| {
+                let fix = if f.corrections.is_empty() { "" } else { " (corrected)" };
+                format!("  {}{fix}", f.summary)
+            }))
+            .collect(),
+        FixProgress::Declared { step } => vec![format!(
+            "step 0: updated the case's own parameters ({}); misfit {:.4e} -> {:.4e}",
+            step.status.name(),
+            step.misfit_before,
+            step.misfit_updated
+        )],
+        FixProgress::Diagnosed { step, diagnosis } => vec![match diagnosis.leader() {
+            Some(l) => format!("diagnosis {}: {} stands out (dBIC {:.1})", step + 1, l.description, l.delta_bic),
+            None if diagnosis.consistent() => format!("diagnosis {}: nothing significant", step + 1),
+            None => format!("diagnosis {}: significant effects, none at plausible values", step + 1),
+        }],
+        FixProgress::LookedAhead { ahead, .. } => {
+            let what = match &ahead.with {
+                Some(with) => format!("{} with {with} (fitted together)", ahead.effect),
+                None => ahead.effect.clone(),
+            };
+            vec![match &ahead.rejected {
+                _ if ahead.misfit_ahead.is_nan() => {
+                    format!("  tried {what}: {}", ahead.failed.as_deref().unwrap_or("failed"))
+                }
+                Some(why) => format!("  tried {what}: misfit {:.4e}, not kept: {why}", ahead.misfit_ahead),
+                None => format!("  tried {what}: misfit {:.4e}, dBIC {:.1}", ahead.misfit_ahead, ahead.delta_bic),
+            }]
+        }
+        FixProgress::Updated { step, effect, removed, misfit, status } => {
+            let verb = if *removed { "took out" } else { "added" };
+            vec![format!("step {}: {verb} {effect} and updated ({}); misfit {misfit:.4e}", step + 1, status.name())]
+        }
+    }
+}
+
+/// The exit code of `rfm fix`: success only when the loop ended with the
+/// data explained down to their noise; a model that stays above it with
+/// nothing the evidence singles out (or several effects it cannot tell
+/// apart) is inadequate.
+pub fn fix_exit(outcome: &FixOutcome) -> Exit {
+    match outcome.stop {
+        _ if outcome.explained() => Exit::Success,
+        FixStop::ModelInadequate | FixStop::Ambiguous => Exit::ModelInadequate,
+        _ => Exit::NotConverged,
+    }
+}
+
+/// Writes the outputs of `rfm fix` (not yet committed).
+fn write_fix(
+    study: &Study,
+    outcome: &FixOutcome,
+    report: &crate::report::ReportOptions,
+    output: &mut Outputs,
+) -> Result<()> {
+    let synthesised = synthesises(study);
     let data_file = synthesised.then(|| output.path(DATA_FILE));
     if synthesised {
         output.write(DATA_FILE, frf::io::csv::to_csv_string(study.measured()).as_bytes())?;
@@ -133,23 +192,25 @@ pub(crate) fn fix(args: &FixArgs<'_>) -> Result<Exit> {
         output.write(&name, text.as_bytes())?;
     }
     output.write("results.json", serde_json::to_string_pretty(&outcome)?.as_bytes())?;
-    crate::report::fix_report::write(&study, &outcome, &args.report.for_case(study.case()), &mut output)?;
-    let written = output.commit()?;
-    if !json {
-        outln!("\nwrote {} files into {}", written.len(), args.out.display());
-        if outcome.final_case().is_some() {
-            let last = if outcome.steps.is_empty() { 0 } else { outcome.steps.len() };
-            outln!("the fixed model: {}", args.out.join(step_file(last)).display());
-        }
-    }
-    // success only when the loop ended with the data explained down to their
-    // noise; a model that stays above it with nothing the evidence singles
-    // out (or several effects it cannot tell apart) is inadequate
-    Ok(match outcome.stop {
-        _ if outcome.explained() => Exit::Success,
-        FixStop::ModelInadequate | FixStop::Ambiguous => Exit::ModelInadequate,
-        _ => Exit::NotConverged,
-    })
+    crate::report::fix_report::write(study, outcome, &report.for_case(study.case()), output)?;
+    Ok(())
+}
+
+/// Writes what `rfm fix --out DIR` writes for `outcome` (the loop on
+/// `study` with at most `steps` effects) into `dir`, all or nothing: the
+/// case after every step (`step-1.toml`, ...), `results.json`,
+/// `report.html` and the figures, and the data synthesised from the case's
+/// `[truth]` (`measured.csv`) where the steps read them; returns the files.
+pub fn save_fix(
+    study: &Study,
+    outcome: &FixOutcome,
+    steps: usize,
+    dir: &Path,
+    report: &crate::report::ReportOptions,
+) -> Result<Vec<PathBuf>> {
+    let mut output = fix_outputs(study, steps, dir)?;
+    write_fix(study, outcome, report, &mut output)?;
+    Ok(output.commit()?)
 }
 
 fn print_outcome(o: &FixOutcome) -> Result<()> {
