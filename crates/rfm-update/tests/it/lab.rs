@@ -1741,10 +1741,11 @@ pub(crate) fn walkthrough_truth(t: &LabTrial, r: &Resonator) -> String {
     let mu = r.damp.mu.map_or(String::new(), |mu| format!("mu = {}                 # rad/s: non-viscous\n", num(mu)));
     format!(
         "# The answer to the lab walkthrough (do not read it before you have tried!).\n#\n\
-         # The frame that was measured: the model of lab-frame.toml with a resonator\n\
-         # on the arm, {res}. The test set-up\n\
-         # also went wrong: {setup}. Written by\n\
-         # crates/rfm-update/tests/it/lab.rs (LAB_CASES_WRITE=1 rewrites it).\n\n\
+         # The frame that was measured: the model of lab-frame.toml with a\n\
+         # {res}.\n\
+         # The test set-up also went wrong: {setup} (in the data,\n\
+         # not in this file). Written by crates/rfm-update/tests/it/lab.rs\n\
+         # (LAB_CASES_WRITE=1 rewrites it).\n\n\
          title = \"Steel L-frame with a resonator (lab walkthrough truth)\"\n\
          nodes = [[{id}, {x}, {y}]]      # the resonator's mass, at node {node}'s place\n\n{body}\n\
          [groups.resonator]\nalpha = {alpha}\n{mu}\n\
