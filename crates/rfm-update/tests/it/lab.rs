@@ -41,6 +41,11 @@
 //! channels, and a resonator's truth has as many more modes in band than
 //! the nominal model as the resonator has directions (a fin at least one).
 //!
+//! A study draws its trials with [`trials`] (every family, and every set-up
+//! error with a structural effect), gives each nominal case the data of
+//! [`LabTrial::measure`], and scores what the tool concludes against
+//! [`LabTrial::expect`].
+//!
 //! `LAB_DUMP=DIR` writes a sample of trials (one per family and a few
 //! combinations) as cases to run `rfm fix` on by hand; `LAB_CASES_WRITE=1`
 //! rewrites the committed acceptance cases
@@ -1536,6 +1541,24 @@ fn finish(
     }
 }
 
+/// A study's trials from `seed`: `per` of every family, each on a structure
+/// it fits, then `per` of every set-up error with a structural effect of a
+/// family drawn from truths.rs's (13 x per + 5 x per trials: 72 at 4).
+pub(crate) fn trials(per: usize, seed: u64) -> Vec<LabTrial> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut all = Vec::new();
+    for family in LabFamily::ALL {
+        all.extend((0..per).map(|_| draw(&mut rng, family, None)));
+    }
+    for family in LabFamily::ALL.into_iter().filter(|f| f.is_setup()) {
+        for _ in 0..per {
+            let structural = Family::ALL[rng.random_range(0..Family::ALL.len())];
+            all.push(draw(&mut rng, family, Some(structural)));
+        }
+    }
+    all
+}
+
 // ------------------------------------------------------- the fixed trials
 
 /// The acceptance trials of issue 32, committed under
@@ -2629,6 +2652,23 @@ mod tests {
         let e = &effects(&t)[0];
         assert_eq!(e.family, "resonator");
         assert!((12..=23).contains(&e.nodes[0]), "on the arm");
+    }
+
+    /// A study's trials: every family and every pairing of a set-up error
+    /// with a structural effect, all distinct.
+    #[test]
+    fn a_study_draws_every_family_and_pairing() {
+        let all = trials(2, 47);
+        assert_eq!(all.len(), 2 * 13 + 2 * 5);
+        for family in LabFamily::ALL {
+            assert_eq!(all.iter().filter(|t| t.family == family && t.with.is_none()).count(), 2, "{family:?}");
+        }
+        assert!(all.iter().filter(|t| t.with.is_some()).all(|t| t.family.is_setup()));
+        let mut labels: Vec<&String> = all.iter().map(|t| &t.label).collect();
+        labels.sort();
+        labels.dedup();
+        assert_eq!(labels.len(), all.len());
+        assert!(Structure::ALL.iter().all(|&s| all.iter().any(|t| t.structure == s)), "both structures");
     }
 
     /// A sample of every family and of set-up errors with structural
