@@ -729,7 +729,14 @@ impl LabTrial {
     pub(crate) fn dump_as(&self, dir: &Path, names: &FileNames, seed: u64) -> std::io::Result<()> {
         std::fs::create_dir_all(dir)?;
         std::fs::write(dir.join(&names.nominal), names.nominal_text(self))?;
-        std::fs::write(dir.join(&names.data), csv_text(&self.measure(seed), self.gain.is_some()))?;
+        let data = self.measure(seed);
+        let per_volt = self.gain.is_some();
+        let bytes = if names.data.ends_with(".uff") {
+            uff_bytes(&data, per_volt)
+        } else {
+            csv_text(&data, per_volt).into_bytes()
+        };
+        std::fs::write(dir.join(&names.data), bytes)?;
         std::fs::write(dir.join(&names.truth), &self.truth)?;
         std::fs::write(dir.join(&names.expect), self.expect_text(seed))
     }
@@ -761,6 +768,21 @@ impl FileNames {
         assert_eq!(t.nominal.matches(&from).count(), 1, "the nominal case reads its data once");
         t.nominal.replace(&from, &format!("data = \"{}\"", self.data))
     }
+}
+
+/// A set as a universal file (ASCII dataset 58, complex double), its
+/// denominators in volts when per volt, as a test system exports it: a
+/// case reads it through its `[[measurement.map]]`, whose `sign = -1`
+/// corrects an inverted channel (the CSV reader names model DOFs and
+/// ignores the map).
+pub(crate) fn uff_bytes(set: &FrfSet, per_volt: bool) -> Vec<u8> {
+    use frf::io::uff::{self, DataAxis, Encoding, UffWriteOptions};
+    let mut functions =
+        uff::frf_set_to_functions(set, &UffWriteOptions::default()).expect("FRFs a universal file holds");
+    for f in functions.iter_mut().filter(|f| per_volt && f.header.function_type == uff::FUNCTION_FRF) {
+        f.header.denominator = DataAxis::new(0, "Voltage", "V");
+    }
+    uff::encode(&functions, Encoding::Ascii).expect("an encodable file")
 }
 
 /// A set as CSV with eight significant digits (far below the noise, and
@@ -2527,6 +2549,46 @@ mod tests {
             let text = std::fs::read_to_string(dir.join("expect.txt")).unwrap();
             assert_eq!(Expect::from_toml(&text).unwrap(), t.expect);
             assert_eq!(std::fs::read_to_string(dir.join("truth.toml")).unwrap(), t.truth);
+        }
+    }
+
+    /// A trial dumped with a universal file reads as its CSV does, and the
+    /// polarity finding's correction, `sign = -1` in the case's map for the
+    /// channel's test point, restores the channel; on the driving point the
+    /// same entry would also turn the reference, and every channel with it.
+    #[test]
+    fn a_universal_file_reads_as_the_csv_and_its_map_corrects_the_polarity() {
+        let t = find(
+            48,
+            Structure::LFrame,
+            LabFamily::Polarity,
+            |t| matches!(t.setup[..], [SetupError::Polarity { channel }] if t.channels[channel].response != t.channels[channel].reference),
+        );
+        let [SetupError::Polarity { channel }] = t.setup[..] else { panic!() };
+        let tmp = tempfile::tempdir().unwrap();
+        let names = FileNames { data: "measured.uff".into(), ..FileNames::default() };
+        t.dump_as(tmp.path(), &names, 12).unwrap();
+        let load = |text: &str| {
+            std::fs::write(tmp.path().join("nominal.toml"), text).unwrap();
+            rfm_update::Study::load(&tmp.path().join("nominal.toml")).unwrap().measured().clone()
+        };
+        let as_written = load(&names.nominal_text(&t));
+        let want = t.measure(12).to_receptance();
+        for c in 0..want.channels().len() {
+            assert!(worst(want.channel(c), as_written.channel(c)) < 1e-9, "{}", want.channels()[c]);
+        }
+        let r = t.channels[channel].response;
+        let axis = if r.dof == Dof::Ux { "X" } else { "Y" };
+        let entry = format!("\n[[measurement.map]]\ntest = \"{}:+{axis}\"\nmodel = \"{r}\"\nsign = -1\n", r.node.0);
+        let corrected = load(&format!("{}{entry}", names.nominal_text(&t)));
+        let truth = receptance(&t.truth, &t.channels, &t.lines_hz);
+        for (c, ch) in t.channels.iter().enumerate() {
+            let flipped: Vec<C64> = as_written.channel(c).iter().map(|v| -v).collect();
+            let expected = if c == channel { flipped } else { as_written.channel(c).to_vec() };
+            assert!(worst(&expected, corrected.channel(c)) < 1e-12, "{ch}");
+            // the corrected data are the truth's with the trial's 1 % noise
+            let error = channel_rms(of(&truth, ch.response, ch.reference), corrected.channel(c));
+            assert!(error < 2.0 * NOISE, "{ch}: {error} from the truth");
         }
     }
 
