@@ -8,6 +8,7 @@ mod fast_vs_naive;
 mod held_out;
 mod hidden_effects;
 mod hidden_effects_3d;
+mod lab;
 mod noise_estimate;
 mod numerics;
 mod output_error;
