@@ -278,8 +278,10 @@ pub struct FixOutcome {
     /// extra mode at f Hz, a channel, a band, a damping form); empty when
     /// it explains the data to their noise.
     pub remains: Vec<String>,
-    /// Effects as good as each other at the last decision (the stop
-    /// [`FixStop::Ambiguous`]), each with its evidence.
+    /// Effects at different places as good as each other, each with its
+    /// evidence: at the stop [`FixStop::Ambiguous`] (none added), or at an
+    /// earlier step when the loop ends without explaining the data (the
+    /// first listed was kept; nothing after told them apart).
     pub equally_good: Vec<LookAhead>,
     /// The diagnosis of the final model (top of its ranking only).
     pub remaining: Vec<Ranked>,
@@ -567,10 +569,15 @@ fn distinct_leaders(d: &Diagnosis, model: &fe_model::Model, width: usize) -> Vec
 struct Move {
     /// The steps it makes (one or two), each with its own evidence.
     steps: Vec<(Added, f64)>,
-    /// Its evidence over the model before the step, all its parameters counted.
-    delta_bic: f64,
     /// What it reads as in the report.
     record: LookAhead,
+}
+
+impl Move {
+    /// The model the move ends with.
+    fn last(&self) -> &Added {
+        &self.steps.last().expect("a move makes a step").0
+    }
 }
 
 /// The model a step starts from: its misfit and parameter count.
@@ -742,6 +749,8 @@ pub fn fix(
     // the diagnosis and rank of each effect added, to rebuild without one
     let mut applied: Vec<(Diagnosis, usize)> = Vec::new();
     let mut equally_good: Vec<LookAhead> = Vec::new();
+    // the first step at which effects elsewhere were as good as the one kept
+    let mut undecided: Vec<LookAhead> = Vec::new();
     let mut last_diagnosis: Option<Result<Diagnosis, String>>;
     let mut rejected_all: Vec<LookAhead> = Vec::new();
     let stop = loop {
@@ -787,11 +796,7 @@ pub fn fix(
                     progress(FixProgress::LookedAhead { step: steps.len(), ahead: &record });
                     let reaches = a.stats.misfit <= CONSISTENT * noise;
                     if verdict.rejected.is_none() {
-                        moves.push(Move {
-                            steps: vec![(a.clone(), verdict.delta_bic)],
-                            delta_bic: verdict.delta_bic,
-                            record,
-                        });
+                        moves.push(Move { steps: vec![(a.clone(), verdict.delta_bic)], record });
                     } else {
                         tried.push(record);
                     }
@@ -844,14 +849,22 @@ pub fn fix(
                 FixStop::ModelInadequate
             };
         }
-        moves.sort_by(|a, b| a.delta_bic.total_cmp(&b.delta_bic));
+        // the best move by the criterion against one variance for all: what
+        // the best of them leaves (each move's own dBIC is against its own)
+        let v = moves.iter().map(|m| m.last().stats.lack_of_fit(noise)).fold(f64::INFINITY, f64::min);
+        let score = |m: &Move| {
+            let a = m.last();
+            let n = a.stats.n as f64;
+            n * a.stats.misfit.powi(2) / v + a.outcome.parameters.len() as f64 * n.ln()
+        };
+        moves.sort_by(|a, b| score(a).total_cmp(&score(b)));
         let best = moves.remove(0);
         // alternatives at other places that the evidence cannot tell from the best
-        let first = &best.steps.last().expect("a step").0;
+        let first = best.last();
         let mut alternatives: Vec<LookAhead> = Vec::new();
         for m in moves {
-            let other = &m.steps.last().expect("a step").0;
-            let mut rec = m.record;
+            let other = m.last();
+            let mut rec = m.record.clone();
             let elsewhere = !near(&d, first, other, &current.model);
             let between = fl.evidence.between(first, other);
             if elsewhere && between < -fl.evidence.significance {
@@ -872,9 +885,18 @@ pub fn fix(
             let mut listed = vec![best.record.clone()];
             listed[0].equally_good = true;
             listed.extend(alternatives.iter().filter(|a| a.equally_good).cloned());
-            equally_good = listed;
-            last_diagnosis = Some(Ok(d));
-            break FixStop::Ambiguous;
+            // where the best would be the last effect (it explains the data
+            // to their noise) the data cannot choose, and none is added;
+            // before that, later steps and the revisions may tell them apart,
+            // and the list is kept for the end
+            if first.stats.misfit <= CONSISTENT * noise {
+                equally_good = listed;
+                last_diagnosis = Some(Ok(d));
+                break FixStop::Ambiguous;
+            }
+            if undecided.is_empty() {
+                undecided = listed;
+            }
         }
         alternatives.extend(tried);
         for (k, (added, delta_bic)) in best.steps.into_iter().enumerate() {
@@ -1007,6 +1029,10 @@ pub fn fix(
         FixStop::NothingSignificant if state.misfit > CONSISTENT * noise => FixStop::ModelInadequate,
         s => s,
     };
+    // effects as good as each other at a step, not told apart by the end
+    if equally_good.is_empty() && !(state.misfit <= CONSISTENT * noise && stop == FixStop::NothingSignificant) {
+        equally_good = undecided;
+    }
     let final_sys = damping::DampedSystem::new(current.model.clone())?;
     let remains = if state.misfit > CONSISTENT * noise {
         remains::describe(&final_sys, &fl.data, d_opts, noise, &findings)

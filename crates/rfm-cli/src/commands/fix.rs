@@ -113,7 +113,7 @@ pub fn fix(args: &FixArgs<'_>) -> Result<Exit> {
 /// package's progress says the same).
 pub fn progress_lines(p: &FixProgress<'_>) -> Vec<String> {
     match p {
-        FixProgress::Checked { findings } if findings.is_empty() => {
+        FixProgress::Checked { findings: [] } => {
             vec!["checked the data for set-up errors: none found".into()]
         }
         FixProgress::Checked { findings } => std::iter::once("checked the data for set-up errors:".to_string())

@@ -137,5 +137,5 @@ pub(super) fn best_pair(
         pair.effect = d.ranking[a - 1].clone();
         pair.rank = a;
     }
-    Some(Move { steps: vec![(s1, v1.delta_bic), (pair, second_evidence)], delta_bic: total.delta_bic, record })
+    Some(Move { steps: vec![(s1, v1.delta_bic), (pair, second_evidence)], record })
 }

@@ -131,5 +131,13 @@ pub(super) fn stop_reason(
         }
         FixStop::NothingSignificant | FixStop::StepsDone => {}
     }
+    if stop != FixStop::Ambiguous && equally_good.len() > 1 {
+        let others: Vec<&str> = equally_good[1..].iter().map(|r| r.effect.as_str()).collect();
+        s.push_str(&format!(
+            "; at one step {} was kept, but {} explained the data as well, and nothing after told them apart",
+            equally_good[0].effect,
+            others.join(", ")
+        ));
+    }
     s
 }

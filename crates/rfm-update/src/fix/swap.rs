@@ -34,6 +34,13 @@ fn left_out_sets(n: usize) -> Vec<Vec<usize>> {
 /// are tried as the first replacement.
 const SWAP_WIDTH: usize = 3;
 
+/// A model after an effect was added, with the effect's own evidence
+/// (dBIC over the model before it).
+type Judged = (Added, f64);
+
+/// An effect kept: the diagnosis it came from and its rank there.
+type Effect<'d> = (&'d Diagnosis, usize);
+
 /// For each set of [`left_out_sets`], the other effects are added to the
 /// nominal case as they were diagnosed and everything is updated; then the
 /// data are diagnosed again and an effect added and updated, as many times
@@ -55,9 +62,9 @@ pub(super) fn swap(
     nominal: &CaseFile,
     applied: &[(Diagnosis, usize)],
     before: State,
-) -> Option<(Vec<usize>, Vec<(Added, f64)>)> {
+) -> Option<(Vec<usize>, Vec<Judged>)> {
     let step = fl.opts.max_steps.max(applied.len() + 1);
-    let mut best: Option<(f64, Vec<usize>, Vec<(Added, f64)>)> = None;
+    let mut best: Option<(f64, Vec<usize>, Vec<Judged>)> = None;
     for outs in left_out_sets(applied.len()) {
         let Ok((kept, kept_state, kept_effects)) = kept_case(fl, nominal, applied, &outs, step) else { continue };
         let Ok(first) = diagnose::diagnose(&kept.model, &fl.data, &fl.opts.diagnose) else { continue };
@@ -87,7 +94,7 @@ fn kept_case<'d>(
     applied: &'d [(Diagnosis, usize)],
     outs: &[usize],
     step: usize,
-) -> Result<(CaseFile, State, Vec<(&'d Diagnosis, usize)>), UpdateError> {
+) -> Result<(CaseFile, State, Vec<Effect<'d>>), UpdateError> {
     let effects: Vec<(&Diagnosis, usize)> =
         applied.iter().enumerate().filter(|(j, _)| !outs.contains(j)).map(|(_, (d, r))| (d, *r)).collect();
     let (case, editor) = super::revise::build(nominal, &effects, None, &[], fl)?;
@@ -109,7 +116,7 @@ fn replace(
     rank: usize,
     count: usize,
     step: usize,
-) -> Result<Vec<(Added, f64)>, UpdateError> {
+) -> Result<Vec<Judged>, UpdateError> {
     // the last replacement's model is the answer: its fit restarts
     let a = fl.add_and_update(kept, first, rank, step, count == 1)?;
     let mut effects: Vec<(&Diagnosis, usize)> = kept_effects.to_vec();

@@ -9,6 +9,7 @@ mod held_out;
 mod hidden_effects;
 mod hidden_effects_3d;
 mod lab;
+mod lab_study;
 mod noise_estimate;
 mod numerics;
 mod output_error;

@@ -87,19 +87,18 @@ fn outcome(found: &[Finding], kind: FindingKind, channels: &[Channel]) -> Outcom
     }
 }
 
-/// The set-up errors of one trial, each applied alone to its clean data:
-/// (what, data, kind, channels concerned).
-fn set_up_errors(
-    t: &Truth,
-    sys: &DampedSystem,
-    rng: &mut ChaCha8Rng,
-) -> Option<Vec<(&'static str, FrfSet, FindingKind, Vec<Channel>)>> {
+/// One set-up error applied to clean data: (what, data, kind, channels
+/// concerned).
+type SetUpError = (&'static str, FrfSet, FindingKind, Vec<Channel>);
+
+/// The set-up errors of one trial, each applied alone to its clean data.
+fn set_up_errors(t: &Truth, sys: &DampedSystem, rng: &mut ChaCha8Rng) -> Option<Vec<SetUpError>> {
     let base = clean(t);
     let n = base.channels().len();
     let c = rng.random_range(0..n);
     let ch = base.channels()[c];
     // another channel, not at the driving point, for the moves
-    let other = (0..n).filter(|&k| k != c && base.channels()[k].response != ch.reference).last().unwrap();
+    let other = (0..n).rev().find(|&k| k != c && base.channels()[k].response != ch.reference).unwrap();
     let oc = base.channels()[other];
     // the nearest node (either side, one or two away) whose response differs
     // from the channel's by at least 10 times the noise: a sensor one node
