@@ -1,6 +1,7 @@
 //! `rfm diagnose --apply` for every candidate of every kind: on the
-//! tutorial, the paper's case studies and small sample models, every ranked
-//! effect is written into a new case file in another folder; the written
+//! tutorials (the lab frame's resonators among them), the paper's case
+//! studies and small sample models, every ranked effect is written into a
+//! new case file in another folder; the written
 //! case loads, reads its measured data through a path relative to itself,
 //! and its misfit with the fitted values equals the diagnosis's to 1e-6.
 //! Its `[update]` holds the effect's determined parameters and all its
@@ -32,7 +33,15 @@ const SAMPLES: [(&str, &str); 2] = [
 fn apply_every(case: CaseFile, dir: &Path) -> BTreeSet<String> {
     let title = case.model.title.clone();
     let study = Study::from_case(case).unwrap_or_else(|e| panic!("{title}: {e}"));
-    let opts = DiagnoseOptions::default();
+    let mut opts = DiagnoseOptions::default();
+    // resonators are offered at the measured modes the model lacks, as
+    // `rfm diagnose` and `rfm fix` offer them (the lab frame has one)
+    let sys = DampedSystem::new(study.case().model.clone()).unwrap();
+    opts.candidates.resonator_hz = rfm_update::checks::extra_modes(&sys, study.measured())
+        .unwrap_or_else(|e| panic!("{title}: {e}"))
+        .iter()
+        .filter_map(|f| f.frequency_hz)
+        .collect();
     let d = diagnose(&study.case().model, study.measured(), &opts).unwrap_or_else(|e| panic!("{title}: {e}"));
     // the new cases go into another folder than the case's
     let out = dir.join("written");
@@ -117,7 +126,9 @@ fn every_ranked_effect_applies_to_the_tutorial_the_papers_cases_and_samples() {
         .collect();
     paths.sort();
     paths.push(cases_dir().join("tutorial/l-frame.toml"));
-    assert!(paths.len() >= 8, "the six paper cases, the frame in space and the tutorial");
+    // a frame that carries a resonator (and an inverted channel)
+    paths.push(cases_dir().join("tutorial/lab-frame.toml"));
+    assert!(paths.len() >= 9, "the six paper cases, the frame in space and the tutorials");
     for (k, path) in paths.iter().enumerate() {
         let case = CaseFile::load(path).unwrap();
         kinds.extend(apply_every(case, &tmp.path().join(format!("case-{k}"))));

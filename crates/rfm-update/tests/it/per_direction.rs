@@ -98,7 +98,7 @@ fn diagnosis(clamp: &Clamp) -> (Diagnosis, tempfile::TempDir) {
     let study = Study::from_case(case).unwrap();
     let d = diagnose(&study.case().model, study.measured(), &DiagnoseOptions::default()).unwrap();
     for r in d.ranking.iter().take(6) {
-        println!("{:>14.1}  {}", r.delta_bic, r.description);
+        println!("{:>14.1}  {} (misfit {:.4e}, noise {:.4e})", r.delta_bic, r.description, r.misfit, d.noise);
     }
     (d, tmp)
 }
