@@ -254,6 +254,17 @@ pub enum FixProgress<'a> {
         /// How the update ended.
         status: &'a Status,
     },
+    /// A step is finished and will stay in the outcome: its effect added (or
+    /// taken out) and every parameter updated. It carries the whole step,
+    /// its case among it, so that a caller can keep it (write its case)
+    /// before the loop goes on: an interrupted loop then loses only the
+    /// step under way.
+    StepDone {
+        /// Its place among the steps (0-based).
+        index: usize,
+        /// The step.
+        done: &'a FixStep,
+    },
 }
 
 /// A final misfit within this multiple of the noise is consistent with it:
@@ -548,6 +559,7 @@ pub fn fix(
             applied.push((d, added.rank));
             let tried = if k == 0 { std::mem::take(&mut alternatives) } else { Vec::new() };
             steps.push(FixStep::of(added, tried, None));
+            progress(FixProgress::StepDone { index: steps.len() - 1, done: steps.last().expect("pushed") });
         }
         if let Some(ahead) = &next {
             progress(FixProgress::Diagnosed { step: steps.len(), diagnosis: ahead });
@@ -584,9 +596,11 @@ pub fn fix(
                     s.misfit_added = s.misfit_updated;
                     s.removed = true;
                     steps.push(s);
+                    progress(FixProgress::StepDone { index: steps.len() - 1, done: steps.last().expect("pushed") });
                 } else {
                     effects[r.index] = r.added.effect.clone();
                     steps.push(FixStep::of(r.added, Vec::new(), Some(r.replaced)));
+                    progress(FixProgress::StepDone { index: steps.len() - 1, done: steps.last().expect("pushed") });
                 }
             }
             applied = revised;
@@ -618,6 +632,7 @@ pub fn fix(
             effects.push(a.effect.clone());
             current = a.case.clone();
             steps.push(FixStep::of(a, Vec::new(), (k == 0).then(|| replaced.clone())));
+            progress(FixProgress::StepDone { index: steps.len() - 1, done: steps.last().expect("pushed") });
         }
         last = None;
     }
