@@ -69,9 +69,12 @@ enum Command {
         /// Measured FRF file(s) to use instead of the case's data (channels of several files are joined).
         #[arg(long, value_name = "FILE")]
         measured: Vec<PathBuf>,
-        /// Folder for the report (report.html, compare.json, SVG figures).
+        /// Folder for the report (report.html, compare.json, SVG figures, CSV tables).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Replace the --out folder even when another command's results are in it.
+        #[arg(long)]
+        replace: bool,
         /// Print machine-readable JSON instead of tables.
         #[arg(long)]
         json: bool,
@@ -98,6 +101,15 @@ enum Command {
         /// New case file for --apply.
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Folder for a report of the ranking (report.html, the structure with the leaders marked, ranking.csv).
+        #[arg(long, value_name = "DIR")]
+        report: Option<PathBuf>,
+        /// Replace the --report folder even when another command's results are in it.
+        #[arg(long)]
+        replace: bool,
+        /// Frequency axis of the report's figures: auto (logarithmic for bands of a decade or more), log or linear.
+        #[arg(long, value_enum, default_value = "auto")]
+        frequency_axis: report::plot::axes::FrequencyScale,
         /// Rows of the ranking to print.
         #[arg(long, default_value_t = 10)]
         top: usize,
@@ -113,9 +125,15 @@ enum Command {
         /// Folder for step-1.toml, step-2.toml, ..., results.json, report.html and figures.
         #[arg(long)]
         out: PathBuf,
-        /// Most effects to add.
+        /// Most effects to add (counting those of a resumed run).
         #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u64).range(1..=20))]
         steps: u64,
+        /// Go on from the steps an interrupted run left in --out.
+        #[arg(long)]
+        resume: bool,
+        /// Replace the --out folder even when another command's results are in it.
+        #[arg(long)]
+        replace: bool,
         /// Print machine-readable JSON instead of tables.
         #[arg(long)]
         json: bool,
@@ -136,9 +154,12 @@ enum Command {
     Update {
         /// Case file.
         case: PathBuf,
-        /// Folder for results (results.json, updated.toml, report.html and SVG figures).
+        /// Folder for results (results.json, updated.toml, report.html, SVG figures and CSV tables).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Replace the --out folder even when another command's results are in it.
+        #[arg(long)]
+        replace: bool,
         /// Print machine-readable JSON instead of tables.
         #[arg(long)]
         json: bool,
@@ -190,11 +211,16 @@ static WRITTEN: AtomicBool = AtomicBool::new(false);
 /// The output phase of a command, from [`writing`] until dropped.
 pub(crate) struct Writing {
     _guard: MutexGuard<'static, ()>,
+    /// A checkpoint ([`writing_part`]): the command's outputs are not all
+    /// written when it ends.
+    part: bool,
 }
 
 impl Drop for Writing {
     fn drop(&mut self) {
-        WRITTEN.store(true, Ordering::Relaxed);
+        if !self.part {
+            WRITTEN.store(true, Ordering::Relaxed);
+        }
     }
 }
 
@@ -203,7 +229,14 @@ impl Drop for Writing {
 /// the guard is dropped, so that a run stops either before its outputs move
 /// into place or after, never while they do.
 pub(crate) fn writing() -> Writing {
-    Writing { _guard: WRITING.lock().unwrap_or_else(PoisonError::into_inner) }
+    Writing { _guard: WRITING.lock().unwrap_or_else(PoisonError::into_inner), part: false }
+}
+
+/// As [`writing`], for a checkpoint that puts part of a command's outputs
+/// in place ([`output::Outputs::checkpoint`]): an interrupt waits for it,
+/// and afterwards still counts the run's outputs as not all written.
+pub(crate) fn writing_part() -> Writing {
+    Writing { _guard: WRITING.lock().unwrap_or_else(PoisonError::into_inner), part: true }
 }
 
 fn main() -> ExitCode {
@@ -211,9 +244,11 @@ fn main() -> ExitCode {
     // its staging folder behind for the next run to clean.
     let interrupt = ctrlc::set_handler(|| {
         let _held = WRITING.lock().unwrap_or_else(PoisonError::into_inner);
-        output::abandon_all();
+        let kept = output::abandon_all();
         if WRITTEN.load(Ordering::Relaxed) {
             eprintln!("interrupted after this run's outputs were written");
+        } else if let Some(kept) = kept {
+            eprintln!("interrupted: {kept}; the rest of this run was not written");
         } else {
             eprintln!("interrupted: the outputs of this run were not written (earlier ones are untouched)");
         }
@@ -262,36 +297,54 @@ fn run(cli: Cli) -> commands::Result<Exit> {
                 json,
             })
         }
-        Command::Compare { case, measured, out, json, bands, frequency_axis } => commands::compare(
-            &case,
-            &measured,
-            out.as_deref(),
-            json,
-            &bands,
-            &report::ReportOptions { frequency_scale: frequency_axis, ..Default::default() },
-        ),
-        Command::Diagnose { case, measured, json, apply, out, top, verbose } => {
-            commands::diagnose(&commands::DiagnoseArgs {
+        Command::Compare { case, measured, out, replace, json, bands, frequency_axis } => {
+            commands::compare(&commands::CompareArgs {
                 case: &case,
-                measured: measured.as_deref(),
-                json,
-                apply,
+                measured: &measured,
                 out: out.as_deref(),
-                top,
-                verbose,
+                replace,
+                json,
+                bands: &bands,
+                report: report::ReportOptions { frequency_scale: frequency_axis, ..Default::default() },
             })
         }
-        Command::Fix { case, out, steps, json, frequency_axis } => commands::fix(&commands::FixArgs {
+        Command::Diagnose {
+            case,
+            measured,
+            json,
+            apply,
+            out,
+            report: report_dir,
+            replace,
+            frequency_axis,
+            top,
+            verbose,
+        } => commands::diagnose(&commands::DiagnoseArgs {
+            case: &case,
+            measured: measured.as_deref(),
+            json,
+            apply,
+            out: out.as_deref(),
+            top,
+            verbose,
+            report: report_dir.as_deref(),
+            replace,
+            report_options: report::ReportOptions { frequency_scale: frequency_axis, ..Default::default() },
+        }),
+        Command::Fix { case, out, steps, resume, replace, json, frequency_axis } => commands::fix(&commands::FixArgs {
             case: &case,
             out: &out,
             steps: steps as usize,
             json,
+            replace,
+            resume,
             report: report::ReportOptions { frequency_scale: frequency_axis, ..Default::default() },
         }),
         Command::Inspect { file, json } => commands::inspect(&file, json),
-        Command::Update { case, out, json, method, lines, iterations, frequency_axis } => commands::update(
+        Command::Update { case, out, replace, json, method, lines, iterations, frequency_axis } => commands::update(
             &case,
             out.as_deref(),
+            replace,
             json,
             &commands::UpdateOverrides { method, lines, max_iterations: iterations },
             &report::ReportOptions { frequency_scale: frequency_axis, ..Default::default() },

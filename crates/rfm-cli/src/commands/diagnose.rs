@@ -4,14 +4,15 @@ use std::path::{Path, PathBuf};
 
 use fe_model::case::Gains;
 use indicatif::ProgressBar;
-use rfm_update::Study;
 use rfm_update::diagnose::{Diagnosis, diagnose_with};
 use rfm_update::study::{describe_masked, read_measured_for};
 
+use rfm_update::quantities;
+
 use super::{Result, WithNotes, print_masked, print_notes};
-use crate::exit::Exit;
+use crate::exit::{Exit, Failure};
 use crate::output::Outputs;
-use crate::table::{Table, num, percent};
+use crate::table::{self, Table, num, percent};
 
 /// Options of the diagnose command.
 pub(crate) struct DiagnoseArgs<'a> {
@@ -22,12 +23,30 @@ pub(crate) struct DiagnoseArgs<'a> {
     pub(crate) out: Option<&'a Path>,
     pub(crate) top: usize,
     pub(crate) verbose: bool,
+    /// Folder for the report of the ranking (`--report DIR`).
+    pub(crate) report: Option<&'a Path>,
+    /// Replace a report folder another command wrote.
+    pub(crate) replace: bool,
+    /// How the report draws.
+    pub(crate) report_options: crate::report::ReportOptions,
 }
 
 pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
-    let mut study = Study::load(args.case)?;
+    // `--out` names the new case of `--apply`; alone it would write nothing
+    if args.out.is_some() && args.apply.is_none() {
+        return Err(Failure::new(
+            Exit::Usage,
+            "--out FILE is where --apply N writes the case with effect N added, and nothing is applied; give \
+             --apply N to write it, or --report DIR for a report of the ranking",
+        ));
+    }
+    let mut study = super::load_study(args.case)?;
     let mut inputs = study.case().inputs();
     inputs.extend(args.measured.map(Path::to_path_buf));
+    let mut report_output = args
+        .report
+        .map(|dir| Outputs::folder(dir, &inputs, &["report.html"])?.of_command("diagnose", args.replace))
+        .transpose()?;
     let mut output = match (args.apply, args.out) {
         (Some(_), Some(out)) => Some(Outputs::file(out, &inputs)?),
         _ => None,
@@ -46,10 +65,13 @@ pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
         }
         _ => None,
     };
-    let (measured, notes) = match args.measured {
+    // the data as read (their kind and per-volt references), for the report
+    let (measured, notes, as_read, per_volt) = match args.measured {
         Some(path) => {
-            let read = read_measured_for(study.system(), path, study.case().measurement.as_ref())?;
+            let read = read_measured_for(study.system(), path, study.case().measurement.as_ref())
+                .map_err(|e| super::mismatch(e.into(), study.case().measurement.as_ref(), Some(path)))?;
             study.set_gains_for(&read)?;
+            let per_volt = read.per_volt_references();
             let mut notes = read.notes.clone();
             if study.gains() != Gains::None {
                 notes.push(format!(
@@ -60,12 +82,12 @@ pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
             }
             print_notes(&notes, args.json)?;
             print_masked(&describe_masked(&read.masked), args.json)?;
-            (read.set.to_receptance(), notes)
+            (read.set.to_receptance(), notes, read.set.clone(), per_volt)
         }
         None => {
             print_notes(study.notes(), args.json)?;
             print_masked(&describe_masked(study.masked()), args.json)?;
-            (study.measured().clone(), study.notes().to_vec())
+            (study.measured().clone(), study.notes().to_vec(), study.measured_as_read(), study.per_volt().to_vec())
         }
     };
     if !args.json {
@@ -95,6 +117,29 @@ pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
         outln!("{}", serde_json::to_string_pretty(&WithNotes { notes: &notes, result: &d })?);
     } else {
         print_diagnosis(&d, args.top)?;
+    }
+    if let Some(mut output) = report_output.take() {
+        let unweighted = if d.weighted { quantities::noise(study.system(), &measured, None)? } else { Some(d.noise) };
+        let data = crate::report::Data::new(&as_read, &per_volt, unweighted);
+        let source = args.measured.map_or_else(
+            || match study.case().measurement.as_ref().and_then(|m| m.data.as_ref()) {
+                Some(p) => format!("measured file {}", crate::report::shown_path(p)),
+                None => "synthesised from the case's truth model".to_string(),
+            },
+            |p| format!("measured file {}", p.display()),
+        );
+        let written = crate::report::diagnose_report::write(
+            &study,
+            &d,
+            &data,
+            &source,
+            &args.report_options.for_case(study.case()),
+            &mut output,
+        )?;
+        output.commit()?;
+        if !args.json {
+            outln!("\nwrote {} (figures and tables beside it)", written.display());
+        }
     }
     if let Some(rank) = args.apply {
         let out = args.out.ok_or("--apply needs --out FILE for the new case file")?;
@@ -154,9 +199,11 @@ fn unfitted_lines(d: &Diagnosis) -> Vec<String> {
 
 fn print_diagnosis(d: &Diagnosis, top: usize) -> Result<()> {
     outln!(
-        "noise level estimated from the data: {:.2} %; nominal model misfit: {:.2} % (RMS relative)",
-        100.0 * d.noise,
-        100.0 * d.nominal_misfit
+        "noise {}; misfit of the nominal model {} ({} x the noise), over the {} lines the diagnosis reads",
+        table::misfit(d.noise),
+        table::misfit(d.nominal_misfit),
+        table::times(quantities::times_noise(d.nominal_misfit, d.noise)),
+        quantities::MISFIT_LINES
     );
     if d.weighted {
         outln!(
@@ -168,19 +215,13 @@ fn print_diagnosis(d: &Diagnosis, top: usize) -> Result<()> {
         let per = if d.gains == Gains::PerChannel { "channel" } else { "reference" };
         outln!("every fit includes an unknown complex gain per {per}; the leader's:");
         if let Some(l) = d.ranking.first() {
-            for g in &l.gains {
-                outln!(
-                    "    {}: x{} ({:+.1} dB), {:+.1} deg",
-                    g.key,
-                    num(g.magnitude),
-                    20.0 * g.magnitude.log10(),
-                    g.phase_deg
-                );
+            for g in crate::report::gain_reports(&l.gains) {
+                outln!("    {}", crate::report::gain_text(&g));
             }
         }
         outln!("");
     }
-    let mut t = Table::new(&["rank", "effect", "explained", "dBIC", "significant", "fitted values", ""]);
+    let mut t = Table::new(&["rank", "effect", "explained", "dBIC", "significant", "", "fitted values"]);
     for (i, r) in d.ranking.iter().enumerate().take(top) {
         let values = r
             .parameters
@@ -206,16 +247,18 @@ fn print_diagnosis(d: &Diagnosis, top: usize) -> Result<()> {
             format!("{}", i + 1),
             r.description.clone(),
             format!("{:.1} %", 100.0 * r.explained),
-            format!("{:.1}", r.delta_bic),
+            table::dbic(r.delta_bic),
             if r.significant { "yes".into() } else { "no".into() },
-            values,
             note,
+            values,
         ]);
     }
     outln!("{}", t.render());
     outln!(
-        "\n(dBIC: change of the Bayesian information criterion; below -10 the evidence is very strong; \
-         {} candidates tried, {} of them replaced by a variant)",
+        "\n(explained: the share of the nominal model's squared misfit the effect removes; dBIC: the change of the \
+         Bayesian information criterion, comparable only within one diagnosis; significant: dBIC below {}, very \
+         strong evidence; {} candidates tried, {} of them replaced by a variant)",
+        quantities::SIGNIFICANT_DBIC,
         d.tried,
         d.superseded
     );

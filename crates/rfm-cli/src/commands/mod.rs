@@ -13,7 +13,7 @@ use fe_model::CaseFile;
 
 use crate::exit::Failure;
 
-pub(crate) use compare::compare;
+pub(crate) use compare::{CompareArgs, compare};
 pub(crate) use diagnose::{DiagnoseArgs, diagnose};
 pub(crate) use fix::{FixArgs, fix};
 pub(crate) use inspect::inspect;
@@ -25,6 +25,49 @@ pub(crate) type Result<T> = std::result::Result<T, Failure>;
 
 pub(crate) fn load_case(path: &Path) -> Result<CaseFile> {
     Ok(CaseFile::load(path)?)
+}
+
+/// A case made ready ([`rfm_update::Study`]); a failure to read its
+/// measured data says, besides what went wrong, what the case wants and
+/// what the file holds, so that a wrong file is seen as such at once
+/// rather than one symptom at a time.
+pub(crate) fn load_study(path: &Path) -> Result<rfm_update::Study> {
+    study_of(load_case(path)?)
+}
+
+/// [`load_study`] of a loaded case.
+pub(crate) fn study_of(case: CaseFile) -> Result<rfm_update::Study> {
+    let spec = case.measurement.clone();
+    rfm_update::Study::from_case(case)
+        .map_err(|e| mismatch(e.into(), spec.as_ref(), spec.as_ref().and_then(|s| s.data.as_deref())))
+}
+
+/// `failure` with what the case wants and what `file` holds, when it is
+/// about that file (its message names it) and the file can be read as it is.
+pub(crate) fn mismatch(
+    failure: Failure,
+    spec: Option<&fe_model::case::MeasurementSpec>,
+    file: Option<&Path>,
+) -> Failure {
+    let (Some(spec), Some(file)) = (spec, file) else {
+        return failure;
+    };
+    let name = file.display().to_string();
+    if !failure.message.contains(&name) {
+        return failure;
+    }
+    match inspect::file_holds(file) {
+        Some(holds) => Failure {
+            message: format!(
+                "{}\n  the case wants {}\n  {} holds {holds}",
+                failure.message,
+                inspect::case_wants(spec),
+                name
+            ),
+            ..failure
+        },
+        None => failure,
+    }
 }
 
 /// Tells what the case's `[measurement] mask` left out of the measured data:

@@ -2,7 +2,9 @@
 //! after each step against the noise, beside the structure with each added
 //! effect marked where it sits; then each step's effect and updated
 //! parameters, what still stands out, the nominal and final models against
-//! the measured FRFs, and the final model's modes against the measured ones.
+//! the measured FRFs (in the data's own kind and unit, each times the gains
+//! that fit it), and the final model's modes against the measured ones with
+//! the natural frequencies and damping of every step's model.
 
 use std::path::PathBuf;
 
@@ -11,12 +13,14 @@ use rfm_update::Study;
 use rfm_update::comparison::{self, GainSource};
 use rfm_update::diagnose::Ranked;
 use rfm_update::fix::{CONSISTENT, FixOutcome};
+use rfm_update::quantities::{self, MisfitReport};
 
 use super::html::{Block, Report, Section, Table, Tone};
 use super::plot::structure::Highlight;
-use super::{ModelFrfs, ReportOptions, Result, loop_story, plot, sig};
+use super::units::parameter_unit;
+use super::{Data, ModelFrfs, ReportOptions, Result, gain_reports, gains_text, loop_story, plot};
 use crate::output::Outputs;
-use crate::table::{num, percent};
+use crate::table::{self, num, percent};
 
 /// The name of the case file written after step `k` (1-based): the
 /// command writes it, the report names it beside the step (here, below the
@@ -25,10 +29,20 @@ pub(crate) fn step_file(k: usize) -> String {
     format!("step-{k}.toml")
 }
 
+/// The steps an earlier, interrupted run into the same folder finished,
+/// when this run resumed after them (`rfm fix --resume`).
+pub(crate) struct Resumed {
+    /// How many.
+    pub(crate) steps: usize,
+    /// The history of the case this run started from (the last of them):
+    /// the misfit after each of the earlier steps.
+    pub(crate) history: Vec<fe_model::HistoryEntry>,
+}
+
 /// How an effect is marked on the structure (see [`loop_story::highlight_kind`]).
-fn highlight(e: &Ranked) -> Highlight {
+pub(crate) fn highlight(e: &Ranked) -> Highlight {
     let kind = loop_story::highlight_kind(Some(e.kind), !e.elements.is_empty());
-    Highlight { label: e.description.clone(), kind, nodes: e.nodes.clone(), elements: e.elements.clone() }
+    Highlight { label: e.description.clone(), kind, nodes: e.nodes.clone(), elements: e.elements.clone(), number: None }
 }
 
 /// An effect in a few words for an axis label (see [`loop_story::short_effect`]).
@@ -38,28 +52,48 @@ fn short_effect(e: &Ranked) -> String {
 
 /// Writes the report files of the loop through `out` and returns where
 /// `report.html` will be.
-pub(crate) fn write(study: &Study, outcome: &FixOutcome, opts: &ReportOptions, out: &mut Outputs) -> Result<PathBuf> {
-    // the model after the last step, with every effect added
-    let fixed = match outcome.steps.last() {
-        Some(s) => {
+pub(crate) fn write(
+    study: &Study,
+    outcome: &FixOutcome,
+    resumed: &Resumed,
+    opts: &ReportOptions,
+    out: &mut Outputs,
+) -> Result<PathBuf> {
+    let offset = resumed.steps;
+    // the model after each step; the last has every effect added
+    let step_systems = outcome
+        .steps
+        .iter()
+        .map(|s| {
             let text = s.case.text_at(&study.case().path)?;
-            Some(damping::DampedSystem::new(fe_model::CaseFile::parse(&study.case().path, &text)?.model)?)
-        }
-        None => None,
-    };
+            Ok(damping::DampedSystem::new(fe_model::CaseFile::parse(&study.case().path, &text)?.model)?)
+        })
+        .collect::<Result<Vec<damping::DampedSystem>>>()?;
+    let fixed = step_systems.last();
     let mut report = Report::new(format!("{}: closing the loop", study.case().model.title));
     report.subtitle = Some(format!(
-        "rfm fix, case file {}: {} effect(s) added; {}",
+        "rfm fix, case file {}: {} effect(s) added{}; {}",
         study.case().path.display(),
         outcome.steps.len(),
+        if offset > 0 { format!(" after the {offset} of an earlier run it resumed") } else { String::new() },
         outcome.stop.describe()
     ));
 
-    let stages = outcome.stages();
-    let mut fall = Section::new("The fall of the misfit");
-    let short: Vec<String> = std::iter::once("nominal".to_string())
+    // a resumed run's stages follow the earlier run's, as the case it
+    // started from records them
+    let mut stages: Vec<(String, f64)> = resumed.history.iter().map(|h| (h.step.clone(), h.misfit)).collect();
+    stages.extend(outcome.stages().into_iter().skip(if offset > 0 { 1 } else { 0 }));
+    let mut fall = Section::new("The misfit after each step");
+    let earlier: Vec<String> = if offset > 0 {
+        resumed.history.iter().map(|h| h.step.chars().take(24).collect()).collect()
+    } else {
+        vec!["nominal".to_string()]
+    };
+    let short: Vec<String> = earlier
+        .into_iter()
         .chain(outcome.steps.iter().enumerate().flat_map(|(k, s)| {
             let sign = if s.removed { "-" } else { "+" };
+            let k = k + offset;
             [format!("{sign} {}: {}", k + 1, short_effect(&s.effect)), format!("updated {}", k + 1)]
         }))
         .collect();
@@ -68,16 +102,19 @@ pub(crate) fn write(study: &Study, outcome: &FixOutcome, opts: &ReportOptions, o
         "misfit-steps",
         plot::misfit_steps(&short, &misfits, outcome.noise, CONSISTENT)?,
         format!(
-            "The misfit (RMS of ln(model / measured) per complex value, over {} lines spread across the band) of \
+            "The misfit (RMS of |ln(model / measured)| per complex value, over the {} lines the diagnosis reads) of \
              the nominal model, after adding each effect at its diagnosed values (numbered as on the structure \
-             below), and after updating every added parameter together. The green band runs from the noise level estimated from the data to {CONSISTENT} \
-             times it: a misfit inside it is consistent with the noise.",
-            rfm_update::diagnose::DiagnoseOptions::default().lines
+             below), and after updating every added parameter together. The green band runs from the noise level \
+             estimated from the data ({}) to {CONSISTENT} times it: a misfit inside it is consistent with the noise.",
+            quantities::MISFIT_LINES,
+            table::misfit(outcome.noise)
         ),
     )?);
-    // the effects in the fixed model (a replaced one is not)
-    let highlights: Vec<Highlight> = outcome.effects.iter().map(highlight).collect();
-    let drawn = fixed.as_ref().map_or(&study.case().model, |f| f.model());
+    // the effects in the fixed model (a replaced one is not), those of an
+    // earlier run first
+    let drawn = fixed.map_or(&study.case().model, |f| f.model());
+    let mut highlights: Vec<Highlight> = loop_story::highlights(&resumed.history, drawn);
+    highlights.extend(outcome.effects.iter().map(highlight));
     fall.push(super::structure_figure(
         drawn,
         study.measured(),
@@ -90,33 +127,33 @@ pub(crate) fn write(study: &Study, outcome: &FixOutcome, opts: &ReportOptions, o
         },
         out,
     )?);
-    let mut t = Table::new(&["step", "misfit", "(dB)", "x noise"]);
+    let mut t = Table::new(&["step", "misfit", "x noise"]).caption(format!(
+        "The misfit of each stage and its multiple of the noise ({}); green within {CONSISTENT} times it.",
+        table::misfit(outcome.noise)
+    ));
     for (label, m) in &stages {
         let tone = if *m <= CONSISTENT * outcome.noise { Tone::Good } else { Tone::Plain };
         t.row_toned(vec![
             (label.clone(), Tone::Plain),
-            (sig(*m, 4), tone),
-            (format!("{:.1}", 20.0 * m.log10()), Tone::Plain),
-            (format!("{:.1}", m / outcome.noise), tone),
+            (table::misfit(*m), tone),
+            (table::times(quantities::times_noise(*m, outcome.noise)), tone),
         ]);
     }
-    fall.push(Block::Table(t));
+    fall.push(out.table("steps", t)?);
     let last = outcome.final_misfit();
+    let times = table::times(quantities::times_noise(last, outcome.noise));
     fall.push(Block::Text(if last <= CONSISTENT * outcome.noise {
-        format!(
-            "The final misfit is {:.2} times the noise: the model explains the data down to their noise.",
-            last / outcome.noise
-        )
+        format!("The final misfit is {times} times the noise: the model explains the data down to their noise.")
     } else {
         format!(
-            "The final misfit is {:.1} times the noise: something the candidate effects cannot represent remains.",
-            last / outcome.noise
+            "The final misfit is {times} times the noise: something the candidate effects cannot represent remains."
         )
     }));
     fall.push(Block::Text(format!("The loop stopped because {}.", outcome.stop.describe())));
     report.sections.push(fall);
 
     for (k, s) in outcome.steps.iter().enumerate() {
+        let k = k + offset;
         let e = &s.effect;
         let title = match &s.replaced {
             _ if s.removed => format!("Step {}: {} taken out again", k + 1, e.description),
@@ -124,24 +161,33 @@ pub(crate) fn write(study: &Study, outcome: &FixOutcome, opts: &ReportOptions, o
             None => format!("Step {}: {}", k + 1, e.description),
         };
         let mut sec = Section::new(title);
-        sec.push(Block::Facts(vec![
-            ("explained".into(), format!("{:.1} % of the misfit before it", 100.0 * e.explained)),
-            ("dBIC".into(), format!("{:.1} (below -10: very strong evidence)", e.delta_bic)),
+        let times = |m: f64| table::times(quantities::times_noise(m, outcome.noise));
+        let mut facts = vec![
+            ("explained".into(), format!("{:.1} % of the squared misfit before it", 100.0 * e.explained)),
             (
-                "misfit with it".into(),
-                format!("{} ({:.1} x noise)", sig(s.misfit_added, 4), s.misfit_added / outcome.noise),
+                "dBIC".into(),
+                format!(
+                    "{} (significant below {}; see the glossary)",
+                    table::dbic(e.delta_bic),
+                    quantities::SIGNIFICANT_DBIC
+                ),
             ),
+            ("misfit with it".into(), format!("{} ({} x noise)", table::misfit(s.misfit_added), times(s.misfit_added))),
             (
                 "after the update".into(),
                 format!(
-                    "{} ({:.1} x noise), {}",
-                    sig(s.misfit_updated, 4),
-                    s.misfit_updated / outcome.noise,
+                    "{} ({} x noise), {}",
+                    table::misfit(s.misfit_updated),
+                    times(s.misfit_updated),
                     s.status.name()
                 ),
             ),
             ("case file".into(), step_file(k + 1)),
-        ]));
+        ];
+        if !e.gains.is_empty() {
+            facts.push(("gain fitted with it".into(), gains_text(&gain_reports(&e.gains))));
+        }
+        sec.push(Block::Facts(facts));
         if !s.alternatives.is_empty() {
             let mut t = Table::new(&["first effect tried", "misfit after it and its best follower", "x noise"])
                 .caption(
@@ -157,9 +203,7 @@ pub(crate) fn write(study: &Study, outcome: &FixOutcome, opts: &ReportOptions, o
                 };
                 match &a.failed {
                     Some(why) => t.row(vec![effect, format!("could not be added: {why}"), "-".into()]),
-                    None => {
-                        t.row(vec![effect, sig(a.misfit_ahead, 4), format!("{:.1}", a.misfit_ahead / outcome.noise)])
-                    }
+                    None => t.row(vec![effect, table::misfit(a.misfit_ahead), times(a.misfit_ahead)]),
                 }
             }
             sec.push(Block::Table(t));
@@ -170,7 +214,7 @@ pub(crate) fn write(study: &Study, outcome: &FixOutcome, opts: &ReportOptions, o
                 e.held.join(", ")
             )));
         }
-        let mut t = Table::new(&["parameter", "diagnosed", "updated", "+-1 sd (noise)"])
+        let mut t = Table::new(&["parameter", "unit", "diagnosed", "updated", "+-1 sd (noise)"])
             .caption("Every parameter updated at this step: the effects added so far and the case's own.");
         for (i, p) in s.parameters.iter().enumerate() {
             let diagnosed = e.parameters.iter().find(|f| f.name == p.name).map_or("-".to_string(), |f| num(f.value));
@@ -179,9 +223,9 @@ pub(crate) fn write(study: &Study, outcome: &FixOutcome, opts: &ReportOptions, o
                 .as_ref()
                 .and_then(|u| u.parameters.get(i))
                 .map_or("-".to_string(), |u| percent(u.relative_std));
-            t.row(vec![p.name.clone(), diagnosed, num(p.updated), sd]);
+            t.row(vec![p.name.clone(), parameter_unit(&p.name).to_string(), diagnosed, num(p.updated), sd]);
         }
-        sec.push(Block::Table(t));
+        sec.push(out.table(&format!("step-{}-parameters", k + 1), t)?);
         report.sections.push(sec);
     }
 
@@ -193,60 +237,98 @@ pub(crate) fn write(study: &Study, outcome: &FixOutcome, opts: &ReportOptions, o
     } else {
         "No candidate is significant in the diagnosis of the final model.".to_string()
     }));
-    let mut t = Table::new(&["effect", "explained", "dBIC", "plausible"]);
+    let mut t = Table::new(&["effect", "explained", "dBIC", "significant", "plausible"]).caption(format!(
+        "The leaders of the diagnosis of the final model; significant: dBIC below {} (see the glossary).",
+        quantities::SIGNIFICANT_DBIC
+    ));
     for r in &outcome.remaining {
         t.row(vec![
             r.description.clone(),
             format!("{:.1} %", 100.0 * r.explained),
-            format!("{:.1}", r.delta_bic),
+            table::dbic(r.delta_bic),
+            if r.significant { "yes".into() } else { "no".into() },
             if r.plausible { "yes".into() } else { r.implausible_reason.clone().unwrap_or_default() },
         ]);
     }
-    rest.push(Block::Table(t));
+    rest.push(out.table("remaining", t)?);
     report.sections.push(rest);
 
-    // the nominal and the final model against the data, each times the
+    // the nominal and the final model against the data as they were
+    // measured (the kind and unit compare and update show), each times the
     // gains that bring it closest to them when the case fits gains
-    let measured = study.measured();
+    let as_read = study.measured_as_read();
+    let measured = &as_read;
+    let unweighted = quantities::noise(study.system(), study.measured(), None)?;
+    let data = Data::new(measured, study.per_volt(), unweighted);
     let weights = study.line_weights(measured)?;
     let gains = match study.gains() {
         fe_model::case::Gains::None => GainSource::None,
         setting => GainSource::Fit { setting, weights: weights.as_deref() },
     };
-    let model = |label: &str, colour, sys: &damping::DampedSystem| -> Result<(ModelFrfs, Vec<frf::C64>)> {
+    let report_of = |m: f64| MisfitReport {
+        misfit: m,
+        noise: Some(outcome.noise),
+        times_noise: Some(quantities::times_noise(m, outcome.noise)),
+        lines: quantities::MISFIT_LINES.min(measured.n_freq()),
+        weighted: weights.is_some(),
+    };
+    let model = |label: &str, colour, sys: &damping::DampedSystem, misfit: f64| -> Result<(ModelFrfs, Vec<frf::C64>)> {
         let compared = comparison::compare(sys, measured, gains, &BandSpec::Auto)?;
         if let Some(&freq_hz) = compared.model.singular_hz.first() {
             return Err(frf::FrfError::Singular { freq_hz }.into());
         }
-        let frfs =
-            ModelFrfs { label: label.into(), colour, frfs: compared.model.frfs, correlation: compared.correlation };
+        let frfs = ModelFrfs {
+            label: label.into(),
+            colour,
+            frfs: compared.model.frfs,
+            correlation: compared.correlation,
+            gains: compared.model.fitted.as_ref().map_or_else(Vec::new, |f| f.reports()),
+            misfit: Some(report_of(misfit)),
+        };
         Ok((frfs, compared.model.gains))
     };
-    let (nominal, mut last_gains) = model("nominal model", plot::INITIAL, study.system())?;
+    let start_label = if offset > 0 { format!("model after step {offset}") } else { "nominal model".to_string() };
+    let (nominal, mut last_gains) = model(&start_label, plot::INITIAL, study.system(), outcome.nominal_misfit)?;
     let mut models = vec![nominal];
-    if let Some(f) = &fixed {
-        let (fixed_frfs, gains) = model("fixed model", plot::UPDATED, f)?;
+    if let Some(f) = fixed {
+        let (fixed_frfs, gains) = model("fixed model", plot::UPDATED, f, outcome.final_misfit())?;
         models.push(fixed_frfs);
         last_gains = gains;
     }
     let mut notes = vec!["The nominal model and the model after the last step against the measured FRFs.".to_string()];
     if !matches!(gains, GainSource::None) {
-        notes.push("Each model's FRFs are multiplied by the unknown complex gains that fit it best.".to_string());
+        notes.push(format!(
+            "Each model's FRFs are multiplied by the unknown complex gains that fit it best: {}.",
+            models
+                .iter()
+                .map(|m| format!("the {} by {}", m.label, gains_text(&m.gains)))
+                .collect::<Vec<_>>()
+                .join("; ")
+        ));
     }
-    report.sections.push(super::correlation_section(measured, &models, opts, out, notes)?);
-    let last_system = fixed.as_ref().unwrap_or(study.system());
+    report.sections.push(super::correlation_section(&data, &models, opts, out, notes)?);
+    let last_system = fixed.unwrap_or(study.system());
     let comparison =
         comparison::compare_modes(last_system, measured, &last_gains, super::modes::MIN_MAC).map_err(|e| e.to_string());
     let against = if fixed.is_some() { "the fixed model" } else { "the nominal model" };
-    report.sections.push(super::modes::section(
+    let mut modes = super::modes::section(
         comparison.as_ref(),
         against,
         last_system.model(),
         measured,
+        last <= CONSISTENT * outcome.noise,
         opts,
         out,
-    )?);
-    report.sections.push(super::overlay_section(measured, &models, &[], opts, out)?);
+    )?;
+    let f = measured.frequencies_hz();
+    let band = (f.first().copied().unwrap_or(0.0), f.last().copied().unwrap_or(0.0));
+    let first = if offset > 0 { format!("step {offset}") } else { "nominal".to_string() };
+    let mut systems: Vec<(String, &damping::DampedSystem)> = vec![(first, study.system())];
+    systems.extend(step_systems.iter().enumerate().map(|(k, s)| (format!("step {}", k + offset + 1), s)));
+    let table = super::natural_frequency_table(&systems, band, comparison.as_ref().ok());
+    modes.push(out.table("modes-per-step", table)?);
+    report.sections.push(modes);
+    report.sections.push(super::overlay_section(&data, &models, &[], opts, out)?);
     report.sections.push(super::definitions_section());
     Ok(out.write("report.html", report.render().as_bytes())?)
 }

@@ -89,7 +89,7 @@ pub(crate) fn highlights(history: &[HistoryEntry], model: &Model) -> Vec<Highlig
             if nodes.is_empty() && elements.is_empty() {
                 label.push_str(" (no longer in the model)");
             }
-            Highlight { label, kind: highlight_kind(kind, !h.elements.is_empty()), nodes, elements }
+            Highlight { label, kind: highlight_kind(kind, !h.elements.is_empty()), nodes, elements, number: None }
         })
         .collect()
 }

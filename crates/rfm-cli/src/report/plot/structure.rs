@@ -221,6 +221,9 @@ pub(crate) struct Highlight {
     pub(crate) nodes: Vec<u32>,
     /// Element ids where it acts.
     pub(crate) elements: Vec<u32>,
+    /// Its number on the drawing and in the legend (`None`: its place in
+    /// the list, from 1): the step that added it, or its rank.
+    pub(crate) number: Option<usize>,
 }
 
 /// Draws the beams, supports, springs and masses of `model` in `view`.
@@ -314,7 +317,8 @@ pub(crate) fn structure(
         legend.push(LegendEntry::new("excitation", EXCITATION, Mark::Line(3)));
     }
     for (i, h) in highlights.iter().enumerate() {
-        legend.push(LegendEntry::new(format!("{}: {}", i + 1, h.label), HIGHLIGHTS[i % HIGHLIGHTS.len()], Mark::Dot));
+        let n = h.number.unwrap_or(i + 1);
+        legend.push(LegendEntry::new(format!("{n}: {}", h.label), HIGHLIGHTS[i % HIGHLIGHTS.len()], Mark::Dot));
     }
     let height = drawing_height(aspect(model)) + 40 + super::legend_height(&legend);
     svg(title, height, |root| {
@@ -398,7 +402,7 @@ pub(crate) fn structure(
             } else {
                 first
             };
-            draw_badge(&body, (centre.0 + 22, centre.1 - 22), i + 1, colour)?;
+            draw_badge(&body, (centre.0 + 22, centre.1 - 22), h.number.unwrap_or(i + 1), colour)?;
         }
         Ok(())
     })
@@ -602,8 +606,20 @@ mod tests {
         let responses = [DofRef::new(3, Dof::Uy), DofRef::new(2, Dof::Ux)];
         let references = [DofRef::new(3, Dof::Uy)];
         let highlights = vec![
-            Highlight { label: "a joint".into(), kind: HighlightKind::Joint, nodes: vec![2], elements: vec![2] },
-            Highlight { label: "a patch".into(), kind: HighlightKind::Patch, nodes: vec![], elements: vec![1] },
+            Highlight {
+                label: "a joint".into(),
+                kind: HighlightKind::Joint,
+                nodes: vec![2],
+                elements: vec![2],
+                number: None,
+            },
+            Highlight {
+                label: "a patch".into(),
+                kind: HighlightKind::Patch,
+                nodes: vec![],
+                elements: vec![1],
+                number: None,
+            },
         ];
         let svg =
             structure("frame", &m, &Sensors { responses: &responses, references: &references }, &highlights).unwrap();
@@ -631,6 +647,7 @@ mod tests {
                 kind: *kind,
                 nodes: nodes.clone(),
                 elements: elements.clone(),
+                number: None,
             })
             .collect();
         let svg = structure("frame", &m, &Sensors { responses: &[], references: &[] }, &highlights).unwrap();
