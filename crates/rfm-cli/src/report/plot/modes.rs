@@ -209,7 +209,7 @@ pub(crate) fn stabilisation(
             label_rows(modes_hz.iter().map(|&f| axis.shows(f).then(|| chart.backend_coord(&(f, y_top)).0)).collect());
         for (k, (&f, row)) in modes_hz.iter().zip(placed).enumerate() {
             let Some(row) = row else { continue };
-            let y = y_top - per_px * (2.0 + f64::from(LABEL_ROW_PX) * row as f64);
+            let y = y_top - per_px * (6.0 + f64::from(LABEL_ROW_PX) * row as f64);
             chart.draw_series(std::iter::once(Text::new(format!("{}", k + 1), (f, y), style.clone())))?;
         }
         Ok(())
