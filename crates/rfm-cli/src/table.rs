@@ -179,6 +179,20 @@ pub(crate) fn misfit(v: f64) -> String {
     digits_of(v, 4, false)
 }
 
+/// `v` with `decimals` decimals, never a negative zero (`-0.00` of a tiny
+/// negative value reads `0.00`); `signed` puts a `+` before positive values.
+pub(crate) fn fixed(v: f64, decimals: usize, signed: bool) -> String {
+    if !v.is_finite() {
+        return "-".into();
+    }
+    let s = if signed { format!("{v:+.decimals$}") } else { format!("{v:.decimals$}") };
+    if s.trim_start_matches(['-', '+']).chars().all(|c| c == '0' || c == '.') {
+        format!("{:.decimals$}", 0.0)
+    } else {
+        s
+    }
+}
+
 /// A misfit as a multiple of the noise: two decimals below 10 (`0.95`,
 /// `1.50`, where the line between explained and not lies), one above.
 pub(crate) fn times(v: f64) -> String {
@@ -242,6 +256,10 @@ mod tests {
         assert_eq!(misfit(1.0700), "1.070");
         assert_eq!(misfit(2.5e-5), "2.500e-5");
         assert_eq!(times(0.947), "0.95");
+        assert_eq!(fixed(-0.001, 2, true), "0.00");
+        assert_eq!(fixed(-0.0, 1, false), "0.0");
+        assert_eq!(fixed(19.294, 2, true), "+19.29");
+        assert_eq!(fixed(-2.2, 2, true), "-2.20");
         assert_eq!(times(132.19), "132.2");
     }
 

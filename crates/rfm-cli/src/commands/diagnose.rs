@@ -246,7 +246,7 @@ fn print_diagnosis(d: &Diagnosis, top: usize) -> Result<()> {
         t.row(vec![
             format!("{}", i + 1),
             r.description.clone(),
-            format!("{:.1} %", 100.0 * r.explained),
+            crate::report::percent(r.explained),
             table::dbic(r.delta_bic),
             if r.significant { "yes".into() } else { "no".into() },
             note,

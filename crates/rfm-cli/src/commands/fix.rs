@@ -321,6 +321,10 @@ fn print_outcome(o: &FixOutcome, done: usize) -> Result<()> {
             t.row(vec![p.name.clone(), unit.to_string(), num(p.updated), sd]);
         }
         outln!("{}", t.render());
+        // the data's level: every misfit above is after the gains that fit the model best
+        for g in crate::report::gain_reports(&s.effect.gains) {
+            outln!("gain fitted with the last effect: {}", crate::report::gain_text(&g));
+        }
     }
     if let Some(e) = &o.diagnosis_error {
         outln!("\nthe diagnosis of the final model failed, so what remains is not known: {e}");

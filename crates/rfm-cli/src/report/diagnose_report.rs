@@ -153,7 +153,7 @@ pub(crate) fn write(
         let row = vec![
             (format!("{}", i + 1), Tone::Plain),
             (r.description.clone(), if recommended { Tone::Good } else { Tone::Plain }),
-            (format!("{:.1} %", 100.0 * r.explained), Tone::Plain),
+            (super::percent(r.explained), Tone::Plain),
             (table::dbic(r.delta_bic), Tone::Plain),
             ((if r.significant { "yes" } else { "no" }).to_string(), Tone::Plain),
             (plausible, if r.implausible_reason.is_some() { Tone::Bad } else { Tone::Plain }),

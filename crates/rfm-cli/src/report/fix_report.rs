@@ -163,7 +163,7 @@ pub(crate) fn write(
         let mut sec = Section::new(title);
         let times = |m: f64| table::times(quantities::times_noise(m, outcome.noise));
         let mut facts = vec![
-            ("explained".into(), format!("{:.1} % of the squared misfit before it", 100.0 * e.explained)),
+            ("explained".into(), format!("{} of the squared misfit before it", super::percent(e.explained))),
             (
                 "dBIC".into(),
                 format!(
@@ -244,7 +244,7 @@ pub(crate) fn write(
     for r in &outcome.remaining {
         t.row(vec![
             r.description.clone(),
-            format!("{:.1} %", 100.0 * r.explained),
+            super::percent(r.explained),
             table::dbic(r.delta_bic),
             if r.significant { "yes".into() } else { "no".into() },
             if r.plausible { "yes".into() } else { r.implausible_reason.clone().unwrap_or_default() },

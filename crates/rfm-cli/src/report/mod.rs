@@ -245,7 +245,7 @@ pub(crate) fn signed(v: f64, digits: usize) -> String {
 
 /// Percent with one decimal.
 pub(crate) fn percent(v: f64) -> String {
-    if v.is_finite() { format!("{:.1} %", 100.0 * v) } else { "-".into() }
+    if v.is_finite() { format!("{} %", table::fixed(100.0 * v, 1, false)) } else { "-".into() }
 }
 
 /// Below this complex-log misfit (about 0.4 dB or 3 degrees RMS) a channel

@@ -195,7 +195,7 @@ pub(crate) fn mode_table_rows(m: &ModesJson) -> (Vec<&'static str>, Vec<Vec<Stri
                 number(r.model_mode),
                 opt(r.measured_hz, |f| format!("{f:.2}")),
                 opt(r.model_hz, |f| format!("{f:.2}")),
-                opt(r.frequency_error_pct, |e| format!("{e:+.2}")),
+                opt(r.frequency_error_pct, |e| crate::table::fixed(e, 2, true)),
                 opt(r.measured_damping_ratio, |z| format!("{:.3}", 100.0 * z)),
                 opt(r.model_damping_ratio, |z| format!("{:.3}", 100.0 * z)),
                 opt(r.mac, |m| format!("{m:.3}")),
