@@ -134,7 +134,7 @@ pub(crate) fn fall_figure(history: &[HistoryEntry], this_run: bool, out: &mut Ou
         " The history records no noise level.".to_string()
     };
     let caption = format!(
-        "The misfit (RMS of ln(model / measured) per complex value, weighted as the fits weigh the lines) after \
+        "The misfit (RMS of |ln(model / measured)| per complex value, weighted as the fits weigh the lines) after \
          each step that led to this case, as its [[history]] records them (written by rfm diagnose --apply, rfm \
          fix and rfm update){}; added effects are numbered as on the structure.{band}",
         if this_run { ", and after this run" } else { "" }
