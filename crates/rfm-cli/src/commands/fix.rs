@@ -9,6 +9,7 @@
 
 use std::path::{Path, PathBuf};
 
+use fe_model::case::CaseEditor;
 use rfm_update::Study;
 use rfm_update::fix::{CONSISTENT, FixOptions, FixOutcome, FixProgress, FixStop, fix as run_fix};
 use rfm_update::quantities;
@@ -27,16 +28,21 @@ const DATA_FILE: &str = "measured.csv";
 const PROGRESS_FILE: &str = "fix-progress.json";
 
 /// Options of the fix command.
-pub(crate) struct FixArgs<'a> {
-    pub(crate) case: &'a Path,
-    pub(crate) out: &'a Path,
-    pub(crate) steps: usize,
-    pub(crate) json: bool,
+pub struct FixArgs<'a> {
+    /// The case file.
+    pub case: &'a Path,
+    /// The output folder.
+    pub out: &'a Path,
+    /// Most effects to add.
+    pub steps: usize,
+    /// Print JSON instead of tables.
+    pub json: bool,
     /// Replace a folder another command wrote.
-    pub(crate) replace: bool,
+    pub replace: bool,
     /// Go on from the steps an interrupted run left in `out`.
-    pub(crate) resume: bool,
-    pub(crate) report: crate::report::ReportOptions,
+    pub resume: bool,
+    /// How the report draws.
+    pub report: crate::report::ReportOptions,
 }
 
 /// `fix-progress.json`: the case the run started from and the steps it
@@ -48,8 +54,16 @@ struct Progress {
     case: String,
     /// Its text when the run started: a resumed run refuses a changed case.
     case_text: String,
-    /// The step files finished, in order.
+    /// The step files finished, in order (`step-0.toml` first when the
+    /// case's own parameters were updated).
     steps: Vec<String>,
+}
+
+impl Progress {
+    /// The effects added by the finished steps (step 0 adds none).
+    fn effects_done(&self) -> usize {
+        self.steps.iter().filter(|s| **s != step_file(0)).count()
+    }
 }
 
 /// Where a run starts: the case's own, or the last step an interrupted run
@@ -57,9 +71,10 @@ struct Progress {
 struct Start {
     /// The study of the case the loop starts from.
     study: Study,
-    /// Steps finished by earlier runs into the folder.
+    /// Effects added by the steps earlier runs finished into the folder.
     done: usize,
-    /// Their files' text, to be kept in the new outputs.
+    /// The files of those steps (and their data), to be kept in the new
+    /// outputs.
     carried: Vec<(String, Vec<u8>)>,
 }
 
@@ -97,13 +112,13 @@ fn start(args: &FixArgs<'_>, case_text: &str) -> Result<Start> {
             format!("{}: no step finished yet; run without --resume", path.display()),
         ));
     };
-    if progress.steps.len() >= args.steps {
+    let done = progress.effects_done();
+    if done >= args.steps {
         return Err(Failure::new(
             Exit::Usage,
             format!(
-                "{} holds {} finished steps, as many as --steps {} asks for; give more steps to go on",
+                "{} holds {done} finished steps, as many as --steps {} asks for; give more steps to go on",
                 args.out.display(),
-                progress.steps.len(),
                 args.steps
             ),
         ));
@@ -116,27 +131,55 @@ fn start(args: &FixArgs<'_>, case_text: &str) -> Result<Start> {
             Err(e) => return Err(format!("{}: {e}", args.out.join(name).display()).into()),
         }
     }
-    Ok(Start { study: super::load_study(&args.out.join(last))?, done: progress.steps.len(), carried })
+    Ok(Start { study: super::load_study(&args.out.join(last))?, done, carried })
 }
 
-pub(crate) fn fix(args: &FixArgs<'_>) -> Result<Exit> {
-    let case_text = std::fs::read_to_string(args.case).unwrap_or_default();
-    let Start { study, done, carried } = start(args, &case_text)?;
-    // the data every written case reads: the case's own file, or the data
-    // synthesised from its [truth], written once beside the steps
-    let synthesised = study.case().measurement.as_ref().and_then(|m| m.data.as_ref()).is_none();
-    // one more than the steps: the loop may end by replacing an early effect
-    let mut names: Vec<String> = (done + 1..=args.steps + 1).map(step_file).collect();
+/// Whether the study's data are synthesised from its case's `[truth]`:
+/// then `rfm fix` writes them once beside the steps, which read them there.
+fn synthesises(study: &Study) -> bool {
+    study.case().measurement.as_ref().and_then(|m| m.data.as_ref()).is_none()
+}
+
+/// Opens the outputs of `rfm fix` in `dir` for `steps` steps at most,
+/// protecting `inputs`; a folder another command wrote is refused unless
+/// `replace`.
+fn fix_outputs(inputs: &[PathBuf], synthesised: bool, steps: usize, dir: &Path, replace: bool) -> Result<Outputs> {
+    // step 0 and one more than the steps: the loop may end by replacing an early effect
+    let mut names: Vec<String> = (0..=steps + 1).map(step_file).collect();
     names.extend(["results.json", "report.html"].map(String::from));
     if synthesised {
         names.push(DATA_FILE.into());
     }
     let known: Vec<&str> = names.iter().map(String::as_str).collect();
+    Ok(Outputs::folder(dir, inputs, &known)?.of_command("fix", replace)?)
+}
+
+/// The options of `rfm fix` on `study`: at most `steps` effects, each
+/// diagnosis with the study's options, and where the study's data are
+/// synthesised from its `[truth]`, `data` for the file the cases of the
+/// steps read them from (written by [`save_fix`], which points the cases
+/// at the file it writes).
+pub fn fix_options(study: &Study, steps: usize, data: PathBuf) -> Result<FixOptions> {
+    Ok(FixOptions {
+        max_steps: steps,
+        diagnose: study.diagnose_options(study.measured())?,
+        data: synthesises(study).then_some(data),
+        ..FixOptions::default()
+    })
+}
+
+/// `rfm fix`: prints each step and the outcome (or `--json`) and writes the
+/// cases of the steps, the results and the report; each step's case is
+/// kept in the folder as soon as the step is done.
+pub fn fix(args: &FixArgs<'_>) -> Result<Exit> {
+    let case_text = std::fs::read_to_string(args.case).unwrap_or_default();
+    let Start { study, done, carried } = start(args, &case_text)?;
+    let synthesised = synthesises(&study);
     // the inputs of a resumed run (its last step's case and data) are files
     // of the folder, staged again below rather than replaced: the case's own
     // inputs are the ones to protect
     let inputs: Vec<PathBuf> = super::load_case(args.case)?.inputs();
-    let mut output = Outputs::folder(args.out, &inputs, &known)?.of_command("fix", args.replace || args.resume)?;
+    let mut output = fix_outputs(&inputs, synthesised, args.steps, args.out, args.replace || args.resume)?;
     for (name, bytes) in &carried {
         output.write(name, bytes)?;
     }
@@ -144,7 +187,7 @@ pub(crate) fn fix(args: &FixArgs<'_>) -> Result<Exit> {
     print_masked(&rfm_update::study::describe_masked(study.masked()), args.json)?;
     if !args.json {
         outln!("{}", study.case().model.title);
-        if done > 0 {
+        if !carried.is_empty() {
             outln!("resuming after step {done} of the run in {}", args.out.display());
         }
         outln!(
@@ -156,64 +199,34 @@ pub(crate) fn fix(args: &FixArgs<'_>) -> Result<Exit> {
             args.steps - done
         );
     }
-    let opts = FixOptions {
-        max_steps: args.steps - done,
-        diagnose: study.diagnose_options(study.measured())?,
-        data: synthesised.then(|| output.path(DATA_FILE)),
-        ..FixOptions::default()
-    };
-    let data_file = synthesised.then(|| output.path(DATA_FILE));
+    let opts = fix_options(&study, args.steps - done, output.path(DATA_FILE))?;
+    let data_file = opts.data.clone();
     if synthesised {
         output.write(DATA_FILE, frf::io::csv::to_csv_string(study.measured()).as_bytes())?;
     }
     let json = args.json;
     let mut finished: Vec<String> = carried.iter().filter(|(n, _)| n != DATA_FILE).map(|(n, _)| n.clone()).collect();
+    let resumed = !carried.is_empty();
     // the first failure to keep a step; the loop goes on, and it is
     // reported when the loop ends
     let mut kept: std::result::Result<(), Failure> = Ok(());
     let outcome = run_fix(study.case(), study.measured(), &opts, |p| {
-        let line = match p {
-            FixProgress::Diagnosed { step, diagnosis } => match diagnosis.leader() {
-                Some(l) => format!(
-                    "diagnosis {}: {} stands out (dBIC {})",
-                    done + step + 1,
-                    l.description,
-                    table::dbic(l.delta_bic)
-                ),
-                None if diagnosis.consistent() => format!("diagnosis {}: nothing significant", done + step + 1),
-                None => format!("diagnosis {}: significant effects, none at plausible values", done + step + 1),
-            },
-            FixProgress::LookedAhead { ahead, .. } => match (&ahead.failed, &ahead.with) {
-                (Some(why), _) => format!("  looking one step ahead from {}: could not add it ({why})", ahead.effect),
-                (None, Some(with)) => format!(
-                    "  the best pair fitted together: {} with {with}: misfit {}",
-                    ahead.effect,
-                    table::misfit(ahead.misfit_ahead)
-                ),
-                (None, None) => format!(
-                    "  looking one step ahead from {}: misfit {} after it and its best follower",
-                    ahead.effect,
-                    table::misfit(ahead.misfit_ahead)
-                ),
-            },
-            FixProgress::Updated { step, effect, removed, misfit, status } => {
-                let verb = if removed { "took out" } else { "added" };
-                format!(
-                    "step {}: {verb} {effect} and updated ({}); misfit {}",
-                    done + step + 1,
-                    status.name(),
-                    table::misfit(misfit)
-                )
-            }
-            FixProgress::StepDone { index, done: step } => {
-                if kept.is_ok() {
-                    let name = step_file(done + index + 1);
-                    kept = keep_step(&mut output, &name, step, data_file.as_deref(), &mut finished, args, &case_text);
-                }
-                return;
-            }
+        // a resumed run's step 0 updates the last kept step's parameters
+        // again; its case stays the earlier run's step 0
+        let keep = match &p {
+            FixProgress::Declared { step } if !resumed => Some((step_file(0), &step.case)),
+            FixProgress::StepDone { index, done: step } => Some((step_file(done + index + 1), &step.case)),
+            _ => None,
         };
-        if !json {
+        if let Some((name, case)) = keep
+            && kept.is_ok()
+        {
+            kept = keep_step(&mut output, &name, case, data_file.as_deref(), &mut finished, args, &case_text);
+        }
+        if json {
+            return;
+        }
+        for line in progress_lines_after(&p, done) {
             // an error here would be the same as at the next print, which reports it
             let _ = crate::print_line(format_args!("{line}"));
         }
@@ -224,32 +237,33 @@ pub(crate) fn fix(args: &FixArgs<'_>) -> Result<Exit> {
     } else {
         print_outcome(&outcome, done)?;
     }
-
-    for (k, s) in outcome.steps.iter().enumerate() {
-        let name = step_file(done + k + 1);
-        output.write(&name, step_text(s, &output.path(&name), data_file.as_deref())?.as_bytes())?;
-    }
-    output.write("results.json", serde_json::to_string_pretty(&outcome)?.as_bytes())?;
+    let resumed = Resumed {
+        earlier: resumed,
+        steps: done,
+        history: if resumed { study.case().history.clone() } else { Vec::new() },
+    };
+    write_fix(&study, &outcome, &resumed, &args.report, &mut output)?;
     // a finished run leaves nothing to resume
     output.forget(PROGRESS_FILE)?;
-    let resumed = Resumed { steps: done, history: if done > 0 { study.case().history.clone() } else { Vec::new() } };
-    crate::report::fix_report::write(&study, &outcome, &resumed, &args.report.for_case(study.case()), &mut output)?;
     let written = output.commit()?;
     if !json {
         outln!("\nwrote {} files into {}", written.len(), args.out.display());
-        if let Some(last) = (done + outcome.steps.len()).checked_sub(1) {
-            outln!("the fixed model: {}", args.out.join(step_file(last + 1)).display());
+        let last = done + outcome.steps.len();
+        if last > 0 || outcome.declared.is_some() {
+            outln!("the fixed model: {}", args.out.join(step_file(last)).display());
         }
     }
-    // success only when the loop ended with the data explained down to their noise
-    let explained = outcome.stop == FixStop::NothingSignificant && outcome.final_misfit() <= CONSISTENT * outcome.noise;
-    Ok(if explained { Exit::Success } else { Exit::NotConverged })
+    let exit = fix_exit(&outcome);
+    if exit != Exit::Success {
+        eprintln!("exit code {}: {}", exit.code(), exit.meaning());
+    }
+    Ok(exit)
 }
 
 /// The text of a step's case written at `path`, reading the data written
 /// beside it when the first case synthesised them.
-fn step_text(step: &rfm_update::fix::FixStep, path: &Path, data: Option<&Path>) -> Result<String> {
-    let mut editor = step.case.clone();
+fn step_text(case: &CaseEditor, path: &Path, data: Option<&Path>) -> Result<String> {
+    let mut editor = case.clone();
     if let Some(data) = data {
         editor.use_data(data);
     }
@@ -261,13 +275,13 @@ fn step_text(step: &rfm_update::fix::FixStep, path: &Path, data: Option<&Path>) 
 fn keep_step(
     output: &mut Outputs,
     name: &str,
-    step: &rfm_update::fix::FixStep,
+    case: &CaseEditor,
     data: Option<&Path>,
     finished: &mut Vec<String>,
     args: &FixArgs<'_>,
     case_text: &str,
 ) -> std::result::Result<(), Failure> {
-    output.write(name, step_text(step, &output.path(name), data)?.as_bytes())?;
+    output.write(name, step_text(case, &output.path(name), data)?.as_bytes())?;
     finished.push(name.to_string());
     let progress =
         Progress { case: args.case.display().to_string(), case_text: case_text.to_string(), steps: finished.clone() };
@@ -281,39 +295,196 @@ fn keep_step(
     Ok(())
 }
 
+/// What `rfm fix` prints as the loop goes, one line each (the Python
+/// package's progress says the same).
+pub fn progress_lines(p: &FixProgress<'_>) -> Vec<String> {
+    progress_lines_after(p, 0)
+}
+
+/// [`progress_lines`] of a run that resumed after `done` steps of an
+/// earlier one: its steps and diagnoses are numbered from the first run's
+/// start.
+fn progress_lines_after(p: &FixProgress<'_>, done: usize) -> Vec<String> {
+    match p {
+        FixProgress::Checked { findings: [] } => {
+            vec!["checked the data for set-up errors: none found".into()]
+        }
+        FixProgress::Checked { findings } => std::iter::once("checked the data for set-up errors:".to_string())
+            .chain(findings.iter().map(|f| {
+                let fix = if f.corrections.is_empty() { "" } else { " (corrected)" };
+                format!("  {}{fix}", f.summary)
+            }))
+            .collect(),
+        FixProgress::Declared { step } => vec![format!(
+            "step 0: updated the case's own parameters ({}); misfit {} -> {}, dBIC {}",
+            step.status.name(),
+            table::misfit(step.misfit_before),
+            table::misfit(step.misfit_updated),
+            table::dbic(step.delta_bic)
+        )],
+        FixProgress::Diagnosed { step, diagnosis } => vec![match diagnosis.leader() {
+            Some(l) => format!(
+                "diagnosis {}: {} stands out (dBIC {})",
+                done + step + 1,
+                l.description,
+                table::dbic(l.delta_bic)
+            ),
+            None if diagnosis.consistent() => format!("diagnosis {}: nothing significant", done + step + 1),
+            None => format!("diagnosis {}: significant effects, none at plausible values", done + step + 1),
+        }],
+        FixProgress::LookedAhead { ahead, .. } => {
+            let what = match &ahead.with {
+                Some(with) => format!("{} with {with} (fitted together)", ahead.effect),
+                None => ahead.effect.clone(),
+            };
+            vec![match &ahead.rejected {
+                _ if ahead.misfit_ahead.is_nan() => {
+                    format!("  tried {what}: {}", ahead.failed.as_deref().unwrap_or("failed"))
+                }
+                Some(why) => format!("  tried {what}: misfit {}, not kept: {why}", table::misfit(ahead.misfit_ahead)),
+                None => format!(
+                    "  tried {what}: misfit {}, dBIC {}",
+                    table::misfit(ahead.misfit_ahead),
+                    table::dbic(ahead.delta_bic)
+                ),
+            }]
+        }
+        FixProgress::Updated { step, effect, removed, misfit, status } => {
+            let verb = if *removed { "took out" } else { "added" };
+            vec![format!(
+                "step {}: {verb} {effect} and updated ({}); misfit {}",
+                done + step + 1,
+                status.name(),
+                table::misfit(*misfit)
+            )]
+        }
+        // the step was announced by `Updated`; this one is for keeping it
+        FixProgress::StepDone { .. } => Vec::new(),
+    }
+}
+
+/// The exit code of `rfm fix`: success only when the loop ended with the
+/// data explained down to their noise; a model that stays above it with
+/// nothing the evidence singles out (or several effects it cannot tell
+/// apart) is inadequate.
+pub fn fix_exit(outcome: &FixOutcome) -> Exit {
+    match outcome.stop {
+        _ if outcome.explained() => Exit::Success,
+        FixStop::ModelInadequate | FixStop::Ambiguous => Exit::ModelInadequate,
+        _ => Exit::NotConverged,
+    }
+}
+
+/// Writes the outputs of `rfm fix` (not yet committed): the case of every
+/// step (step 0's unless the run resumed, numbered after the `resumed`
+/// steps), the synthesised data, `results.json` and the report.
+fn write_fix(
+    study: &Study,
+    outcome: &FixOutcome,
+    resumed: &Resumed,
+    report: &crate::report::ReportOptions,
+    output: &mut Outputs,
+) -> Result<()> {
+    let synthesised = synthesises(study);
+    let data_file = synthesised.then(|| output.path(DATA_FILE));
+    if synthesised {
+        output.write(DATA_FILE, frf::io::csv::to_csv_string(study.measured()).as_bytes())?;
+    }
+    let declared = outcome.declared.iter().filter(|_| !resumed.earlier);
+    let cases = declared
+        .map(|d| (0, &d.case))
+        .chain(outcome.steps.iter().enumerate().map(|(k, s)| (resumed.steps + k + 1, &s.case)));
+    for (k, case) in cases {
+        let name = step_file(k);
+        output.write(&name, step_text(case, &output.path(&name), data_file.as_deref())?.as_bytes())?;
+    }
+    output.write("results.json", serde_json::to_string_pretty(&outcome)?.as_bytes())?;
+    crate::report::fix_report::write(study, outcome, resumed, &report.for_case(study.case()), output)?;
+    Ok(())
+}
+
+/// Writes what `rfm fix --out DIR` writes for `outcome` (the loop on
+/// `study` with at most `steps` effects) into `dir`, all or nothing: the
+/// case after every step (`step-0.toml` for the case's own parameters,
+/// `step-1.toml`, ...), `results.json`, `report.html` and the figures, and
+/// the data synthesised from the case's `[truth]` (`measured.csv`) where
+/// the steps read them; returns the files. A folder another command wrote
+/// is refused, as `rfm fix` without `--replace` refuses it.
+pub fn save_fix(
+    study: &Study,
+    outcome: &FixOutcome,
+    steps: usize,
+    dir: &Path,
+    report: &crate::report::ReportOptions,
+) -> Result<Vec<PathBuf>> {
+    let mut output = fix_outputs(&study.case().inputs(), synthesises(study), steps, dir, false)?;
+    write_fix(study, outcome, &Resumed { earlier: false, steps: 0, history: Vec::new() }, report, &mut output)?;
+    Ok(output.commit()?)
+}
+
 fn print_outcome(o: &FixOutcome, done: usize) -> Result<()> {
+    let corrected: Vec<_> = o.findings.iter().filter(|f| !f.corrections.is_empty()).collect();
+    if !o.findings.is_empty() {
+        outln!("\nfindings about the data (set-up errors are corrected before the model is fitted):");
+        for f in &o.findings {
+            let fix = if f.corrections.is_empty() { "" } else { " [corrected in the case]" };
+            outln!("  - {}{fix}\n    {}", f.summary, f.evidence);
+        }
+    }
+    if !corrected.is_empty() {
+        outln!("  the corrections are written under [[measurement.corrections]] in every step's case");
+    }
     outln!(
         "\nthe misfit after each step (RMS of |ln(model/measured)| per complex value, over the {} lines the diagnosis reads):",
         quantities::MISFIT_LINES
     );
-    let mut t = Table::new(&["step", "misfit", "x noise"]);
-    for (label, m) in o.stages() {
+    let mut t = Table::new(&["step", "misfit", "x noise", "dBIC of the step"]);
+    for ((label, m), bic) in o.stages().into_iter().zip(crate::report::fix_report::stage_dbics(o)) {
         let label = if done == 0 { label } else { renumbered(&label, done) };
-        t.row(vec![label, table::misfit(m), table::times(quantities::times_noise(m, o.noise))]);
+        t.row(vec![label, table::misfit(m), table::times(quantities::times_noise(m, o.noise)), bic]);
     }
     outln!("{}", t.render());
     outln!("noise level estimated from the data: {}", table::misfit(o.noise));
-    outln!("\nstopped: {}", o.stop.describe());
+    outln!(
+        "(dBIC of the step: the evidence for the model after it over the model before, both updated; below {} it is significant)",
+        quantities::SIGNIFICANT_DBIC
+    );
+    outln!("\nstopped: {}", o.stop_reason);
     let last = o.final_misfit();
     let times = table::times(quantities::times_noise(last, o.noise));
-    if last <= CONSISTENT * o.noise {
+    if o.explained() {
         outln!("the final misfit is {times} times the noise: the model explains the data down to their noise");
+    } else if last <= CONSISTENT * o.noise {
+        outln!("the final misfit is {times} times the noise");
     } else {
-        outln!("the final misfit is {times} times the noise: something the candidates cannot represent remains");
+        outln!("the final misfit is {times} times the noise; what remains unexplained:");
+        for r in &o.remains {
+            outln!("  - {r}");
+        }
     }
-    if let Some(s) = o.steps.last() {
+    if !o.equally_good.is_empty() {
+        outln!("\neffects at different places that explain the data equally well (the data cannot tell them apart):");
+        for a in &o.equally_good {
+            outln!("  - {}: misfit {}, dBIC {}", a.effect, table::misfit(a.misfit_ahead), table::dbic(a.delta_bic));
+        }
+    }
+    let last_update = match (o.steps.last(), &o.declared) {
+        (Some(s), _) => Some((&s.parameters, &s.uncertainty, s.effect.gains.as_slice())),
+        (None, Some(d)) => Some((&d.parameters, &d.uncertainty, &[][..])),
+        (None, None) => None,
+    };
+    if let Some((parameters, uncertainty, gains)) = last_update {
         // the standard deviation shown is the one that includes model error
         // (the residual beyond the noise), which equals the noise's alone when
         // the fit reaches the noise
-        let inflated = s.uncertainty.as_ref().is_some_and(|u| u.inflation > 1.0);
+        let inflated = uncertainty.as_ref().is_some_and(|u| u.inflation > 1.0);
         outln!(
             "\nparameters after the last update (relative standard deviation{}):",
             if inflated { ", widened for the misfit beyond the noise" } else { " from the noise" }
         );
         let mut t = Table::new(&["parameter", "unit", "value", "+-1 sd"]);
-        for (i, p) in s.parameters.iter().enumerate() {
-            let sd = s
-                .uncertainty
+        for (i, p) in parameters.iter().enumerate() {
+            let sd = uncertainty
                 .as_ref()
                 .and_then(|u| u.parameters.get(i))
                 .map_or("-".to_string(), |u| crate::table::percent(u.relative_std));
@@ -322,7 +493,7 @@ fn print_outcome(o: &FixOutcome, done: usize) -> Result<()> {
         }
         outln!("{}", t.render());
         // the data's level: every misfit above is after the gains that fit the model best
-        for g in crate::report::gain_reports(&s.effect.gains) {
+        for g in crate::report::gain_reports(gains) {
             outln!("gain fitted with the last effect: {}", crate::report::gain_text(&g));
         }
     }
@@ -340,11 +511,20 @@ fn print_outcome(o: &FixOutcome, done: usize) -> Result<()> {
 /// first run's start: `updated after step 1` after 2 earlier steps reads
 /// `updated after step 3`.
 fn renumbered(label: &str, done: usize) -> String {
-    match label.strip_prefix("updated after step ").and_then(|n| n.parse::<usize>().ok()) {
-        Some(n) => format!("updated after step {}", n + done),
-        None if label == "nominal" => format!("after step {done} (where this run resumed)"),
-        None => label.to_string(),
+    let after = |prefix: &str, rest: &str| -> Option<String> {
+        let (n, tail) = rest.split_once(' ').map_or((rest, ""), |(n, t)| (n, t));
+        let n = n.parse::<usize>().ok()?;
+        Some(format!("{prefix}{}{}{tail}", n + done, if tail.is_empty() { "" } else { " " }))
+    };
+    if let Some(r) = label.strip_prefix("updated after step ").and_then(|rest| after("updated after step ", rest)) {
+        return r;
     }
+    if let Some(r) =
+        label.strip_prefix("data corrected after step ").and_then(|rest| after("data corrected after step ", rest))
+    {
+        return r;
+    }
+    if label == "nominal" { format!("after step {done} (where this run resumed)") } else { label.to_string() }
 }
 
 #[cfg(test)]
@@ -354,15 +534,21 @@ mod tests {
     #[test]
     fn a_resumed_runs_stages_count_from_the_first_runs_start() {
         assert_eq!(renumbered("updated after step 1", 2), "updated after step 3");
+        assert_eq!(renumbered("data corrected after step 1 and updated", 2), "data corrected after step 3 and updated");
         assert_eq!(renumbered("nominal", 2), "after step 2 (where this run resumed)");
         assert_eq!(renumbered("+ lumped mass at node 9", 2), "+ lumped mass at node 9");
     }
 
-    /// The progress file is read back as written.
+    /// The progress file is read back as written, and step 0 adds no effect.
     #[test]
     fn progress_round_trips() {
-        let p = Progress { case: "a.toml".into(), case_text: "x = 1\n".into(), steps: vec!["step-1.toml".into()] };
+        let p = Progress {
+            case: "a.toml".into(),
+            case_text: "x = 1\n".into(),
+            steps: vec!["step-0.toml".into(), "step-1.toml".into()],
+        };
         let back: Progress = serde_json::from_str(&serde_json::to_string(&p).unwrap()).unwrap();
+        assert_eq!(back.effects_done(), 1);
         assert_eq!((back.case, back.case_text, back.steps), (p.case, p.case_text, p.steps));
     }
 }

@@ -1,6 +1,6 @@
 //! `rfm update`: update the model's parameters against the measured FRFs.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use rfm_update::{Method, Study, UpdateOutcome};
@@ -18,16 +18,18 @@ use crate::table::{self, Table, num};
 
 /// Command-line overrides of the case's `[update]` settings.
 #[derive(Default)]
-pub(crate) struct Overrides {
+pub struct Overrides {
     /// Method name.
-    pub(crate) method: Option<String>,
+    pub method: Option<String>,
     /// Fit this many lines spread over the band.
-    pub(crate) lines: Option<usize>,
+    pub lines: Option<usize>,
     /// Iteration limit.
-    pub(crate) max_iterations: Option<usize>,
+    pub max_iterations: Option<usize>,
 }
 
-pub(crate) fn update(
+/// `rfm update`: prints the iterations and the results (or `--json`) and
+/// with `--out` writes them.
+pub fn update(
     case: &Path,
     out: Option<&Path>,
     replace: bool,
@@ -37,32 +39,10 @@ pub(crate) fn update(
 ) -> Result<Exit> {
     let mut study = super::load_study(case)?;
     let mut output = out
-        .map(|dir| {
-            Outputs::folder(dir, &study.case().inputs(), &["results.json", "updated.toml", "report.html"])?
-                .of_command("update", replace)
-        })
+        .map(|dir| Outputs::folder(dir, &study.case().inputs(), &UPDATE_OUTPUTS)?.of_command("update", replace))
         .transpose()?;
-    if over.lines == Some(0) {
-        return Err(Failure::new(Exit::Usage, "--lines 0: give at least one measured line to fit"));
-    }
-    if let Some(n) = over.lines
-        && study.case().update.is_some()
-    {
-        study.set_update_frequencies(fe_model::case::FrequencyChoice::Lines(n))?;
-    }
-    let method = over.method.as_deref();
-    if study.case().update.is_none() {
-        return Err("the case has no [update] section".into());
-    }
-    let method = match method {
-        Some(m) => Method::parse(m).ok_or_else(|| format!("unknown method `{m}` (available: rfm, output-error)"))?,
-        None => study.checked_method().map_err(|e| e.to_string())?,
-    };
-    let lines = study.lines_for(method)?;
-    let max_iterations = over.max_iterations.unwrap_or(match method {
-        Method::Rfm => study.rfm_options().max_iterations,
-        Method::OutputError => study.output_error_options()?.max_iterations,
-    });
+    let setup = UpdateSetup::new(&mut study, over)?;
+    let (method, lines, max_iterations) = (setup.method, &setup.lines, setup.max_iterations);
     print_notes(study.notes(), json)?;
     print_masked(&rfm_update::study::describe_masked(study.masked()), json)?;
     if !json {
@@ -104,55 +84,11 @@ pub(crate) fn update(
         bar.set_position(r.iteration as u64);
         bar.set_message(format!("{} {}", residual_name(method), table::misfit(r.residual)));
     };
-    let mut outcome = match method {
-        Method::Rfm => {
-            let opts = RfmOptions { max_iterations, ..study.rfm_options() };
-            study.run_rfm(&opts, on_iteration)?
-        }
-        Method::OutputError => {
-            let mut opts = study.output_error_options()?;
-            opts.max_iterations = max_iterations;
-            study.run_output_error(&opts, on_iteration)?
-        }
-    };
+    let mut outcome = setup.run(&study, on_iteration)?;
     bar.finish_and_clear();
-    // the misfit the case's history speaks of, after this update, weighted
-    // as the diagnosis weighs it (the fit's line weights)
-    let weights = study.line_weights(study.measured())?;
-    let (measured, weights) = (study.measured(), weights.as_deref());
-    let noise = quantities::noise(&outcome.system, measured, weights)?;
-    let gains = study.gains();
-    let misfit = quantities::misfit(&outcome.system, measured, gains, weights)?;
-    // worse than the start over the whole band, not only at the fitted lines
-    let misfit_initial = quantities::misfit(study.system(), measured, gains, weights)?;
-    if misfit > WORSE_BY * misfit_initial && !outcome.worse_than_start {
-        outcome.worse_than_start = true;
-        outcome.warnings.push(format!(
-            "the update made the misfit over the band worse than the initial model's ({} -> {}): the updated \
-             model is not an improvement",
-            table::misfit(misfit_initial),
-            table::misfit(misfit)
-        ));
-    }
-    let step = fe_model::HistoryEntry {
-        step: format!("updated ({})", outcome.method),
-        misfit,
-        noise,
-        ..fe_model::HistoryEntry::default()
-    };
-    // the initial and the updated model's misfits over the diagnosis's
-    // lines, against the one noise level read for this run
-    let report_of = |m: f64| MisfitReport {
-        misfit: m,
-        noise,
-        times_noise: noise.map(|n| quantities::times_noise(m, n)),
-        lines: HISTORY_LINES.min(measured.n_freq()),
-        weighted: weights.is_some(),
-    };
-    let misfits = [report_of(misfit_initial), report_of(misfit)];
+    let (step, misfits) = finish(&study, &mut outcome)?;
     if json {
-        let doc = UpdateJson { misfit_initial: misfits[0], misfit: misfits[1], outcome: &outcome };
-        outln!("{}", serde_json::to_string_pretty(&doc)?);
+        outln!("{}", json_of(&outcome, &misfits)?);
     } else {
         print_outcome(&outcome, method, &misfits)?;
         if !study.case().history.is_empty() {
@@ -168,20 +104,8 @@ pub(crate) fn update(
             }
         }
     }
-    if let Some(mut output) = output.take() {
-        let doc = UpdateJson { misfit_initial: misfits[0], misfit: misfits[1], outcome: &outcome };
-        let path = output.write("results.json", serde_json::to_string_pretty(&doc)?.as_bytes())?;
-        let updated = write_updated_model(&study, &outcome, &step, &mut output)?;
-        let report = crate::report::update_report::write(
-            &study,
-            &outcome,
-            &step,
-            &misfits,
-            &mut output,
-            case,
-            &report.for_case(study.case()),
-        )?;
-        output.commit()?;
+    if let Some(output) = output.take() {
+        let [path, updated, report] = write_update(&study, &outcome, &step, &misfits, output, case, report)?;
         if !json {
             outln!("\nwrote {} and {}", path.display(), updated.display());
             outln!("wrote {} (figures beside it)", report.display());
@@ -192,6 +116,172 @@ pub(crate) fn update(
         eprintln!("exit code {}: {}", exit.code(), exit.meaning());
     }
     Ok(exit)
+}
+
+/// The files `rfm update --out` writes besides the figures.
+const UPDATE_OUTPUTS: [&str; 3] = ["results.json", "updated.toml", "report.html"];
+
+/// An update as `rfm update` sets it up: the method, the updating lines and
+/// the iteration limit, the case's or the command line's.
+pub struct UpdateSetup {
+    /// The updating method.
+    pub method: Method,
+    /// The updating lines (Hz).
+    pub lines: Vec<f64>,
+    /// The iteration limit.
+    pub max_iterations: usize,
+}
+
+impl UpdateSetup {
+    /// Sets up the update of `study` with the overrides of the command
+    /// line (the study's lines change when `over` gives their number).
+    pub fn new(study: &mut Study, over: &Overrides) -> Result<UpdateSetup> {
+        if over.lines == Some(0) {
+            return Err(Failure::new(Exit::Usage, "--lines 0: give at least one measured line to fit"));
+        }
+        if let Some(n) = over.lines
+            && study.case().update.is_some()
+        {
+            study.set_update_frequencies(fe_model::case::FrequencyChoice::Lines(n))?;
+        }
+        let method = over.method.as_deref();
+        if study.case().update.is_none() {
+            return Err("the case has no [update] section".into());
+        }
+        let method = match method {
+            Some(m) => {
+                Method::parse(m).ok_or_else(|| format!("unknown method `{m}` (available: rfm, output-error)"))?
+            }
+            None => study.checked_method().map_err(|e| e.to_string())?,
+        };
+        let lines = study.lines_for(method)?;
+        let max_iterations = over.max_iterations.unwrap_or(match method {
+            Method::Rfm => study.rfm_options().max_iterations,
+            Method::OutputError => study.output_error_options()?.max_iterations,
+        });
+        Ok(UpdateSetup { method, lines, max_iterations })
+    }
+
+    /// Runs the update, calling `on_iteration` after every iteration.
+    pub fn run(&self, study: &Study, on_iteration: impl FnMut(&IterationRecord)) -> Result<UpdateOutcome> {
+        Ok(match self.method {
+            Method::Rfm => {
+                let opts = RfmOptions { max_iterations: self.max_iterations, ..study.rfm_options() };
+                study.run_rfm(&opts, on_iteration)?
+            }
+            Method::OutputError => {
+                let mut opts = study.output_error_options()?;
+                opts.max_iterations = self.max_iterations;
+                study.run_output_error(&opts, on_iteration)?
+            }
+        })
+    }
+}
+
+/// What `rfm update` adds to an update's outcome before printing it: the
+/// misfit over the whole band against the initial model's (an update that
+/// made it worse is marked so), and the entry of the case's history the
+/// updated case gets, which it returns.
+pub fn finish_update(study: &Study, outcome: &mut UpdateOutcome) -> Result<fe_model::HistoryEntry> {
+    Ok(finish(study, outcome)?.0)
+}
+
+/// [`finish_update`], with the initial and the updated model's misfits.
+fn finish(study: &Study, outcome: &mut UpdateOutcome) -> Result<(fe_model::HistoryEntry, [MisfitReport; 2])> {
+    let misfits = misfits(study, outcome)?;
+    let [initial, updated] = misfits;
+    // worse than the start over the whole band, not only at the fitted lines
+    if updated.misfit > WORSE_BY * initial.misfit && !outcome.worse_than_start {
+        outcome.worse_than_start = true;
+        outcome.warnings.push(format!(
+            "the update made the misfit over the band worse than the initial model's ({} -> {}): the updated \
+             model is not an improvement",
+            table::misfit(initial.misfit),
+            table::misfit(updated.misfit)
+        ));
+    }
+    let step = fe_model::HistoryEntry {
+        step: format!("updated ({})", outcome.method),
+        misfit: updated.misfit,
+        noise: updated.noise,
+        ..fe_model::HistoryEntry::default()
+    };
+    Ok((step, misfits))
+}
+
+/// The initial and the updated model's misfits over the diagnosis's lines
+/// (the misfit the case's history speaks of), weighted as the diagnosis
+/// weighs them (the fit's line weights), against the one noise level read
+/// against the updated model.
+fn misfits(study: &Study, outcome: &UpdateOutcome) -> Result<[MisfitReport; 2]> {
+    let weights = study.line_weights(study.measured())?;
+    let (measured, weights) = (study.measured(), weights.as_deref());
+    let noise = quantities::noise(&outcome.system, measured, weights)?;
+    let gains = study.gains();
+    let misfit = quantities::misfit(&outcome.system, measured, gains, weights)?;
+    let misfit_initial = quantities::misfit(study.system(), measured, gains, weights)?;
+    let report_of = |m: f64| MisfitReport {
+        misfit: m,
+        noise,
+        times_noise: noise.map(|n| quantities::times_noise(m, n)),
+        lines: HISTORY_LINES.min(measured.n_freq()),
+        weighted: weights.is_some(),
+    };
+    Ok([report_of(misfit_initial), report_of(misfit)])
+}
+
+/// What `rfm update --json` prints and `results.json` holds for `outcome`
+/// (finished by [`finish_update`]) of `study`.
+pub fn update_json(study: &Study, outcome: &UpdateOutcome) -> Result<String> {
+    json_of(outcome, &misfits(study, outcome)?)
+}
+
+fn json_of(outcome: &UpdateOutcome, misfits: &[MisfitReport; 2]) -> Result<String> {
+    let doc = UpdateJson { misfit_initial: misfits[0], misfit: misfits[1], outcome };
+    Ok(serde_json::to_string_pretty(&doc)?)
+}
+
+/// Writes the outputs of `rfm update --out` and commits them; returns the
+/// paths of `results.json`, `updated.toml` and `report.html`.
+fn write_update(
+    study: &Study,
+    outcome: &UpdateOutcome,
+    step: &fe_model::HistoryEntry,
+    misfits: &[MisfitReport; 2],
+    mut output: Outputs,
+    case: &Path,
+    report: &crate::report::ReportOptions,
+) -> Result<[PathBuf; 3]> {
+    let path = output.write("results.json", json_of(outcome, misfits)?.as_bytes())?;
+    let updated = write_updated_model(study, outcome, step, &mut output)?;
+    let report = crate::report::update_report::write(
+        study,
+        outcome,
+        step,
+        misfits,
+        &mut output,
+        case,
+        &report.for_case(study.case()),
+    )?;
+    output.commit()?;
+    Ok([path, updated, report])
+}
+
+/// Writes what `rfm update --out DIR` writes for `outcome` (finished by
+/// [`finish_update`], which gave `step`) into `dir`, all or nothing:
+/// `results.json`, `updated.toml`, `report.html` and the figures. `case`
+/// is the case file's path as the report names it. A folder another
+/// command wrote is refused, as `rfm update` without `--replace` refuses it.
+pub fn save_update(
+    study: &Study,
+    outcome: &UpdateOutcome,
+    step: &fe_model::HistoryEntry,
+    case: &Path,
+    dir: &Path,
+    report: &crate::report::ReportOptions,
+) -> Result<[PathBuf; 3]> {
+    let output = Outputs::folder(dir, &study.case().inputs(), &UPDATE_OUTPUTS)?.of_command("update", false)?;
+    write_update(study, outcome, step, &misfits(study, outcome)?, output, case, report)
 }
 
 /// What `--json` prints and `results.json` holds: the library's outcome
@@ -224,6 +314,18 @@ fn write_updated_model(
     step: &fe_model::HistoryEntry,
     output: &mut Outputs,
 ) -> Result<std::path::PathBuf> {
+    let editor = updated_case(study, outcome, step)?;
+    let text = editor.text_at(&output.path("updated.toml"))?;
+    Ok(output.write("updated.toml", text.as_bytes())?)
+}
+
+/// The case `rfm update` writes as `updated.toml`: the updated values with
+/// a comment on the run, the gains it estimated, and `step` in its history.
+pub fn updated_case(
+    study: &Study,
+    outcome: &UpdateOutcome,
+    step: &fe_model::HistoryEntry,
+) -> Result<fe_model::case::CaseEditor> {
     let values = rfm_update::params::quantity_values(study.parameters(), outcome.system.model());
     let times = step
         .noise
@@ -249,8 +351,7 @@ fn write_updated_model(
         editor.set_gains(study.gains(), &fitted)?;
     }
     editor.push_history(step)?;
-    let text = editor.text_at(&output.path("updated.toml"))?;
-    Ok(output.write("updated.toml", text.as_bytes())?)
+    Ok(editor)
 }
 
 /// A band misfit this many times the initial model's is worse than the

@@ -1,8 +1,10 @@
-//! The report of a diagnosis (`rfm diagnose --report DIR`): the noise and
-//! the nominal model's misfit, the structure with the leading candidates
-//! marked where they act, the ranking (also as CSV), and, when an effect is
-//! recommended, the nominal model and the model with it added at its fitted
-//! values against the measured FRFs.
+//! The report of a diagnosis (`rfm diagnose --report DIR`): what the checks
+//! found about the data (with the evidence and the correction applied),
+//! step 0 (the case's own parameters updated), the noise and the diagnosed
+//! model's misfit, the structure with the leading candidates marked where
+//! they act, the ranking (also as CSV), and, when an effect is recommended,
+//! the diagnosed model and the model with it added at its fitted values
+//! against the measured FRFs (corrected as the findings say).
 
 use std::path::PathBuf;
 
@@ -10,6 +12,7 @@ use frf::correlation::BandSpec;
 use rfm_update::Study;
 use rfm_update::comparison::{self, GainSource};
 use rfm_update::diagnose::Diagnosis;
+use rfm_update::fix::Prepared;
 use rfm_update::quantities::{self, MisfitReport};
 
 use super::html::{Block, Report, Section, Table, Tone};
@@ -24,26 +27,34 @@ const MARKED: usize = 5;
 /// Rows of the ranking in the report (the CSV holds every one).
 const RANKED_ROWS: usize = 40;
 
-/// Writes the report of diagnosis `d` of `study`'s model against `data`
-/// (the measured FRFs as read, from `source`) and returns where
-/// `report.html` will be.
+/// Writes the report of diagnosis `d` of `study`'s model, as `prepared`
+/// made it ready (the data corrected, the case's own parameters updated),
+/// against the measured FRFs as read (`as_read`, per volt at the references
+/// `per_volt`; from `source`), and returns where `report.html` will be.
 pub(crate) fn write(
     study: &Study,
+    prepared: &Prepared,
     d: &Diagnosis,
-    data: &Data<'_>,
+    (as_read, per_volt): (&frf::FrfSet, &[fe_model::DofRef]),
     source: &str,
     opts: &ReportOptions,
     out: &mut Outputs,
 ) -> Result<PathBuf> {
-    let case = study.case();
+    // the model the diagnosis read: corrected and its own parameters updated
+    let case = &prepared.case;
+    let diagnosed = damping::DampedSystem::new(case.model.clone())?;
+    // the data as they were measured (their kind), corrected as the findings say
+    let corrected = rfm_update::checks::corrected(as_read, &prepared.findings)?;
+    let unweighted = if d.weighted { quantities::noise(&diagnosed, &prepared.data, None)? } else { Some(d.noise) };
+    let data = &Data::new(&corrected, per_volt, unweighted);
     let mut report = Report::new(format!("{}: what is missing", case.model.title));
-    report.subtitle = Some(format!("rfm diagnose, case file {}", case.path.display()));
+    report.subtitle = Some(format!("rfm diagnose, case file {}", study.case().path.display()));
     let measured = data.set;
     let f = measured.frequencies_hz();
 
     let mut summary = Section::new("Summary");
     let mut facts = vec![
-        ("case".to_string(), case.path.display().to_string()),
+        ("case".to_string(), study.case().path.display().to_string()),
         ("data".into(), source.to_string()),
         (
             "measurement".into(),
@@ -59,7 +70,12 @@ pub(crate) fn write(
         ),
         ("noise".into(), table::misfit(d.noise)),
         (
-            "misfit of the nominal model".into(),
+            if prepared.declared.is_some() {
+                "misfit of the model diagnosed (after step 0)"
+            } else {
+                "misfit of the nominal model"
+            }
+            .into(),
             format!(
                 "{} ({} x the noise), over the {} lines the diagnosis reads{}",
                 table::misfit(d.nominal_misfit),
@@ -74,6 +90,14 @@ pub(crate) fn write(
         facts.push(("gain fitted with the first".into(), gains_text(&gain_reports(&l.gains))));
     }
     summary.push(Block::Facts(facts));
+    let before = super::setup::Before {
+        noise: prepared.noise,
+        nominal: prepared.nominal_misfit,
+        corrected: prepared.corrected_misfit,
+    };
+    for block in super::setup::blocks(&prepared.findings, prepared.declared.as_ref(), before, out)? {
+        summary.push(block);
+    }
     summary.push(Block::Text(match d.leader() {
         Some(l) => format!(
             "Most likely missing (rank {}): {}. It explains {:.1} % of the nominal model's squared misfit and leaves \
@@ -108,9 +132,9 @@ pub(crate) fn write(
         measured,
         &marked,
         if marked.is_empty() {
-            "The nominal model: no candidate is both significant and plausible."
+            "The model diagnosed: no candidate is both significant and plausible."
         } else {
-            "The nominal model with the leading significant, plausible candidates (distinct places, at most five) \
+            "The model diagnosed with the leading significant, plausible candidates (distinct places, at most five) \
              marked where they act, each numbered by its rank (a ring at a joint, a support or a mass, a broad band \
              along the elements of a changed region)."
         },
@@ -211,11 +235,11 @@ pub(crate) fn write(
         };
         let leader = &d.ranking[rank - 1];
         let models = [
-            model("nominal model".into(), plot::INITIAL, study.system(), d.nominal_misfit)?,
+            model("model diagnosed".into(), plot::INITIAL, &diagnosed, d.nominal_misfit)?,
             model(format!("with rank {rank} added"), plot::UPDATED, &with, leader.misfit)?,
         ];
         let notes = vec![format!(
-            "The nominal model, and the model with the recommended effect ({}) added at its fitted values, \
+            "The model diagnosed, and the model with the recommended effect ({}) added at its fitted values, \
              against the measured FRFs.",
             leader.description
         )];

@@ -1,10 +1,15 @@
 //! The report of the loop (`rfm fix --out DIR`): its headline is the misfit
-//! after each step against the noise, beside the structure with each added
-//! effect marked where it sits; then each step's effect and updated
-//! parameters, what still stands out, the nominal and final models against
-//! the measured FRFs (in the data's own kind and unit, each times the gains
-//! that fit it), and the final model's modes against the measured ones with
-//! the natural frequencies and damping of every step's model.
+//! after each step against the noise, with each step's dBIC, why the loop
+//! stopped, what remains unexplained and the effects the data could not
+//! tell apart, beside the structure with each added effect marked where it
+//! sits; then what was set right before the model was blamed (the findings
+//! about the data, step 0), each step's effect, the others tried and its
+//! updated parameters, what still stands out, the nominal and final models
+//! against the measured FRFs (in the data's own kind and unit, corrected as
+//! the findings say, each model times the gains that fit it), and the final
+//! model's modes against the measured ones with the natural frequencies and
+//! damping of every step's model. The terminal says the same in
+//! `commands/fix.rs`.
 
 use std::path::PathBuf;
 
@@ -12,7 +17,7 @@ use frf::correlation::BandSpec;
 use rfm_update::Study;
 use rfm_update::comparison::{self, GainSource};
 use rfm_update::diagnose::Ranked;
-use rfm_update::fix::{CONSISTENT, FixOutcome};
+use rfm_update::fix::{CONSISTENT, FixOutcome, LookAhead};
 use rfm_update::quantities::{self, MisfitReport};
 
 use super::html::{Block, Report, Section, Table, Tone};
@@ -22,7 +27,8 @@ use super::{Data, ModelFrfs, ReportOptions, Result, gain_reports, gains_text, lo
 use crate::output::Outputs;
 use crate::table::{self, num, percent};
 
-/// The name of the case file written after step `k` (1-based): the
+/// The name of the case file written after step `k` (1-based; 0 for the
+/// case's own parameters updated before any effect is added): the
 /// command writes it, the report names it beside the step (here, below the
 /// command, so that the two do not import each other).
 pub(crate) fn step_file(k: usize) -> String {
@@ -32,7 +38,9 @@ pub(crate) fn step_file(k: usize) -> String {
 /// The steps an earlier, interrupted run into the same folder finished,
 /// when this run resumed after them (`rfm fix --resume`).
 pub(crate) struct Resumed {
-    /// How many.
+    /// Whether this run resumed an earlier one at all.
+    pub(crate) earlier: bool,
+    /// How many effects its finished steps added.
     pub(crate) steps: usize,
     /// The history of the case this run started from (the last of them):
     /// the misfit after each of the earlier steps.
@@ -50,6 +58,82 @@ fn short_effect(e: &Ranked) -> String {
     loop_story::short_effect(Some(e.kind), &e.nodes, &e.elements)
 }
 
+/// The dBIC of each of [`FixOutcome::stages`], formatted as the terminal
+/// and the report show it: step 0's and each update's own evidence (the
+/// model after it over the model before, both updated), blank for the
+/// stages that fit nothing.
+pub(crate) fn stage_dbics(o: &FixOutcome) -> Vec<String> {
+    let mut bics: Vec<String> = vec![String::new()];
+    if o.findings.iter().any(|f| !f.corrections.is_empty()) {
+        bics.push(String::new());
+    }
+    if let Some(d) = &o.declared {
+        bics.push(table::dbic(d.delta_bic));
+    }
+    for s in &o.steps {
+        bics.push(String::new());
+        bics.push(table::dbic(s.delta_bic));
+        if s.corrected_misfit.is_some() {
+            bics.push(String::new());
+        }
+    }
+    bics
+}
+
+/// The stages of [`FixOutcome::stages`] in a few words for the figure's
+/// axis, the steps numbered after `offset` earlier ones.
+fn short_stages(o: &FixOutcome, offset: usize) -> Vec<String> {
+    let mut v = Vec::new();
+    if o.findings.iter().any(|f| !f.corrections.is_empty()) {
+        v.push("data corrected".to_string());
+    }
+    if o.declared.is_some() {
+        v.push("step 0".to_string());
+    }
+    for (k, s) in o.steps.iter().enumerate() {
+        let sign = if s.removed { "-" } else { "+" };
+        let k = k + offset;
+        v.push(format!("{sign} {}: {}", k + 1, short_effect(&s.effect)));
+        v.push(format!("updated {}", k + 1));
+        if s.corrected_misfit.is_some() {
+            v.push(format!("corrected {}", k + 1));
+        }
+    }
+    v
+}
+
+/// A table of effects tried (the alternatives of a step, or those the data
+/// could not tell apart), with the misfit each left and its evidence.
+fn tried_table(tried: &[LookAhead], noise: f64, caption: &str) -> Table {
+    let times = |m: f64| table::times(quantities::times_noise(m, noise));
+    let mut t = Table::new(&["effect", "misfit after it", "x noise", "dBIC", "why not kept"]).caption(caption);
+    for a in tried {
+        let effect = match &a.with {
+            Some(with) => format!("{} together with {with}", a.effect),
+            None => a.effect.clone(),
+        };
+        let why = a.rejected.clone().unwrap_or_else(|| "kept".into());
+        let tone = if a.equally_good { Tone::Good } else { Tone::Plain };
+        match &a.failed {
+            Some(e) => t.row_toned(vec![
+                (effect, Tone::Plain),
+                (format!("could not be added: {e}"), Tone::Plain),
+                ("-".into(), Tone::Plain),
+                ("-".into(), Tone::Plain),
+                (why, Tone::Plain),
+            ]),
+            None => t.row_toned(vec![
+                (effect, tone),
+                (table::misfit(a.misfit_ahead), Tone::Plain),
+                (times(a.misfit_ahead), Tone::Plain),
+                (table::dbic(a.delta_bic), Tone::Plain),
+                (why, Tone::Plain),
+            ]),
+        }
+    }
+    t
+}
+
 /// Writes the report files of the loop through `out` and returns where
 /// `report.html` will be.
 pub(crate) fn write(
@@ -60,21 +144,19 @@ pub(crate) fn write(
     out: &mut Outputs,
 ) -> Result<PathBuf> {
     let offset = resumed.steps;
-    // the model after each step; the last has every effect added
-    let step_systems = outcome
-        .steps
-        .iter()
-        .map(|s| {
-            let text = s.case.text_at(&study.case().path)?;
-            Ok(damping::DampedSystem::new(fe_model::CaseFile::parse(&study.case().path, &text)?.model)?)
-        })
-        .collect::<Result<Vec<damping::DampedSystem>>>()?;
-    let fixed = step_systems.last();
+    let system_of = |case: &fe_model::case::CaseEditor| -> Result<damping::DampedSystem> {
+        let text = case.text_at(&study.case().path)?;
+        Ok(damping::DampedSystem::new(fe_model::CaseFile::parse(&study.case().path, &text)?.model)?)
+    };
+    // the model after step 0 and after each step; the last has every effect added
+    let declared_system = outcome.declared.as_ref().map(|d| system_of(&d.case)).transpose()?;
+    let step_systems = outcome.steps.iter().map(|s| system_of(&s.case)).collect::<Result<Vec<_>>>()?;
+    let fixed = step_systems.last().or(declared_system.as_ref());
     let mut report = Report::new(format!("{}: closing the loop", study.case().model.title));
     report.subtitle = Some(format!(
         "rfm fix, case file {}: {} effect(s) added{}; {}",
         study.case().path.display(),
-        outcome.steps.len(),
+        outcome.effects.len(),
         if offset > 0 { format!(" after the {offset} of an earlier run it resumed") } else { String::new() },
         outcome.stop.describe()
     ));
@@ -82,29 +164,26 @@ pub(crate) fn write(
     // a resumed run's stages follow the earlier run's, as the case it
     // started from records them
     let mut stages: Vec<(String, f64)> = resumed.history.iter().map(|h| (h.step.clone(), h.misfit)).collect();
-    stages.extend(outcome.stages().into_iter().skip(if offset > 0 { 1 } else { 0 }));
+    let mut bics: Vec<String> = vec![String::new(); resumed.history.len()];
+    let skip = usize::from(resumed.earlier);
+    stages.extend(outcome.stages().into_iter().skip(skip));
+    bics.extend(stage_dbics(outcome).into_iter().skip(skip));
     let mut fall = Section::new("The misfit after each step");
-    let earlier: Vec<String> = if offset > 0 {
+    let earlier: Vec<String> = if resumed.earlier {
         resumed.history.iter().map(|h| h.step.chars().take(24).collect()).collect()
     } else {
         vec!["nominal".to_string()]
     };
-    let short: Vec<String> = earlier
-        .into_iter()
-        .chain(outcome.steps.iter().enumerate().flat_map(|(k, s)| {
-            let sign = if s.removed { "-" } else { "+" };
-            let k = k + offset;
-            [format!("{sign} {}: {}", k + 1, short_effect(&s.effect)), format!("updated {}", k + 1)]
-        }))
-        .collect();
+    let short: Vec<String> = earlier.into_iter().chain(short_stages(outcome, offset)).collect();
     let misfits: Vec<f64> = stages.iter().map(|(_, m)| *m).collect();
     fall.push(out.figure(
         "misfit-steps",
         plot::misfit_steps(&short, &misfits, outcome.noise, CONSISTENT)?,
         format!(
             "The misfit (RMS of |ln(model / measured)| per complex value, over the {} lines the diagnosis reads) of \
-             the nominal model, after adding each effect at its diagnosed values (numbered as on the structure \
-             below), and after updating every added parameter together. The green band runs from the noise level \
+             the nominal model, on the data corrected as the findings below say, after updating the case's own \
+             parameters (step 0), after adding each effect at its diagnosed values (numbered as on the structure \
+             below), and after updating every parameter together. The green band runs from the noise level \
              estimated from the data ({}) to {CONSISTENT} times it: a misfit inside it is consistent with the noise.",
             quantities::MISFIT_LINES,
             table::misfit(outcome.noise)
@@ -120,37 +199,67 @@ pub(crate) fn write(
         study.measured(),
         &highlights,
         if highlights.is_empty() {
-            "Nothing was added: the nominal model."
+            "Nothing was added: the model after the last update."
         } else {
             "The model after the last step, each added effect numbered by its step and marked where it sits (a \
-             ring at a joint, a support or a mass, a broad band along the elements of a changed region)."
+             ring at a joint, a support or a mass, a broad band along the elements of a changed region, a mass on \
+             a spring for a resonator)."
         },
         out,
     )?);
-    let mut t = Table::new(&["step", "misfit", "x noise"]).caption(format!(
-        "The misfit of each stage and its multiple of the noise ({}); green within {CONSISTENT} times it.",
-        table::misfit(outcome.noise)
+    let mut t = Table::new(&["step", "misfit", "x noise", "dBIC of the step"]).caption(format!(
+        "The misfit of each stage and its multiple of the noise ({}); green within {CONSISTENT} times it. The dBIC \
+         of a step is its own evidence: the model after it against the model before, both updated, every parameter \
+         counted; a step is kept only when it is below {} (significant).",
+        table::misfit(outcome.noise),
+        quantities::SIGNIFICANT_DBIC
     ));
-    for (label, m) in &stages {
+    for ((label, m), bic) in stages.iter().zip(bics) {
         let tone = if *m <= CONSISTENT * outcome.noise { Tone::Good } else { Tone::Plain };
         t.row_toned(vec![
             (label.clone(), Tone::Plain),
             (table::misfit(*m), tone),
             (table::times(quantities::times_noise(*m, outcome.noise)), tone),
+            (bic, Tone::Plain),
         ]);
     }
     fall.push(out.table("steps", t)?);
     let last = outcome.final_misfit();
     let times = table::times(quantities::times_noise(last, outcome.noise));
-    fall.push(Block::Text(if last <= CONSISTENT * outcome.noise {
+    fall.push(Block::Text(if outcome.explained() {
         format!("The final misfit is {times} times the noise: the model explains the data down to their noise.")
+    } else if last <= CONSISTENT * outcome.noise {
+        format!("The final misfit is {times} times the noise.")
     } else {
-        format!(
-            "The final misfit is {times} times the noise: something the candidate effects cannot represent remains."
-        )
+        format!("The final misfit is {times} times the noise: something the model lacks remains.")
     }));
-    fall.push(Block::Text(format!("The loop stopped because {}.", outcome.stop.describe())));
+    fall.push(Block::Facts(vec![("stopped".into(), outcome.stop_reason.clone())]));
+    if !outcome.remains.is_empty() {
+        fall.push(Block::Text(format!("What remains unexplained: {}.", outcome.remains.join("; "))));
+    }
+    if !outcome.equally_good.is_empty() {
+        fall.push(out.table(
+            "equally-good",
+            tried_table(
+                &outcome.equally_good,
+                outcome.noise,
+                "Effects at different places that explain the data equally well: the evidence between them is not \
+                 significant, so the data cannot tell them apart (more channels, or a band with more modes, may).",
+            ),
+        )?);
+    }
     report.sections.push(fall);
+
+    let mut setup = Section::new("Before the model was blamed: the data and the case's own parameters");
+    let before = super::setup::Before {
+        noise: outcome.noise,
+        nominal: outcome.nominal_misfit,
+        corrected: outcome.corrected_misfit,
+    };
+    for block in super::setup::blocks(&outcome.findings, outcome.declared.as_ref(), before, out)? {
+        setup.push(block);
+    }
+    report.sections.push(setup);
 
     for (k, s) in outcome.steps.iter().enumerate() {
         let k = k + offset;
@@ -164,11 +273,12 @@ pub(crate) fn write(
         let times = |m: f64| table::times(quantities::times_noise(m, outcome.noise));
         let mut facts = vec![
             ("explained".into(), format!("{} of the squared misfit before it", super::percent(e.explained))),
+            ("dBIC in the diagnosis".into(), format!("{} (against the other candidates)", table::dbic(e.delta_bic))),
             (
-                "dBIC".into(),
+                "dBIC of the step".into(),
                 format!(
-                    "{} (significant below {}; see the glossary)",
-                    table::dbic(e.delta_bic),
+                    "{} (the model after the step against the model before, both updated; significant below {})",
+                    table::dbic(s.delta_bic),
                     quantities::SIGNIFICANT_DBIC
                 ),
             ),
@@ -182,31 +292,26 @@ pub(crate) fn write(
                     s.status.name()
                 ),
             ),
-            ("case file".into(), step_file(k + 1)),
         ];
+        if let Some(m) = s.corrected_misfit {
+            facts.push((
+                "after the data found wrong since were corrected".into(),
+                format!("{} ({} x noise), every parameter updated again", table::misfit(m), times(m)),
+            ));
+        }
+        facts.push(("case file".into(), step_file(k + 1)));
         if !e.gains.is_empty() {
             facts.push(("gain fitted with it".into(), gains_text(&gain_reports(&e.gains))));
         }
         sec.push(Block::Facts(facts));
         if !s.alternatives.is_empty() {
-            let mut t = Table::new(&["first effect tried", "misfit after it and its best follower", "x noise"])
-                .caption(
-                    "The best single effect left more than three times the noise, so two effects may hide at once: \
-                 the pairs of the leading effects were added and updated together (the best pair is shown), and \
-                 unless it reached the noise each leader was added and updated, the data diagnosed again; the \
-                 pair, or the leader whose best follower, left the smallest misfit was kept.",
-                );
-            for a in &s.alternatives {
-                let effect = match &a.with {
-                    Some(with) => format!("{} together with {with}", a.effect),
-                    None => a.effect.clone(),
-                };
-                match &a.failed {
-                    Some(why) => t.row(vec![effect, format!("could not be added: {why}"), "-".into()]),
-                    None => t.row(vec![effect, table::misfit(a.misfit_ahead), times(a.misfit_ahead)]),
-                }
-            }
-            sec.push(Block::Table(t));
+            sec.push(Block::Table(tried_table(
+                &s.alternatives,
+                outcome.noise,
+                "The other effects tried at this step, each added and every parameter updated (a pair fitted \
+                 together where the best single effect left more than three times the noise), with the evidence for \
+                 it over the model before the step and why it was not kept.",
+            )));
         }
         if !e.held.is_empty() {
             sec.push(Block::Text(format!(
@@ -228,7 +333,6 @@ pub(crate) fn write(
         sec.push(out.table(&format!("step-{}-parameters", k + 1), t)?);
         report.sections.push(sec);
     }
-
     let mut rest = Section::new("What the last diagnosis finds");
     rest.push(Block::Text(if let Some(e) = &outcome.diagnosis_error {
         format!("The diagnosis of the final model failed, so what remains is not known: {e}.")
@@ -254,11 +358,13 @@ pub(crate) fn write(
     report.sections.push(rest);
 
     // the nominal and the final model against the data as they were
-    // measured (the kind and unit compare and update show), each times the
-    // gains that bring it closest to them when the case fits gains
-    let as_read = study.measured_as_read();
+    // measured (the kind and unit compare and update show), corrected as
+    // the findings say, each times the gains that bring it closest to them
+    // when the case fits gains
+    let as_read = rfm_update::checks::corrected(&study.measured_as_read(), &outcome.findings)?;
     let measured = &as_read;
-    let unweighted = quantities::noise(study.system(), study.measured(), None)?;
+    let corrected = rfm_update::checks::corrected(study.measured(), &outcome.findings)?;
+    let unweighted = quantities::noise(study.system(), &corrected, None)?;
     let data = Data::new(measured, study.per_volt(), unweighted);
     let weights = study.line_weights(measured)?;
     let gains = match study.gains() {
@@ -288,14 +394,20 @@ pub(crate) fn write(
         Ok((frfs, compared.model.gains))
     };
     let start_label = if offset > 0 { format!("model after step {offset}") } else { "nominal model".to_string() };
-    let (nominal, mut last_gains) = model(&start_label, plot::INITIAL, study.system(), outcome.nominal_misfit)?;
+    let (nominal, mut last_gains) = model(&start_label, plot::INITIAL, study.system(), outcome.corrected_misfit)?;
     let mut models = vec![nominal];
     if let Some(f) = fixed {
         let (fixed_frfs, gains) = model("fixed model", plot::UPDATED, f, outcome.final_misfit())?;
         models.push(fixed_frfs);
         last_gains = gains;
     }
-    let mut notes = vec!["The nominal model and the model after the last step against the measured FRFs.".to_string()];
+    let mut notes = vec![if outcome.findings.iter().any(|f| !f.corrections.is_empty()) {
+        "The nominal model and the model after the last step against the measured FRFs, corrected as the findings \
+         about the data say."
+            .to_string()
+    } else {
+        "The nominal model and the model after the last step against the measured FRFs.".to_string()
+    }];
     if !matches!(gains, GainSource::None) {
         notes.push(format!(
             "Each model's FRFs are multiplied by the unknown complex gains that fit it best: {}.",
@@ -324,6 +436,9 @@ pub(crate) fn write(
     let band = (f.first().copied().unwrap_or(0.0), f.last().copied().unwrap_or(0.0));
     let first = if offset > 0 { format!("step {offset}") } else { "nominal".to_string() };
     let mut systems: Vec<(String, &damping::DampedSystem)> = vec![(first, study.system())];
+    if let (Some(d), false) = (&declared_system, resumed.earlier) {
+        systems.push(("step 0".into(), d));
+    }
     systems.extend(step_systems.iter().enumerate().map(|(k, s)| (format!("step {}", k + offset + 1), s)));
     let table = super::natural_frequency_table(&systems, band, comparison.as_ref().ok());
     modes.push(out.table("modes-per-step", table)?);

@@ -2,8 +2,9 @@
 //! report ([`html`]), the report sections shared by `rfm compare`, `rfm update` and `rfm fix`
 //! (this module: the correlation, the overlays of every channel, the
 //! structure, the definitions), the modal comparison ([`modes`]), the
-//! update report ([`update_report`]) and the report of the loop
-//! ([`fix_report`]).
+//! update report ([`update_report`]), the report of a diagnosis
+//! ([`diagnose_report`]), the report of the loop ([`fix_report`]), and
+//! the data's findings and step 0 that the last two share ([`setup`]).
 //!
 //! Figures are drawn to strings and written through the run's
 //! [`Outputs`], all or nothing.
@@ -14,6 +15,7 @@ pub(crate) mod html;
 pub(crate) mod loop_story;
 pub(crate) mod modes;
 pub(crate) mod plot;
+pub(crate) mod setup;
 pub(crate) mod units;
 pub(crate) mod update_report;
 
@@ -63,12 +65,12 @@ impl Outputs {
 
 /// How a report draws what the command line and the case choose.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct ReportOptions {
+pub struct ReportOptions {
     /// Scale of every frequency axis.
-    pub(crate) frequency_scale: FrequencyScale,
+    pub frequency_scale: FrequencyScale,
     /// Lines of measured coherence below it are shaded in the FRF figures
-    /// (the case's `[measurement] coherence_threshold`, see [`Self::for_case`]).
-    pub(crate) coherence_threshold: f64,
+    /// (the case's `[measurement] coherence_threshold`, see `ReportOptions::for_case`).
+    pub coherence_threshold: f64,
 }
 
 impl Default for ReportOptions {
