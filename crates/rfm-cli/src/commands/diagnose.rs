@@ -82,23 +82,17 @@ pub fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
     let bar = if args.json { ProgressBar::hidden() } else { ProgressBar::new_spinner() };
     bar.enable_steady_tick(std::time::Duration::from_millis(120));
     let start = std::time::Instant::now();
-    let json = args.json;
     let data_file = outputs.as_ref().and_then(|(_, data)| data.as_ref().map(|(_, path)| path.clone()));
     let (prepared, d) = run_diagnosis(
         &study,
         measured,
         data_file,
         &mut |p| {
-            if let FixProgress::Declared { step } = p
-                && !json
-            {
-                let line = format!(
-                    "step 0: updated the case's own [update] parameters first ({}); misfit {} -> {}",
-                    step.status.name(),
-                    table::misfit(step.misfit_before),
-                    table::misfit(step.misfit_updated)
-                );
-                bar.suspend(|| eprintln!("{line}"));
+            // the spinner says what runs; the findings and step 0 are printed with the ranking
+            match p {
+                FixProgress::Checked { .. } => bar.set_message("checked the data for set-up errors"),
+                FixProgress::Declared { .. } => bar.set_message("updated the case's own [update] parameters (step 0)"),
+                _ => {}
             }
         },
         |stage| {
@@ -114,7 +108,7 @@ pub fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
         outln!("{}", diagnosis_json(notes, &prepared, &d)?);
     } else {
         print_checks(&prepared)?;
-        print_diagnosis(&d, args.top)?;
+        print_diagnosis(&d, args.top, prepared.declared.is_some())?;
     }
     if let Some(mut output) = report_output.take() {
         let source = args.measured.map_or_else(
@@ -335,7 +329,9 @@ fn unfitted_lines(d: &Diagnosis) -> Vec<String> {
 
 /// What was found about the data and corrected, and step 0, before the ranking.
 fn print_checks(p: &Prepared) -> Result<()> {
-    if !p.findings.is_empty() {
+    if p.findings.is_empty() {
+        outln!("checked the data for set-up errors: none found\n");
+    } else {
         outln!("findings about the data (corrected before the diagnosis when a correction is given):");
         for f in &p.findings {
             let fix = if f.corrections.is_empty() { "" } else { " [corrected]" };
@@ -370,10 +366,13 @@ pub(crate) fn declared_text(d: &rfm_update::fix::DeclaredStep, noise: f64) -> St
     )
 }
 
-fn print_diagnosis(d: &Diagnosis, top: usize) -> Result<()> {
+/// The ranking and what it recommends; `after_step0`: the model diagnosed
+/// is the case's with its own parameters updated.
+fn print_diagnosis(d: &Diagnosis, top: usize, after_step0: bool) -> Result<()> {
     outln!(
-        "noise {}; misfit of the nominal model {} ({} x the noise), over the {} lines the diagnosis reads",
+        "noise {}; misfit of the {} {} ({} x the noise), over the {} lines the diagnosis reads",
         table::misfit(d.noise),
+        if after_step0 { "model after step 0" } else { "nominal model" },
         table::misfit(d.nominal_misfit),
         table::times(quantities::times_noise(d.nominal_misfit, d.noise)),
         quantities::MISFIT_LINES

@@ -181,9 +181,9 @@ pub(crate) fn write(
         plot::misfit_steps(&short, &misfits, outcome.noise, CONSISTENT)?,
         format!(
             "The misfit (RMS of |ln(model / measured)| per complex value, over the {} lines the diagnosis reads) of \
-             the nominal model, on the data corrected as the findings below say, after updating the case's own \
-             parameters (step 0), after adding each effect at its diagnosed values (numbered as on the structure \
-             below), and after updating every parameter together. The green band runs from the noise level \
+             the nominal model (and where there were any, on the data corrected as the findings below say, and \
+             after updating the case's own parameters, step 0), after adding each effect at its diagnosed values \
+             (numbered as on the structure below), and after updating every parameter together. The green band runs from the noise level \
              estimated from the data ({}) to {CONSISTENT} times it: a misfit inside it is consistent with the noise.",
             quantities::MISFIT_LINES,
             table::misfit(outcome.noise)

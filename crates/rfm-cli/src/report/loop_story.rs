@@ -22,6 +22,7 @@ pub(crate) fn highlight_kind(kind: Option<EffectKind>, has_elements: bool) -> Hi
     match kind {
         Some(EffectKind::FlexibleSupport) => HighlightKind::Support,
         Some(EffectKind::LumpedMass) => HighlightKind::Mass,
+        Some(EffectKind::Resonator) => HighlightKind::Resonator,
         Some(
             EffectKind::StiffnessChange
             | EffectKind::MassChange

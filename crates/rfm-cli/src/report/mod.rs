@@ -763,7 +763,7 @@ pub(crate) fn structure_figure(
     )?;
     let text = format!(
         "{caption} The structure to scale ({} nodes, {} beams): supports hatched, joints as hinges, springs as \
-         zigzags, masses as squares; green arrows at the {} measured responses in their direction, orange arrows at \
+         zigzags, masses as squares, a resonator as a square on a zigzag beside its node; green arrows at the {} measured responses in their direction, orange arrows at \
          the {} excitation point{}; node numbers where something is measured, supported or added.",
         model.nodes().len(),
         model.beams().len(),

@@ -41,7 +41,7 @@ pub(crate) fn correction_text(c: &Correction) -> String {
     if what.is_empty() {
         what.push("kept as measured".into());
     }
-    format!("H({}, {}): {}", c.response, c.reference, what.join(", "))
+    format!("H({},{}): {}", c.response, c.reference, what.join(", "))
 }
 
 /// The report's blocks on the findings and step 0 (nothing when there are
@@ -171,11 +171,11 @@ mod tests {
     fn a_correction_says_what_it_does_to_the_channel() {
         let (r, f) = (DofRef::new(5, Dof::Uy), DofRef::new(23, Dof::Uy));
         let c = Correction { response: r, reference: f, sign: -1.0, scale: 1.0, measured_at: None };
-        assert_eq!(correction_text(&c), format!("H({r}, {f}): sign inverted"));
+        assert_eq!(correction_text(&c), format!("H({r},{f}): sign inverted"));
         let c = Correction { scale: 0.8, sign: 1.0, measured_at: Some(DofRef::new(6, Dof::Uy)), ..c };
         assert_eq!(
             correction_text(&c),
-            format!("H({r}, {f}): scaled by 0.8, read as measured at {}", DofRef::new(6, Dof::Uy))
+            format!("H({r},{f}): scaled by 0.8, read as measured at {}", DofRef::new(6, Dof::Uy))
         );
     }
 }

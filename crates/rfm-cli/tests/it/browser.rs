@@ -335,7 +335,12 @@ fn every_report_kind_loads_offline_in_chromium_without_console_errors() {
         assert!(headings.iter().any(|x| x == h), "compare lacks {h}: {headings:?}");
     }
     let headings = check_report(&mut b, &fix.dir, "the fix report");
-    for h in ["The misfit after each step", "Modes", "FRF overlays"] {
+    for h in [
+        "The misfit after each step",
+        "Before the model was blamed: the data and the case's own parameters",
+        "Modes",
+        "FRF overlays",
+    ] {
         assert!(headings.iter().any(|x| x == h), "fix lacks {h}: {headings:?}");
     }
     // a stalled update (the clamp), a converged one (the walkthrough's) and
@@ -372,6 +377,12 @@ fn every_report_kind_loads_offline_in_chromium_without_console_errors() {
             && s.text.contains("step 1 Hz"),
         "the fix report has no natural frequencies before and after the step"
     );
+    // the loop's story as the terminal tells it: each step's dBIC, why it
+    // stopped, and the data checked before the model was blamed
+    for said in ["dBIC of the step", "-56,161,045", "stopped", "nothing significant remains", "none found"] {
+        assert!(s.text.contains(said), "the fix report does not say {said}");
+    }
+    assert!(text(&fix.output.stdout).contains("dBIC of the step"), "{}", text(&fix.output.stdout));
 }
 
 /// The lap-joint tutorial is measured as accelerance per volt, with an
