@@ -316,7 +316,12 @@ fn progress_lines_after(p: &FixProgress<'_>, done: usize) -> Vec<String> {
             }))
             .collect(),
         FixProgress::Declared { step } => vec![format!(
-            "step 0: updated the case's own parameters ({}); misfit {} -> {}, dBIC {}",
+            "{} ({}); misfit {} -> {}, dBIC {}",
+            if done == 0 {
+                "step 0: updated the case's own parameters"
+            } else {
+                "updated every parameter of the steps before again (where this run resumed)"
+            },
             step.status.name(),
             table::misfit(step.misfit_before),
             table::misfit(step.misfit_updated),
@@ -440,7 +445,7 @@ fn print_outcome(o: &FixOutcome, done: usize) -> Result<()> {
     );
     let mut t = Table::new(&["step", "misfit", "x noise", "dBIC of the step"]);
     for ((label, m), bic) in o.stages().into_iter().zip(crate::report::fix_report::stage_dbics(o)) {
-        let label = if done == 0 { label } else { renumbered(&label, done) };
+        let label = if done == 0 { label } else { crate::report::fix_report::renumbered(&label, done) };
         t.row(vec![label, table::misfit(m), table::times(quantities::times_noise(m, o.noise)), bic]);
     }
     outln!("{}", t.render());
@@ -507,37 +512,9 @@ fn print_outcome(o: &FixOutcome, done: usize) -> Result<()> {
     Ok(())
 }
 
-/// A stage label of a resumed run with its step number counted from the
-/// first run's start: `updated after step 1` after 2 earlier steps reads
-/// `updated after step 3`.
-fn renumbered(label: &str, done: usize) -> String {
-    let after = |prefix: &str, rest: &str| -> Option<String> {
-        let (n, tail) = rest.split_once(' ').map_or((rest, ""), |(n, t)| (n, t));
-        let n = n.parse::<usize>().ok()?;
-        Some(format!("{prefix}{}{}{tail}", n + done, if tail.is_empty() { "" } else { " " }))
-    };
-    if let Some(r) = label.strip_prefix("updated after step ").and_then(|rest| after("updated after step ", rest)) {
-        return r;
-    }
-    if let Some(r) =
-        label.strip_prefix("data corrected after step ").and_then(|rest| after("data corrected after step ", rest))
-    {
-        return r;
-    }
-    if label == "nominal" { format!("after step {done} (where this run resumed)") } else { label.to_string() }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn a_resumed_runs_stages_count_from_the_first_runs_start() {
-        assert_eq!(renumbered("updated after step 1", 2), "updated after step 3");
-        assert_eq!(renumbered("data corrected after step 1 and updated", 2), "data corrected after step 3 and updated");
-        assert_eq!(renumbered("nominal", 2), "after step 2 (where this run resumed)");
-        assert_eq!(renumbered("+ lumped mass at node 9", 2), "+ lumped mass at node 9");
-    }
 
     /// The progress file is read back as written, and step 0 adds no effect.
     #[test]

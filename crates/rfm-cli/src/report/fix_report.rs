@@ -80,6 +80,32 @@ pub(crate) fn stage_dbics(o: &FixOutcome) -> Vec<String> {
     bics
 }
 
+/// A stage label of a resumed run with its step number counted from the
+/// first run's start: `updated after step 1` after 2 earlier steps reads
+/// `updated after step 3`; its step 0 updates the parameters of the
+/// steps before again.
+pub(crate) fn renumbered(label: &str, done: usize) -> String {
+    let after = |prefix: &str, rest: &str| -> Option<String> {
+        let (n, tail) = rest.split_once(' ').map_or((rest, ""), |(n, t)| (n, t));
+        let n = n.parse::<usize>().ok()?;
+        Some(format!("{prefix}{}{}{tail}", n + done, if tail.is_empty() { "" } else { " " }))
+    };
+    if let Some(r) = label.strip_prefix("updated after step ").and_then(|rest| after("updated after step ", rest)) {
+        return r;
+    }
+    if let Some(r) =
+        label.strip_prefix("data corrected after step ").and_then(|rest| after("data corrected after step ", rest))
+    {
+        return r;
+    }
+    match label {
+        "nominal" => format!("after step {done} (where this run resumed)"),
+        // the case it resumed from declares every parameter so far
+        "the case's own parameters updated (step 0)" => "every parameter updated again (where it resumed)".into(),
+        _ => label.to_string(),
+    }
+}
+
 /// The stages of [`FixOutcome::stages`] in a few words for the figure's
 /// axis, the steps numbered after `offset` earlier ones.
 fn short_stages(o: &FixOutcome, offset: usize) -> Vec<String> {
@@ -88,7 +114,7 @@ fn short_stages(o: &FixOutcome, offset: usize) -> Vec<String> {
         v.push("data corrected".to_string());
     }
     if o.declared.is_some() {
-        v.push("step 0".to_string());
+        v.push(if offset > 0 { "updated again" } else { "step 0" }.to_string());
     }
     for (k, s) in o.steps.iter().enumerate() {
         let sign = if s.removed { "-" } else { "+" };
@@ -166,7 +192,13 @@ pub(crate) fn write(
     let mut stages: Vec<(String, f64)> = resumed.history.iter().map(|h| (h.step.clone(), h.misfit)).collect();
     let mut bics: Vec<String> = vec![String::new(); resumed.history.len()];
     let skip = usize::from(resumed.earlier);
-    stages.extend(outcome.stages().into_iter().skip(skip));
+    stages.extend(
+        outcome
+            .stages()
+            .into_iter()
+            .skip(skip)
+            .map(|(label, m)| (if offset > 0 { renumbered(&label, offset) } else { label }, m)),
+    );
     bics.extend(stage_dbics(outcome).into_iter().skip(skip));
     let mut fall = Section::new("The misfit after each step");
     let earlier: Vec<String> = if resumed.earlier {
@@ -446,4 +478,21 @@ pub(crate) fn write(
     report.sections.push(super::overlay_section(&data, &models, &[], opts, out)?);
     report.sections.push(super::definitions_section());
     Ok(out.write("report.html", report.render().as_bytes())?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_resumed_runs_stages_count_from_the_first_runs_start() {
+        assert_eq!(renumbered("updated after step 1", 2), "updated after step 3");
+        assert_eq!(renumbered("data corrected after step 1 and updated", 2), "data corrected after step 3 and updated");
+        assert_eq!(renumbered("nominal", 2), "after step 2 (where this run resumed)");
+        assert_eq!(renumbered("+ lumped mass at node 9", 2), "+ lumped mass at node 9");
+        assert_eq!(
+            renumbered("the case's own parameters updated (step 0)", 2),
+            "every parameter updated again (where it resumed)"
+        );
+    }
 }
