@@ -174,6 +174,13 @@ impl CaseEditor {
     /// `reference`, or of every reference), its `sign`, `scale` and the DOF
     /// its sensor `measured_at`, each written only when it changes
     /// something, and `why` as the entry's reason.
+    ///
+    /// `response` names the channel as the data read after the corrections
+    /// already written: a channel an earlier entry moved (`measured_at`) is
+    /// named by where it was moved, as a check of the corrected data names
+    /// it. A second correction of a channel is composed into its entry
+    /// (signs and scales multiplied, the later `measured_at` kept, both
+    /// reasons), since the case allows one entry per channel.
     pub fn add_correction(
         &mut self,
         response: DofRef,
@@ -183,6 +190,41 @@ impl CaseEditor {
         measured_at: Option<DofRef>,
         why: &str,
     ) -> Result<(), CaseError> {
+        // (an `Item`'s own `get_mut` would insert the key it does not find)
+        if let Some(Item::ArrayOfTables(a)) =
+            self.doc.get_mut("measurement").and_then(Item::as_table_like_mut).and_then(|m| m.get_mut("corrections"))
+        {
+            let text = |t: &Table, k: &str| t.get(k).and_then(Item::as_str).map(str::to_string);
+            let number = |t: &Table, k: &str| {
+                t.get(k).and_then(|v| v.as_float().or_else(|| v.as_integer().map(|i| i as f64))).unwrap_or(1.0)
+            };
+            let (response_s, reference_s) = (response.to_string(), reference.map(|r| r.to_string()));
+            let earlier = a.iter().position(|t| {
+                let now = text(t, "measured_at").or_else(|| text(t, "response"));
+                now.as_deref() == Some(response_s.as_str()) && text(t, "reference") == reference_s
+            });
+            if let Some(i) = earlier {
+                let t = a.get_mut(i).expect("found above");
+                let (sign, scale) = (number(t, "sign") * sign, number(t, "scale") * scale);
+                for (key, v, unit) in [("sign", sign, 1.0), ("scale", scale, 1.0)] {
+                    if v == unit {
+                        t.remove(key);
+                    } else {
+                        t.insert(key, value(v));
+                    }
+                }
+                if let Some(d) = measured_at {
+                    t.insert("measured_at", value(d.to_string()));
+                }
+                let reason = text(t, "why").map_or_else(|| why.to_string(), |w| format!("{w}; then {why}"));
+                t.insert("why", value(reason));
+                // two corrections that undo each other leave the channel as read
+                if ["sign", "scale", "measured_at"].iter().all(|k| !t.contains_key(k)) {
+                    a.remove(i);
+                }
+                return Ok(());
+            }
+        }
         let mut t = Table::new();
         t.insert("response", value(response.to_string()));
         if let Some(r) = reference {
@@ -405,6 +447,33 @@ mod tests {
         let got = back.measurement.unwrap().data.unwrap();
         assert_eq!(resolved(&got), resolved(&dir.join("study/data/measured.csv")));
         assert!(same.contains("# the user's comment"), "comments stay");
+    }
+
+    /// A correction found after another was written names the channel as
+    /// the corrected data do; it is composed into the channel's one entry,
+    /// and two that undo each other leave none.
+    #[test]
+    fn a_later_correction_of_a_channel_is_composed_into_its_entry() {
+        let dir = std::env::temp_dir().join(format!("rfm-correct-{}", std::process::id()));
+        let c = case(&dir);
+        let ux = |n| DofRef::new(n, crate::dof::Dof::Ux);
+        let mut e = c.editor().unwrap();
+        e.add_correction(ux(3), Some(ux(5)), 1.0, 1.0, Some(ux(4)), "at node 4").unwrap();
+        e.add_correction(ux(2), None, -1.0, 1.0, None, "inverted").unwrap();
+        // the moved channel, as the corrected data name it, turns out inverted
+        e.add_correction(ux(4), Some(ux(5)), -1.0, 1.25, None, "inverted too").unwrap();
+        // and the inverted one was not
+        e.add_correction(ux(2), None, -1.0, 1.0, None, "not inverted after all").unwrap();
+        let text = e.text_at(&dir.join("case.toml")).unwrap();
+        assert_eq!(text.matches("[[measurement.corrections]]").count(), 1, "{text}");
+        let back = CaseFile::parse(&dir.join("case.toml"), &text).unwrap();
+        let m = back.measurement.unwrap();
+        let k = &m.corrections[0];
+        assert_eq!(
+            (k.response, k.reference, k.sign, k.scale, k.measured_at),
+            (ux(3), Some(ux(5)), -1.0, 1.25, Some(ux(4)))
+        );
+        assert_eq!(k.why.as_deref(), Some("at node 4; then inverted too"));
     }
 
     /// A derived case does not inherit the shipped case's acceptance.

@@ -11,6 +11,7 @@ mod gains;
 mod imported;
 mod imported_diagnosis;
 mod inspect;
+mod lab_cases;
 mod measurement;
 mod nothing_lost;
 mod pairing;

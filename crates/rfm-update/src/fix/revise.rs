@@ -60,8 +60,30 @@ fn family(kind: EffectKind) -> u8 {
     }
 }
 
+/// Whether `r` is `own` in its other damping form: the same kind at the
+/// same nodes, elements and directions.
+fn other_form(r: &Ranked, own: &Ranked) -> bool {
+    r.kind == own.kind
+        && r.nodes == own.nodes
+        && r.elements == own.elements
+        && r.dof == own.dof
+        && r.damping != own.damping
+}
+
+/// `own`'s description in `other`'s damping form.
+fn retitled(own: &Ranked, other: &Ranked) -> String {
+    match (own.damping, other.damping) {
+        (Some(a), Some(b)) if own.description.contains(a) => own.description.replacen(a, b, 1),
+        _ => other.description.clone(),
+    }
+}
+
 /// The candidates of `d` (ranks) at the place of `own`: significant,
-/// plausible and near it, `own` itself left out; the best three of its
+/// plausible and near it, `own` itself left out; `own` in its other
+/// damping form first (its screening fit, started alone, can miss the
+/// tuning or the stiffness the update of `own` found: the tutorial's lab
+/// frame has a non-viscous resonator whose non-viscous candidate ranks
+/// 21st at 10 Hz, while the viscous one, updated, sits at 72 Hz), then the best three of its
 /// kind (its other variants and windows), the best two of a kind that
 /// stands in for it, the best of another kind, then the best of the rest
 /// up to [`REVISE_WIDTH`]. A diagnosis ranks the variant the data prefer
@@ -70,7 +92,7 @@ fn family(kind: EffectKind) -> u8 {
 /// changes at the corner), and windows of a mass change can fill every
 /// place before the lumped mass they stand for (trial 27).
 fn neighbours(d: &Diagnosis, own: &Ranked, model: &fe_model::Model) -> Vec<usize> {
-    let near: Vec<(usize, usize)> = d
+    let near: Vec<(i8, usize)> = d
         .ranking
         .iter()
         .enumerate()
@@ -81,7 +103,9 @@ fn neighbours(d: &Diagnosis, own: &Ranked, model: &fe_model::Model) -> Vec<usize
                 && d.candidates[r.candidate].near(model, &own.nodes, &own.elements)
         })
         .map(|(i, r)| {
-            let order = if r.kind == own.kind {
+            let order = if other_form(r, own) {
+                -1
+            } else if r.kind == own.kind {
                 0
             } else if family(r.kind) == family(own.kind) {
                 1
@@ -92,7 +116,7 @@ fn neighbours(d: &Diagnosis, own: &Ranked, model: &fe_model::Model) -> Vec<usize
         })
         .collect();
     let mut out: Vec<usize> = Vec::new();
-    for (order, quota) in [(0, 3), (1, 2), (2, 1)] {
+    for (order, quota) in [(-1, 1), (0, 3), (1, 2), (2, 1)] {
         out.extend(near.iter().filter(|(o, _)| *o == order).map(|&(_, r)| r).take(quota));
     }
     for &(_, r) in &near {
@@ -118,6 +142,7 @@ pub(super) fn build(
     applied: &[(&Diagnosis, usize)],
     warm: Option<&fe_model::Model>,
     fresh: &[String],
+    carry: &[String],
     fl: &Loop<'_>,
 ) -> Result<(CaseFile, CaseEditor), UpdateError> {
     let mut case = nominal.clone();
@@ -129,13 +154,43 @@ pub(super) fn build(
     }
     let mut editor = editor.ok_or_else(|| UpdateError::Method("no effect to add".into()))?;
     if let (Some(warm), Some(update)) = (warm, &case.update) {
-        let params: Vec<fe_model::Parameter> = update
-            .parameters
+        // the parameters `carry` names join the update (an effect's other
+        // form keeps updating what the effect did, from where it stopped,
+        // though its screening held some of them at its own fit)
+        let listed: Vec<String> = update.parameters.iter().map(|p| p.name.clone()).collect();
+        let carried: Vec<String> = carry.iter().filter(|n| !listed.contains(n)).cloned().collect();
+        if !carried.is_empty() {
+            let all: Vec<String> = listed.iter().chain(&carried).cloned().collect();
+            let method = update.method.as_ref().map_or("output-error", |(m, _)| m.as_str());
+            editor.set_update(&all, method)?;
+        }
+        let carried: Vec<fe_model::Parameter> = carried.iter().filter_map(|n| warm.parameter(n).ok()).collect();
+        let kept: Vec<&fe_model::Parameter> =
+            update.parameters.iter().chain(&carried).filter(|p| !fresh.contains(&p.name)).collect();
+        let params: Vec<fe_model::Parameter> = kept.iter().filter_map(|p| warm.parameter(&p.name).ok()).collect();
+        // the mu of a group the warm model holds viscous
+        let viscous_mu: Vec<String> = kept
             .iter()
-            .filter(|p| !fresh.contains(&p.name))
-            .filter_map(|p| warm.parameter(&p.name).ok())
+            .filter(|p| {
+                p.name.strip_suffix(".mu").is_some_and(|g| warm.parameter(&format!("{g}.alpha")).is_ok())
+                    && warm.parameter(&p.name).is_err()
+            })
+            .map(|p| p.name.clone())
             .collect();
-        editor.set_values(&crate::params::quantity_values(&params, warm), "started where the loop left them")?;
+        // a viscous group's mu is infinite: its non-viscous form starts
+        // from a kernel relaxing ten times faster than the highest line,
+        // which damps as the viscous one did over the band, so that the
+        // update starts at the fit the viscous form reached and moves mu
+        // down as the data ask (its own screening fit, started alone, can
+        // stop far from it: the lab frame's resonator at 10 Hz)
+        let fast = 10.0 * std::f64::consts::TAU * fl.data.frequencies_hz().iter().copied().fold(0.0, f64::max);
+        let values: Vec<(String, f64)> = crate::params::quantity_values(&params, warm)
+            .into_iter()
+            .map(|(name, v)| if v.is_infinite() && name.ends_with(".mu") { (name, fast) } else { (name, v) })
+            .filter(|(_, v)| v.is_finite())
+            .chain(viscous_mu.into_iter().map(|name| (name, fast)))
+            .collect();
+        editor.set_values(&values, "started where the loop left them")?;
         case = CaseFile::parse(&nominal.path, &editor.text_at(&nominal.path)?)?;
     }
     Ok((case, editor))
@@ -149,10 +204,10 @@ fn with_effects(
     applied: &[(&Diagnosis, usize)],
     index: usize,
     warm: Option<&fe_model::Model>,
-    fresh: &[String],
+    (fresh, carry): (&[String], &[String]),
     (step, last): (usize, bool),
 ) -> Result<Added, UpdateError> {
-    let (case, editor) = build(nominal, applied, warm, fresh, fl)?;
+    let (case, editor) = build(nominal, applied, warm, fresh, carry, fl)?;
     let (d, rank) = applied[index];
     let (editor, case, stats, outcome) = fl.update_case(&case, editor, step, last)?;
     Ok(Added { effect: d.ranking[rank - 1].clone(), rank, editor, case, stats, outcome })
@@ -204,7 +259,7 @@ pub(super) fn revise(
         let without_built = if without.is_empty() {
             Err(UpdateError::Method("no effect left".into()))
         } else {
-            build(nominal, &without, Some(&warm), &[], fl)
+            build(nominal, &without, Some(&warm), &[], &[], fl)
         };
         // taken out: an effect added to make up for a wrong form of
         // another may not be needed once that is mended (trial 25: a stiff
@@ -219,16 +274,35 @@ pub(super) fn revise(
                 best = Some((v.delta_bic, None, a));
             }
         }
-        let d = without_built
-            .and_then(|(case, _)| diagnose::diagnose(&case.model, &fl.data, &fl.opts.diagnose).map(|d| (d, case)));
+        // an effect alone: the diagnosis it came from is that of the model
+        // without it (its other form is the revision it may need)
+        let d = if without.is_empty() {
+            Ok((applied[index].0.clone(), nominal.clone()))
+        } else {
+            without_built
+                .and_then(|(case, _)| diagnose::diagnose(&case.model, &fl.data, &fl.opts.diagnose).map(|d| (d, case)))
+        };
         if let Ok((d, without_case)) = &d {
             for other in neighbours(d, &own, &without_case.model) {
                 let mut tried = refs(&applied);
                 tried[index] = (d, other);
-                let fresh: Vec<String> = d.ranking[other - 1].parameters.iter().map(|p| p.name.clone()).collect();
-                let Ok(a) = with_effects(fl, nominal, &tried, index, Some(&warm), &fresh, (step, false)) else {
+                // the other form starts from the values `own` was updated to
+                // (the names it shares), the rest from the diagnosis
+                let names = |r: &Ranked| r.parameters.iter().map(|p| p.name.clone()).collect::<Vec<String>>();
+                let (fresh, carry) = if other_form(&d.ranking[other - 1], &own) {
+                    (Vec::new(), names(&own))
+                } else {
+                    (names(&d.ranking[other - 1]), Vec::new())
+                };
+                let Ok(mut a) = with_effects(fl, nominal, &tried, index, Some(&warm), (&fresh, &carry), (step, false))
+                else {
                     continue;
                 };
+                if !carry.is_empty() {
+                    // it was started from `own`'s values, not its screening
+                    // fit's (whose tuning its description may give)
+                    a.effect.description = retitled(&own, &a.effect);
+                }
                 let v = fl.evidence.judge(state, &a, &tried);
                 if v.rejected.is_none() && best.as_ref().is_none_or(|(b, ..)| v.delta_bic < *b) {
                     best = Some((v.delta_bic, Some(other), a));
@@ -257,7 +331,7 @@ pub(super) fn revise(
     // when it leaves more than the noise
     if let Some(last) = kept.last_mut()
         && !applied.is_empty()
-        && let Ok((case, editor)) = build(nominal, &refs(&applied), Some(&warm), &[], fl)
+        && let Ok((case, editor)) = build(nominal, &refs(&applied), Some(&warm), &[], &[], fl)
         && let Ok((editor, case, stats, outcome)) = fl.update_case(&case, editor, step, true)
         && stats.misfit <= last.added.stats.misfit
     {

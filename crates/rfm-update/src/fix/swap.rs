@@ -97,7 +97,7 @@ fn kept_case<'d>(
 ) -> Result<(CaseFile, State, Vec<Effect<'d>>), UpdateError> {
     let effects: Vec<(&Diagnosis, usize)> =
         applied.iter().enumerate().filter(|(j, _)| !outs.contains(j)).map(|(_, (d, r))| (d, *r)).collect();
-    let (case, editor) = super::revise::build(nominal, &effects, None, &[], fl)?;
+    let (case, editor) = super::revise::build(nominal, &effects, None, &[], &[], fl)?;
     let (_, kept, stats, outcome) = fl.update_case(&case, editor, step, false)?;
     Ok((kept, State { misfit: stats.misfit, k: outcome.parameters.len() }, effects))
 }

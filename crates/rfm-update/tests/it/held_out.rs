@@ -44,9 +44,7 @@ use crate::truths::{self, Family, HiddenEffect, Truth};
 /// The relative noise of the measurements.
 const NOISE: f64 = 0.01;
 
-fn count(var: &str, default: usize) -> usize {
-    std::env::var(var).ok().and_then(|v| v.parse().ok()).unwrap_or(default)
-}
+use crate::{full_study, study_size};
 
 /// The candidate kinds that represent a hidden family.
 fn kinds_of(f: Family) -> &'static [EffectKind] {
@@ -282,31 +280,40 @@ fn the_loop_keeps_its_steps_when_the_last_diagnosis_fails() {
 }
 
 /// Trial 76 of the full study: a splice near the arm's end and a mass on
-/// the column. One at a time, a flexible support at the base explains most
-/// of both and neither right effect leads (the mass ranks eleventh, the
-/// splice twentieth); each leader added alone, updated and diagnosed again
-/// left more than 30 times the noise, and the loop ended 22 times above
-/// it. Pairs of leaders added together and updated jointly find a mass
-/// beside the right node with the splice.
+/// the column. One at a time, a flexible support at the base once explained
+/// most of both and neither right effect led (the mass ranked eleventh, the
+/// splice twentieth): the loop ended 22 times above the noise until pairs of
+/// leaders were fitted together. Diagnosed with the lack-of-fit variance,
+/// the mass beside its node now leads, and the splice follows. Whichever
+/// way the loop goes (alone or as a pair), both effects are found, and
+/// every step it keeps passes the rule on its own: a dBIC below the
+/// diagnosis's significance against the model before it, so that no
+/// partner rides along with a strong effect.
 #[test]
-fn two_effects_that_mislead_one_at_a_time_are_fitted_together() {
+fn two_effects_that_mislead_one_at_a_time_are_both_found() {
     let trial = trial_of(12, 16, 76);
     let o = &trial.outcome;
-    let pair = o.steps[0].alternatives.iter().find(|a| a.with.is_some()).expect("pairs tried at the first step");
-    println!("{}: {} with {:?}: {:.2} x noise", trial.label, pair.effect, pair.with, pair.misfit_ahead / NOISE);
-    let best_single = o.steps[0].alternatives.iter().filter(|a| a.with.is_none()).map(|a| a.misfit_ahead);
-    assert!(best_single.fold(f64::INFINITY, f64::min) > pair.misfit_ahead, "{:?}", o.steps[0].alternatives);
-    // the pair is what the loop added, as two steps
-    assert_eq!(o.steps[0].effect.description, pair.effect);
-    assert_eq!(Some(&o.steps[1].effect.description), pair.with.as_ref());
+    for s in &o.steps {
+        println!(
+            "{}: {} (dBIC {:.3e}, {:.2} x noise)",
+            trial.label,
+            s.effect.description,
+            s.delta_bic,
+            s.misfit_updated / NOISE
+        );
+        if s.replaced.is_none() {
+            let significance = DiagnoseOptions::default().significance;
+            assert!(s.delta_bic < significance, "{} kept with dBIC {:.3e}", s.effect.description, s.delta_bic);
+        }
+    }
     assert!(trial.found.iter().all(|&f| f), "both effects found: {:?}", trial.found);
     assert!(o.final_misfit() < 4.0 * NOISE, "the loop ends {:.2} times the noise", o.final_misfit() / NOISE);
 }
 
 #[test]
 fn the_loop_finds_and_fixes_held_out_effects() {
-    let singles = count("HELD_OUT_SINGLE", 12);
-    let pairs = count("HELD_OUT_PAIRS", 8);
+    let singles = study_size("HELD_OUT_SINGLE", 2, 12);
+    let pairs = study_size("HELD_OUT_PAIRS", 2, 8);
     let opts = FixOptions { max_steps: 3, ..FixOptions::default() };
     let mut trials: Vec<Trial> = Vec::new();
     let draws = draws(singles, pairs);
@@ -370,7 +377,7 @@ fn the_loop_finds_and_fixes_held_out_effects() {
         return;
     }
     let resized = std::env::var("HELD_OUT_SINGLE").is_ok() || std::env::var("HELD_OUT_PAIRS").is_ok();
-    assert!(n >= 80 || resized, "at least 80 trials with effects, not {n}");
+    assert!(n >= 80 || resized || !full_study(), "at least 80 trials with effects, not {n}");
     assert!(rate(first_ok, n) >= 0.90, "right kind and place first in {first_ok}/{n}");
     assert!(rate(fixed, n) >= 0.85, "misfit within 1.5 x noise in {fixed}/{n}");
     assert!(rate(values_ok, with_values.len()) >= 0.85, "values within 3 sd in {values_ok}/{}", with_values.len());
@@ -379,8 +386,11 @@ fn the_loop_finds_and_fixes_held_out_effects() {
 
 #[test]
 fn null_trials_find_nothing_significant() {
-    let trials = count("HELD_OUT_NULL", 20);
-    assert!(trials >= 20 || std::env::var("HELD_OUT_NULL").is_ok(), "at least 20 null trials, not {trials}");
+    let trials = study_size("HELD_OUT_NULL", 5, 20);
+    assert!(
+        trials >= 20 || std::env::var("HELD_OUT_NULL").is_ok() || !full_study(),
+        "at least 20 null trials, not {trials}"
+    );
     let mut rng = ChaCha8Rng::seed_from_u64(2612);
     let mut quiet = 0;
     for i in 0..trials {

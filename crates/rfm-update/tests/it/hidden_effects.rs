@@ -189,7 +189,7 @@ fn diagnosis_names_hidden_effects_and_updating_recovers_them() {
         EffectKind::FlexibleSupport,
         EffectKind::NonViscousDamping,
     ];
-    let per_kind = std::env::var("HIDDEN_TRIALS_PER_KIND").ok().and_then(|v| v.parse().ok()).unwrap_or(13);
+    let per_kind = crate::study_size("HIDDEN_TRIALS_PER_KIND", 3, 13);
     let opts = DiagnoseOptions::default();
     let mut rng = ChaCha8Rng::seed_from_u64(2026);
     let mut table: Vec<(EffectKind, Vec<Outcome>)> = Vec::new();
@@ -252,7 +252,7 @@ fn diagnosis_names_hidden_effects_and_updating_recovers_them() {
 
 #[test]
 fn diagnosis_finds_nothing_significant_when_nothing_is_hidden() {
-    let trials = std::env::var("NULL_TRIALS").ok().and_then(|v| v.parse().ok()).unwrap_or(20);
+    let trials = crate::study_size("NULL_TRIALS", 5, 20) as u64;
     let opts = DiagnoseOptions::default();
     let mut false_alarms = 0;
     for t in 0..trials {

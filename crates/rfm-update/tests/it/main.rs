@@ -21,3 +21,17 @@ mod setup_checks;
 mod study;
 mod trust;
 mod truths;
+
+/// Whether the statistical studies run at the size their criteria ask for:
+/// `cargo xtask heldout` sets `RFM_STUDY=full` (and CI runs it); `cargo
+/// test` runs each study at a reduced size that goes through every
+/// behaviour and checks the rates, not the counts.
+pub(crate) fn full_study() -> bool {
+    std::env::var("RFM_STUDY").is_ok_and(|v| v == "full")
+}
+
+/// A study's size: `var` when set, else `full` under [`full_study`], else
+/// `reduced`.
+pub(crate) fn study_size(var: &str, reduced: usize, full: usize) -> usize {
+    std::env::var(var).ok().and_then(|v| v.parse().ok()).unwrap_or(if full_study() { full } else { reduced })
+}
