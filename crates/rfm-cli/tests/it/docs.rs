@@ -137,13 +137,13 @@ fn copy_folder(from: &Path, to: &Path) {
     }
 }
 
-/// Runs the walkthrough `name` of `docs/` from a fresh folder that holds
-/// a copy of the repository's `cases/`, each command's output checked
-/// against the excerpts after it.
-fn run_walkthrough(name: &str) {
+/// Runs the walkthrough `name` of `docs/` (at least `commands` commands)
+/// from a fresh folder that holds a copy of the repository's `cases/`, each
+/// command's output checked against the excerpts after it.
+fn run_walkthrough(name: &str, commands: usize) {
     let doc = std::fs::read_to_string(root().join("docs").join(name)).expect("the walkthrough");
     let steps = steps(&doc);
-    assert!(steps.len() >= 3, "{name}: only {} commands found", steps.len());
+    assert!(steps.len() >= commands, "{name}: only {} commands found, of {commands}", steps.len());
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("docs").join(name.trim_end_matches(".md"));
     let _ = std::fs::remove_dir_all(&dir);
     copy_folder(&root().join("cases"), &dir.join("cases"));
@@ -178,12 +178,17 @@ fn run_walkthrough(name: &str) {
 
 #[test]
 fn the_walkthrough_prints_what_it_shows() {
-    run_walkthrough("walkthrough.md");
+    run_walkthrough("walkthrough.md", 5);
 }
 
 #[test]
 fn the_test_data_walkthrough_prints_what_it_shows() {
-    run_walkthrough("walkthrough-test-data.md");
+    run_walkthrough("walkthrough-test-data.md", 4);
+}
+
+#[test]
+fn the_lab_walkthrough_prints_what_it_shows() {
+    run_walkthrough("walkthrough-lab.md", 1);
 }
 
 /// Excerpts match with `...` for what is left out, and a changed number
