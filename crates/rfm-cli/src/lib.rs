@@ -3,7 +3,7 @@
 //! calls their non-printing parts, so that its results serialise as
 //! `--json` does and its `save` writes the files the commands write:
 //! [`CompareRun`] (`rfm compare`), [`diagnosis_data`], [`run_diagnosis`],
-//! [`diagnosis_json`] and [`write_applied`] (`rfm diagnose`, `--apply`), [`UpdateSetup`], [`finish_update`] and
+//! [`diagnosis_json`] and [`write_applied`] (`rfm diagnose`, `--apply`), [`UpdateSetup`], [`finish_update`], [`update_json`] and
 //! [`save_update`] (`rfm update`), [`fix_options`] and [`save_fix`] (`rfm
 //! fix`), with [`Failure`] for their errors.
 //!
@@ -29,9 +29,10 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Mutex, MutexGuard, PoisonError};
 
 pub use commands::{
-    CompareRun, DiagnoseArgs, FixArgs, Result, SimulateArgs, UpdateOverrides, UpdateSetup, WithNotes, compare,
-    diagnose, diagnosis_data, diagnosis_json, finish_update, fix, fix_exit, fix_options, fix_progress_lines, inspect,
-    run_diagnosis, save_fix, save_update, simulate, synthesised, update, updated_case, write_applied,
+    CompareArgs, CompareRun, DiagnoseArgs, FixArgs, Result, SimulateArgs, UpdateOverrides, UpdateSetup, WithNotes,
+    compare, diagnose, diagnosis_data, diagnosis_json, finish_update, fix, fix_exit, fix_options, fix_progress_lines,
+    inspect, run_diagnosis, save_fix, save_update, simulate, synthesised, update, update_json, updated_case,
+    write_applied,
 };
 pub use exit::{Exit, Failure};
 pub use report::ReportOptions;
@@ -70,11 +71,16 @@ static WRITTEN: AtomicBool = AtomicBool::new(false);
 /// The output phase of a command, from [`writing`] until dropped.
 pub(crate) struct Writing {
     _guard: MutexGuard<'static, ()>,
+    /// A checkpoint ([`writing_part`]): the command's outputs are not all
+    /// written when it ends.
+    part: bool,
 }
 
 impl Drop for Writing {
     fn drop(&mut self) {
-        WRITTEN.store(true, Ordering::Relaxed);
+        if !self.part {
+            WRITTEN.store(true, Ordering::Relaxed);
+        }
     }
 }
 
@@ -83,15 +89,25 @@ impl Drop for Writing {
 /// the guard is dropped, so that a run stops either before its outputs move
 /// into place or after, never while they do.
 pub(crate) fn writing() -> Writing {
-    Writing { _guard: WRITING.lock().unwrap_or_else(PoisonError::into_inner) }
+    Writing { _guard: WRITING.lock().unwrap_or_else(PoisonError::into_inner), part: false }
+}
+
+/// As [`writing`], for a checkpoint that puts part of a command's outputs
+/// in place (`Outputs::checkpoint`, as `rfm fix` keeps each finished step):
+/// an interrupt waits for it, and afterwards still counts the run's outputs
+/// as not all written.
+pub(crate) fn writing_part() -> Writing {
+    Writing { _guard: WRITING.lock().unwrap_or_else(PoisonError::into_inner), part: true }
 }
 
 /// What an interrupt (Ctrl-C, SIGTERM, SIGHUP) does to the outputs: waits
 /// for a commit under way, removes the staging folders of this process,
 /// and returns the guard that keeps any other commit from starting until
-/// the process ends, with whether this run's outputs were written.
-pub fn interrupt_outputs() -> (MutexGuard<'static, ()>, bool) {
+/// the process ends, with whether this run's outputs were written and,
+/// when they were not all written, what its checkpoints kept in words
+/// (`the 2 finished step(s) are in out/fix ...`).
+pub fn interrupt_outputs() -> (MutexGuard<'static, ()>, bool, Option<String>) {
     let held = WRITING.lock().unwrap_or_else(PoisonError::into_inner);
-    output::abandon_all();
-    (held, WRITTEN.load(Ordering::Relaxed))
+    let kept = output::abandon_all();
+    (held, WRITTEN.load(Ordering::Relaxed), kept)
 }

@@ -52,9 +52,12 @@ enum Command {
         /// Measured FRF file(s) to use instead of the case's data (channels of several files are joined).
         #[arg(long, value_name = "FILE")]
         measured: Vec<PathBuf>,
-        /// Folder for the report (report.html, compare.json, SVG figures).
+        /// Folder for the report (report.html, compare.json, SVG figures, CSV tables).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Replace the --out folder even when another command's results are in it.
+        #[arg(long)]
+        replace: bool,
         /// Print machine-readable JSON instead of tables.
         #[arg(long)]
         json: bool,
@@ -81,6 +84,15 @@ enum Command {
         /// New case file for --apply.
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Folder for a report of the ranking (report.html, the structure with the leaders marked, ranking.csv).
+        #[arg(long, value_name = "DIR")]
+        report: Option<PathBuf>,
+        /// Replace the --report folder even when another command's results are in it.
+        #[arg(long)]
+        replace: bool,
+        /// Frequency axis of the report's figures: auto (logarithmic for bands of a decade or more), log or linear.
+        #[arg(long, value_enum, default_value = "auto")]
+        frequency_axis: FrequencyScale,
         /// Rows of the ranking to print.
         #[arg(long, default_value_t = 10)]
         top: usize,
@@ -93,12 +105,18 @@ enum Command {
     Fix {
         /// Case file.
         case: PathBuf,
-        /// Folder for step-1.toml, step-2.toml, ..., results.json, report.html and figures.
+        /// Folder for step-0.toml (the case's own parameters updated), step-1.toml, ..., results.json, report.html and figures.
         #[arg(long)]
         out: PathBuf,
-        /// Most effects to add.
+        /// Most effects to add (counting those of a resumed run).
         #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u64).range(1..=20))]
         steps: u64,
+        /// Go on from the steps an interrupted run left in --out.
+        #[arg(long)]
+        resume: bool,
+        /// Replace the --out folder even when another command's results are in it.
+        #[arg(long)]
+        replace: bool,
         /// Print machine-readable JSON instead of tables.
         #[arg(long)]
         json: bool,
@@ -119,9 +137,12 @@ enum Command {
     Update {
         /// Case file.
         case: PathBuf,
-        /// Folder for results (results.json, updated.toml, report.html and SVG figures).
+        /// Folder for results (results.json, updated.toml, report.html, SVG figures and CSV tables).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Replace the --out folder even when another command's results are in it.
+        #[arg(long)]
+        replace: bool,
         /// Print machine-readable JSON instead of tables.
         #[arg(long)]
         json: bool,
@@ -144,9 +165,11 @@ fn main() -> ExitCode {
     // Without a handler the signal would end the process at once, leaving
     // its staging folder behind for the next run to clean.
     let interrupt = ctrlc::set_handler(|| {
-        let (_held, written) = rfm_cli::interrupt_outputs();
+        let (_held, written, kept) = rfm_cli::interrupt_outputs();
         if written {
             eprintln!("interrupted after this run's outputs were written");
+        } else if let Some(kept) = kept {
+            eprintln!("interrupted: {kept}; the rest of this run was not written");
         } else {
             eprintln!("interrupted: the outputs of this run were not written (earlier ones are untouched)");
         }
@@ -195,36 +218,54 @@ fn run(cli: Cli) -> rfm_cli::Result<Exit> {
                 json,
             })
         }
-        Command::Compare { case, measured, out, json, bands, frequency_axis } => rfm_cli::compare(
-            &case,
-            &measured,
-            out.as_deref(),
-            json,
-            &bands,
-            &ReportOptions { frequency_scale: frequency_axis, ..Default::default() },
-        ),
-        Command::Diagnose { case, measured, json, apply, out, top, verbose } => {
-            rfm_cli::diagnose(&rfm_cli::DiagnoseArgs {
+        Command::Compare { case, measured, out, replace, json, bands, frequency_axis } => {
+            rfm_cli::compare(&rfm_cli::CompareArgs {
                 case: &case,
-                measured: measured.as_deref(),
-                json,
-                apply,
+                measured: &measured,
                 out: out.as_deref(),
-                top,
-                verbose,
+                replace,
+                json,
+                bands: &bands,
+                report: ReportOptions { frequency_scale: frequency_axis, ..Default::default() },
             })
         }
-        Command::Fix { case, out, steps, json, frequency_axis } => rfm_cli::fix(&rfm_cli::FixArgs {
+        Command::Diagnose {
+            case,
+            measured,
+            json,
+            apply,
+            out,
+            report: report_dir,
+            replace,
+            frequency_axis,
+            top,
+            verbose,
+        } => rfm_cli::diagnose(&rfm_cli::DiagnoseArgs {
+            case: &case,
+            measured: measured.as_deref(),
+            json,
+            apply,
+            out: out.as_deref(),
+            top,
+            verbose,
+            report: report_dir.as_deref(),
+            replace,
+            report_options: ReportOptions { frequency_scale: frequency_axis, ..Default::default() },
+        }),
+        Command::Fix { case, out, steps, resume, replace, json, frequency_axis } => rfm_cli::fix(&rfm_cli::FixArgs {
             case: &case,
             out: &out,
             steps: steps as usize,
             json,
+            replace,
+            resume,
             report: ReportOptions { frequency_scale: frequency_axis, ..Default::default() },
         }),
         Command::Inspect { file, json } => rfm_cli::inspect(&file, json),
-        Command::Update { case, out, json, method, lines, iterations, frequency_axis } => rfm_cli::update(
+        Command::Update { case, out, replace, json, method, lines, iterations, frequency_axis } => rfm_cli::update(
             &case,
             out.as_deref(),
+            replace,
             json,
             &rfm_cli::UpdateOverrides { method, lines, max_iterations: iterations },
             &ReportOptions { frequency_scale: frequency_axis, ..Default::default() },

@@ -60,7 +60,21 @@ use self::lock::Lock;
 
 /// The file in a folder target that lists the names the last run wrote,
 /// so that the next run can replace them without touching other files.
+/// Its first line names the command that wrote them (`# rfm update`).
 pub(crate) const MANIFEST: &str = ".rfm-outputs";
+
+/// How the manifest's first line begins.
+const COMMAND_LINE: &str = "# rfm ";
+
+/// What the manifest of `dir` says the last run wrote: the command (when
+/// it names one; folders written before commands were recorded do not) and
+/// the names.
+pub(crate) fn previous_run(dir: &Path) -> (Option<String>, Vec<String>) {
+    let text = fs::read_to_string(dir.join(MANIFEST)).unwrap_or_default();
+    let command = text.lines().find_map(|l| l.strip_prefix(COMMAND_LINE)).map(str::to_string);
+    let names = text.lines().filter(|l| !l.starts_with('#') && !l.is_empty()).map(str::to_string).collect();
+    (command, names)
+}
 
 /// Why a run's outputs could not be written. In every case the target is
 /// as it was before the run.
@@ -91,6 +105,22 @@ pub(crate) enum OutputError {
         /// Why.
         message: String,
     },
+    /// The folder holds the results of another command, which this run
+    /// would replace.
+    #[error(
+        "{}: holds the results of `rfm {command}` ({}); give another folder, or --replace to replace them with \
+         this run's",
+        target.display(),
+        list_names(files)
+    )]
+    OtherCommand {
+        /// The target.
+        target: PathBuf,
+        /// The command that wrote it (`update`).
+        command: String,
+        /// What it wrote there.
+        files: Vec<String>,
+    },
     /// A file system operation failed.
     #[error("{}: cannot {what}: {source}; nothing of this run was written", path.display())]
     Io {
@@ -101,6 +131,18 @@ pub(crate) enum OutputError {
         /// The error.
         source: std::io::Error,
     },
+}
+
+/// A few of `names`, and how many more.
+fn list_names(names: &[String]) -> String {
+    const SHOWN: usize = 4;
+    let mut shown: Vec<&str> = names.iter().map(String::as_str).take(SHOWN).collect();
+    let more = names.len().saturating_sub(SHOWN);
+    let extra = format!("and {more} more");
+    if more > 0 {
+        shown.push(&extra);
+    }
+    shown.join(", ")
 }
 
 fn io(path: &Path, what: impl Into<String>) -> impl FnOnce(std::io::Error) -> OutputError {
@@ -128,14 +170,25 @@ fn deregister(staging: &Path) {
     ACTIVE.lock().unwrap_or_else(PoisonError::into_inner).retain(|(s, _)| s != staging);
 }
 
+/// What the checkpoints of this process have kept, for the message of an
+/// interrupt (see [`Outputs::checkpoint`]).
+static CHECKPOINTED: Mutex<Option<String>> = Mutex::new(None);
+
+/// Records what the last checkpoint kept, in words.
+pub(crate) fn note_checkpoint(what: String) {
+    *CHECKPOINTED.lock().unwrap_or_else(PoisonError::into_inner) = Some(what);
+}
+
 /// Removes the staging folders (and lock files) of every uncommitted
-/// output of this process. The signal handler calls it while it holds the
-/// output phase ([`crate::writing`]), so no commit is under way.
-pub(crate) fn abandon_all() {
+/// output of this process, and returns what its checkpoints kept, if any.
+/// The signal handler calls it while it holds the output phase
+/// ([`crate::writing`]), so no commit is under way.
+pub(crate) fn abandon_all() -> Option<String> {
     for (staging, lock) in ACTIVE.lock().unwrap_or_else(PoisonError::into_inner).drain(..) {
         let _ = fs::remove_dir_all(&staging);
         let _ = fs::remove_file(&lock);
     }
+    CHECKPOINTED.lock().unwrap_or_else(PoisonError::into_inner).take()
 }
 
 /// The outputs of one run into one target, written all or nothing; see the
@@ -148,6 +201,9 @@ pub(crate) struct Outputs {
     written: Vec<String>,
     committed: bool,
     lock: Option<Lock>,
+    /// The command whose outputs these are (`compare`), recorded in the
+    /// manifest.
+    command: Option<&'static str>,
 }
 
 impl Outputs {
@@ -187,7 +243,24 @@ impl Outputs {
             written: Vec::new(),
             committed: false,
             lock: Some(lock),
+            command: None,
         })
+    }
+
+    /// Marks a folder's outputs as those of `rfm command`. A folder whose
+    /// last run was another command's is refused
+    /// ([`OutputError::OtherCommand`]) unless `replace`: a `compare` into
+    /// the folder of an `update` would otherwise replace its results and
+    /// its updated case without a word. Checked here, before any work.
+    pub(crate) fn of_command(mut self, command: &'static str, replace: bool) -> Result<Outputs, OutputError> {
+        if self.kind == Kind::Folder && !replace {
+            let (previous, files) = previous_run(&self.target);
+            if let Some(previous) = previous.filter(|p| p != command) {
+                return Err(OutputError::OtherCommand { target: self.target.clone(), command: previous, files });
+            }
+        }
+        self.command = Some(command);
+        Ok(self)
     }
 
     /// Where `name` will be once committed.
@@ -208,6 +281,11 @@ impl Outputs {
             fs::create_dir_all(dir).map_err(io(&self.path(name), "write"))?;
         }
         let result = (|| {
+            // a new file, never through a link a checkpoint left: writing
+            // through it would change the committed file in place
+            if fs::symlink_metadata(&staged).is_ok() {
+                fs::remove_file(&staged)?;
+            }
             let mut f = File::create(&staged)?;
             f.write_all(bytes)?;
             f.sync_all()
@@ -223,6 +301,21 @@ impl Outputs {
     pub(crate) fn write_file(&mut self, bytes: &[u8]) -> Result<PathBuf, OutputError> {
         let name = self.target.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
         self.write(&name, bytes)
+    }
+
+    /// Takes `name` back out of the staged files: the commit does not
+    /// write it, and where a checkpoint put it in place, removes it (a file
+    /// that only an unfinished run needs, such as `rfm fix`'s progress).
+    pub(crate) fn forget(&mut self, name: &str) -> Result<(), OutputError> {
+        self.check_name(name)?;
+        if let Some(k) = self.written.iter().position(|w| w == name) {
+            self.written.remove(k);
+            let staged = self.staging.join(name);
+            if fs::symlink_metadata(&staged).is_ok() {
+                fs::remove_file(&staged).map_err(io(&self.path(name), "take back"))?;
+            }
+        }
+        Ok(())
     }
 
     /// Where the files written so far will be once committed.
@@ -281,6 +374,44 @@ impl Outputs {
         deregister(&self.staging);
         self.committed = true;
         Ok(self.written())
+    }
+}
+
+impl Outputs {
+    /// Moves what a folder's run has written so far into place, as a
+    /// commit does, and goes on with the same names staged: each file
+    /// committed is linked back into a fresh staging folder, so that the
+    /// final commit holds it too unless the run writes it again. A run
+    /// stopped after a checkpoint (Ctrl-C, a failure) leaves the folder as
+    /// the checkpoint left it; `rfm fix` checkpoints after each step.
+    pub(crate) fn checkpoint(&mut self) -> Result<(), OutputError> {
+        if self.kind != Kind::Folder {
+            return Err(OutputError::Target {
+                target: self.target.clone(),
+                message: "only a folder's outputs can be committed in parts (a bug in rfm)".into(),
+            });
+        }
+        {
+            let _writing = crate::writing_part();
+            for name in &self.written {
+                self.refuse_input_at(&self.path(name))?;
+            }
+            self.swap_folder()?;
+            if let Ok((parent, _)) = split(&self.target) {
+                sync_dir(&parent);
+            }
+            fs::create_dir(&self.staging).map_err(io(&self.staging, "create the staging folder"))?;
+        }
+        for name in &self.written {
+            let (from, to) = (self.target.join(name), self.staging.join(name));
+            if let Some(dir) = to.parent() {
+                fs::create_dir_all(dir).map_err(io(&self.path(name), "stage again"))?;
+            }
+            fs::hard_link(&from, &to)
+                .or_else(|_| fs::copy(&from, &to).map(drop))
+                .map_err(io(&self.path(name), "stage again"))?;
+        }
+        Ok(())
     }
 }
 
@@ -481,6 +612,72 @@ mod tests {
         out.write("results.json", b"{}").unwrap();
         out.commit().unwrap();
         assert_eq!(FileId::of(&dir.join("updated.toml")), FileId::of(&case));
+    }
+
+    /// A folder another command wrote is refused before any work, and
+    /// replaced only when asked; the same command replaces its own.
+    #[test]
+    fn another_commands_folder_is_refused_unless_replace_is_given() {
+        let root = tempfile::tempdir().unwrap();
+        let dir = root.path().join("out");
+        let mut out = Outputs::folder(&dir, &[], &[]).unwrap().of_command("update", false).unwrap();
+        out.write("results.json", b"{}").unwrap();
+        out.write("updated.toml", b"x").unwrap();
+        out.commit().unwrap();
+        assert_eq!(previous_run(&dir), (Some("update".into()), vec!["results.json".into(), "updated.toml".into()]));
+        let e = Outputs::folder(&dir, &[], &[]).unwrap().of_command("compare", false).err().expect("refused");
+        assert!(matches!(e, OutputError::OtherCommand { .. }), "{e:?}");
+        assert!(
+            e.to_string().contains("holds the results of `rfm update` (results.json, updated.toml)")
+                && e.to_string().contains("--replace"),
+            "{e}"
+        );
+        assert_eq!(fs::read_to_string(dir.join("updated.toml")).unwrap(), "x");
+        // its own command replaces it, and so does another with --replace
+        Outputs::folder(&dir, &[], &[]).unwrap().of_command("update", false).unwrap();
+        let mut out = Outputs::folder(&dir, &[], &[]).unwrap().of_command("compare", true).unwrap();
+        out.write("compare.json", b"{}").unwrap();
+        out.commit().unwrap();
+        assert!(!dir.join("updated.toml").exists());
+        assert_eq!(previous_run(&dir).0.as_deref(), Some("compare"));
+    }
+
+    /// A checkpoint puts what was written so far in place; the run goes
+    /// on, and its final commit holds the files of the checkpoint, rewritten
+    /// or not, and never changes a committed file in place. A run dropped
+    /// after a checkpoint leaves the checkpoint's folder.
+    #[test]
+    fn a_checkpoint_commits_what_was_written_and_the_run_goes_on() {
+        let root = tempfile::tempdir().unwrap();
+        let dir = root.path().join("out");
+        let mut out = Outputs::folder(&dir, &[], &[]).unwrap().of_command("fix", false).unwrap();
+        out.write("step-1.toml", b"one").unwrap();
+        out.checkpoint().unwrap();
+        assert_eq!(fs::read_to_string(dir.join("step-1.toml")).unwrap(), "one");
+        out.write("step-1.toml", b"one, revised").unwrap();
+        // the committed file is untouched until the next commit
+        assert_eq!(fs::read_to_string(dir.join("step-1.toml")).unwrap(), "one");
+        out.write("step-2.toml", b"two").unwrap();
+        out.checkpoint().unwrap();
+        out.write("report.html", b"<html>").unwrap();
+        drop(out);
+        let names: Vec<String> = contents(&dir).into_iter().map(|(n, _)| n).collect();
+        assert_eq!(names, vec![MANIFEST, "step-1.toml", "step-2.toml"], "the second checkpoint stays");
+        assert_eq!(fs::read_to_string(dir.join("step-1.toml")).unwrap(), "one, revised");
+        assert_eq!(siblings(&dir), vec!["out"], "no staging folder or lock is left");
+        // a run that finishes holds every file of its checkpoints
+        let mut out = Outputs::folder(&dir, &[], &[]).unwrap().of_command("fix", false).unwrap();
+        out.write("step-1.toml", b"1").unwrap();
+        out.checkpoint().unwrap();
+        out.write("progress.json", b"{}").unwrap();
+        out.checkpoint().unwrap();
+        assert!(dir.join("progress.json").exists());
+        out.write("results.json", b"{}").unwrap();
+        // what only an unfinished run needs goes at the final commit
+        out.forget("progress.json").unwrap();
+        out.commit().unwrap();
+        let names: Vec<String> = contents(&dir).into_iter().map(|(n, _)| n).collect();
+        assert_eq!(names, vec![MANIFEST, "results.json", "step-1.toml"]);
     }
 
     #[test]

@@ -300,7 +300,7 @@ pub(crate) fn update(
 impl UpdateResult {
     /// What `rfm update --json` prints.
     fn json(&self, py: Python<'_>) -> PyResult<String> {
-        raise(py, serde_json::to_string_pretty(&self.outcome).map_err(|e| Error::from(rfm_cli::Failure::from(e))))
+        raise(py, rfm_cli::update_json(&self.study, &self.outcome).map_err(Error::from))
     }
 
     /// Writes what `rfm update --out DIR` writes; returns the paths of

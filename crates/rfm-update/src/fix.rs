@@ -383,6 +383,17 @@ pub enum FixProgress<'a> {
         /// How the update ended.
         status: &'a Status,
     },
+    /// A step is finished and will stay in the outcome: its effect added (or
+    /// taken out), every parameter updated, and the data checked again after
+    /// it. It carries the whole step, its case among it, so that a caller
+    /// can keep it (write its case) before the loop goes on: an interrupted
+    /// loop then loses only the step under way.
+    StepDone {
+        /// Its place among the steps (0-based).
+        index: usize,
+        /// The step.
+        done: &'a FixStep,
+    },
 }
 
 /// A final misfit within this multiple of the noise is consistent with it:
@@ -955,6 +966,7 @@ pub fn fix(
             }
         }
         alternatives.extend(tried);
+        let first_new = steps.len();
         for (k, (added, delta_bic)) in best.steps.into_iter().enumerate() {
             progress(FixProgress::Updated {
                 step: steps.len(),
@@ -1002,6 +1014,10 @@ pub fn fix(
                 findings.extend(late);
             }
         }
+        // announced only now: a late correction above rewrites the last step
+        for (index, done) in steps.iter().enumerate().skip(first_new) {
+            progress(FixProgress::StepDone { index, done });
+        }
     };
     let mut effects: Vec<Ranked> = steps.iter().map(|s| s.effect.clone()).collect();
     // revisions and replacements, each kept by the same rule
@@ -1034,6 +1050,7 @@ pub fn fix(
                     effects[r.index] = r.added.effect.clone();
                     steps.push(FixStep::of(r.added, r.delta_bic, Vec::new(), Some(r.replaced)));
                 }
+                progress(FixProgress::StepDone { index: steps.len() - 1, done: steps.last().expect("pushed") });
             }
             applied = revised;
             last_diagnosis = None;
@@ -1066,6 +1083,7 @@ pub fn fix(
             current = a.case.clone();
             state = State { misfit: a.stats.misfit, k: a.outcome.parameters.len() };
             steps.push(FixStep::of(a, delta_bic, Vec::new(), (k == 0).then(|| replaced.clone())));
+            progress(FixProgress::StepDone { index: steps.len() - 1, done: steps.last().expect("pushed") });
         }
         last_diagnosis = None;
     }

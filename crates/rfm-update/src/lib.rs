@@ -100,6 +100,7 @@ pub mod lstsq;
 pub mod measured;
 pub mod output_error;
 pub mod params;
+pub mod quantities;
 pub mod response_function;
 pub mod sensitivity;
 pub mod status;

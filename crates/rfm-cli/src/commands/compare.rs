@@ -13,9 +13,9 @@ use fe_model::CaseFile;
 use fe_model::case::Gains;
 use frf::correlation::{BandSpec, Correlation};
 use frf::{FrfError, FrfSet, MismatchError};
-use rfm_update::Study;
 use rfm_update::comparison::{self, GainSource};
 use rfm_update::gain::{self, FittedGains, GainReport};
+use rfm_update::quantities::MisfitReport;
 use rfm_update::study::{describe_masked, read_measured_for};
 use serde::Serialize;
 
@@ -24,8 +24,8 @@ use crate::exit::Exit;
 use crate::output::Outputs;
 use crate::report::html::{Block, Report, Section};
 use crate::report::modes::{MIN_MAC, ModesJson, mode_table_rows, rows};
-use crate::report::{self, ModelFrfs, ReportOptions, plot, sig, signed};
-use crate::table::Table;
+use crate::report::{self, Data, ModelFrfs, ReportOptions, plot, sig, signed};
+use crate::table::{self, Table};
 
 /// What `--json` prints and `compare.json` holds: the library's results
 /// (the correlation, the fitted gains) with what only the command knows.
@@ -41,6 +41,13 @@ struct CompareJson<'a> {
     bands: String,
     /// The FRF kind compared: the data's, whichever way they arrive.
     kind: String,
+    /// What the compared values are, in words (`accelerance per volt`).
+    quantity: String,
+    /// The unit of the compared values (`m/s²/V` for data per volt).
+    unit: String,
+    /// The model's misfit over the diagnosis's lines and the data's noise
+    /// (the same numbers `rfm diagnose` and `rfm fix` give this model).
+    misfit: MisfitReport,
     correlation: &'a Correlation,
     /// The unknown gains the model's FRFs were multiplied by (`none`,
     /// `per-reference`, `per-channel`) and why.
@@ -65,7 +72,7 @@ fn print_gains(gains: &[GainReport]) -> Result<()> {
     }
     outln!("\nfitted gains (model FRFs multiplied by them before the comparison)");
     for g in gains {
-        outln!("    {}: x{} ({:+.1} dB), {:+.1} deg", g.key, sig(g.magnitude, 4), g.magnitude_db, g.phase_deg);
+        outln!("    {}", report::gain_text(g));
     }
     Ok(())
 }
@@ -103,12 +110,14 @@ struct MeasuredData {
     notes: Vec<String>,
     /// The gains to fit and why.
     gains: (Gains, String),
+    /// The references whose data are per volt.
+    per_volt: Vec<fe_model::DofRef>,
 }
 
 /// The measured FRFs: the case's data or truth, or the `--measured` files.
 fn measured_data(case: CaseFile, system: &DampedSystem, files: &[PathBuf]) -> Result<MeasuredData> {
     if files.is_empty() {
-        let study = Study::from_case(case)?;
+        let study = super::study_of(case)?;
         let source = match (study.case().measurement.as_ref().and_then(|m| m.data.as_ref()), &study.case().truth) {
             (Some(p), _) => format!("measured file {} (from the case)", report::shown_path(p)),
             (None, Some(t)) if t.noise > 0.0 => format!(
@@ -123,15 +132,16 @@ fn measured_data(case: CaseFile, system: &DampedSystem, files: &[PathBuf]) -> Re
         // compared in the kind the data were measured in, as with --measured
         let set = study.measured_as_read();
         let gains = (study.gains(), study.gains_reason().to_string());
-        let (case, notes) = (study.case().clone(), study.notes().to_vec());
-        return Ok(MeasuredData { case, set, source, masked, notes, gains });
+        let (case, notes, per_volt) = (study.case().clone(), study.notes().to_vec(), study.per_volt().to_vec());
+        return Ok(MeasuredData { case, set, source, masked, notes, gains, per_volt });
     }
     let mut sets = Vec::new();
     let mut masked = Vec::new();
     let mut notes = Vec::new();
     let mut per_volt = Vec::new();
     for f in files {
-        let read = read_measured_for(system, f, case.measurement.as_ref())?;
+        let read = read_measured_for(system, f, case.measurement.as_ref())
+            .map_err(|e| super::mismatch(e.into(), case.measurement.as_ref(), Some(f)))?;
         per_volt.extend(read.per_volt_references());
         masked.extend(describe_masked(&read.masked).into_iter().map(|m| format!("{}: {m}", f.display())));
         notes.extend(read.notes.iter().map(|n| format!("{}: {n}", f.display())));
@@ -145,7 +155,7 @@ fn measured_data(case: CaseFile, system: &DampedSystem, files: &[PathBuf]) -> Re
         notes.push(format!("model FRFs are multiplied by fitted gains ({}): {}", gains.0, gains.1));
     }
     let source = format!("measured file(s) {names}");
-    Ok(MeasuredData { case, set: merge(sets)?, source, masked, notes, gains })
+    Ok(MeasuredData { case, set: merge(sets)?, source, masked, notes, gains, per_volt })
 }
 
 /// Joins the channels of several measured files on the same lines, in the
@@ -168,28 +178,43 @@ fn merge(sets: Vec<(PathBuf, FrfSet)>) -> Result<FrfSet> {
     })
 }
 
+/// Options of the compare command.
+pub struct CompareArgs<'a> {
+    /// The case file.
+    pub case: &'a Path,
+    /// Measured FRF files to use instead of the case's data.
+    pub measured: &'a [PathBuf],
+    /// The report folder.
+    pub out: Option<&'a Path>,
+    /// Replace a folder another command wrote.
+    pub replace: bool,
+    /// Print JSON instead of tables.
+    pub json: bool,
+    /// The bands, as `--bands` takes them.
+    pub bands: &'a str,
+    /// How the report draws.
+    pub report: ReportOptions,
+}
+
 /// `rfm compare`: prints the tables (or `--json`) and with `--out` writes
 /// the report.
-pub fn compare(
-    case_path: &Path,
-    measured_files: &[PathBuf],
-    out: Option<&Path>,
-    json: bool,
-    bands: &str,
-    opts: &ReportOptions,
-) -> Result<Exit> {
-    parse_bands(bands)?;
-    let case = load_case(case_path)?;
-    let inputs = CompareRun::inputs(&case, measured_files);
-    let output = out.map(|dir| Outputs::folder(dir, &inputs, &CompareRun::OUTPUTS)).transpose()?;
-    let run = CompareRun::new(case_path, case, measured_files, bands)?;
+pub fn compare(args: &CompareArgs<'_>) -> Result<Exit> {
+    let json = args.json;
+    parse_bands(args.bands)?;
+    let case = load_case(args.case)?;
+    let inputs = CompareRun::inputs(&case, args.measured);
+    let output = args
+        .out
+        .map(|dir| Outputs::folder(dir, &inputs, &CompareRun::OUTPUTS)?.of_command("compare", args.replace))
+        .transpose()?;
+    let run = CompareRun::new(args.case, case, args.measured, args.bands)?;
     print_notes(&run.read_notes, json)?;
     print_masked(&run.masked, json)?;
     let doc = run.doc();
     if json {
         outln!("{}", serde_json::to_string_pretty(&doc)?);
     } else {
-        print_tables(&run.case, &run.measured, &run.source, &run.model.correlation)?;
+        print_tables(&run.case, &run.data(), &run.source, &run.model.correlation, &run.misfit)?;
         print_gains(&doc.gains)?;
         match &run.comparison {
             Ok(_) => {
@@ -199,15 +224,25 @@ pub fn compare(
                 for r in rows {
                     t.row(r);
                 }
-                outln!("\nmodes (measured by LSCF, paired with the model's by MAC)\n{}", t.render());
+                outln!(
+                    "\nmodes (measured by LSCF, paired with the model's by MAC; each numbered in frequency order)\n{}",
+                    t.render()
+                );
             }
             Err(e) => outln!("\nmodes not compared: {e}"),
         }
     }
     if let Some(output) = output {
-        let (path, html, written) = run.write(output, opts)?;
+        let (path, html, written) = run.write(output, &args.report)?;
         if !json {
-            outln!("\nwrote {}, {} and {} figures", path.display(), html.display(), written.len() - 2);
+            let count = |ext: &str| written.iter().filter(|p| p.extension().is_some_and(|e| e == ext)).count();
+            outln!(
+                "\nwrote {}, {}, {} figures and {} tables (CSV)",
+                path.display(),
+                html.display(),
+                count("svg"),
+                count("csv")
+            );
         }
     }
     Ok(Exit::Success)
@@ -227,6 +262,12 @@ pub struct CompareRun {
     comparison: std::result::Result<frf::ModalComparison, String>,
     gain_setting: String,
     gains: Vec<GainReport>,
+    /// The model's misfit over the diagnosis's lines, with the noise.
+    misfit: MisfitReport,
+    /// The references whose data are per volt.
+    per_volt: Vec<fe_model::DofRef>,
+    /// The data's noise level without line weights (for the noise floors).
+    unweighted_noise: Option<f64>,
     masked: Vec<String>,
     /// The notes of reading the data, as printed before the tables.
     read_notes: Vec<String>,
@@ -251,7 +292,7 @@ impl CompareRun {
     pub fn new(case_path: &Path, case: CaseFile, measured_files: &[PathBuf], bands: &str) -> Result<CompareRun> {
         let spec = parse_bands(bands)?;
         let system = DampedSystem::new(case.model.clone())?;
-        let MeasuredData { case, set: measured, source, masked, notes, gains } =
+        let MeasuredData { case, set: measured, source, masked, notes, gains, per_volt } =
             measured_data(case, &system, measured_files)?;
         let read_notes = notes.clone();
         // the model's FRFs in the data's kind, times the gains that bring them
@@ -271,6 +312,10 @@ impl CompareRun {
         if coherent && gains.0 != Gains::None && weights.is_some() {
             notes.push("the gains are fitted with each line weighted by its measured coherence".into());
         }
+        // the misfit and the noise as the diagnosis reads them (receptances,
+        // the same gains and weights), so that every command gives this model
+        // one misfit
+        let misfit = MisfitReport::of(&system, &measured.to_receptance(), gains.0, weights.as_deref())?;
         let comparison =
             comparison::compare_modes(&system, &measured, &compared.model.gains, MIN_MAC).map_err(|e| e.to_string());
         let model = ModelFrfs {
@@ -278,6 +323,12 @@ impl CompareRun {
             colour: plot::UPDATED,
             frfs: compared.model.frfs,
             correlation: compared.correlation,
+            gains: fitted.reports(),
+            misfit: Some(misfit),
+        };
+        let unweighted_noise = match weights {
+            Some(_) => rfm_update::quantities::noise(&system, &measured.to_receptance(), None)?,
+            None => misfit.noise,
         };
         Ok(CompareRun {
             case_path: case_path.to_path_buf(),
@@ -289,18 +340,28 @@ impl CompareRun {
             comparison,
             gain_setting: format!("{} ({})", gains.0, gains.1),
             gains: fitted.reports(),
+            misfit,
+            per_volt,
+            unweighted_noise,
             masked,
             read_notes,
             notes,
         })
     }
 
+    /// The measured data as the report draws them: their kind and unit.
+    fn data(&self) -> Data<'_> {
+        Data::new(&self.measured, &self.per_volt, self.unweighted_noise)
+    }
+
     /// The document `--json` prints and `compare.json` holds.
     fn doc(&self) -> CompareJson<'_> {
-        let (modes, modes_error) = match self.comparison.as_ref().map(rows) {
+        let consistent = self.misfit.consistent();
+        let (modes, modes_error) = match self.comparison.as_ref().map(|c| rows(c, consistent)) {
             Ok(m) => (Some(m), None),
             Err(e) => (None, Some(e.clone())),
         };
+        let data = self.data();
         CompareJson {
             case: self.case_path.display().to_string(),
             title: self.case.model.title.clone(),
@@ -308,6 +369,9 @@ impl CompareRun {
             model: "the case's model (initial values)".into(),
             bands: self.bands.clone(),
             kind: self.measured.kind().to_string(),
+            quantity: data.quantity(),
+            unit: data.unit(),
+            misfit: self.misfit,
             correlation: &self.model.correlation,
             gain_setting: self.gain_setting.clone(),
             gains: self.gains.clone(),
@@ -341,10 +405,12 @@ impl CompareRun {
     }
 
     /// Writes what `rfm compare --out DIR` writes (`compare.json`,
-    /// `report.html` and the figures), all or nothing; returns the files.
+    /// `report.html`, the figures and the tables as CSV), all or nothing;
+    /// returns the files. A folder another command wrote is refused, as
+    /// `rfm compare` without `--replace` refuses it.
     pub fn save(&self, dir: &Path, opts: &ReportOptions) -> Result<Vec<PathBuf>> {
         let inputs = CompareRun::inputs(&self.case, &[]);
-        let output = Outputs::folder(dir, &inputs, &CompareRun::OUTPUTS)?;
+        let output = Outputs::folder(dir, &inputs, &CompareRun::OUTPUTS)?.of_command("compare", false)?;
         Ok(self.write(output, opts)?.2)
     }
 
@@ -358,7 +424,7 @@ impl CompareRun {
         report.subtitle = Some(format!("rfm compare, case file {}", self.case_path.display()));
         report.sections = report_sections(
             case,
-            &self.measured,
+            &self.data(),
             &self.source,
             &self.model,
             self.comparison.as_ref(),
@@ -375,7 +441,7 @@ impl CompareRun {
 /// The report's sections, in order.
 fn report_sections(
     case: &CaseFile,
-    measured: &FrfSet,
+    data: &Data<'_>,
     source: &str,
     model: &ModelFrfs,
     modes: std::result::Result<&frf::ModalComparison, &String>,
@@ -384,7 +450,8 @@ fn report_sections(
     out: &mut Outputs,
 ) -> Result<Vec<Section>> {
     let c = &model.correlation;
-    let mut first = summary(case, measured, source, c);
+    let measured = data.set;
+    let mut first = summary(case, data, source, c, &doc.misfit, &doc.gains);
     // the loop so far, when the case was written by an earlier step
     if let Some(fall) = report::loop_story::fall_figure(&case.history, false, out)? {
         first.push(fall);
@@ -400,49 +467,78 @@ fn report_sections(
     let mut sections = vec![first];
     let mut notes = vec!["The case's model with its initial parameter values against the measured FRFs.".to_string()];
     if !doc.gains.is_empty() {
-        let list: Vec<String> = doc
-            .gains
-            .iter()
-            .map(|g| {
-                format!("{}: x{} ({:+.1} dB, {:+.1} deg)", g.key, sig(g.magnitude, 4), g.magnitude_db, g.phase_deg)
-            })
-            .collect();
         notes.push(format!(
             "The model's FRFs are multiplied by unknown complex gains fitted in closed form ({}): {}.",
             doc.gain_setting,
-            list.join("; ")
+            report::gains_text(&doc.gains)
         ));
     }
-    sections.push(report::correlation_section(measured, std::slice::from_ref(model), opts, out, notes)?);
-    sections.push(report::modes::section(modes, "the model", &case.model, measured, opts, out)?);
-    sections.push(report::overlay_section(measured, std::slice::from_ref(model), &[], opts, out)?);
+    sections.push(report::correlation_section(data, std::slice::from_ref(model), opts, out, notes)?);
+    sections.push(report::modes::section(
+        modes,
+        "the model",
+        &case.model,
+        measured,
+        doc.misfit.consistent(),
+        opts,
+        out,
+    )?);
+    sections.push(report::overlay_section(data, std::slice::from_ref(model), &[], opts, out)?);
     sections.push(report::definitions_section());
     Ok(sections)
 }
 
-fn summary(case: &CaseFile, measured: &FrfSet, source: &str, c: &Correlation) -> Section {
+/// The model's misfit in words: `0.4325, 86.67 x the noise (0.00499), over
+/// the 200 lines the diagnosis reads, each value weighted by its coherence`.
+pub(crate) fn misfit_text(m: &MisfitReport) -> String {
+    let noise = match (m.noise, m.times_noise) {
+        (Some(n), Some(t)) => format!(", {} x the noise ({})", table::times(t), table::misfit(n)),
+        _ => String::new(),
+    };
+    format!(
+        "{}{noise}, over the {} lines the diagnosis reads{}",
+        table::misfit(m.misfit),
+        m.lines,
+        if m.weighted { ", each value weighted by its coherence" } else { "" }
+    )
+}
+
+fn summary(
+    case: &CaseFile,
+    data: &Data<'_>,
+    source: &str,
+    c: &Correlation,
+    misfit: &MisfitReport,
+    gains: &[GainReport],
+) -> Section {
+    let measured = data.set;
     let f = measured.frequencies_hz();
     let t = &c.total;
     let mut s = Section::new("Summary");
-    s.push(Block::Facts(vec![
+    let mut facts = vec![
         ("case".into(), case.path.display().to_string()),
         ("data".into(), source.to_string()),
         (
             "measurement".into(),
             format!(
-                "{} channels x {} lines, {} to {} Hz, {}",
+                "{} channels x {} lines, {} to {} Hz, {} ({})",
                 measured.channels().len(),
                 f.len(),
                 report::short(f.first().copied().unwrap_or(0.0)),
                 report::short(f.last().copied().unwrap_or(0.0)),
-                measured.kind()
+                data.quantity(),
+                data.unit()
             ),
         ),
-        ("RMS magnitude error".into(), format!("{} dB (mean {} dB)", sig(t.rms_db, 3), signed(t.mean_db, 3))),
+        ("misfit".into(), misfit_text(misfit)),
+        ("RMS dB error".into(), format!("{} dB (mean {} dB), all lines", sig(t.rms_db, 3), signed(t.mean_db, 3))),
         ("RMS phase error".into(), format!("{} deg", sig(t.rms_phase_deg, 3))),
         ("FRAC".into(), format!("mean {:.4}, lowest {:.4}", t.mean_frac, t.min_frac)),
-        ("complex-log misfit".into(), sig(t.log_misfit, 3)),
-    ]));
+    ];
+    if !gains.is_empty() {
+        facts.push(("fitted gain".into(), report::gains_text(gains)));
+    }
+    s.push(Block::Facts(facts));
     let bands: Vec<String> = report::notable_bands(c, 3)
         .into_iter()
         .map(|i| format!("{} ({} of the misfit)", c.bands[i].band.label(), report::percent(c.bands[i].share)))
@@ -455,7 +551,7 @@ fn summary(case: &CaseFile, measured: &FrfSet, source: &str, c: &Correlation) ->
         .collect();
     if bands.is_empty() && channels.is_empty() {
         s.push(Block::Text(format!(
-            "The model matches the measured FRFs in every band and channel (complex-log misfit below {}).",
+            "The model matches the measured FRFs in every band and channel (misfit below {}).",
             report::NOTABLE_MISFIT
         )));
     }
@@ -468,32 +564,44 @@ fn summary(case: &CaseFile, measured: &FrfSet, source: &str, c: &Correlation) ->
     s
 }
 
-fn print_tables(case: &CaseFile, measured: &FrfSet, source: &str, c: &Correlation) -> Result<()> {
+fn print_tables(case: &CaseFile, data: &Data<'_>, source: &str, c: &Correlation, misfit: &MisfitReport) -> Result<()> {
+    let measured = data.set;
     let f = measured.frequencies_hz();
     let t = &c.total;
     outln!("{}", case.model.title);
     outln!(
-        "model against {source}: {} channels x {} lines, {} to {} Hz, {}",
+        "model against {source}: {} channels x {} lines, {} to {} Hz, {} ({})",
         measured.channels().len(),
         f.len(),
         report::short(f.first().copied().unwrap_or(0.0)),
         report::short(f.last().copied().unwrap_or(0.0)),
-        measured.kind()
+        data.quantity(),
+        data.unit()
     );
+    outln!("misfit {}", misfit_text(misfit));
     outln!(
-        "overall: RMS {} dB (mean {} dB), RMS phase {} deg, FRAC mean {:.4} / lowest {:.4}, complex-log misfit {}",
+        "all lines: RMS dB error {} (mean {}), RMS phase error {} deg, FRAC mean {:.4} / lowest {:.4}",
         sig(t.rms_db, 3),
         signed(t.mean_db, 3),
         sig(t.rms_phase_deg, 3),
         t.mean_frac,
         t.min_frac,
-        sig(t.log_misfit, 3)
     );
     if t.lines_excluded > 0 {
         outln!("({} values left out: zero or not finite)", t.lines_excluded);
     }
     let worst = c.worst_channels(3);
-    let mut table = Table::new(&["channel", "RMS dB", "mean dB", "max |dB| at Hz", "RMS phase", "FRAC", "share", ""]);
+    let mut table = Table::new(&[
+        "channel",
+        "RMS dB error",
+        "mean dB error",
+        "max |dB error| at Hz",
+        "RMS phase error",
+        "FRAC",
+        "misfit",
+        "share",
+        "",
+    ]);
     for (i, ch) in c.channels.iter().enumerate() {
         table.row(vec![
             ch.channel.to_string(),
@@ -502,13 +610,15 @@ fn print_tables(case: &CaseFile, measured: &FrfSet, source: &str, c: &Correlatio
             format!("{} @ {}", sig(ch.max_abs_db.0, 3), report::short(ch.max_abs_db.1)),
             sig(ch.rms_phase_deg, 3),
             format!("{:.4}", ch.frac),
+            table::misfit(ch.log_misfit),
             report::percent(ch.share),
             if worst.contains(&i) { "<- worst".into() } else { String::new() },
         ]);
     }
-    outln!("\nper channel\n{}", table.render());
+    outln!("\nper channel (all its lines; worst by misfit)\n{}", table.render());
     let worst = c.worst_bands(3);
-    let mut table = Table::new(&["band", "lines", "RMS dB", "mean dB", "RMS phase", "share", ""]);
+    let mut table =
+        Table::new(&["band", "lines", "RMS dB error", "mean dB error", "RMS phase error", "misfit", "share", ""]);
     for (i, b) in c.bands.iter().enumerate() {
         table.row(vec![
             format!("{}: {}", i + 1, b.band.label()),
@@ -516,11 +626,12 @@ fn print_tables(case: &CaseFile, measured: &FrfSet, source: &str, c: &Correlatio
             sig(b.rms_db, 3),
             signed(b.mean_db, 3),
             sig(b.rms_phase_deg, 3),
+            table::misfit(b.log_misfit),
             report::percent(b.share),
             if worst.contains(&i) { "<- worst".into() } else { String::new() },
         ]);
     }
-    outln!("\nper band\n{}", table.render());
+    outln!("\nper band (worst by misfit)\n{}", table.render());
     Ok(())
 }
 

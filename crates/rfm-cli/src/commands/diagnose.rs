@@ -9,12 +9,13 @@ use indicatif::ProgressBar;
 use rfm_update::Study;
 use rfm_update::diagnose::Diagnosis;
 use rfm_update::fix::{CheckedDiagnosis, FixOptions, FixProgress, Prepared, diagnose_prepared};
+use rfm_update::quantities;
 use rfm_update::study::{describe_masked, read_measured_for};
 
 use super::{Result, WithNotes, print_masked, print_notes};
-use crate::exit::Exit;
+use crate::exit::{Exit, Failure};
 use crate::output::Outputs;
-use crate::table::{Table, num, percent};
+use crate::table::{self, Table, num, percent};
 
 /// Options of the diagnose command.
 pub struct DiagnoseArgs<'a> {
@@ -32,19 +33,41 @@ pub struct DiagnoseArgs<'a> {
     pub top: usize,
     /// Print each stage with its time.
     pub verbose: bool,
+    /// Folder for the report of the ranking (`--report DIR`).
+    pub report: Option<&'a Path>,
+    /// Replace a report folder another command wrote.
+    pub replace: bool,
+    /// How the report draws.
+    pub report_options: crate::report::ReportOptions,
 }
 
-/// `rfm diagnose`: prints the ranking (or `--json`) and with `--apply`
-/// writes the case with an effect added.
+/// `rfm diagnose`: prints the ranking (or `--json`), with `--apply` writes
+/// the case with an effect added, and with `--report` a report of the
+/// ranking.
 pub fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
-    let mut study = Study::load(args.case)?;
+    // `--out` names the new case of `--apply`; alone it would write nothing
+    if args.out.is_some() && args.apply.is_none() {
+        return Err(Failure::new(
+            Exit::Usage,
+            "--out FILE is where --apply N writes the case with effect N added, and nothing is applied; give \
+             --apply N to write it, or --report DIR for a report of the ranking",
+        ));
+    }
+    let mut study = super::load_study(args.case)?;
+    let mut inputs = study.case().inputs();
+    inputs.extend(args.measured.map(Path::to_path_buf));
+    let mut report_output = args
+        .report
+        .map(|dir| Outputs::folder(dir, &inputs, &["report.html"])?.of_command("diagnose", args.replace))
+        .transpose()?;
     let mut outputs = match (args.apply, args.out) {
         (Some(_), Some(out)) => Some(apply_outputs(&study, args.measured, out)?),
         _ => None,
     };
-    let (measured, notes, masked) = diagnosis_data(&mut study, args.measured)?;
-    print_notes(&notes, args.json)?;
-    print_masked(&masked, args.json)?;
+    let read = read_data(&mut study, args.measured)?;
+    let (measured, notes) = (&read.receptances, &read.notes);
+    print_notes(notes, args.json)?;
+    print_masked(&read.masked, args.json)?;
     if !args.json {
         outln!("{}", study.case().model.title);
         outln!(
@@ -59,23 +82,17 @@ pub fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
     let bar = if args.json { ProgressBar::hidden() } else { ProgressBar::new_spinner() };
     bar.enable_steady_tick(std::time::Duration::from_millis(120));
     let start = std::time::Instant::now();
-    let json = args.json;
     let data_file = outputs.as_ref().and_then(|(_, data)| data.as_ref().map(|(_, path)| path.clone()));
     let (prepared, d) = run_diagnosis(
         &study,
-        &measured,
+        measured,
         data_file,
         &mut |p| {
-            if let FixProgress::Declared { step } = p
-                && !json
-            {
-                let line = format!(
-                    "step 0: updated the case's own [update] parameters first ({}); misfit {:.4e} -> {:.4e}",
-                    step.status.name(),
-                    step.misfit_before,
-                    step.misfit_updated
-                );
-                bar.suspend(|| eprintln!("{line}"));
+            // the spinner says what runs; the findings and step 0 are printed with the ranking
+            match p {
+                FixProgress::Checked { .. } => bar.set_message("checked the data for set-up errors"),
+                FixProgress::Declared { .. } => bar.set_message("updated the case's own [update] parameters (step 0)"),
+                _ => {}
             }
         },
         |stage| {
@@ -88,10 +105,32 @@ pub fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
     )?;
     bar.finish_and_clear();
     if args.json {
-        outln!("{}", diagnosis_json(&notes, &prepared, &d)?);
+        outln!("{}", diagnosis_json(notes, &prepared, &d)?);
     } else {
         print_checks(&prepared)?;
-        print_diagnosis(&d, args.top)?;
+        print_diagnosis(&d, args.top, prepared.declared.is_some())?;
+    }
+    if let Some(mut output) = report_output.take() {
+        let source = args.measured.map_or_else(
+            || match study.case().measurement.as_ref().and_then(|m| m.data.as_ref()) {
+                Some(p) => format!("measured file {}", crate::report::shown_path(p)),
+                None => "synthesised from the case's truth model".to_string(),
+            },
+            |p| format!("measured file {}", p.display()),
+        );
+        let written = crate::report::diagnose_report::write(
+            &study,
+            &prepared,
+            &d,
+            (&read.as_read, &read.per_volt),
+            &source,
+            &args.report_options.for_case(study.case()),
+            &mut output,
+        )?;
+        output.commit()?;
+        if !args.json {
+            outln!("\nwrote {} (figures and tables beside it)", written.display());
+        }
     }
     if let Some(rank) = args.apply {
         let out = args.out.ok_or("--apply needs --out FILE for the new case file")?;
@@ -133,14 +172,35 @@ pub fn diagnosis_json(notes: &[String], prepared: &Prepared, d: &Diagnosis) -> R
     Ok(serde_json::to_string_pretty(&WithNotes { notes, result: &report })?)
 }
 
+/// The measured data `rfm diagnose` reads, and what is known of them.
+struct DiagnosisData {
+    /// As receptances: what the diagnosis fits.
+    receptances: FrfSet,
+    /// What reading them changed or passed over.
+    notes: Vec<String>,
+    /// What the case's mask left out of them.
+    masked: Vec<String>,
+    /// As they were measured (their kind), as the report draws them.
+    as_read: FrfSet,
+    /// The references whose data are per volt.
+    per_volt: Vec<fe_model::DofRef>,
+}
+
 /// The measured receptances `rfm diagnose` fits: the file `measured` as
 /// `--measured` reads it (the study's gains decided again for it), or the
 /// study's own data; with the notes on reading them and what the case's
-/// mask left out.
+/// mask left out. A file that does not fit the case is refused with what
+/// the case wants and what the file holds.
 pub fn diagnosis_data(study: &mut Study, measured: Option<&Path>) -> Result<(FrfSet, Vec<String>, Vec<String>)> {
+    let d = read_data(study, measured)?;
+    Ok((d.receptances, d.notes, d.masked))
+}
+
+fn read_data(study: &mut Study, measured: Option<&Path>) -> Result<DiagnosisData> {
     Ok(match measured {
         Some(path) => {
-            let read = read_measured_for(study.system(), path, study.case().measurement.as_ref())?;
+            let read = read_measured_for(study.system(), path, study.case().measurement.as_ref())
+                .map_err(|e| super::mismatch(e.into(), study.case().measurement.as_ref(), Some(path)))?;
             study.set_gains_for(&read)?;
             let mut notes = read.notes.clone();
             if study.gains() != Gains::None {
@@ -150,9 +210,21 @@ pub fn diagnosis_data(study: &mut Study, measured: Option<&Path>) -> Result<(Frf
                     study.gains_reason()
                 ));
             }
-            (read.set.to_receptance(), notes, describe_masked(&read.masked))
+            DiagnosisData {
+                receptances: read.set.to_receptance(),
+                notes,
+                masked: describe_masked(&read.masked),
+                per_volt: read.per_volt_references(),
+                as_read: read.set,
+            }
         }
-        None => (study.measured().clone(), study.notes().to_vec(), describe_masked(study.masked())),
+        None => DiagnosisData {
+            receptances: study.measured().clone(),
+            notes: study.notes().to_vec(),
+            masked: describe_masked(study.masked()),
+            as_read: study.measured_as_read(),
+            per_volt: study.per_volt().to_vec(),
+        },
     })
 }
 
@@ -257,32 +329,53 @@ fn unfitted_lines(d: &Diagnosis) -> Vec<String> {
 
 /// What was found about the data and corrected, and step 0, before the ranking.
 fn print_checks(p: &Prepared) -> Result<()> {
-    if !p.findings.is_empty() {
+    if p.findings.is_empty() {
+        outln!("checked the data for set-up errors: none found\n");
+    } else {
         outln!("findings about the data (corrected before the diagnosis when a correction is given):");
         for f in &p.findings {
             let fix = if f.corrections.is_empty() { "" } else { " [corrected]" };
             outln!("  - {}{fix}\n    {}", f.summary, f.evidence);
         }
+        if p.corrected_misfit != p.nominal_misfit {
+            outln!(
+                "  the nominal model's misfit {} on the data as read, {} on the corrected data",
+                table::misfit(p.nominal_misfit),
+                table::misfit(p.corrected_misfit)
+            );
+        }
         outln!("");
     }
     if let Some(d) = &p.declared {
-        outln!(
-            "the case's own [update] parameters were updated first (step 0, {}): misfit {:.2} % -> {:.2} % (RMS relative); \
-             the diagnosis below is of the updated model",
-            d.status.name(),
-            100.0 * d.misfit_before,
-            100.0 * d.misfit_updated
-        );
-        outln!("");
+        outln!("{}; the diagnosis below is of the updated model\n", declared_text(d, p.noise));
     }
     Ok(())
 }
 
-fn print_diagnosis(d: &Diagnosis, top: usize) -> Result<()> {
+/// Step 0 in one sentence, as `rfm diagnose` and its report say it.
+pub(crate) fn declared_text(d: &rfm_update::fix::DeclaredStep, noise: f64) -> String {
+    format!(
+        "the case's own [update] parameters were updated first (step 0, {}): misfit {} -> {} ({} -> {} x the \
+         noise), dBIC {}",
+        d.status.name(),
+        table::misfit(d.misfit_before),
+        table::misfit(d.misfit_updated),
+        table::times(quantities::times_noise(d.misfit_before, noise)),
+        table::times(quantities::times_noise(d.misfit_updated, noise)),
+        table::dbic(d.delta_bic)
+    )
+}
+
+/// The ranking and what it recommends; `after_step0`: the model diagnosed
+/// is the case's with its own parameters updated.
+fn print_diagnosis(d: &Diagnosis, top: usize, after_step0: bool) -> Result<()> {
     outln!(
-        "noise level estimated from the data: {:.2} %; nominal model misfit: {:.2} % (RMS relative)",
-        100.0 * d.noise,
-        100.0 * d.nominal_misfit
+        "noise {}; misfit of the {} {} ({} x the noise), over the {} lines the diagnosis reads",
+        table::misfit(d.noise),
+        if after_step0 { "model after step 0" } else { "nominal model" },
+        table::misfit(d.nominal_misfit),
+        table::times(quantities::times_noise(d.nominal_misfit, d.noise)),
+        quantities::MISFIT_LINES
     );
     if d.weighted {
         outln!(
@@ -298,19 +391,13 @@ fn print_diagnosis(d: &Diagnosis, top: usize) -> Result<()> {
         let per = if d.gains == Gains::PerChannel { "channel" } else { "reference" };
         outln!("every fit includes an unknown complex gain per {per}; the leader's:");
         if let Some(l) = d.ranking.first() {
-            for g in &l.gains {
-                outln!(
-                    "    {}: x{} ({:+.1} dB), {:+.1} deg",
-                    g.key,
-                    num(g.magnitude),
-                    20.0 * g.magnitude.log10(),
-                    g.phase_deg
-                );
+            for g in crate::report::gain_reports(&l.gains) {
+                outln!("    {}", crate::report::gain_text(&g));
             }
         }
         outln!("");
     }
-    let mut t = Table::new(&["rank", "effect", "explained", "dBIC", "significant", "fitted values", ""]);
+    let mut t = Table::new(&["rank", "effect", "explained", "dBIC", "significant", "", "fitted values"]);
     for (i, r) in d.ranking.iter().enumerate().take(top) {
         let values = r
             .parameters
@@ -335,17 +422,19 @@ fn print_diagnosis(d: &Diagnosis, top: usize) -> Result<()> {
         t.row(vec![
             format!("{}", i + 1),
             r.description.clone(),
-            format!("{:.1} %", 100.0 * r.explained),
-            format!("{:.1}", r.delta_bic),
+            crate::report::percent(r.explained),
+            table::dbic(r.delta_bic),
             if r.significant { "yes".into() } else { "no".into() },
-            values,
             note,
+            values,
         ]);
     }
     outln!("{}", t.render());
     outln!(
-        "\n(dBIC: change of the Bayesian information criterion; below -10 the evidence is very strong; \
-         {} candidates tried, {} of them replaced by a variant)",
+        "\n(explained: the share of the nominal model's squared misfit the effect removes; dBIC: the change of the \
+         Bayesian information criterion, comparable only within one diagnosis; significant: dBIC below {}, very \
+         strong evidence; {} candidates tried, {} of them replaced by a variant)",
+        quantities::SIGNIFICANT_DBIC,
         d.tried,
         d.superseded
     );

@@ -1,20 +1,31 @@
 //! `rfm fix`: diagnose, add the recommended effect, update, and again,
 //! until nothing significant remains; the case after every step, and a
-//! report whose headline is the fall of the misfit.
+//! report whose headline is the misfit after each step.
+//!
+//! Each step's case is committed into the output folder as soon as the
+//! step is done ([`Outputs::checkpoint`]), with `fix-progress.json`: an
+//! interrupted run leaves the steps it finished, and `--resume` goes on
+//! from the last of them.
 
 use std::path::{Path, PathBuf};
 
+use fe_model::case::CaseEditor;
 use rfm_update::Study;
 use rfm_update::fix::{CONSISTENT, FixOptions, FixOutcome, FixProgress, FixStop, fix as run_fix};
+use rfm_update::quantities;
+use serde::{Deserialize, Serialize};
 
 use super::{Result, print_masked, print_notes};
-use crate::exit::Exit;
+use crate::exit::{Exit, Failure};
 use crate::output::Outputs;
-use crate::report::fix_report::step_file;
-use crate::table::{Table, num};
+use crate::report::fix_report::{Resumed, step_file};
+use crate::table::{self, Table, num};
 
 /// The data a case synthesised from its `[truth]`, written beside the steps.
 const DATA_FILE: &str = "measured.csv";
+
+/// What a run that has not finished has done so far, beside its steps.
+const PROGRESS_FILE: &str = "fix-progress.json";
 
 /// Options of the fix command.
 pub struct FixArgs<'a> {
@@ -26,8 +37,101 @@ pub struct FixArgs<'a> {
     pub steps: usize,
     /// Print JSON instead of tables.
     pub json: bool,
+    /// Replace a folder another command wrote.
+    pub replace: bool,
+    /// Go on from the steps an interrupted run left in `out`.
+    pub resume: bool,
     /// How the report draws.
     pub report: crate::report::ReportOptions,
+}
+
+/// `fix-progress.json`: the case the run started from and the steps it
+/// has finished, so that `--resume` can check it goes on with the same case
+/// and knows where to start.
+#[derive(Serialize, Deserialize)]
+struct Progress {
+    /// The case file as given.
+    case: String,
+    /// Its text when the run started: a resumed run refuses a changed case.
+    case_text: String,
+    /// The step files finished, in order (`step-0.toml` first when the
+    /// case's own parameters were updated).
+    steps: Vec<String>,
+}
+
+impl Progress {
+    /// The effects added by the finished steps (step 0 adds none).
+    fn effects_done(&self) -> usize {
+        self.steps.iter().filter(|s| **s != step_file(0)).count()
+    }
+}
+
+/// Where a run starts: the case's own, or the last step an interrupted run
+/// left (`--resume`).
+struct Start {
+    /// The study of the case the loop starts from.
+    study: Study,
+    /// Effects added by the steps earlier runs finished into the folder.
+    done: usize,
+    /// The files of those steps (and their data), to be kept in the new
+    /// outputs.
+    carried: Vec<(String, Vec<u8>)>,
+}
+
+fn start(args: &FixArgs<'_>, case_text: &str) -> Result<Start> {
+    if !args.resume {
+        return Ok(Start { study: super::load_study(args.case)?, done: 0, carried: Vec::new() });
+    }
+    let path = args.out.join(PROGRESS_FILE);
+    let text = std::fs::read_to_string(&path).map_err(|e| {
+        Failure::new(
+            Exit::Usage,
+            format!(
+                "{}: nothing to resume ({e}): an interrupted rfm fix leaves it beside its steps; run without --resume",
+                path.display()
+            ),
+        )
+    })?;
+    let progress: Progress =
+        serde_json::from_str(&text).map_err(|e| format!("{}: not a progress file of rfm fix: {e}", path.display()))?;
+    if progress.case_text != case_text {
+        return Err(Failure::new(
+            Exit::Usage,
+            format!(
+                "{}: the run it records started from {} as it was then, and {} has changed since; run without \
+                 --resume to start again",
+                path.display(),
+                progress.case,
+                args.case.display()
+            ),
+        ));
+    }
+    let Some(last) = progress.steps.last() else {
+        return Err(Failure::new(
+            Exit::Usage,
+            format!("{}: no step finished yet; run without --resume", path.display()),
+        ));
+    };
+    let done = progress.effects_done();
+    if done >= args.steps {
+        return Err(Failure::new(
+            Exit::Usage,
+            format!(
+                "{} holds {done} finished steps, as many as --steps {} asks for; give more steps to go on",
+                args.out.display(),
+                args.steps
+            ),
+        ));
+    }
+    let mut carried = Vec::new();
+    for name in progress.steps.iter().map(String::as_str).chain([DATA_FILE]) {
+        match std::fs::read(args.out.join(name)) {
+            Ok(bytes) => carried.push((name.to_string(), bytes)),
+            Err(_) if name == DATA_FILE => {}
+            Err(e) => return Err(format!("{}: {e}", args.out.join(name).display()).into()),
+        }
+    }
+    Ok(Start { study: super::load_study(&args.out.join(last))?, done, carried })
 }
 
 /// Whether the study's data are synthesised from its case's `[truth]`:
@@ -36,16 +140,18 @@ fn synthesises(study: &Study) -> bool {
     study.case().measurement.as_ref().and_then(|m| m.data.as_ref()).is_none()
 }
 
-/// Opens the outputs of `rfm fix` in `dir` for `steps` steps at most.
-fn fix_outputs(study: &Study, steps: usize, dir: &Path) -> Result<Outputs> {
-    // one more than the steps: the loop may end by replacing an early effect
+/// Opens the outputs of `rfm fix` in `dir` for `steps` steps at most,
+/// protecting `inputs`; a folder another command wrote is refused unless
+/// `replace`.
+fn fix_outputs(inputs: &[PathBuf], synthesised: bool, steps: usize, dir: &Path, replace: bool) -> Result<Outputs> {
+    // step 0 and one more than the steps: the loop may end by replacing an early effect
     let mut names: Vec<String> = (0..=steps + 1).map(step_file).collect();
     names.extend(["results.json", "report.html"].map(String::from));
-    if synthesises(study) {
+    if synthesised {
         names.push(DATA_FILE.into());
     }
     let known: Vec<&str> = names.iter().map(String::as_str).collect();
-    Ok(Outputs::folder(dir, &study.case().inputs(), &known)?)
+    Ok(Outputs::folder(dir, inputs, &known)?.of_command("fix", replace)?)
 }
 
 /// The options of `rfm fix` on `study`: at most `steps` effects, each
@@ -63,55 +169,142 @@ pub fn fix_options(study: &Study, steps: usize, data: PathBuf) -> Result<FixOpti
 }
 
 /// `rfm fix`: prints each step and the outcome (or `--json`) and writes the
-/// cases of the steps, the results and the report.
+/// cases of the steps, the results and the report; each step's case is
+/// kept in the folder as soon as the step is done.
 pub fn fix(args: &FixArgs<'_>) -> Result<Exit> {
-    let study = Study::load(args.case)?;
-    let mut output = fix_outputs(&study, args.steps, args.out)?;
+    let case_text = std::fs::read_to_string(args.case).unwrap_or_default();
+    let Start { study, done, carried } = start(args, &case_text)?;
+    let synthesised = synthesises(&study);
+    // the inputs of a resumed run (its last step's case and data) are files
+    // of the folder, staged again below rather than replaced: the case's own
+    // inputs are the ones to protect
+    let inputs: Vec<PathBuf> = super::load_case(args.case)?.inputs();
+    let mut output = fix_outputs(&inputs, synthesised, args.steps, args.out, args.replace || args.resume)?;
+    for (name, bytes) in &carried {
+        output.write(name, bytes)?;
+    }
     print_notes(study.notes(), args.json)?;
     print_masked(&rfm_update::study::describe_masked(study.masked()), args.json)?;
     if !args.json {
         outln!("{}", study.case().model.title);
+        if !carried.is_empty() {
+            outln!("resuming after step {done} of the run in {}", args.out.display());
+        }
         outln!(
             "closing the loop on {} channels x {} lines ({} to {} Hz), at most {} steps",
             study.measured().channels().len(),
             study.measured().n_freq(),
             num(study.measured().frequencies_hz()[0]),
             num(*study.measured().frequencies_hz().last().expect("lines")),
-            args.steps
+            args.steps - done
         );
     }
-    let opts = fix_options(&study, args.steps, output.path(DATA_FILE))?;
+    let opts = fix_options(&study, args.steps - done, output.path(DATA_FILE))?;
+    let data_file = opts.data.clone();
+    if synthesised {
+        output.write(DATA_FILE, frf::io::csv::to_csv_string(study.measured()).as_bytes())?;
+    }
     let json = args.json;
+    let mut finished: Vec<String> = carried.iter().filter(|(n, _)| n != DATA_FILE).map(|(n, _)| n.clone()).collect();
+    let resumed = !carried.is_empty();
+    // the first failure to keep a step; the loop goes on, and it is
+    // reported when the loop ends
+    let mut kept: std::result::Result<(), Failure> = Ok(());
     let outcome = run_fix(study.case(), study.measured(), &opts, |p| {
+        // a resumed run's step 0 updates the last kept step's parameters
+        // again; its case stays the earlier run's step 0
+        let keep = match &p {
+            FixProgress::Declared { step } if !resumed => Some((step_file(0), &step.case)),
+            FixProgress::StepDone { index, done: step } => Some((step_file(done + index + 1), &step.case)),
+            _ => None,
+        };
+        if let Some((name, case)) = keep
+            && kept.is_ok()
+        {
+            kept = keep_step(&mut output, &name, case, data_file.as_deref(), &mut finished, args, &case_text);
+        }
         if json {
             return;
         }
-        for line in progress_lines(&p) {
+        for line in progress_lines_after(&p, done) {
             // an error here would be the same as at the next print, which reports it
             let _ = crate::print_line(format_args!("{line}"));
         }
     })?;
+    kept?;
     if json {
         outln!("{}", serde_json::to_string_pretty(&outcome)?);
     } else {
-        print_outcome(&outcome)?;
+        print_outcome(&outcome, done)?;
     }
-
-    write_fix(&study, &outcome, &args.report, &mut output)?;
+    let resumed = Resumed {
+        earlier: resumed,
+        steps: done,
+        history: if resumed { study.case().history.clone() } else { Vec::new() },
+    };
+    write_fix(&study, &outcome, &resumed, &args.report, &mut output)?;
+    // a finished run leaves nothing to resume
+    output.forget(PROGRESS_FILE)?;
     let written = output.commit()?;
     if !json {
         outln!("\nwrote {} files into {}", written.len(), args.out.display());
-        if outcome.final_case().is_some() {
-            let last = if outcome.steps.is_empty() { 0 } else { outcome.steps.len() };
+        let last = done + outcome.steps.len();
+        if last > 0 || outcome.declared.is_some() {
             outln!("the fixed model: {}", args.out.join(step_file(last)).display());
         }
     }
-    Ok(fix_exit(&outcome))
+    let exit = fix_exit(&outcome);
+    if exit != Exit::Success {
+        eprintln!("exit code {}: {}", exit.code(), exit.meaning());
+    }
+    Ok(exit)
+}
+
+/// The text of a step's case written at `path`, reading the data written
+/// beside it when the first case synthesised them.
+fn step_text(case: &CaseEditor, path: &Path, data: Option<&Path>) -> Result<String> {
+    let mut editor = case.clone();
+    if let Some(data) = data {
+        editor.use_data(data);
+    }
+    Ok(editor.text_at(path)?)
+}
+
+/// Commits a finished step's case into the output folder at once, with the
+/// progress so far, so that an interrupted run keeps it.
+fn keep_step(
+    output: &mut Outputs,
+    name: &str,
+    case: &CaseEditor,
+    data: Option<&Path>,
+    finished: &mut Vec<String>,
+    args: &FixArgs<'_>,
+    case_text: &str,
+) -> std::result::Result<(), Failure> {
+    output.write(name, step_text(case, &output.path(name), data)?.as_bytes())?;
+    finished.push(name.to_string());
+    let progress =
+        Progress { case: args.case.display().to_string(), case_text: case_text.to_string(), steps: finished.clone() };
+    output.write(PROGRESS_FILE, serde_json::to_string_pretty(&progress)?.as_bytes())?;
+    output.checkpoint()?;
+    crate::output::note_checkpoint(format!(
+        "the {} finished step(s) are in {} (rfm fix ... --resume goes on from them)",
+        finished.len(),
+        args.out.display()
+    ));
+    Ok(())
 }
 
 /// What `rfm fix` prints as the loop goes, one line each (the Python
 /// package's progress says the same).
 pub fn progress_lines(p: &FixProgress<'_>) -> Vec<String> {
+    progress_lines_after(p, 0)
+}
+
+/// [`progress_lines`] of a run that resumed after `done` steps of an
+/// earlier one: its steps and diagnoses are numbered from the first run's
+/// start.
+fn progress_lines_after(p: &FixProgress<'_>, done: usize) -> Vec<String> {
     match p {
         FixProgress::Checked { findings: [] } => {
             vec!["checked the data for set-up errors: none found".into()]
@@ -123,15 +316,26 @@ pub fn progress_lines(p: &FixProgress<'_>) -> Vec<String> {
             }))
             .collect(),
         FixProgress::Declared { step } => vec![format!(
-            "step 0: updated the case's own parameters ({}); misfit {:.4e} -> {:.4e}",
+            "{} ({}); misfit {} -> {}, dBIC {}",
+            if done == 0 {
+                "step 0: updated the case's own parameters"
+            } else {
+                "updated every parameter of the steps before again (where this run resumed)"
+            },
             step.status.name(),
-            step.misfit_before,
-            step.misfit_updated
+            table::misfit(step.misfit_before),
+            table::misfit(step.misfit_updated),
+            table::dbic(step.delta_bic)
         )],
         FixProgress::Diagnosed { step, diagnosis } => vec![match diagnosis.leader() {
-            Some(l) => format!("diagnosis {}: {} stands out (dBIC {:.1})", step + 1, l.description, l.delta_bic),
-            None if diagnosis.consistent() => format!("diagnosis {}: nothing significant", step + 1),
-            None => format!("diagnosis {}: significant effects, none at plausible values", step + 1),
+            Some(l) => format!(
+                "diagnosis {}: {} stands out (dBIC {})",
+                done + step + 1,
+                l.description,
+                table::dbic(l.delta_bic)
+            ),
+            None if diagnosis.consistent() => format!("diagnosis {}: nothing significant", done + step + 1),
+            None => format!("diagnosis {}: significant effects, none at plausible values", done + step + 1),
         }],
         FixProgress::LookedAhead { ahead, .. } => {
             let what = match &ahead.with {
@@ -142,14 +346,25 @@ pub fn progress_lines(p: &FixProgress<'_>) -> Vec<String> {
                 _ if ahead.misfit_ahead.is_nan() => {
                     format!("  tried {what}: {}", ahead.failed.as_deref().unwrap_or("failed"))
                 }
-                Some(why) => format!("  tried {what}: misfit {:.4e}, not kept: {why}", ahead.misfit_ahead),
-                None => format!("  tried {what}: misfit {:.4e}, dBIC {:.1}", ahead.misfit_ahead, ahead.delta_bic),
+                Some(why) => format!("  tried {what}: misfit {}, not kept: {why}", table::misfit(ahead.misfit_ahead)),
+                None => format!(
+                    "  tried {what}: misfit {}, dBIC {}",
+                    table::misfit(ahead.misfit_ahead),
+                    table::dbic(ahead.delta_bic)
+                ),
             }]
         }
         FixProgress::Updated { step, effect, removed, misfit, status } => {
             let verb = if *removed { "took out" } else { "added" };
-            vec![format!("step {}: {verb} {effect} and updated ({}); misfit {misfit:.4e}", step + 1, status.name())]
+            vec![format!(
+                "step {}: {verb} {effect} and updated ({}); misfit {}",
+                done + step + 1,
+                status.name(),
+                table::misfit(*misfit)
+            )]
         }
+        // the step was announced by `Updated`; this one is for keeping it
+        FixProgress::StepDone { .. } => Vec::new(),
     }
 }
 
@@ -165,10 +380,13 @@ pub fn fix_exit(outcome: &FixOutcome) -> Exit {
     }
 }
 
-/// Writes the outputs of `rfm fix` (not yet committed).
+/// Writes the outputs of `rfm fix` (not yet committed): the case of every
+/// step (step 0's unless the run resumed, numbered after the `resumed`
+/// steps), the synthesised data, `results.json` and the report.
 fn write_fix(
     study: &Study,
     outcome: &FixOutcome,
+    resumed: &Resumed,
     report: &crate::report::ReportOptions,
     output: &mut Outputs,
 ) -> Result<()> {
@@ -177,30 +395,26 @@ fn write_fix(
     if synthesised {
         output.write(DATA_FILE, frf::io::csv::to_csv_string(study.measured()).as_bytes())?;
     }
-    let cases = outcome
-        .declared
-        .iter()
+    let declared = outcome.declared.iter().filter(|_| !resumed.earlier);
+    let cases = declared
         .map(|d| (0, &d.case))
-        .chain(outcome.steps.iter().enumerate().map(|(k, s)| (k + 1, &s.case)));
+        .chain(outcome.steps.iter().enumerate().map(|(k, s)| (resumed.steps + k + 1, &s.case)));
     for (k, case) in cases {
         let name = step_file(k);
-        let mut editor = case.clone();
-        if let Some(data) = &data_file {
-            editor.use_data(data);
-        }
-        let text = editor.text_at(&output.path(&name))?;
-        output.write(&name, text.as_bytes())?;
+        output.write(&name, step_text(case, &output.path(&name), data_file.as_deref())?.as_bytes())?;
     }
     output.write("results.json", serde_json::to_string_pretty(&outcome)?.as_bytes())?;
-    crate::report::fix_report::write(study, outcome, &report.for_case(study.case()), output)?;
+    crate::report::fix_report::write(study, outcome, resumed, &report.for_case(study.case()), output)?;
     Ok(())
 }
 
 /// Writes what `rfm fix --out DIR` writes for `outcome` (the loop on
 /// `study` with at most `steps` effects) into `dir`, all or nothing: the
-/// case after every step (`step-1.toml`, ...), `results.json`,
-/// `report.html` and the figures, and the data synthesised from the case's
-/// `[truth]` (`measured.csv`) where the steps read them; returns the files.
+/// case after every step (`step-0.toml` for the case's own parameters,
+/// `step-1.toml`, ...), `results.json`, `report.html` and the figures, and
+/// the data synthesised from the case's `[truth]` (`measured.csv`) where
+/// the steps read them; returns the files. A folder another command wrote
+/// is refused, as `rfm fix` without `--replace` refuses it.
 pub fn save_fix(
     study: &Study,
     outcome: &FixOutcome,
@@ -208,12 +422,12 @@ pub fn save_fix(
     dir: &Path,
     report: &crate::report::ReportOptions,
 ) -> Result<Vec<PathBuf>> {
-    let mut output = fix_outputs(study, steps, dir)?;
-    write_fix(study, outcome, report, &mut output)?;
+    let mut output = fix_outputs(&study.case().inputs(), synthesises(study), steps, dir, false)?;
+    write_fix(study, outcome, &Resumed { earlier: false, steps: 0, history: Vec::new() }, report, &mut output)?;
     Ok(output.commit()?)
 }
 
-fn print_outcome(o: &FixOutcome) -> Result<()> {
+fn print_outcome(o: &FixOutcome, done: usize) -> Result<()> {
     let corrected: Vec<_> = o.findings.iter().filter(|f| !f.corrections.is_empty()).collect();
     if !o.findings.is_empty() {
         outln!("\nfindings about the data (set-up errors are corrected before the model is fitted):");
@@ -225,45 +439,46 @@ fn print_outcome(o: &FixOutcome) -> Result<()> {
     if !corrected.is_empty() {
         outln!("  the corrections are written under [[measurement.corrections]] in every step's case");
     }
-    outln!("\nthe misfit after each step (RMS of ln(model/measured) per value):");
-    let mut t = Table::new(&["step", "misfit", "(dB)", "x noise", "dBIC of the step"]);
-    let mut bics: Vec<String> = vec![String::new(); 1];
-    if o.findings.iter().any(|f| !f.corrections.is_empty()) {
-        bics.push(String::new());
-    }
-    if let Some(d) = &o.declared {
-        bics.push(format!("{:.1}", d.delta_bic));
-    }
-    for s in &o.steps {
-        bics.push(String::new());
-        bics.push(format!("{:.1}", s.delta_bic));
-    }
-    for ((label, m), bic) in o.stages().into_iter().zip(bics) {
-        t.row(vec![label, format!("{m:.4e}"), format!("{:.1}", 20.0 * m.log10()), format!("{:.1}", m / o.noise), bic]);
+    outln!(
+        "\nthe misfit after each step (RMS of |ln(model/measured)| per complex value, over the {} lines the diagnosis reads):",
+        quantities::MISFIT_LINES
+    );
+    let mut t = Table::new(&["step", "misfit", "x noise", "dBIC of the step"]);
+    for ((label, m), bic) in o.stages().into_iter().zip(crate::report::fix_report::stage_dbics(o)) {
+        let label = if done == 0 { label } else { crate::report::fix_report::renumbered(&label, done) };
+        t.row(vec![label, table::misfit(m), table::times(quantities::times_noise(m, o.noise)), bic]);
     }
     outln!("{}", t.render());
-    outln!("noise level estimated from the data: {:.3e}", o.noise);
+    outln!("noise level estimated from the data: {}", table::misfit(o.noise));
+    outln!(
+        "(dBIC of the step: the evidence for the model after it over the model before, both updated; below {} it is significant)",
+        quantities::SIGNIFICANT_DBIC
+    );
     outln!("\nstopped: {}", o.stop_reason);
     let last = o.final_misfit();
+    let times = table::times(quantities::times_noise(last, o.noise));
     if o.explained() {
-        outln!(
-            "the final misfit is {:.2} times the noise: the model explains the data down to their noise",
-            last / o.noise
-        );
+        outln!("the final misfit is {times} times the noise: the model explains the data down to their noise");
     } else if last <= CONSISTENT * o.noise {
-        outln!("the final misfit is {:.2} times the noise", last / o.noise);
+        outln!("the final misfit is {times} times the noise");
     } else {
-        outln!("the final misfit is {:.1} times the noise; what remains unexplained:", last / o.noise);
+        outln!("the final misfit is {times} times the noise; what remains unexplained:");
         for r in &o.remains {
             outln!("  - {r}");
         }
     }
+    if !o.equally_good.is_empty() {
+        outln!("\neffects at different places that explain the data equally well (the data cannot tell them apart):");
+        for a in &o.equally_good {
+            outln!("  - {}: misfit {}, dBIC {}", a.effect, table::misfit(a.misfit_ahead), table::dbic(a.delta_bic));
+        }
+    }
     let last_update = match (o.steps.last(), &o.declared) {
-        (Some(s), _) => Some((&s.parameters, &s.uncertainty)),
-        (None, Some(d)) => Some((&d.parameters, &d.uncertainty)),
+        (Some(s), _) => Some((&s.parameters, &s.uncertainty, s.effect.gains.as_slice())),
+        (None, Some(d)) => Some((&d.parameters, &d.uncertainty, &[][..])),
         (None, None) => None,
     };
-    if let Some((parameters, uncertainty)) = last_update {
+    if let Some((parameters, uncertainty, gains)) = last_update {
         // the standard deviation shown is the one that includes model error
         // (the residual beyond the noise), which equals the noise's alone when
         // the fit reaches the noise
@@ -272,22 +487,45 @@ fn print_outcome(o: &FixOutcome) -> Result<()> {
             "\nparameters after the last update (relative standard deviation{}):",
             if inflated { ", widened for the misfit beyond the noise" } else { " from the noise" }
         );
-        let mut t = Table::new(&["parameter", "value", "+-1 sd"]);
+        let mut t = Table::new(&["parameter", "unit", "value", "+-1 sd"]);
         for (i, p) in parameters.iter().enumerate() {
             let sd = uncertainty
                 .as_ref()
                 .and_then(|u| u.parameters.get(i))
                 .map_or("-".to_string(), |u| crate::table::percent(u.relative_std));
-            t.row(vec![p.name.clone(), num(p.updated), sd]);
+            let unit = crate::report::units::parameter_unit(&p.name);
+            t.row(vec![p.name.clone(), unit.to_string(), num(p.updated), sd]);
         }
         outln!("{}", t.render());
+        // the data's level: every misfit above is after the gains that fit the model best
+        for g in crate::report::gain_reports(gains) {
+            outln!("gain fitted with the last effect: {}", crate::report::gain_text(&g));
+        }
     }
     if let Some(e) = &o.diagnosis_error {
         outln!("\nthe diagnosis of the final model failed, so what remains is not known: {e}");
     } else if o.significant_remains
         && let Some(r) = o.remaining.first()
     {
-        outln!("\nstill significant in the last diagnosis: {} (dBIC {:.1})", r.description, r.delta_bic);
+        outln!("\nstill significant in the last diagnosis: {} (dBIC {})", r.description, table::dbic(r.delta_bic));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The progress file is read back as written, and step 0 adds no effect.
+    #[test]
+    fn progress_round_trips() {
+        let p = Progress {
+            case: "a.toml".into(),
+            case_text: "x = 1\n".into(),
+            steps: vec!["step-0.toml".into(), "step-1.toml".into()],
+        };
+        let back: Progress = serde_json::from_str(&serde_json::to_string(&p).unwrap()).unwrap();
+        assert_eq!(back.effects_done(), 1);
+        assert_eq!((back.case, back.case_text, back.steps), (p.case, p.case_text, p.steps));
+    }
 }

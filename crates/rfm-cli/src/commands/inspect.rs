@@ -25,6 +25,102 @@ pub fn inspect(file: &Path, json: bool) -> Result<Exit> {
     Ok(Exit::Success)
 }
 
+/// At most this many DOFs are named in a summary; the rest are counted.
+const NAMED: usize = 8;
+
+/// `a, b, c` of the first [`NAMED`] items and how many more.
+fn listed(items: &[String]) -> String {
+    let mut out = items.iter().take(NAMED).cloned().collect::<Vec<_>>().join(", ");
+    if items.len() > NAMED {
+        out.push_str(&format!(" and {} more", items.len() - NAMED));
+    }
+    out
+}
+
+/// The distinct items of `items`, in their order.
+fn distinct(items: impl Iterator<Item = String>) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    for i in items {
+        if !out.contains(&i) {
+            out.push(i);
+        }
+    }
+    out
+}
+
+/// What a measurement file holds, in one sentence, as an error about a
+/// case's channels shows it beside what the case wants ([`case_wants`]):
+/// its channels by the DOFs the file names (test DOFs of a universal file,
+/// model DOFs of a CSV file), its lines and its kind. `None` when the file
+/// cannot be read as it is.
+pub(crate) fn file_holds(file: &Path) -> Option<String> {
+    let lines = |n: usize, lo: Option<f64>, hi: Option<f64>| match (lo, hi) {
+        (Some(a), Some(b)) => format!("{n} lines from {} to {} Hz", num(a), num(b)),
+        _ => format!("{n} lines"),
+    };
+    match frf::io::detect_format(file).ok()? {
+        MeasuredFormat::Uff => {
+            let u = uff::read_uff(file).ok()?;
+            let frfs: Vec<&Record58> =
+                u.records.iter().filter(|r| r.function.header.function_type == uff::FUNCTION_FRF).collect();
+            let first = frfs.first()?;
+            let responses = distinct(frfs.iter().map(|r| r.function.header.response.to_string()));
+            let references = distinct(frfs.iter().map(|r| r.function.header.reference.to_string()));
+            let x = first.function.abscissa_values();
+            let kind = uff::frf_units(&first.function.header)
+                .ok()
+                .map_or(String::new(), |k| format!(", {}{}", k.kind.name(), if k.per_volt { " per volt" } else { "" }));
+            Some(format!(
+                "{} channels (universal file, test DOFs): responses {} at reference{} {}, {}{kind}",
+                frfs.len(),
+                listed(&responses),
+                if references.len() == 1 { "" } else { "s" },
+                listed(&references),
+                lines(first.function.len(), x.first().copied(), x.last().copied())
+            ))
+        }
+        MeasuredFormat::Csv => {
+            let read = frf::io::csv::read_csv_with(file, &[]).ok()?;
+            let set = &read.set;
+            let responses = distinct(set.channels().iter().map(|c| c.response.to_string()));
+            let references = distinct(set.channels().iter().map(|c| c.reference.to_string()));
+            let f = set.frequencies_hz();
+            Some(format!(
+                "{} channels (CSV, model DOFs): responses {} at reference{} {}, {}, {}{}",
+                set.channels().len(),
+                listed(&responses),
+                if references.len() == 1 { "" } else { "s" },
+                listed(&references),
+                lines(f.len(), f.first().copied(), f.last().copied()),
+                set.kind().name(),
+                if read.per_volt { " per volt" } else { "" }
+            ))
+        }
+    }
+}
+
+/// What a case's `[measurement]` wants of its data, in one sentence (see
+/// [`file_holds`]): its channels, the test DOFs its map reads them from,
+/// and its band.
+pub(crate) fn case_wants(spec: &fe_model::case::MeasurementSpec) -> String {
+    let responses: Vec<String> = spec.responses.iter().map(ToString::to_string).collect();
+    let references: Vec<String> = spec.references.iter().map(ToString::to_string).collect();
+    let map = if spec.map.is_empty() {
+        String::new()
+    } else {
+        let entries: Vec<String> = spec.map.iter().map(|m| format!("{} -> {}", m.test, m.model)).collect();
+        format!(", read through its map ({})", listed(&entries))
+    };
+    let band = spec.band.map_or(String::new(), |(lo, hi)| format!(", within {} to {} Hz", num(lo), num(hi)));
+    format!(
+        "{} channels: responses {} at reference{} {}{map}{band}",
+        responses.len() * references.len(),
+        listed(&responses),
+        if references.len() == 1 { "" } else { "s" },
+        listed(&references)
+    )
+}
+
 fn uff_report(file: &Path) -> Result<Value> {
     let u = uff::read_uff(file)?;
     let records: Vec<Value> = u.records.iter().map(record_json).collect();

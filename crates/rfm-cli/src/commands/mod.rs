@@ -13,18 +13,63 @@ use fe_model::CaseFile;
 
 use crate::exit::Failure;
 
-pub use compare::{CompareRun, compare};
+pub use compare::{CompareArgs, CompareRun, compare};
 pub use diagnose::{DiagnoseArgs, diagnose, diagnosis_data, diagnosis_json, run_diagnosis, write_applied};
 pub use fix::{FixArgs, fix, fix_exit, fix_options, progress_lines as fix_progress_lines, save_fix};
 pub use inspect::inspect;
 pub use simulate::{SimulateArgs, simulate, synthesised};
-pub use update::{Overrides as UpdateOverrides, UpdateSetup, finish_update, save_update, update, updated_case};
+pub use update::{
+    Overrides as UpdateOverrides, UpdateSetup, finish_update, save_update, update, update_json, updated_case,
+};
 
 /// A command's result: its exit code, or why it failed (see [`Failure`]).
 pub type Result<T> = std::result::Result<T, Failure>;
 
 pub(crate) fn load_case(path: &Path) -> Result<CaseFile> {
     Ok(CaseFile::load(path)?)
+}
+
+/// A case made ready ([`rfm_update::Study`]); a failure to read its
+/// measured data says, besides what went wrong, what the case wants and
+/// what the file holds, so that a wrong file is seen as such at once
+/// rather than one symptom at a time.
+pub(crate) fn load_study(path: &Path) -> Result<rfm_update::Study> {
+    study_of(load_case(path)?)
+}
+
+/// [`load_study`] of a loaded case.
+pub(crate) fn study_of(case: CaseFile) -> Result<rfm_update::Study> {
+    let spec = case.measurement.clone();
+    rfm_update::Study::from_case(case)
+        .map_err(|e| mismatch(e.into(), spec.as_ref(), spec.as_ref().and_then(|s| s.data.as_deref())))
+}
+
+/// `failure` with what the case wants and what `file` holds, when it is
+/// about that file (its message names it) and the file can be read as it is.
+pub(crate) fn mismatch(
+    failure: Failure,
+    spec: Option<&fe_model::case::MeasurementSpec>,
+    file: Option<&Path>,
+) -> Failure {
+    let (Some(spec), Some(file)) = (spec, file) else {
+        return failure;
+    };
+    let name = file.display().to_string();
+    if !failure.message.contains(&name) {
+        return failure;
+    }
+    match inspect::file_holds(file) {
+        Some(holds) => Failure {
+            message: format!(
+                "{}\n  the case wants {}\n  {} holds {holds}",
+                failure.message,
+                inspect::case_wants(spec),
+                name
+            ),
+            ..failure
+        },
+        None => failure,
+    }
 }
 
 /// Tells what the case's `[measurement] mask` left out of the measured data:

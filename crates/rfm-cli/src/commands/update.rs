@@ -9,14 +9,12 @@ use rfm_update::{
     status::{IterationRecord, Status},
 };
 
+use rfm_update::quantities::{self, MisfitReport};
+
 use super::{Result, print_masked, print_notes};
 use crate::exit::{Exit, Failure};
 use crate::output::Outputs;
-use crate::table::{Table, num};
-
-fn db(x: f64) -> f64 {
-    20.0 * x.log10()
-}
+use crate::table::{self, Table, num};
 
 /// Command-line overrides of the case's `[update]` settings.
 #[derive(Default)]
@@ -34,12 +32,15 @@ pub struct Overrides {
 pub fn update(
     case: &Path,
     out: Option<&Path>,
+    replace: bool,
     json: bool,
     over: &Overrides,
     report: &crate::report::ReportOptions,
 ) -> Result<Exit> {
-    let mut study = Study::load(case)?;
-    let mut output = out.map(|dir| Outputs::folder(dir, &study.case().inputs(), &UPDATE_OUTPUTS)).transpose()?;
+    let mut study = super::load_study(case)?;
+    let mut output = out
+        .map(|dir| Outputs::folder(dir, &study.case().inputs(), &UPDATE_OUTPUTS)?.of_command("update", replace))
+        .transpose()?;
     let setup = UpdateSetup::new(&mut study, over)?;
     let (method, lines, max_iterations) = (setup.method, &setup.lines, setup.max_iterations);
     print_notes(study.notes(), json)?;
@@ -58,7 +59,7 @@ pub fn update(
             num(lines[0]),
             num(lines[lines.len() - 1])
         );
-        outln!("{:>5}  {:>11}  {:>9}  {:>11}", "iter", "misfit", "(dB)", "max step");
+        outln!("{:>5}  {:>12}  {:>10}", "iter", residual_name(method), "max step");
     }
     let bar = if json { ProgressBar::hidden() } else { ProgressBar::new(max_iterations as u64) };
     bar.set_style(
@@ -67,11 +68,10 @@ pub fn update(
     let on_iteration = |r: &IterationRecord| {
         if !json {
             let line = format!(
-                "{:>5}  {:>11.4e}  {:>9.2}  {:>11.3e}",
+                "{:>5}  {:>12}  {:>10}",
                 r.iteration,
-                r.residual,
-                db(r.residual),
-                r.max_correction
+                table::misfit(r.residual),
+                table::significant(r.max_correction, 3)
             );
             // a hidden bar (output not a terminal) swallows println
             if bar.is_hidden() {
@@ -82,28 +82,30 @@ pub fn update(
             }
         }
         bar.set_position(r.iteration as u64);
-        bar.set_message(format!("misfit {:.3e}", r.residual));
+        bar.set_message(format!("{} {}", residual_name(method), table::misfit(r.residual)));
     };
     let mut outcome = setup.run(&study, on_iteration)?;
     bar.finish_and_clear();
-    let step = finish_update(&study, &mut outcome)?;
+    let (step, misfits) = finish(&study, &mut outcome)?;
     if json {
-        outln!("{}", serde_json::to_string_pretty(&outcome)?);
+        outln!("{}", json_of(&outcome, &misfits)?);
     } else {
-        print_outcome(&outcome)?;
+        print_outcome(&outcome, method, &misfits)?;
         if !study.case().history.is_empty() {
-            outln!("the fall of the misfit, from the case's history to this update:");
+            outln!("the misfit after each step, from the case's history to this update:");
             print_history(&[study.case().history.clone(), vec![step.clone()]].concat())?;
             if let (Some(ratio), true) = (outcome.noise_ratio, outcome.residual_noise != outcome.noise_estimate) {
                 outln!(
-                    "(misfits over the band, weighted as the fit weighs its lines; the status, from the fit's \
-                     residual on its own lines: {ratio:.2} times the noise)"
+                    "(misfits over the {} lines the diagnosis reads, weighted as the fit weighs its lines; the \
+                     status, from the fit residual on its own lines: {} times the noise)",
+                    misfits[1].lines,
+                    table::times(ratio)
                 );
             }
         }
     }
     if let Some(output) = output.take() {
-        let [path, updated, report] = write_update(&study, &outcome, &step, output, case, report)?;
+        let [path, updated, report] = write_update(&study, &outcome, &step, &misfits, output, case, report)?;
         if !json {
             outln!("\nwrote {} and {}", path.display(), updated.display());
             outln!("wrote {} (figures beside it)", report.display());
@@ -181,29 +183,62 @@ impl UpdateSetup {
 /// made it worse is marked so), and the entry of the case's history the
 /// updated case gets, which it returns.
 pub fn finish_update(study: &Study, outcome: &mut UpdateOutcome) -> Result<fe_model::HistoryEntry> {
-    // the misfit the case's history speaks of, after this update, weighted
-    // as the diagnosis weighs it (the fit's line weights)
-    let weights = study.line_weights(study.measured())?;
-    let (measured, weights) = (study.measured(), weights.as_deref());
-    let noise = rfm_update::diagnose::estimate_noise_against_weighted(&outcome.system, measured, weights)?;
-    let gains = study.gains();
-    let misfit = rfm_update::diagnose::log_misfit_with(&outcome.system, measured, HISTORY_LINES, gains, weights)?;
+    Ok(finish(study, outcome)?.0)
+}
+
+/// [`finish_update`], with the initial and the updated model's misfits.
+fn finish(study: &Study, outcome: &mut UpdateOutcome) -> Result<(fe_model::HistoryEntry, [MisfitReport; 2])> {
+    let misfits = misfits(study, outcome)?;
+    let [initial, updated] = misfits;
     // worse than the start over the whole band, not only at the fitted lines
-    let misfit_initial =
-        rfm_update::diagnose::log_misfit_with(study.system(), measured, HISTORY_LINES, gains, weights)?;
-    if misfit > WORSE_BY * misfit_initial && !outcome.worse_than_start {
+    if updated.misfit > WORSE_BY * initial.misfit && !outcome.worse_than_start {
         outcome.worse_than_start = true;
         outcome.warnings.push(format!(
-            "the update made the misfit over the band worse than the initial model's ({misfit_initial:.3e} -> \
-             {misfit:.3e}): the updated model is not an improvement"
+            "the update made the misfit over the band worse than the initial model's ({} -> {}): the updated \
+             model is not an improvement",
+            table::misfit(initial.misfit),
+            table::misfit(updated.misfit)
         ));
     }
-    Ok(fe_model::HistoryEntry {
+    let step = fe_model::HistoryEntry {
         step: format!("updated ({})", outcome.method),
-        misfit,
-        noise,
+        misfit: updated.misfit,
+        noise: updated.noise,
         ..fe_model::HistoryEntry::default()
-    })
+    };
+    Ok((step, misfits))
+}
+
+/// The initial and the updated model's misfits over the diagnosis's lines
+/// (the misfit the case's history speaks of), weighted as the diagnosis
+/// weighs them (the fit's line weights), against the one noise level read
+/// against the updated model.
+fn misfits(study: &Study, outcome: &UpdateOutcome) -> Result<[MisfitReport; 2]> {
+    let weights = study.line_weights(study.measured())?;
+    let (measured, weights) = (study.measured(), weights.as_deref());
+    let noise = quantities::noise(&outcome.system, measured, weights)?;
+    let gains = study.gains();
+    let misfit = quantities::misfit(&outcome.system, measured, gains, weights)?;
+    let misfit_initial = quantities::misfit(study.system(), measured, gains, weights)?;
+    let report_of = |m: f64| MisfitReport {
+        misfit: m,
+        noise,
+        times_noise: noise.map(|n| quantities::times_noise(m, n)),
+        lines: HISTORY_LINES.min(measured.n_freq()),
+        weighted: weights.is_some(),
+    };
+    Ok([report_of(misfit_initial), report_of(misfit)])
+}
+
+/// What `rfm update --json` prints and `results.json` holds for `outcome`
+/// (finished by [`finish_update`]) of `study`.
+pub fn update_json(study: &Study, outcome: &UpdateOutcome) -> Result<String> {
+    json_of(outcome, &misfits(study, outcome)?)
+}
+
+fn json_of(outcome: &UpdateOutcome, misfits: &[MisfitReport; 2]) -> Result<String> {
+    let doc = UpdateJson { misfit_initial: misfits[0], misfit: misfits[1], outcome };
+    Ok(serde_json::to_string_pretty(&doc)?)
 }
 
 /// Writes the outputs of `rfm update --out` and commits them; returns the
@@ -212,14 +247,22 @@ fn write_update(
     study: &Study,
     outcome: &UpdateOutcome,
     step: &fe_model::HistoryEntry,
+    misfits: &[MisfitReport; 2],
     mut output: Outputs,
     case: &Path,
     report: &crate::report::ReportOptions,
 ) -> Result<[PathBuf; 3]> {
-    let path = output.write("results.json", serde_json::to_string_pretty(&outcome)?.as_bytes())?;
+    let path = output.write("results.json", json_of(outcome, misfits)?.as_bytes())?;
     let updated = write_updated_model(study, outcome, step, &mut output)?;
-    let report =
-        crate::report::update_report::write(study, outcome, step, &mut output, case, &report.for_case(study.case()))?;
+    let report = crate::report::update_report::write(
+        study,
+        outcome,
+        step,
+        misfits,
+        &mut output,
+        case,
+        &report.for_case(study.case()),
+    )?;
     output.commit()?;
     Ok([path, updated, report])
 }
@@ -227,7 +270,8 @@ fn write_update(
 /// Writes what `rfm update --out DIR` writes for `outcome` (finished by
 /// [`finish_update`], which gave `step`) into `dir`, all or nothing:
 /// `results.json`, `updated.toml`, `report.html` and the figures. `case`
-/// is the case file's path as the report names it.
+/// is the case file's path as the report names it. A folder another
+/// command wrote is refused, as `rfm update` without `--replace` refuses it.
 pub fn save_update(
     study: &Study,
     outcome: &UpdateOutcome,
@@ -236,8 +280,31 @@ pub fn save_update(
     dir: &Path,
     report: &crate::report::ReportOptions,
 ) -> Result<[PathBuf; 3]> {
-    let output = Outputs::folder(dir, &study.case().inputs(), &UPDATE_OUTPUTS)?;
-    write_update(study, outcome, step, output, case, report)
+    let output = Outputs::folder(dir, &study.case().inputs(), &UPDATE_OUTPUTS)?.of_command("update", false)?;
+    write_update(study, outcome, step, &misfits(study, outcome)?, output, case, report)
+}
+
+/// What `--json` prints and `results.json` holds: the library's outcome
+/// with the initial and the updated model's misfits over the diagnosis's
+/// lines (the numbers the case's history and `rfm diagnose` give).
+#[derive(serde::Serialize)]
+struct UpdateJson<'a> {
+    /// The initial model's misfit and the noise.
+    misfit_initial: MisfitReport,
+    /// The updated model's misfit and the noise.
+    misfit: MisfitReport,
+    #[serde(flatten)]
+    outcome: &'a UpdateOutcome,
+}
+
+/// What the method minimises, as the iteration table names it: the
+/// output-error fit's residual is the misfit at the fitted lines, the
+/// RFM's a relative residual of its own.
+fn residual_name(method: Method) -> &'static str {
+    match method {
+        Method::Rfm => "RFM residual",
+        Method::OutputError => "fit residual",
+    }
 }
 
 /// Writes the case with the updated values as `DIR/updated.toml`.
@@ -260,12 +327,15 @@ pub fn updated_case(
     step: &fe_model::HistoryEntry,
 ) -> Result<fe_model::case::CaseEditor> {
     let values = rfm_update::params::quantity_values(study.parameters(), outcome.system.model());
-    let times = outcome.noise_ratio.map_or(String::new(), |r| format!(", {r:.2} times the noise"));
+    let times = step
+        .noise
+        .filter(|n| *n > 0.0)
+        .map_or(String::new(), |n| format!(", {} x the noise", table::times(quantities::times_noise(step.misfit, n))));
     let mut comment = format!(
-        "Updated by rfm ({}, status {}, misfit {:.3e}{times}) from {}",
+        "Updated by rfm ({}, status {}, misfit {}{times}, as the last [[history]] entry records it) from {}",
         outcome.method,
         outcome.status.name(),
-        outcome.residual,
+        table::misfit(step.misfit),
         study.case().path.display()
     );
     if outcome.worse_than_start {
@@ -291,18 +361,21 @@ pub fn updated_case(
 const WORSE_BY: f64 = 1.01;
 
 /// Lines of the misfit in the case history (as in `rfm diagnose`).
-const HISTORY_LINES: usize = 200;
+const HISTORY_LINES: usize = quantities::MISFIT_LINES;
 
-/// The misfit after each step of a case's history, in dB and as a multiple
-/// of the noise.
+/// The misfit after each step of a case's history, and as a multiple of
+/// the noise.
 fn print_history(history: &[fe_model::HistoryEntry]) -> Result<()> {
     if history.is_empty() {
         return Ok(());
     }
-    let mut t = Table::new(&["step", "misfit", "(dB)", "x noise"]);
+    let mut t = Table::new(&["step", "misfit", "x noise"]);
     for h in history {
-        let times = h.noise.filter(|&n| n > 0.0).map_or("-".to_string(), |n| format!("{:.1}", h.misfit / n));
-        t.row(vec![h.step.clone(), format!("{:.4e}", h.misfit), format!("{:.1}", db(h.misfit)), times]);
+        let times = h
+            .noise
+            .filter(|&n| n > 0.0)
+            .map_or("-".to_string(), |n| table::times(quantities::times_noise(h.misfit, n)));
+        t.row(vec![h.step.clone(), table::misfit(h.misfit), times]);
     }
     outln!("{}\n", t.render());
     Ok(())
@@ -313,28 +386,44 @@ fn print_history(history: &[fe_model::HistoryEntry]) -> Result<()> {
 fn noise_level(outcome: &UpdateOutcome, noise: f64) -> String {
     match outcome.noise_estimate {
         Some(plain) if plain != noise => format!(
-            "{noise:.3e} under the fit's {} weights, as its residual is (the data's, unweighted: {plain:.3e})",
-            if outcome.coherence_weighted { "coherence" } else { "line" }
+            "{} under the fit's {} weights, as its residual is (the data's, unweighted: {})",
+            table::misfit(noise),
+            if outcome.coherence_weighted { "coherence" } else { "line" },
+            table::misfit(plain)
         ),
-        _ => format!("estimated from the data {noise:.3e}"),
+        _ => format!("estimated from the data {}", table::misfit(noise)),
     }
 }
 
-fn print_outcome(outcome: &UpdateOutcome) -> Result<()> {
+fn print_outcome(outcome: &UpdateOutcome, method: Method, misfits: &[MisfitReport; 2]) -> Result<()> {
     let status = outcome.status.name();
     let first = outcome.history.first().map_or(f64::NAN, |r| r.residual);
     outln!(
-        "{status} after {} iterations; misfit {:.3e} -> {:.3e} ({:+.1} dB)\n",
+        "{status} after {} iterations; {} {} -> {} on the {} fitted lines",
         outcome.history.len().saturating_sub(1),
-        first,
-        outcome.residual,
-        db(outcome.residual) - db(first)
+        residual_name(method),
+        table::misfit(first),
+        table::misfit(outcome.residual),
+        outcome.frequencies_hz.len()
+    );
+    let [before, after] = misfits;
+    let times = match (before.times_noise, after.times_noise, after.noise) {
+        (Some(a), Some(b), Some(n)) => {
+            format!(" ({} -> {} x the noise, {})", table::times(a), table::times(b), table::misfit(n))
+        }
+        _ => String::new(),
+    };
+    outln!(
+        "misfit {} -> {}{times}, over the {} lines the diagnosis reads\n",
+        table::misfit(before.misfit),
+        table::misfit(after.misfit),
+        after.lines
     );
     outln!("{}: {}\n", outcome.status.name(), outcome.status.meaning());
     let unc = outcome.uncertainty.as_ref();
     let has_truth = outcome.parameters.iter().any(|p| p.truth.is_some());
     let has_paper = outcome.parameters.iter().any(|p| p.paper.is_some());
-    let mut header = vec!["parameter", "initial", "updated"];
+    let mut header = vec!["parameter", "unit", "initial", "updated"];
     if unc.is_some() {
         header.extend(["+-1 sd", "95 % interval"]);
     }
@@ -351,7 +440,8 @@ fn print_outcome(outcome: &UpdateOutcome) -> Result<()> {
     let mut t = Table::new(&header);
     for (i, p) in outcome.parameters.iter().enumerate() {
         let u = unc.map(|u| &u.parameters[i]);
-        let mut row = vec![p.name.clone(), num(p.initial), num(p.updated)];
+        let unit = crate::report::units::parameter_unit(&p.name);
+        let mut row = vec![p.name.clone(), unit.to_string(), num(p.initial), num(p.updated)];
         if let Some(u) = u {
             if u.relative_std > 10.0 {
                 row.push("unbounded".into());
@@ -400,7 +490,6 @@ fn print_outcome(outcome: &UpdateOutcome) -> Result<()> {
                 outln!("  - {n}");
             }
         }
-        outln!("\nresidual RMS per value {:.3e} (the noise level the fit leaves)", u.residual_rms);
     }
     if unc.is_none() {
         outln!(
@@ -409,22 +498,23 @@ fn print_outcome(outcome: &UpdateOutcome) -> Result<()> {
         );
     }
     if let (Some(noise), Some(ratio)) = (outcome.residual_noise, outcome.noise_ratio) {
+        let times = table::times(ratio);
         let reading = match outcome.status {
             _ if ratio <= rfm_update::verdict::NOISE_FACTOR => {
-                format!("the fit leaves {ratio:.2} times it: the model explains the data down to their noise")
+                format!("the fit residual is {times} times it: the model explains the data down to their noise")
             }
             Status::ModelInadequate => format!(
-                "the fit leaves {ratio:.1} times it at a minimum its restarts confirm: something the parameters cannot represent remains (try rfm diagnose on the updated case)"
+                "the fit residual is {times} times it at a minimum its restarts confirm: something the parameters cannot represent remains (try rfm diagnose on the updated case)"
             ),
             _ => format!(
-                "the fit leaves {ratio:.1} times it; it is not known to be the best fit ({})",
+                "the fit residual is {times} times it; it is not known to be the best fit ({})",
                 outcome.status.name()
             ),
         };
         outln!("\nnoise level {}: {reading}", noise_level(outcome, noise));
     }
     if !outcome.restarts.is_empty() {
-        let ends: Vec<String> = outcome.restarts.iter().map(|r| format!("{:.3e}", r.residual)).collect();
+        let ends: Vec<String> = outcome.restarts.iter().map(|r| table::misfit(r.residual)).collect();
         outln!(
             "restarts from {} spread starts (residual RMS where they ended: {})",
             outcome.restarts.len(),
@@ -437,8 +527,8 @@ fn print_outcome(outcome: &UpdateOutcome) -> Result<()> {
             outln!("  - {w}");
         }
     }
-    for g in &outcome.gains {
-        outln!("gain of {} {}: {:.4} at {:+.2} deg", g.key.noun(), g.key, g.magnitude, g.phase_deg);
+    for g in crate::report::gain_reports(&outcome.gains) {
+        outln!("fitted gain (per {}): {}", outcome.gains[0].key.noun(), crate::report::gain_text(&g));
     }
     let nf = &outcome.natural_frequencies_hz;
     if nf.kind == "none" {

@@ -6,7 +6,7 @@ use std::fs::{self, File};
 use std::path::Path;
 
 use super::leftovers::is_legacy_temporary;
-use super::{MANIFEST, OutputError, Outputs, find_input, io, split, sync_dir};
+use super::{COMMAND_LINE, MANIFEST, OutputError, Outputs, find_input, io, previous_run, split, sync_dir};
 
 impl Outputs {
     pub(super) fn swap_folder(&self) -> Result<(), OutputError> {
@@ -17,9 +17,7 @@ impl Outputs {
             .collect();
         let exists = self.target.is_dir();
         if exists {
-            let previous: Vec<OsString> = fs::read_to_string(self.target.join(MANIFEST))
-                .map(|t| t.lines().map(OsString::from).collect())
-                .unwrap_or_default();
+            let previous: Vec<OsString> = previous_run(&self.target).1.into_iter().map(OsString::from).collect();
             let entries = fs::read_dir(&self.target).map_err(io(&self.target, "list"))?;
             for entry in entries {
                 let entry = entry.map_err(io(&self.target, "list"))?;
@@ -44,6 +42,9 @@ impl Outputs {
         let mut manifest: Vec<String> = top.iter().map(|n| n.to_string_lossy().into_owned()).collect();
         manifest.sort();
         manifest.dedup();
+        if let Some(command) = self.command {
+            manifest.insert(0, format!("{COMMAND_LINE}{command}"));
+        }
         let listing = self.staging.join(MANIFEST);
         fs::write(&listing, manifest.join("\n") + "\n").map_err(io(&self.path(MANIFEST), "write"))?;
         File::open(&listing).and_then(|f| f.sync_all()).map_err(io(&self.path(MANIFEST), "write"))?;

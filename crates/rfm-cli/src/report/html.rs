@@ -116,6 +116,22 @@ impl Table {
     pub(crate) fn row_toned(&mut self, cells: Vec<(String, Tone)>) {
         self.rows.push(cells);
     }
+
+    /// The table as CSV (RFC 4180): the header, then every row, each cell
+    /// as the report shows it, quoted where it holds a comma, a quote or a
+    /// line break.
+    pub(crate) fn to_csv(&self) -> String {
+        let cell = |c: &str| {
+            if c.contains([',', '"', '\n', '\r']) { format!("\"{}\"", c.replace('"', "\"\"")) } else { c.to_string() }
+        };
+        let mut out = self.header.iter().map(|h| cell(h)).collect::<Vec<_>>().join(",");
+        out.push('\n');
+        for r in &self.rows {
+            out.push_str(&r.iter().map(|(c, _)| cell(c)).collect::<Vec<_>>().join(","));
+            out.push('\n');
+        }
+        out
+    }
 }
 
 /// An inline SVG figure.
@@ -200,7 +216,7 @@ p.table-caption + .scroll table { margin-top: 6px; }
 th, td { padding: 4px 9px; border-bottom: 1px solid var(--rule); }
 th { text-align: right; vertical-align: bottom; background: #eef0f4; font-weight: 600; min-width: 4.5em; }
 td { text-align: right; white-space: nowrap; }
-th:first-child, td:first-child { text-align: left; }
+th:first-child, td:first-child, th.text, td.text { text-align: left; }
 tbody tr:nth-child(even) { background: var(--zebra); }
 td.bad { background: var(--bad); color: var(--bad-ink); font-weight: 600; }
 td.good { background: var(--good); color: var(--good-ink); }
@@ -302,22 +318,39 @@ fn render_table(h: &mut String, t: &Table) {
     }
 }
 
+/// Whether a cell reads as a number (or is empty or a dash): numbers are
+/// right-aligned, a column of words left-aligned.
+fn numeric(c: &str) -> bool {
+    let c = c.trim().trim_end_matches('%').trim_end().replace(',', "");
+    let c = c.split_whitespace().next().unwrap_or("");
+    c.is_empty() || c == "-" || c.trim_start_matches(['+', 'x']).parse::<f64>().is_ok()
+}
+
 fn render_rows(h: &mut String, header: &[String], rows: &[Vec<(String, Tone)>]) {
+    // a column whose cells are not numbers is text, aligned to the left
+    let text: Vec<bool> =
+        (0..header.len()).map(|k| k > 0 && rows.iter().any(|r| r.get(k).is_some_and(|(c, _)| !numeric(c)))).collect();
     h.push_str("<div class=\"scroll\"><table>\n");
     h.push_str("<thead><tr>");
-    for c in header {
-        h.push_str(&format!("<th>{}</th>", escape(c)));
+    for (k, c) in header.iter().enumerate() {
+        let class = if text[k] { " class=\"text\"" } else { "" };
+        h.push_str(&format!("<th{class}>{}</th>", escape(c)));
     }
     h.push_str("</tr></thead>\n<tbody>\n");
     for r in rows {
         h.push_str("<tr>");
-        for (text, tone) in r {
-            let class = match tone {
-                Tone::Plain => "",
-                Tone::Bad => " class=\"bad\"",
-                Tone::Good => " class=\"good\"",
-            };
-            h.push_str(&format!("<td{class}>{}</td>", escape(text)));
+        for (k, (text_cell, tone)) in r.iter().enumerate() {
+            let mut classes: Vec<&str> = Vec::new();
+            match tone {
+                Tone::Plain => {}
+                Tone::Bad => classes.push("bad"),
+                Tone::Good => classes.push("good"),
+            }
+            if text.get(k).copied().unwrap_or(false) {
+                classes.push("text");
+            }
+            let class = if classes.is_empty() { String::new() } else { format!(" class=\"{}\"", classes.join(" ")) };
+            h.push_str(&format!("<td{class}>{}</td>", escape(text_cell)));
         }
         h.push_str("</tr>\n");
     }
@@ -349,6 +382,26 @@ mod tests {
         ));
         assert!(!html.contains("width=\"960\""));
         assert!(!html.contains("<script"));
+        // a column of words is left-aligned, one of numbers not
+        let mut t = Table::new(&["k", "effect", "dBIC"]);
+        t.row(vec!["1".into(), "joint at node 13".into(), "-56,161,045".into()]);
+        t.row(vec!["2".into(), "mass".into(), "-".into()]);
+        let mut r = Report::new("t");
+        let mut s = Section::new("one");
+        s.push(Block::Table(t));
+        r.sections.push(s);
+        let html = r.render();
+        assert!(html.contains("<th class=\"text\">effect</th><th>dBIC</th>"), "{html}");
+        assert!(html.contains("<td class=\"text\">joint at node 13</td><td>-56,161,045</td>"), "{html}");
+    }
+
+    /// Every row and cell, cells with commas or quotes quoted.
+    #[test]
+    fn tables_write_as_csv() {
+        let mut t = Table::new(&["effect", "dBIC"]);
+        t.row(vec!["joint at node 13, \"viscous\"".into(), "-56,161,045".into()]);
+        t.row(vec!["mass".into(), "-7.0".into()]);
+        assert_eq!(t.to_csv(), "effect,dBIC\n\"joint at node 13, \"\"viscous\"\"\",\"-56,161,045\"\nmass,-7.0\n");
     }
 
     #[test]

@@ -22,6 +22,7 @@ pub(crate) fn highlight_kind(kind: Option<EffectKind>, has_elements: bool) -> Hi
     match kind {
         Some(EffectKind::FlexibleSupport) => HighlightKind::Support,
         Some(EffectKind::LumpedMass) => HighlightKind::Mass,
+        Some(EffectKind::Resonator) => HighlightKind::Resonator,
         Some(
             EffectKind::StiffnessChange
             | EffectKind::MassChange
@@ -90,7 +91,7 @@ pub(crate) fn highlights(history: &[HistoryEntry], model: &Model) -> Vec<Highlig
             if nodes.is_empty() && elements.is_empty() {
                 label.push_str(" (no longer in the model)");
             }
-            Highlight { label, kind: highlight_kind(kind, !h.elements.is_empty()), nodes, elements }
+            Highlight { label, kind: highlight_kind(kind, !h.elements.is_empty()), nodes, elements, number: None }
         })
         .collect()
 }
@@ -135,7 +136,7 @@ pub(crate) fn fall_figure(history: &[HistoryEntry], this_run: bool, out: &mut Ou
         " The history records no noise level.".to_string()
     };
     let caption = format!(
-        "The misfit (RMS of ln(model / measured) per complex value, weighted as the fits weigh the lines) after \
+        "The misfit (RMS of |ln(model / measured)| per complex value, weighted as the fits weigh the lines) after \
          each step that led to this case, as its [[history]] records them (written by rfm diagnose --apply, rfm \
          fix and rfm update){}; added effects are numbered as on the structure.{band}",
         if this_run { ", and after this run" } else { "" }

@@ -2,17 +2,21 @@
 //! report ([`html`]), the report sections shared by `rfm compare`, `rfm update` and `rfm fix`
 //! (this module: the correlation, the overlays of every channel, the
 //! structure, the definitions), the modal comparison ([`modes`]), the
-//! update report ([`update_report`]) and the report of the loop
-//! ([`fix_report`]).
+//! update report ([`update_report`]), the report of a diagnosis
+//! ([`diagnose_report`]), the report of the loop ([`fix_report`]), and
+//! the data's findings and step 0 that the last two share ([`setup`]).
 //!
 //! Figures are drawn to strings and written through the run's
 //! [`Outputs`], all or nothing.
 
+pub(crate) mod diagnose_report;
 pub(crate) mod fix_report;
 pub(crate) mod html;
 pub(crate) mod loop_story;
 pub(crate) mod modes;
 pub(crate) mod plot;
+pub(crate) mod setup;
+pub(crate) mod units;
 pub(crate) mod update_report;
 
 use std::path::{Path, PathBuf};
@@ -21,21 +25,41 @@ use fe_model::{DofRef, Model};
 use frf::correlation::Correlation;
 use frf::{Channel, FrfSet};
 use plotters::style::RGBColor;
+use rfm_update::gain::GainReport;
+use rfm_update::quantities::MisfitReport;
 
 use plot::axes::FrequencyScale;
 use plot::structure::{Highlight, Sensors};
 
 use html::{Block, Figure, Section, Table, Tone};
+use units::DataUnits;
 
 use crate::output::Outputs;
 
 pub(crate) type Result<T> = crate::commands::Result<T>;
+
+use rfm_update::quantities;
+
+use crate::table;
 
 impl Outputs {
     /// Writes a figure as `name.svg` and returns it as a report block.
     pub(crate) fn figure(&mut self, name: &str, svg: String, caption: impl Into<String>) -> Result<Block> {
         self.write(&format!("{name}.svg"), svg.as_bytes())?;
         Ok(Block::Figure(Figure { svg, caption: caption.into() }))
+    }
+
+    /// Writes a table as `name.csv` beside the report (for a spreadsheet)
+    /// and returns it as a report block whose caption names the file.
+    pub(crate) fn table(&mut self, name: &str, mut table: Table) -> Result<Block> {
+        let file = format!("{name}.csv");
+        self.write(&file, table.to_csv().as_bytes())?;
+        let note = format!("(Also in {file}.)");
+        table.caption = Some(match table.caption.take() {
+            Some(c) => format!("{c} {note}"),
+            None => note,
+        });
+        Ok(Block::Table(table))
     }
 }
 
@@ -66,6 +90,38 @@ impl ReportOptions {
     }
 }
 
+/// The measured FRFs a report shows, in the kind they were measured in,
+/// with their unit and noise level.
+pub(crate) struct Data<'a> {
+    /// The FRFs as measured (accelerance per volt, say): every report of a
+    /// case draws and compares this one kind.
+    pub(crate) set: &'a FrfSet,
+    /// What their values are in.
+    pub(crate) units: DataUnits,
+    /// Their noise level ([`rfm_update::quantities::NOISE`]) without line
+    /// weights, as the errors the figures draw have none: for the noise
+    /// floors; `None` when it is not known.
+    pub(crate) noise: Option<f64>,
+}
+
+impl<'a> Data<'a> {
+    /// The data `set`, per volt at the references `per_volt`, with their
+    /// unweighted noise level.
+    pub(crate) fn new(set: &'a FrfSet, per_volt: &[fe_model::DofRef], noise: Option<f64>) -> Data<'a> {
+        Data { set, units: DataUnits::new(set.kind(), per_volt), noise }
+    }
+
+    /// The unit every channel shares (`m/s²/V`), or both.
+    pub(crate) fn unit(&self) -> String {
+        self.units.common(self.set.channels())
+    }
+
+    /// The data's quantity in words (`accelerance per volt`).
+    pub(crate) fn quantity(&self) -> String {
+        self.units.describe(self.set.channels())
+    }
+}
+
 /// One model's FRFs on the measured lines and their correlation with the
 /// measurement.
 pub(crate) struct ModelFrfs {
@@ -73,10 +129,43 @@ pub(crate) struct ModelFrfs {
     pub(crate) label: String,
     /// Colour in the figures.
     pub(crate) colour: RGBColor,
-    /// FRFs on the measured lines and channels.
+    /// FRFs on the measured lines and channels, times `gains`.
     pub(crate) frfs: FrfSet,
     /// Correlation with the measured FRFs.
     pub(crate) correlation: Correlation,
+    /// The gains the model's FRFs were multiplied by (empty without gains).
+    pub(crate) gains: Vec<GainReport>,
+    /// Its [`rfm_update::quantities::MISFIT`] and the noise, when known.
+    pub(crate) misfit: Option<MisfitReport>,
+}
+
+/// The gains an update estimated, as reports show gains.
+pub(crate) fn gain_reports(gains: &[rfm_update::output_error::Gain]) -> Vec<GainReport> {
+    gains
+        .iter()
+        .map(|g| GainReport {
+            key: g.key.to_string(),
+            magnitude: g.magnitude,
+            magnitude_db: 20.0 * g.magnitude.log10(),
+            phase_deg: g.phase_deg,
+        })
+        .collect()
+}
+
+/// A gain in one form for every output: `5:uy: x40.26 (+32.1 dB) at -37.0 deg`.
+pub(crate) fn gain_text(g: &GainReport) -> String {
+    format!(
+        "{}: x{} ({:+.1} dB) at {:+.1} deg",
+        g.key,
+        crate::table::digits(g.magnitude, 4),
+        g.magnitude_db,
+        g.phase_deg
+    )
+}
+
+/// The gains of a model in one phrase (empty without gains).
+pub(crate) fn gains_text(gains: &[GainReport]) -> String {
+    gains.iter().map(gain_text).collect::<Vec<_>>().join("; ")
 }
 
 /// A file-name-safe form of a channel: `H(31:uy,2:rz)` -> `frf-31uy-2rz`.
@@ -158,7 +247,7 @@ pub(crate) fn signed(v: f64, digits: usize) -> String {
 
 /// Percent with one decimal.
 pub(crate) fn percent(v: f64) -> String {
-    if v.is_finite() { format!("{:.1} %", 100.0 * v) } else { "-".into() }
+    if v.is_finite() { format!("{} %", table::fixed(100.0 * v, 1, false)) } else { "-".into() }
 }
 
 /// Below this complex-log misfit (about 0.4 dB or 3 degrees RMS) a channel
@@ -198,15 +287,17 @@ fn per_model_header(first: &[&str], per_model: &[&str], models: &[ModelFrfs]) ->
 }
 
 /// The FRF correlation section: totals per model, error against frequency,
-/// error per channel, the band table and the channel table. Figures are
-/// written through `out`; `notes` are paragraphs put first.
+/// error per channel, the band table and the channel table. Figures and
+/// tables (as CSV) are written through `out`; `notes` are paragraphs put
+/// first.
 pub(crate) fn correlation_section(
-    measured: &FrfSet,
+    data: &Data<'_>,
     models: &[ModelFrfs],
     opts: &ReportOptions,
     out: &mut Outputs,
     notes: Vec<String>,
 ) -> Result<Section> {
+    let measured = data.set;
     let mut s = Section::new("FRF correlation");
     for n in notes {
         s.push(Block::Text(n));
@@ -217,31 +308,44 @@ pub(crate) fn correlation_section(
     // totals, one column per model
     let mut header = vec!["measure"];
     header.extend(models.iter().map(|m| m.label.as_str()));
+    let with_misfit = models.iter().find_map(|m| m.misfit);
     let mut t = Table::new(&header).caption(format!(
-        "Over all {} channels and {} lines ({} to {} Hz), compared as {}.",
+        "The misfit over the {} lines the diagnosis reads{}; the other measures over all {} channels and {} lines \
+         ({} to {} Hz), compared as {}.",
+        with_misfit.map_or(quantities::MISFIT_LINES, |m| m.lines),
+        if with_misfit.is_some_and(|m| m.weighted) { ", each value weighted by its coherence" } else { "" },
         measured.channels().len(),
         measured.n_freq(),
         short(measured.frequencies_hz().first().copied().unwrap_or(0.0)),
         short(measured.frequencies_hz().last().copied().unwrap_or(0.0)),
-        measured.kind()
+        data.quantity()
     ));
-    type Measure = (&'static str, fn(&frf::correlation::Totals) -> String);
-    let rows: [Measure; 7] = [
-        ("RMS magnitude error (dB)", |t| sig(t.rms_db, 3)),
-        ("mean magnitude error (dB)", |t| signed(t.mean_db, 3)),
-        ("RMS phase error (deg)", |t| sig(t.rms_phase_deg, 3)),
-        ("mean FRAC", |t| format!("{:.4}", t.mean_frac)),
-        ("lowest FRAC", |t| format!("{:.4}", t.min_frac)),
-        ("complex-log misfit", |t| sig(t.log_misfit, 3)),
-        ("relative residual |A - X| / |X|", |t| sig(t.relative_residual, 3)),
-    ];
-    for (name, f) in rows {
-        let mut row = vec![name.to_string()];
-        row.extend(models.iter().map(|m| f(&m.correlation.total)));
+    let cell = |f: &dyn Fn(&ModelFrfs) -> String| models.iter().map(f).collect::<Vec<String>>();
+    let mut rows: Vec<(String, Vec<String>)> = Vec::new();
+    if with_misfit.is_some() {
+        rows.push(("misfit".into(), cell(&|m| m.misfit.map_or("-".into(), |r| table::misfit(r.misfit)))));
+        rows.push(("x noise".into(), cell(&|m| m.misfit.and_then(|r| r.times_noise).map_or("-".into(), table::times))));
+    }
+    rows.extend([
+        ("RMS dB error".to_string(), cell(&|m| sig(m.correlation.total.rms_db, 3))),
+        ("mean dB error".to_string(), cell(&|m| signed(m.correlation.total.mean_db, 3))),
+        ("RMS phase error (deg)".to_string(), cell(&|m| sig(m.correlation.total.rms_phase_deg, 3))),
+        ("mean FRAC".to_string(), cell(&|m| format!("{:.4}", m.correlation.total.mean_frac))),
+        ("lowest FRAC".to_string(), cell(&|m| format!("{:.4}", m.correlation.total.min_frac))),
+    ]);
+    if models.iter().any(|m| !m.gains.is_empty()) {
+        rows.push((
+            "gain applied".into(),
+            cell(&|m| if m.gains.is_empty() { "none".into() } else { gains_text(&m.gains) }),
+        ));
+    }
+    for (name, cells) in rows {
+        let mut row = vec![name];
+        row.extend(cells);
         t.row(row);
     }
     let excluded: usize = models.iter().map(|m| m.correlation.total.lines_excluded).sum();
-    s.push(Block::Table(t));
+    s.push(out.table("totals", t)?);
     if excluded > 0 {
         s.push(Block::Text(format!(
             "{excluded} (channel, line) values were left out because a value was zero or not finite."
@@ -253,15 +357,33 @@ pub(crate) fn correlation_section(
         .iter()
         .map(|m| plot::ErrorCurve { label: m.label.clone(), colour: m.colour, lines: &m.correlation.lines })
         .collect();
-    let svg =
-        plot::error_vs_frequency("Error against frequency (RMS over channels)", &curves, &bands, opts.frequency_scale)?;
+    let svg = plot::error_vs_frequency(
+        "Error against frequency (RMS over channels)",
+        &curves,
+        &bands,
+        opts.frequency_scale,
+        data.noise,
+    )?;
+    let floor = match data.noise {
+        Some(n) => format!(
+            " The dashed lines are the noise floor: the RMS errors the data's noise alone leaves, {1} dB and {2} \
+             deg (its level {0}, read over all lines without weights, as these errors are); a model whose curve lies \
+             on them is as good as the data allow.",
+            table::misfit(n),
+            sig(quantities::noise_floor_db(n), 2),
+            sig(quantities::noise_floor_deg(n), 2)
+        ),
+        None => String::new(),
+    };
     s.push(out.figure(
         "error-vs-frequency",
         svg,
-        "RMS over all channels of the magnitude error 20 log10(|model| / |measured|) and of the wrapped phase \
-         error at each line. Peaks near resonances mean a frequency shift (stiffness or mass) or a wrong peak \
-         height (damping); a raised level across a whole band points at a gain or a broad stiffness error. \
-         Shaded bands are numbered as in the band table.",
+        format!(
+            "RMS over all channels of the dB error 20 log10(|model| / |measured|) and of the phase error at each \
+             line. Peaks near resonances mean a frequency shift (stiffness or mass) or a wrong peak height \
+             (damping); a raised level across a whole band points at a gain or a broad stiffness error. Shaded \
+             bands are numbered as in the band table.{floor}"
+        ),
     )?);
 
     let names: Vec<String> = measured.channels().iter().map(|c| c.response.to_string()).collect();
@@ -278,20 +400,23 @@ pub(crate) fn correlation_section(
     s.push(out.figure(
         "channel-errors",
         svg,
-        "RMS magnitude error (bars) and FRAC (dots) per measured channel, labelled by response DOF, one colour \
-         per model. A single bad channel suggests a sensor problem (position, direction, calibration) or a local \
+        "RMS dB error (bars) and FRAC (dots) per measured channel, labelled by response DOF, one colour per \
+         model. A single bad channel suggests a sensor problem (position, direction, calibration) or a local \
          model error near it; FRAC near 1 with a large dB error means the right shape at the wrong level.",
     )?);
 
     // bands
     let worst_bands = notable_bands(&last.correlation, 3);
-    let header =
-        per_model_header(&["band", "range", "lines"], &["RMS dB", "mean dB", "RMS phase (deg)", "share"], models);
+    let header = per_model_header(
+        &["band", "range", "lines"],
+        &["RMS dB error", "mean dB error", "RMS phase error (deg)", "misfit", "share"],
+        models,
+    );
     let header_refs: Vec<&str> = header.iter().map(String::as_str).collect();
     let mut t = Table::new(&header_refs).caption(format!(
-        "Errors per frequency band over all channels; share is the band's part of the total squared \
-         complex-log error. Highlighted: the worst bands of the {} (at most three, only where the misfit \
-         exceeds {NOTABLE_MISFIT}).",
+        "Errors per frequency band over all channels and the band's lines; share is the band's part of the \
+         squared misfit of all lines. Highlighted: the worst bands of the {} (at most three, only where the \
+         misfit exceeds {NOTABLE_MISFIT}).",
         last.label
     ));
     for (i, b) in last.correlation.bands.iter().enumerate() {
@@ -310,19 +435,24 @@ pub(crate) fn correlation_section(
             row.push((sig(mb.rms_db, 3), tone));
             row.push((signed(mb.mean_db, 3), Tone::Plain));
             row.push((sig(mb.rms_phase_deg, 3), Tone::Plain));
+            row.push((table::misfit(mb.log_misfit), Tone::Plain));
             row.push((percent(mb.share), Tone::Plain));
         }
         t.row_toned(row);
     }
-    s.push(Block::Table(t));
+    s.push(out.table("bands", t)?);
 
     // channels
     let worst = notable_channels(&last.correlation, 3);
-    let header = per_model_header(&["channel"], &["RMS dB", "mean dB", "RMS phase (deg)", "FRAC", "share"], models);
+    let header = per_model_header(
+        &["channel"],
+        &["RMS dB error", "mean dB error", "RMS phase error (deg)", "FRAC", "misfit", "share"],
+        models,
+    );
     let header_refs: Vec<&str> = header.iter().map(String::as_str).collect();
     let mut t = Table::new(&header_refs).caption(format!(
-        "Errors per channel over all lines. Highlighted: the worst channels of the {} by complex-log \
-         misfit (at most three, only where it exceeds {NOTABLE_MISFIT}).",
+        "Errors per channel over all its lines. Highlighted: the worst channels of the {} by misfit (at most \
+         three, only where it exceeds {NOTABLE_MISFIT}).",
         last.label
     ));
     for (c, ch) in measured.channels().iter().enumerate() {
@@ -334,11 +464,12 @@ pub(crate) fn correlation_section(
             row.push((signed(mc.mean_db, 3), Tone::Plain));
             row.push((sig(mc.rms_phase_deg, 3), Tone::Plain));
             row.push((format!("{:.4}", mc.frac), Tone::Plain));
+            row.push((table::misfit(mc.log_misfit), Tone::Plain));
             row.push((percent(mc.share), Tone::Plain));
         }
         t.row_toned(row);
     }
-    s.push(Block::Table(t));
+    s.push(out.table("channels", t)?);
     Ok(s)
 }
 
@@ -349,21 +480,53 @@ const LARGE_OVERLAYS: usize = 2;
 /// small multiples from the worst to the best (by the last model's
 /// misfit), the updating lines as ticks on the frequency axis when given.
 pub(crate) fn overlay_section(
-    measured: &FrfSet,
+    data: &Data<'_>,
     models: &[ModelFrfs],
     ticks_hz: &[f64],
     opts: &ReportOptions,
     out: &mut Outputs,
 ) -> Result<Section> {
+    let measured = data.set;
     let mut s = Section::new("FRF overlays");
     let n = measured.channels().len();
+    let gains: Vec<String> = models
+        .iter()
+        .filter(|m| !m.gains.is_empty())
+        .map(|m| format!("the {} by {}", m.label, gains_text(&m.gains)))
+        .collect();
     s.push(Block::Text(format!(
         "Measured and model FRFs ({}) of all {n} channels, the driving point{} large first. Magnitude in dB \
          (20 log10 |H|, re 1 {}), phase in degrees drawn continuous: each model's phase at the turn nearest the \
-         measured one, so that the gap between the curves is the phase error.{}",
-        measured.kind(),
+         measured one, so that the gap between the curves is the phase error. The measurement is the wide grey \
+         line; a model that matches it runs along its middle.{}{}{}{}",
+        data.quantity(),
         if driving_points(measured, LARGE_OVERLAYS).len() > 1 { "s" } else { "" },
-        plot::unit(measured.kind()),
+        data.unit(),
+        if gains.is_empty() {
+            String::new()
+        } else {
+            format!(" The model FRFs are multiplied by their fitted gains: {}.", gains.join("; "))
+        },
+        if data.noise.is_some() && !models.is_empty() {
+            format!(
+                " The thin line under the curves is the residual |model - measured| of the {}, the dashed one \
+                 the noise floor (the data's noise level over all lines, {}, times |measured|): where the residual \
+                 lies on the floor the model is as good as the data allow.",
+                models.last().map_or("model", |m| m.label.as_str()),
+                data.noise.map_or("-".into(), table::misfit)
+            )
+        } else {
+            String::new()
+        },
+        if (0..n).any(|c| measured.coherence(c).is_some()) {
+            format!(
+                " Under the phase, the measured coherence, with the case's threshold ({}) dashed; lines below \
+                 it are shaded in every panel.",
+                opts.coherence_threshold
+            )
+        } else {
+            String::new()
+        },
         if ticks_hz.is_empty() { "" } else { " Ticks on the frequency axis mark the lines used for updating." }
     )));
     // every model's FRFs in the measured channels' order
@@ -381,7 +544,7 @@ pub(crate) fn overlay_section(
         title,
         curves: std::iter::once(plot::frf::FrfCurve {
             label: "measured".into(),
-            colour: plot::MEASURED,
+            colour: plot::MEASURED_FRF,
             values: measured.channel(c),
         })
         .chain(models.iter().zip(&columns).map(|(m, col)| plot::frf::FrfCurve {
@@ -398,7 +561,7 @@ pub(crate) fn overlay_section(
             .map(|m| {
                 let cc = &m.correlation.channels[c];
                 format!(
-                    "{}: RMS {} dB, {} deg, FRAC {:.3}",
+                    "{}: RMS dB error {}, RMS phase error {} deg, FRAC {:.3}",
                     m.label,
                     sig(cc.rms_db, 3),
                     sig(cc.rms_phase_deg, 3),
@@ -408,21 +571,22 @@ pub(crate) fn overlay_section(
             .collect::<Vec<_>>()
             .join("; ")
     };
-    let figure = |panels, title: String| plot::frf::FrfFigure {
+    let figure = |panels, title: String, unit: String| plot::frf::FrfFigure {
         title,
         frequencies_hz: measured.frequencies_hz(),
-        kind: measured.kind(),
+        unit,
         panels,
         ticks_hz,
         coherence_threshold: opts.coherence_threshold,
         scale: opts.frequency_scale,
+        noise: data.noise,
     };
 
     for c in driving_points(measured, LARGE_OVERLAYS) {
         let ch = measured.channels()[c];
         let title = format!("{ch}: response {} over excitation {}", ch.response, ch.reference);
-        let svg = plot::frf::frf_overlay(&figure(vec![panel(c, String::new())], title))?;
-        let caption = format!("{ch} (driving point). {}.", stats(c));
+        let svg = plot::frf::frf_overlay(&figure(vec![panel(c, String::new())], title, data.units.of(&ch)))?;
+        let caption = format!("{ch} (driving point), {}. {}.", data.units.describe(&[ch]), stats(c));
         s.push(out.figure(&channel_file_stem(ch), svg, caption)?);
     }
 
@@ -454,15 +618,18 @@ pub(crate) fn overlay_section(
                 ),
             )
         };
-        let svg = plot::frf::frf_multiples(&figure(panels, title))?;
+        let shown: Vec<Channel> = chunk.iter().map(|&c| measured.channels()[c]).collect();
+        let svg = plot::frf::frf_multiples(&figure(panels, title, data.units.common(&shown)))?;
         let last = models.last().map_or("model".into(), |m| m.label.clone());
         let caption = format!(
-            "Measured (black) and model FRFs of {} channels, ordered by the complex-log misfit of the {last}, the \
-             worst first; each panel's title gives its RMS magnitude error and FRAC. Every panel has its own \
-             magnitude scale.{}",
+            "Measured (wide grey) and model FRFs of {} channels, magnitude in dB re 1 {}, ordered by the misfit \
+             of the {last}, the worst first; each panel's title gives its RMS dB error and FRAC. Every panel has \
+             its own magnitude scale.{}",
             chunk.len(),
+            data.units.common(&shown),
             if chunk.iter().any(|&c| measured.coherence(c).is_some()) {
-                " Shading marks lines where the measured coherence is poor: the data are less certain there."
+                " Shading marks lines where the measured coherence is below the case's threshold, and the \
+                 coherence itself is drawn under the phase: the data are less certain there."
             } else {
                 ""
             }
@@ -470,6 +637,75 @@ pub(crate) fn overlay_section(
         s.push(out.figure(&name, svg, caption)?);
     }
     Ok(s)
+}
+
+/// The natural frequencies and damping ratios of each model's complex
+/// modes in the band `band_hz`, side by side (the k-th mode of each model
+/// in frequency order on row k), after those the modal estimate found in
+/// the data when given; a model too large for the dense modal analysis
+/// has its column say so.
+pub(crate) fn natural_frequency_table(
+    models: &[(String, &damping::DampedSystem)],
+    band_hz: (f64, f64),
+    measured: Option<&frf::ModalComparison>,
+) -> Table {
+    /// A column's modes, `(Hz, damping ratio)` in frequency order; `None`
+    /// where the modal analysis could not be made.
+    type Modes = Option<Vec<(f64, f64)>>;
+    let in_band = |f: f64| band_hz.0 <= f && f <= band_hz.1;
+    let mut columns: Vec<(String, Modes)> = Vec::new();
+    if let Some(c) = measured {
+        let mut m: Vec<(f64, f64)> = c.measured.iter().map(|m| (m.frequency_hz, m.damping_ratio)).collect();
+        m.sort_by(|a, b| a.0.total_cmp(&b.0));
+        columns.push(("measured".into(), Some(m)));
+    }
+    for (label, sys) in models {
+        let modes = damping::complex_modes(sys).ok().map(|m| {
+            let mut v: Vec<(f64, f64)> = m
+                .oscillatory
+                .iter()
+                .filter(|m| in_band(m.frequency_hz))
+                .map(|m| (m.frequency_hz, m.damping_ratio))
+                .collect();
+            v.sort_by(|a, b| a.0.total_cmp(&b.0));
+            v
+        });
+        columns.push((label.clone(), modes));
+    }
+    let mut header = vec!["mode".to_string()];
+    for (label, _) in &columns {
+        header.push(format!("{label} Hz"));
+        header.push(format!("{label} zeta %"));
+    }
+    let header_refs: Vec<&str> = header.iter().map(String::as_str).collect();
+    let rows = columns.iter().filter_map(|(_, m)| m.as_ref().map(Vec::len)).max().unwrap_or(0);
+    let too_large: Vec<&str> = columns.iter().filter(|(_, m)| m.is_none()).map(|(l, _)| l.as_str()).collect();
+    let mut t = Table::new(&header_refs).caption(format!(
+        "Natural frequencies and damping ratios of the complex modes in the band {} to {} Hz{}, each column in \
+         frequency order (row k: the k-th mode of each){}.",
+        short(band_hz.0),
+        short(band_hz.1),
+        if measured.is_some() { ", and the modes the modal estimate (LSCF) found in the data" } else { "" },
+        if too_large.is_empty() {
+            String::new()
+        } else {
+            format!("; not computed for {} (too large for the dense modal analysis)", too_large.join(", "))
+        }
+    ));
+    for k in 0..rows {
+        let mut row = vec![format!("{}", k + 1)];
+        for (_, m) in &columns {
+            match m.as_ref().and_then(|m| m.get(k)) {
+                Some(&(f, z)) => {
+                    row.push(format!("{f:.2}"));
+                    row.push(format!("{:.3}", 100.0 * z));
+                }
+                None => row.extend(["-".to_string(), "-".to_string()]),
+            }
+        }
+        t.row(row);
+    }
+    t
 }
 
 /// The distinct responses and references of a set's channels.
@@ -527,7 +763,7 @@ pub(crate) fn structure_figure(
     )?;
     let text = format!(
         "{caption} The structure to scale ({} nodes, {} beams): supports hatched, joints as hinges, springs as \
-         zigzags, masses as squares; green arrows at the {} measured responses in their direction, orange arrows at \
+         zigzags, masses as squares, a resonator as a square on a zigzag beside its node; green arrows at the {} measured responses in their direction, orange arrows at \
          the {} excitation point{}; node numbers where something is measured, supported or added.",
         model.nodes().len(),
         model.beams().len(),
@@ -538,36 +774,44 @@ pub(crate) fn structure_figure(
     out.figure("structure", svg, text)
 }
 
-/// A short section that says how to read the numbers.
+/// Heading of the glossary every report ends with.
+pub(crate) const GLOSSARY: &str = "How to read this report";
+
+/// The glossary every report ends with: each reported quantity under the
+/// name every output gives it, as [`rfm_update::quantities`] defines it,
+/// then the words the report's tables use.
 pub(crate) fn definitions_section() -> Section {
-    let mut s = Section::new("How to read this report");
-    s.push(Block::Facts(vec![
-        (
-            "magnitude error".into(),
-            "20 log10(|model| / |measured|) in dB, per line; positive when the model is too high. \
-             A constant 2x is 6.02 dB."
-                .into(),
-        ),
-        (
-            "phase error".into(),
-            "arg(model / measured) in degrees, wrapped to (-180, 180]; 90 means a quarter period late/early.".into(),
-        ),
-        (
-            "FRAC".into(),
-            "|sum conj(X) A|^2 / (sum |X|^2 sum |A|^2) per channel: 1 when the FRF shapes agree up to a \
-             constant factor; falls when peaks move or change shape."
-                .into(),
-        ),
-        (
-            "complex-log misfit".into(),
-            "RMS of |ln(A / X)|: magnitude (in nepers, 1 Np = 8.69 dB) and phase (in radians) errors together; \
-             0.1 is about 0.9 dB or 6 deg."
-                .into(),
-        ),
-        ("share".into(), "the part of the total squared complex-log misfit in a channel or band.".into()),
+    let mut s = Section::new(GLOSSARY);
+    s.push(Block::Text(
+        "Each number in this report, in the terminal, in the JSON files and in the documentation goes by one of \
+         these names and means the same in each."
+            .into(),
+    ));
+    let mut items: Vec<(String, String)> = rfm_update::quantities::GLOSSARY
+        .iter()
+        .map(|q| {
+            let name = if q.unit.is_empty() { q.name.to_string() } else { format!("{} ({})", q.name, q.unit) };
+            (name, q.definition.to_string())
+        })
+        .collect();
+    items.extend([
+        ("share".into(), "the part of the total squared misfit of all lines that a channel or band holds.".into()),
         (
             "bands".into(),
             "by default one band per measured resonance, edges halfway (geometrically) between neighbours.".into(),
+        ),
+        (
+            "gain".into(),
+            "data referenced to a voltage (per volt) or from an uncalibrated sensor carry an unknown complex \
+             factor: the model's FRFs are multiplied by the gain that fits them best before any comparison, and \
+             the report says where."
+                .into(),
+        ),
+        (
+            "LSCF".into(),
+            "the least-squares complex frequency method: the measured modes are the poles of rational fits of the \
+             FRFs at increasing model orders that stay put from one order to the next (the stabilisation diagram)."
+                .into(),
         ),
         (
             "symptoms".into(),
@@ -576,7 +820,8 @@ pub(crate) fn definitions_section() -> Section {
              uniform offset in one channel as a constant mean dB error (gain or calibration)."
                 .into(),
         ),
-    ]));
+    ]);
+    s.push(Block::Facts(items));
     s
 }
 

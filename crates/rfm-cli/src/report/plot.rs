@@ -39,9 +39,8 @@ use axes::*;
 use frame::*;
 use style::*;
 
-pub(crate) use axes::unit;
 pub(crate) use correlation::{ChannelSeries, ErrorCurve, channel_errors, error_vs_frequency};
 pub(crate) use frame::{LegendEntry, Mark, PlotError};
 pub(crate) use history::{ParameterTrace, convergence, parameter_history};
 pub(crate) use steps::misfit_steps;
-pub(crate) use style::{INITIAL, MEASURED, UPDATED};
+pub(crate) use style::{INITIAL, MEASURED, MEASURED_FRF, UPDATED};

@@ -9,22 +9,26 @@ use std::path::{Path, PathBuf};
 use frf::correlation::BandSpec;
 use rfm_update::comparison::{self, GainSource};
 use rfm_update::output_error::Gain;
+use rfm_update::quantities::MisfitReport;
 use rfm_update::status::Status;
 use rfm_update::study::FrequencyTable;
 use rfm_update::{Study, UpdateOutcome};
 
 use super::html::{Block, Report, Section, Table, Tone};
-use super::{ModelFrfs, ReportOptions, Result, loop_story, plot, sig};
+use super::units::parameter_unit;
+use super::{Data, ModelFrfs, ReportOptions, Result, gain_reports, gains_text, loop_story, plot, sig};
 use crate::output::Outputs;
-use crate::table::num;
+use crate::table::{self, num};
 
 /// Writes the report files of an updating run into the run's outputs and
 /// returns where `report.html` will be; `step` is this run's entry in the
-/// case's history (the updated model's misfit over the band).
+/// case's history (the updated model's misfit over the band), `misfits`
+/// the initial and the updated model's misfits with the noise.
 pub(crate) fn write(
     study: &Study,
     outcome: &UpdateOutcome,
     step: &fe_model::HistoryEntry,
+    misfits: &[MisfitReport; 2],
     out: &mut Outputs,
     case_path: &Path,
     opts: &ReportOptions,
@@ -33,12 +37,27 @@ pub(crate) fn write(
     // model's FRFs are converted to: what the overlays show
     let as_read = study.measured_as_read();
     let measured = &as_read;
+    let unweighted = if outcome.coherence_weighted || study.line_weights(measured)?.is_some() {
+        rfm_update::quantities::noise(&outcome.system, study.measured(), None)?
+    } else {
+        misfits[1].noise
+    };
+    let data = Data::new(measured, study.per_volt(), unweighted);
     let freqs = measured.frequencies_hz();
     // a model singular at a line (an RFM run that wandered off, an undamped
     // model on a resonance) is shown everywhere else, and the report says where
     let mut singular = Vec::new();
     let weights = study.line_weights(measured)?;
-    let mut model = |label: &str, colour, sys: &damping::DampedSystem, gains: GainSource<'_>| -> Result<ModelFrfs> {
+    let mut model = |label: &str,
+                     colour,
+                     sys: &damping::DampedSystem,
+                     gains: GainSource<'_>,
+                     misfit: MisfitReport|
+     -> Result<ModelFrfs> {
+        let estimated = match gains {
+            GainSource::Estimated(g) => gain_reports(g),
+            _ => Vec::new(),
+        };
         let compared = comparison::compare(sys, measured, gains, &BandSpec::Auto)?;
         if !compared.model.singular_hz.is_empty() {
             singular.push(format!(
@@ -47,7 +66,15 @@ pub(crate) fn write(
                 compared.model.singular_hz.iter().map(|&f| super::short(f)).collect::<Vec<_>>().join(", ")
             ));
         }
-        Ok(ModelFrfs { label: label.into(), colour, frfs: compared.model.frfs, correlation: compared.correlation })
+        let gains = compared.model.fitted.as_ref().map_or(estimated, |f| f.reports());
+        Ok(ModelFrfs {
+            label: label.into(),
+            colour,
+            frfs: compared.model.frfs,
+            correlation: compared.correlation,
+            gains,
+            misfit: Some(misfit),
+        })
     };
     // the initial model with the gains that fit it best, when the study
     // fits gains: without them it would sit the data's unknown level (tens
@@ -57,30 +84,29 @@ pub(crate) fn write(
     } else {
         GainSource::Fit { setting: study.gains(), weights: weights.as_deref() }
     };
-    let (initial_label, updated_label) = if outcome.gains.is_empty() {
-        ("initial model", "updated model")
-    } else {
-        ("initial model (with the gains that fit it)", "updated model (with fitted gains)")
-    };
     let models = [
-        model(initial_label, plot::INITIAL, study.system(), initial_gains)?,
-        model(updated_label, plot::UPDATED, &outcome.system, GainSource::Estimated(&outcome.gains))?,
+        model("initial model", plot::INITIAL, study.system(), initial_gains, misfits[0])?,
+        model("updated model", plot::UPDATED, &outcome.system, GainSource::Estimated(&outcome.gains), misfits[1])?,
     ];
-    let (all_lines_db, stride) = rfm_update::history::rms_db_per_iteration(study, outcome, measured);
+    // each iterate with the gains that fit it, the last with those the
+    // update estimated: the ends are the summary's initial and updated model
+    let (all_lines_db, stride) = rfm_update::history::rms_db_per_iteration_with_gains(study, outcome, measured);
     let mut which_lines = if stride == 1 {
         "all measured lines".to_string()
     } else {
         format!("every {stride}th measured line (thinned to keep the report quick on a large model)")
     };
     if !outcome.gains.is_empty() {
-        // the history records parameter values only, not the gains of each step
-        which_lines.push_str(", without the fitted gains");
+        which_lines.push_str(
+            ", each iterate times the gains that fit it best and the last (the updated model) times those the \
+             update estimated",
+        );
     }
 
     let mut report = Report::new(format!("{}: model updating", study.case().model.title));
     report.subtitle =
         Some(format!("rfm update, {} method, case file {}", method_name(&outcome.method), case_path.display()));
-    let mut first = summary(study, outcome, &models);
+    let mut first = summary(study, outcome, &data, &models);
     for text in singular {
         first.push(Block::Text(text));
     }
@@ -115,9 +141,10 @@ pub(crate) fn write(
         "convergence",
         plot::convergence(residual_label, &residuals, Some(&all_lines_db))?,
         format!(
-            "Top: the updating method's own misfit, {residual_text}, per iteration (iteration 0 is the initial \
-             model). Bottom: the RMS magnitude error of the model at each iteration over {which_lines} and all \
-             channels, which shows whether fitting the updating lines improved the whole band."
+            "Top: {residual_text}, per iteration (iteration 0 is the initial model). Bottom: the RMS dB error of \
+             the model at each iteration over {which_lines} and all channels, which shows whether fitting the \
+             updating lines improved the whole band; its first and last points are the summary's RMS dB error of \
+             the initial and the updated model."
         ),
     )?);
     let traces: Vec<plot::ParameterTrace> = outcome
@@ -136,7 +163,7 @@ pub(crate) fn write(
         "Each parameter divided by its initial value, per iteration (logarithmic axis). A parameter that \
          wanders far or keeps changing after the misfit has levelled off is poorly determined by the data.",
     )?);
-    conv.push(Block::Table(iteration_table(outcome, &all_lines_db)));
+    conv.push(out.table("iterations", iteration_table(outcome, &all_lines_db))?);
     report.sections.push(conv);
 
     let (params, csv) = parameter_table(outcome);
@@ -162,14 +189,16 @@ pub(crate) fn write(
     if !outcome.gains.is_empty() {
         // one setting per run: every gain is of a reference, or of a channel
         let per = outcome.gains[0].key.noun();
-        let mut t = Table::new(&[per, "gain magnitude", "gain phase (deg)"])
-            .caption(format!("Fitted gain per {per} (the model FRFs are multiplied by it before comparison)."));
-        for g in &outcome.gains {
-            t.row(vec![g.key.to_string(), sig(g.magnitude, 4), sig(g.phase_deg, 3)]);
+        let mut t = Table::new(&[per, "gain magnitude", "gain (dB)", "gain phase (deg)"]).caption(format!(
+            "Fitted gain per {per}, estimated with the parameters: the updated model's FRFs are multiplied by it \
+             before every comparison and figure of this report."
+        ));
+        for g in gain_reports(&outcome.gains) {
+            t.row(vec![g.key.clone(), sig(g.magnitude, 4), format!("{:+.1}", g.magnitude_db), sig(g.phase_deg, 3)]);
         }
-        ps.push(Block::Table(t));
+        ps.push(out.table("gains", t)?);
     }
-    ps.push(Block::Table(frequency_table(outcome)));
+    ps.push(out.table("natural-frequencies", frequency_table(outcome))?);
     report.sections.push(ps);
 
     let notes = vec![format!(
@@ -178,19 +207,28 @@ pub(crate) fn write(
         freqs.len(),
         outcome.frequencies_hz.len()
     )];
-    report.sections.push(super::correlation_section(measured, &models, opts, out, notes)?);
+    report.sections.push(super::correlation_section(&data, &models, opts, out, notes)?);
     let gains: Vec<_> = measured.channels().iter().map(|c| Gain::factor_of(&outcome.gains, c)).collect();
     let comparison =
         comparison::compare_modes(&outcome.system, measured, &gains, super::modes::MIN_MAC).map_err(|e| e.to_string());
-    report.sections.push(super::modes::section(
+    let mut modes = super::modes::section(
         comparison.as_ref(),
         "the updated model",
         outcome.system.model(),
         measured,
+        misfits[1].consistent(),
         opts,
         out,
-    )?);
-    report.sections.push(super::overlay_section(measured, &models, &outcome.frequencies_hz, opts, out)?);
+    )?;
+    let band = (freqs.first().copied().unwrap_or(0.0), freqs.last().copied().unwrap_or(0.0));
+    let table = super::natural_frequency_table(
+        &[("initial".to_string(), study.system()), ("updated".to_string(), &outcome.system)],
+        band,
+        comparison.as_ref().ok(),
+    );
+    modes.push(out.table("modes-before-after", table)?);
+    report.sections.push(modes);
+    report.sections.push(super::overlay_section(&data, &models, &outcome.frequencies_hz, opts, out)?);
     report.sections.push(super::definitions_section());
     Ok(out.write("report.html", report.render().as_bytes())?)
 }
@@ -202,11 +240,19 @@ fn method_name(m: &str) -> String {
     }
 }
 
-/// Axis label and caption wording of a method's own misfit.
+/// Axis label and caption wording of a method's own residual.
 fn residual_names(method: &str) -> (&'static str, &'static str) {
     match method {
-        "rfm" => ("Relative residual", "the RMS of the relative residual |R_FE - R_EX| / |R_EX| at the updating lines"),
-        _ => ("RMS weighted residual", "the RMS of the weighted residual at the fitted lines"),
+        "rfm" => (
+            "RFM residual",
+            "the RFM residual, the RMS of the relative differences |R_FE - R_EX| / |R_EX| at the updating lines \
+             (what the response function method minimises)",
+        ),
+        _ => (
+            "fit residual",
+            "the fit residual, the misfit at the fitted lines weighted as the fit weighs them (what the \
+             output-error fit minimises)",
+        ),
     }
 }
 
@@ -214,9 +260,9 @@ fn status_text(s: &Status) -> String {
     s.describe()
 }
 
-fn summary(study: &Study, outcome: &UpdateOutcome, models: &[ModelFrfs; 2]) -> Section {
+fn summary(study: &Study, outcome: &UpdateOutcome, data: &Data<'_>, models: &[ModelFrfs; 2]) -> Section {
     let (a, b) = (&models[0].correlation, &models[1].correlation);
-    let measured = &study.measured_as_read();
+    let measured = data.set;
     let f = measured.frequencies_hz();
     let source = match (&study.case().measurement.as_ref().and_then(|m| m.data.clone()), &study.case().truth) {
         (Some(path), _) => format!("measured file {}", super::shown_path(path)),
@@ -233,35 +279,70 @@ fn summary(study: &Study, outcome: &UpdateOutcome, models: &[ModelFrfs; 2]) -> S
     let iterations = outcome.history.last().map_or(0, |r| r.iteration);
     let first = outcome.history.first().map_or(f64::NAN, |r| r.residual);
     let mut s = Section::new("Summary");
-    s.push(Block::Facts(vec![
+    let (residual_label, _) = residual_names(&outcome.method);
+    let misfit = match (models[0].misfit, models[1].misfit) {
+        (Some(m0), Some(m1)) => {
+            let times = match (m0.times_noise, m1.times_noise, m1.noise) {
+                (Some(t0), Some(t1), Some(n)) => {
+                    format!(" ({} -> {} x the noise, {})", table::times(t0), table::times(t1), table::misfit(n))
+                }
+                _ => String::new(),
+            };
+            format!(
+                "{} -> {}{times}, over the {} lines the diagnosis reads",
+                table::misfit(m0.misfit),
+                table::misfit(m1.misfit),
+                m1.lines
+            )
+        }
+        _ => "-".into(),
+    };
+    let mut facts = vec![
         ("case".into(), study.case().path.display().to_string()),
         ("data".into(), source),
         (
             "measurement".into(),
             format!(
-                "{} channels x {} lines, {} to {} Hz, {}",
+                "{} channels x {} lines, {} to {} Hz, {} ({})",
                 measured.channels().len(),
                 f.len(),
                 super::short(f.first().copied().unwrap_or(0.0)),
                 super::short(f.last().copied().unwrap_or(0.0)),
-                measured.kind()
+                data.quantity(),
+                data.unit()
             ),
         ),
         ("method".into(), method_name(&outcome.method)),
-        ("parameters".into(), outcome.parameters.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join(", ")),
+        (
+            "parameters".into(),
+            outcome
+                .parameters
+                .iter()
+                .map(|p| match parameter_unit(&p.name) {
+                    "" | "-" => p.name.clone(),
+                    unit => format!("{} ({unit})", p.name),
+                })
+                .collect::<Vec<_>>()
+                .join(", "),
+        ),
         ("updating lines".into(), lines_summary(&outcome.frequencies_hz)),
         ("status".into(), format!("{} after {iterations} iterations", status_text(&outcome.status))),
-        ("residual at updating lines".into(), format!("{} -> {}", sig(first, 3), sig(outcome.residual, 3))),
+        ("misfit".into(), misfit),
         (
-            "RMS magnitude error, all lines".into(),
-            format!("{} dB -> {} dB", sig(a.total.rms_db, 3), sig(b.total.rms_db, 3)),
+            format!("{residual_label} at the updating lines"),
+            format!("{} -> {}", table::misfit(first), table::misfit(outcome.residual)),
         ),
+        ("RMS dB error, all lines".into(), format!("{} dB -> {} dB", sig(a.total.rms_db, 3), sig(b.total.rms_db, 3))),
         (
             "RMS phase error, all lines".into(),
             format!("{} deg -> {} deg", sig(a.total.rms_phase_deg, 3), sig(b.total.rms_phase_deg, 3)),
         ),
         ("mean FRAC".into(), format!("{:.4} -> {:.4}", a.total.mean_frac, b.total.mean_frac)),
-    ]));
+    ];
+    if !models[1].gains.is_empty() {
+        facts.push(("fitted gain".into(), gains_text(&models[1].gains)));
+    }
+    s.push(Block::Facts(facts));
     if outcome.frequencies_hz.len() > 12 {
         s.push(Block::Details {
             summary: format!("The {} updating lines (Hz)", outcome.frequencies_hz.len()),
@@ -307,20 +388,24 @@ fn lines_summary(f: &[f64]) -> String {
 }
 
 fn iteration_table(outcome: &UpdateOutcome, all_lines_db: &[f64]) -> Table {
+    let residual = format!("{} at the updating lines", residual_names(&outcome.method).0);
     let mut t = Table::new(&[
         "iteration",
-        "residual at updating lines",
+        &residual,
         "max |du/u| of the step",
         "limited",
         "rank",
         "damping lambda",
-        "RMS dB over the band",
+        "RMS dB error over the band",
     ])
-    .caption("The iteration history (each row is the model after the step that led to it).");
+    .caption(
+        "The iteration history (each row is the model after the step that led to it); the RMS dB error as the \
+         convergence figure's lower panel draws it.",
+    );
     for (r, db) in outcome.history.iter().zip(all_lines_db) {
         t.row(vec![
             r.iteration.to_string(),
-            sig(r.residual, 4),
+            table::misfit(r.residual),
             sig(r.max_correction, 3),
             r.limited.to_string(),
             r.rank.to_string(),
@@ -336,7 +421,7 @@ fn parameter_table(outcome: &UpdateOutcome) -> (Table, String) {
     let has_truth = outcome.parameters.iter().any(|p| p.truth.is_some());
     let has_paper = outcome.parameters.iter().any(|p| p.paper.is_some());
     let unc = outcome.uncertainty.as_ref();
-    let mut header = vec!["parameter", "initial", "updated", "updated / initial"];
+    let mut header = vec!["parameter", "unit", "initial", "updated", "updated / initial"];
     if unc.is_some() {
         header.extend(["std (%)", "95 % interval", "determined"]);
     }
@@ -353,7 +438,7 @@ fn parameter_table(outcome: &UpdateOutcome) -> (Table, String) {
         "Parameter values before and after updating."
     });
     // the CSV has one value per cell and plain names
-    let mut csv_header = vec!["parameter", "initial", "updated", "updated/initial"];
+    let mut csv_header = vec!["parameter", "unit", "initial", "updated", "updated/initial"];
     if unc.is_some() {
         csv_header.extend(["relative_std", "interval95_low", "interval95_high", "well_determined"]);
     }
@@ -368,12 +453,14 @@ fn parameter_table(outcome: &UpdateOutcome) -> (Table, String) {
     for p in &outcome.parameters {
         let mut row = vec![
             (p.name.clone(), Tone::Plain),
+            (parameter_unit(&p.name).to_string(), Tone::Plain),
             (num(p.initial), Tone::Plain),
             (num(p.updated), Tone::Plain),
             (sig(p.updated / p.initial, 4), Tone::Plain),
         ];
         let mut line = vec![
             p.name.clone(),
+            parameter_unit(&p.name).to_string(),
             format!("{:e}", p.initial),
             format!("{:e}", p.updated),
             format!("{:e}", p.updated / p.initial),

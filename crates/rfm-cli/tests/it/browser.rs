@@ -19,7 +19,8 @@ use serde_json::{Value, json};
 use tungstenite::{Message, WebSocket};
 
 use super::fixtures::{
-    clamp_update, svg_files, text, tutorial_applied_update, tutorial_compare, tutorial_fix, tutorial_update,
+    clamp_update, lap_compare, lap_fix, lap_update, svg_files, text, tutorial_applied_update, tutorial_compare,
+    tutorial_diagnose_report, tutorial_fix, tutorial_update,
 };
 
 /// The Chromium binary: `RFM_CHROMIUM`, else the first of the usual names on `PATH`.
@@ -250,6 +251,57 @@ fn check_report(b: &mut Browser, dir: &Path, what: &str) -> Vec<String> {
     page["headings"].as_array().expect("headings").iter().map(|h| h.as_str().unwrap_or("").to_string()).collect()
 }
 
+/// What a loaded report shows a reader: its text (every text node, tables,
+/// captions and the text of its figures, each apart), the terms its
+/// glossary defines, and the y-axis labels of its FRF figures.
+struct Shown {
+    text: String,
+    glossary: Vec<String>,
+    axes: Vec<String>,
+}
+
+fn shown(b: &mut Browser, dir: &Path) -> Shown {
+    // the report itself (a check of its figures leaves the last one loaded)
+    let loaded = b.load(&dir.join("report.html"));
+    assert!(loaded.errors.is_empty(), "{}: {:?}", dir.display(), loaded.errors);
+    let page = b.eval(
+        "JSON.stringify({ text: (() => { const w = document.createTreeWalker(document.body, NodeFilter.SHOW_TEXT); \
+         const out = []; while (w.nextNode()) out.push(w.currentNode.textContent); return out.join(' '); })(), \
+         glossary: [...document.querySelectorAll('section')].filter(s => s.querySelector('h2')?.textContent === \
+         'How to read this report').flatMap(s => [...s.querySelectorAll('dt')].map(d => d.textContent)), \
+         axes: [...document.querySelectorAll('svg text')].map(t => t.textContent.trim()).filter(t => t.startsWith('Magnitude')) })",
+    );
+    let list = |v: &Value| {
+        v.as_array().map_or(Vec::new(), |a| a.iter().filter_map(|x| x.as_str().map(String::from)).collect())
+    };
+    Shown {
+        text: page["text"].as_str().unwrap_or("").to_string(),
+        glossary: list(&page["glossary"]),
+        axes: list(&page["axes"]),
+    }
+}
+
+/// Every report ends with the glossary of every reported quantity, under
+/// the names the tool gives them, and prints no raw number of seven digits
+/// or more (a dBIC of -56161044.7 reads as -56,161,045).
+fn check_glossary_and_numbers(s: &Shown, what: &str) {
+    for q in rfm_update::quantities::GLOSSARY {
+        assert!(
+            s.glossary.iter().any(|g| g.starts_with(q.name)),
+            "{what}: the glossary lacks {}: {:?}",
+            q.name,
+            s.glossary
+        );
+    }
+    // whole numbers only: the fraction of a small value may hold zeros (0.00429208)
+    let mut digits = 0;
+    for part in s.text.split(|c: char| !c.is_ascii_digit() && c != '.') {
+        let whole = part.split('.').next().unwrap_or("");
+        digits = digits.max(whole.len());
+    }
+    assert!(digits < 7, "{what}: a number of {digits} digits is printed unformatted");
+}
+
 #[test]
 fn every_report_kind_loads_offline_in_chromium_without_console_errors() {
     let Some(exe) = chromium() else {
@@ -283,7 +335,12 @@ fn every_report_kind_loads_offline_in_chromium_without_console_errors() {
         assert!(headings.iter().any(|x| x == h), "compare lacks {h}: {headings:?}");
     }
     let headings = check_report(&mut b, &fix.dir, "the fix report");
-    for h in ["The fall of the misfit", "Modes", "FRF overlays"] {
+    for h in [
+        "The misfit after each step",
+        "Before the model was blamed: the data and the case's own parameters",
+        "Modes",
+        "FRF overlays",
+    ] {
         assert!(headings.iter().any(|x| x == h), "fix lacks {h}: {headings:?}");
     }
     // a stalled update (the clamp), a converged one (the walkthrough's) and
@@ -301,5 +358,61 @@ fn every_report_kind_loads_offline_in_chromium_without_console_errors() {
         for h in ["Summary", "Convergence", "Parameters", "Modes", "FRF overlays"] {
             assert!(headings.iter().any(|x| x == h), "{what} lacks {h}: {headings:?}");
         }
+        check_glossary_and_numbers(&shown(&mut b, dir), what);
+    }
+    let diagnosis = tutorial_diagnose_report();
+    assert!(diagnosis.output.status.success(), "{}", text(&diagnosis.output.stderr));
+    let headings = check_report(&mut b, &diagnosis.dir, "the diagnosis report");
+    for h in ["Summary", "The ranking", "FRF correlation", "FRF overlays"] {
+        assert!(headings.iter().any(|x| x == h), "the diagnosis report lacks {h}: {headings:?}");
+    }
+    let s = shown(&mut b, &diagnosis.dir);
+    check_glossary_and_numbers(&s, "the diagnosis report");
+    assert!(s.text.contains("1: flexible, lossy joint at node 13"), "the leader is not marked on the structure");
+    let s = shown(&mut b, &fix.dir);
+    check_glossary_and_numbers(&s, "the fix report");
+    assert!(
+        s.text.contains("Natural frequencies and damping ratios")
+            && s.text.contains("nominal Hz")
+            && s.text.contains("step 1 Hz"),
+        "the fix report has no natural frequencies before and after the step"
+    );
+    // the loop's story as the terminal tells it: each step's dBIC, why it
+    // stopped, and the data checked before the model was blamed
+    for said in ["dBIC of the step", "-56,161,045", "stopped", "nothing significant remains", "none found"] {
+        assert!(s.text.contains(said), "the fix report does not say {said}");
+    }
+    assert!(text(&fix.output.stdout).contains("dBIC of the step"), "{}", text(&fix.output.stdout));
+}
+
+/// The lap-joint tutorial is measured as accelerance per volt, with an
+/// amplifier's gain: its compare, update and fix reports all draw and label
+/// the data as measured, in m/s²/V, and show the gain the model's FRFs were
+/// multiplied by; none draws them as receptance or per newton.
+#[test]
+fn reports_of_data_per_volt_are_labelled_per_volt_with_their_gain() {
+    let Some(exe) = chromium() else {
+        eprintln!(
+            "skipped: no Chromium found (install chromium or set RFM_CHROMIUM to check the reports in a browser)"
+        );
+        return;
+    };
+    let reports = [
+        (lap_compare(), "the lap-joint compare report"),
+        (lap_update(), "the lap-joint update report"),
+        (lap_fix(), "the lap-joint fix report"),
+    ];
+    let mut b = Browser::launch(&exe);
+    for (w, what) in reports {
+        assert!(w.dir.join("report.html").exists(), "{what}: {}", text(&w.output.stderr));
+        check_report(&mut b, &w.dir, what);
+        let s = shown(&mut b, &w.dir);
+        check_glossary_and_numbers(&s, what);
+        assert!(!s.axes.is_empty() && s.axes.iter().all(|a| a == "Magnitude (dB re 1 m/s²/V)"), "{what}: {:?}", s.axes);
+        for wrong in ["m/N", "m/s²/N", "receptance"] {
+            assert!(!s.text.contains(wrong), "{what} says {wrong}");
+        }
+        assert!(s.text.contains("accelerance per volt"), "{what} does not name the data's quantity");
+        assert!(s.text.contains("gain applied") && s.text.contains("5:uy: x4"), "{what} does not show the gain");
     }
 }

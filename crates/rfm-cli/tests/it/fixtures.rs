@@ -114,6 +114,47 @@ pub(crate) fn tutorial_applied_compare() -> &'static Written {
     W.get_or_init(|| write_case("tutorial-applied-compare", "compare", tutorial_applied(), &[]))
 }
 
+/// `rfm compare` of the lap-joint tutorial (accelerance per volt, a fitted gain).
+pub(crate) fn lap_compare() -> &'static Written {
+    static W: OnceLock<Written> = OnceLock::new();
+    W.get_or_init(|| write("lap-compare", "compare", "tutorial/lap-joint", &[]))
+}
+
+/// `rfm fix` of the lap-joint tutorial.
+pub(crate) fn lap_fix() -> &'static Written {
+    static W: OnceLock<Written> = OnceLock::new();
+    W.get_or_init(|| write("lap-fix", "fix", "tutorial/lap-joint", &[]))
+}
+
+/// `rfm update` of the lap-joint tutorial with the diagnosis's leader (the
+/// lap) added by `rfm diagnose --apply 1`: data per volt, its gain
+/// estimated with the parameters.
+pub(crate) fn lap_update() -> &'static Written {
+    static W: OnceLock<Written> = OnceLock::new();
+    W.get_or_init(|| {
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("reports");
+        std::fs::create_dir_all(&dir).expect("the reports folder");
+        let applied = dir.join("lap-with-joint.toml");
+        let _ = std::fs::remove_file(&applied);
+        let case = case("tutorial/lap-joint");
+        let out = rfm(&["diagnose", case.to_str().unwrap(), "--apply", "1", "--out", applied.to_str().unwrap()]);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        write_case("lap-update", "update", &applied, &[])
+    })
+}
+
+/// `rfm diagnose --report` of the tutorial.
+pub(crate) fn tutorial_diagnose_report() -> &'static Written {
+    static W: OnceLock<Written> = OnceLock::new();
+    W.get_or_init(|| {
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("reports").join("tutorial-diagnose");
+        let _ = std::fs::remove_dir_all(&dir);
+        let case = case("tutorial/l-frame");
+        let output = rfm(&["diagnose", case.to_str().unwrap(), "--report", dir.to_str().unwrap()]);
+        Written { dir, output }
+    })
+}
+
 /// `rfm update` of the flexible-clamp cantilever (it stalls short of the
 /// tolerance, exit code 5, and writes its report all the same).
 pub(crate) fn clamp_update() -> &'static Written {

@@ -3,7 +3,9 @@
 mod browser;
 mod catalogue;
 mod commands;
+mod consistency;
 mod diagnose;
+mod docs;
 mod fixtures;
 mod gains;
 mod imported;

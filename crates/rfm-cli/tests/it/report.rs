@@ -157,7 +157,7 @@ fn update_out_writes_figures_parameters_and_a_self_contained_report() {
     assert!(text(&out.stdout).contains("report.html"), "{}", text(&out.stdout));
 
     let d = w.dir.as_path();
-    check_svg(&d.join("convergence.svg"), &["Iteration", "Relative residual", "RMS error over the band (dB)"]);
+    check_svg(&d.join("convergence.svg"), &["Iteration", "RFM residual", "RMS dB error over the band"]);
     let params =
         check_svg(&d.join("parameters.svg"), &["Value / initial value", "spring.clamp_r.kr", "group.clamp_x.alpha"]);
     check_svg(&d.join("error-vs-frequency.svg"), &["Frequency (Hz", "RMS phase error (deg)", "initial model"]);
@@ -200,11 +200,11 @@ fn update_out_writes_figures_parameters_and_a_self_contained_report() {
     let csv = read(&d.join("parameters.csv"));
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines.len(), params_json.len() + 1);
-    assert!(lines[0].starts_with("parameter,initial,updated"));
+    assert!(lines[0].starts_with("parameter,unit,initial,updated"));
     for (line, p) in lines[1..].iter().zip(params_json) {
         let cells: Vec<&str> = line.split(',').collect();
         assert_eq!(cells[0], p["name"].as_str().unwrap());
-        let updated: f64 = cells[2].parse().unwrap();
+        let updated: f64 = cells[3].parse().unwrap();
         let expect = p["updated"].as_f64().unwrap();
         assert!(((updated - expect) / expect).abs() < 1e-12, "{line}");
         assert!(html.contains(&format!("<td>{}</td>", cells[0])));
@@ -255,8 +255,8 @@ fn an_output_error_report_shows_the_uncertainty_of_each_parameter() {
     }
     let html = read(&dir.path().join("report.html"));
     check_self_contained(&html);
-    assert!(html.contains("<th>95 % interval</th>") && html.contains("<th>determined</th>"));
-    check_svg(&dir.path().join("convergence.svg"), &["RMS weighted residual"]);
+    assert!(html.contains(">95 % interval</th>") && html.contains(">determined</th>"));
+    check_svg(&dir.path().join("convergence.svg"), &["fit residual"]);
 }
 
 #[test]
@@ -337,7 +337,7 @@ fn compare_reads_a_measured_file_and_writes_a_report_with_given_bands() {
     assert_eq!(bands.iter().map(|b| b["lines"].as_u64().unwrap()).sum::<u64>(), 1000);
     assert_eq!(json["correlation"]["channels"].as_array().unwrap().len(), 5);
 
-    check_svg(&report_dir.join("error-vs-frequency.svg"), &["RMS magnitude error (dB)"]);
+    check_svg(&report_dir.join("error-vs-frequency.svg"), &["RMS dB error"]);
     check_figure(&report_dir.join("channel-errors.svg"), &["Channel (response DOF)"]);
     check_svg(&report_dir.join("frf-7uy-7uy.svg"), &["measured", "model", "Phase (deg)"]);
     let html = read(&report_dir.join("report.html"));
@@ -456,7 +456,7 @@ fn the_tutorial_compare_report_shows_every_channel_the_modes_and_the_structure()
         check_figure(&d.join("stabilisation.svg"), &["Model order", "identified mode", "stable (and participation)"]);
     assert!(stab.matches(&format!("fill=\"{}\"", hex(0, 114, 178))).count() >= 5 * measured, "columns of stable poles");
     let shapes = check_figure(&d.join("mode-shapes.svg"), &["undeformed", "model", "measured"]);
-    assert_eq!(shapes.matches("\nMode ").count(), pairs, "one panel per pair");
+    assert_eq!(shapes.matches("\nMeasured mode ").count(), pairs, "one panel per pair");
 
     let structure = check_figure(&d.join("structure.svg"), &["measured response", "excitation"]);
     // an arrowhead per measured response (8 translations) and one for the excitation
@@ -503,7 +503,7 @@ fn the_tutorial_fix_report_marks_the_added_joint_where_it_sits() {
     let html = read(&d.join("report.html"));
     check_self_contained(&html);
     assert_eq!(html.matches("<svg").count(), svg_files(d).len());
-    for heading in ["The fall of the misfit", "Modes", "FRF overlays"] {
+    for heading in ["The misfit after each step", "Modes", "FRF overlays"] {
         assert!(html.contains(&format!("<h2>{heading}</h2>")), "report.html lacks the section {heading}");
     }
 }

@@ -89,7 +89,7 @@ const CALIBRATION_SE: f64 = 5.0;
 /// Options of the checks.
 #[derive(Clone, Debug)]
 pub struct CheckOptions {
-    /// Lines read ([`informative_lines`] of the data, as the diagnosis).
+    /// Lines read ([`informative_lines`](crate::diagnose::informative_lines) of the data, as the diagnosis).
     pub lines: usize,
     /// The gains every fit of the case fits.
     pub gains: Gains,

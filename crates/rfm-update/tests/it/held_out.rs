@@ -132,12 +132,22 @@ fn run(truth: &Truth, seed: u64, opts: &FixOptions) -> Trial {
     }
     let measured = data.to_receptance();
     let mut first: Option<Ranked> = None;
-    let outcome = fix(&case, &measured, opts, |p| {
-        if let rfm_update::fix::FixProgress::Diagnosed { step: 0, diagnosis } = p {
-            first = diagnosis.leader().cloned();
+    // every finished step as the loop hands it out, to keep (rfm fix writes
+    // each one as it comes, so that an interrupted loop keeps them)
+    let mut done: Vec<(usize, String)> = Vec::new();
+    let outcome = fix(&case, &measured, opts, |p| match p {
+        rfm_update::fix::FixProgress::Diagnosed { step: 0, diagnosis } => first = diagnosis.leader().cloned(),
+        rfm_update::fix::FixProgress::StepDone { index, done: step } => {
+            done.push((index, step.case.text_at(&case.path).expect("the step's case")));
         }
+        _ => {}
     })
     .expect("the loop runs");
+    // each step of the outcome was handed out once, in order, as it is in the outcome
+    assert_eq!(done.iter().map(|d| d.0).collect::<Vec<_>>(), (0..outcome.steps.len()).collect::<Vec<_>>());
+    for ((_, text), step) in done.iter().zip(&outcome.steps) {
+        assert_eq!(text, &step.case.text_at(&case.path).expect("the step's case"), "{}", truth.label);
+    }
     let model = &case.model;
     // the loop's first effect (it may look one step ahead past the first
     // diagnosis's leader), else what the first diagnosis recommended

@@ -10,8 +10,6 @@
 
 use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, Ranged};
 
-use ::frf::FrfKind;
-
 use super::C64;
 
 /// How the frequency axis of a figure is scaled.
@@ -313,14 +311,6 @@ pub(super) fn segments(x: &[f64], y: &[f64], wrap: Option<f64>) -> Vec<Vec<(f64,
         out.push(current);
     }
     out
-}
-
-pub(crate) fn unit(kind: FrfKind) -> &'static str {
-    match kind {
-        FrfKind::Receptance => "m/N",
-        FrfKind::Mobility => "m/s/N",
-        FrfKind::Accelerance => "m/s\u{b2}/N",
-    }
 }
 
 /// A logarithmic axis with ticks on whole decades for wide ranges and on

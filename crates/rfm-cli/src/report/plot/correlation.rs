@@ -5,7 +5,13 @@ use ::frf::correlation::{Band, LineError};
 use plotters::prelude::*;
 
 use super::axes::{self, FreqAxis};
-use super::{BAND_SHADE, FONT, HouseStyle, LegendEntry, Mark, PlotError, frame, range, segments, svg, tick};
+use super::{
+    BAND_SHADE, Dash, FONT, HouseStyle, LegendEntry, Look, Mark, PlotError, draw_line, frame, range, segments, svg,
+    tick,
+};
+
+/// Colour of the noise floor.
+const NOISE_FLOOR: RGBColor = RGBColor(0, 128, 64);
 
 /// One model's error per line, for [`error_vs_frequency`].
 pub(crate) struct ErrorCurve<'a> {
@@ -18,22 +24,44 @@ pub(crate) struct ErrorCurve<'a> {
 }
 
 /// RMS (over channels) dB and phase errors against frequency, one curve
-/// per model, bands shaded alternately and numbered as in the band table.
+/// per model, bands shaded alternately and numbered as in the band table;
+/// with the data's noise level, the RMS errors that noise alone leaves
+/// (the noise floor, [`rfm_update::quantities::noise_floor_db`]) as dashed
+/// lines: a model whose curve lies on them is as good as the data allow.
 pub(crate) fn error_vs_frequency(
     title: &str,
     curves: &[ErrorCurve<'_>],
     bands: &[Band],
     scale: axes::FrequencyScale,
+    noise: Option<f64>,
 ) -> Result<String, PlotError> {
     let f: Vec<f64> = curves.first().map(|c| c.lines.iter().map(|l| l.frequency_hz).collect()).unwrap_or_default();
     let axis = FreqAxis::new(&f, scale);
     let (f0, f1) = axis.ends();
     // lines a logarithmic axis cannot show (0 Hz) are left out of the curves
     let f: Vec<f64> = f.iter().map(|&x| if axis.shows(x) { x } else { f64::NAN }).collect();
-    let db_max = range(curves.iter().flat_map(|c| c.lines.iter().map(|l| l.rms_db)), (0.0, 1.0)).1.max(1e-3);
-    let ph_max = range(curves.iter().flat_map(|c| c.lines.iter().map(|l| l.rms_phase_deg)), (0.0, 1.0)).1.max(1e-3);
+    let floor = noise
+        .filter(|n| *n > 0.0)
+        .map(|n| (rfm_update::quantities::noise_floor_db(n), rfm_update::quantities::noise_floor_deg(n)));
+    let db_max =
+        range(curves.iter().flat_map(|c| c.lines.iter().map(|l| l.rms_db)).chain(floor.map(|f| 2.0 * f.0)), (0.0, 1.0))
+            .1
+            .max(1e-3);
+    let ph_max = range(
+        curves.iter().flat_map(|c| c.lines.iter().map(|l| l.rms_phase_deg)).chain(floor.map(|f| 2.0 * f.1)),
+        (0.0, 1.0),
+    )
+    .1
+    .max(1e-3);
     let mut legend: Vec<LegendEntry> =
         curves.iter().map(|c| LegendEntry::new(c.label.clone(), c.colour, Mark::Line(2))).collect();
+    if floor.is_some() {
+        legend.push(LegendEntry::new(
+            "noise floor (what the noise alone leaves)",
+            NOISE_FLOOR,
+            Mark::Styled(1, Dash::Dashed),
+        ));
+    }
     if bands.len() > 1 {
         legend.push(LegendEntry::new("bands (numbered as in the table)", BAND_SHADE, Mark::Shade));
     }
@@ -64,7 +92,7 @@ pub(crate) fn error_vs_frequency(
                 }
             }
             let mut mesh = chart.configure_mesh();
-            mesh.y_desc(if panel == 0 { "RMS magnitude error (dB)" } else { "RMS phase error (deg)" })
+            mesh.y_desc(if panel == 0 { "RMS dB error" } else { "RMS phase error (deg)" })
                 .house_style(13, 15)
                 .x_labels(12)
                 .x_label_formatter(&x_label)
@@ -92,6 +120,10 @@ pub(crate) fn error_vs_frequency(
                         )))?;
                     }
                 }
+            }
+            if let Some((db, deg)) = floor {
+                let y = if panel == 0 { db } else { deg };
+                draw_line(&mut chart, vec![(f0, y), (f1, y)], Look { colour: NOISE_FLOOR, dash: Dash::Dashed }, 1)?;
             }
             for c in curves.iter().rev() {
                 let y: Vec<f64> = c.lines.iter().map(|l| if panel == 0 { l.rms_db } else { l.rms_phase_deg }).collect();
@@ -202,7 +234,7 @@ mod tests {
             })
             .collect();
         let curves = [ErrorCurve { label: "model".into(), colour: UPDATED, lines: &lines }];
-        let svg = error_vs_frequency("errors", &curves, &[], axes::FrequencyScale::Linear).unwrap();
+        let svg = error_vs_frequency("errors", &curves, &[], axes::FrequencyScale::Linear, None).unwrap();
         let drawn = polylines(&svg, "stroke-width=\"2\"");
         // dB and phase
         assert_eq!(drawn.iter().filter(|l| l.len() > 2).count(), 2);

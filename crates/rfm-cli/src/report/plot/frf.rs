@@ -6,18 +6,22 @@
 //! The measurement is drawn first and thick, the models thin on top of it,
 //! so that a model that matches shows as a coloured line inside the black
 //! one. The lines used for updating are ticks on the frequency axis (marks
-//! on the curve would bury it), lines of poor coherence are shaded, and the
-//! phase is drawn continuous ([`super::axes::phases`]). Curves and shades
-//! of more lines than pixel columns are thinned to what draws them
+//! on the curve would bury it), lines of poor coherence are shaded and the
+//! coherence itself drawn as a trace under the phase, the last model's
+//! residual `|model - measured|` is drawn beside the noise floor (the
+//! data's noise level times the measured magnitude), and the phase is
+//! drawn continuous ([`super::axes::phases`]). Curves and shades of more
+//! lines than pixel columns are thinned to what draws them
 //! ([`super::decimate`]).
 
-use frf::{C64, FrfKind};
+use frf::C64;
 use plotters::prelude::*;
 
 use super::axes::{FreqAxis, FrequencyScale, PhaseAxis, phases};
 use super::decimate::{per_pixel_column, spans_per_pixel};
 use super::{
-    Area, DrawResult, FONT, HouseStyle, LegendEntry, MEASURED, Mark, PlotError, frame, range, segments, svg, tick, unit,
+    Area, Dash, DrawResult, FONT, HouseStyle, LegendEntry, Look, MEASURED, Mark, PlotError, draw_line, frame, range,
+    segments, svg, tick,
 };
 
 /// Shade of lines whose coherence is below the case's threshold
@@ -28,6 +32,13 @@ const COHERENCE_DARK: RGBColor = RGBColor(246, 190, 160);
 /// Below this coherence a line is shaded darker (and below the case's
 /// threshold, when that is lower).
 pub(crate) const COHERENCE_POOR: f64 = 0.5;
+
+/// Colour of the coherence trace and its threshold.
+const COHERENCE_TRACE: RGBColor = RGBColor(190, 80, 20);
+/// Colour of the last model's residual `|model - measured|`.
+const RESIDUAL: RGBColor = RGBColor(136, 34, 85);
+/// Colour of the noise floor (the noise level times the measured magnitude).
+const NOISE_FLOOR: RGBColor = RGBColor(0, 128, 64);
 
 /// Panels of [`frf_multiples`] per row.
 pub(crate) const COLUMNS: usize = 2;
@@ -60,8 +71,8 @@ pub(crate) struct FrfFigure<'a> {
     pub(crate) title: String,
     /// Lines (Hz).
     pub(crate) frequencies_hz: &'a [f64],
-    /// What the values relate (sets the unit).
-    pub(crate) kind: FrfKind,
+    /// The unit of the values (`m/s²/V`): the magnitude is in dB re 1 of it.
+    pub(crate) unit: String,
     /// One panel per channel; every panel has the same curve labels.
     pub(crate) panels: Vec<FrfPanel<'a>>,
     /// Lines to tick on the frequency axis (the updating lines), Hz.
@@ -71,15 +82,34 @@ pub(crate) struct FrfFigure<'a> {
     pub(crate) coherence_threshold: f64,
     /// Frequency axis scale.
     pub(crate) scale: FrequencyScale,
+    /// The data's noise level (relative, RMS per value): with it, each
+    /// panel with a model draws the last model's residual `|model -
+    /// measured|` and the noise floor `noise |measured|` under the curves.
+    pub(crate) noise: Option<f64>,
 }
 
-/// The first curve (the measurement) is drawn thicker, under the others.
+/// The first curve (the measurement) is drawn wide and pale, under the
+/// others, so that a model that matches it shows as a coloured line along
+/// its middle instead of vanishing into it.
 fn width_of(i: usize, compact: bool) -> u32 {
     match (i, compact) {
-        (0, false) => 3,
-        (0, true) => 2,
-        _ => 1,
+        (0, false) => 5,
+        (0, true) => 4,
+        (_, false) => 2,
+        (_, true) => 1,
     }
+}
+
+/// The residual of the last model against the measurement and the noise
+/// floor, in dB (NaN where either is zero or not finite); `None` without a
+/// model or a noise level.
+fn residual_and_floor(panel: &FrfPanel<'_>, noise: Option<f64>) -> Option<(Vec<f64>, Vec<f64>)> {
+    let noise = noise.filter(|n| *n > 0.0)?;
+    let (measured, last) = (panel.curves.first()?, panel.curves.get(1..)?.last()?);
+    let db = |v: f64| if v > 0.0 && v.is_finite() { 20.0 * v.log10() } else { f64::NAN };
+    let residual = measured.values.iter().zip(last.values).map(|(x, a)| db((a - x).norm())).collect();
+    let floor = measured.values.iter().map(|x| db(noise * x.norm())).collect();
+    Some((residual, floor))
 }
 
 /// Coherence level of a line: 0 fair, 1 below the case's `threshold`, 2
@@ -128,8 +158,16 @@ fn legend(fig: &FrfFigure<'_>, axis: &FreqAxis, compact: bool) -> Vec<LegendEntr
             .map(|(i, c)| LegendEntry::new(c.label.clone(), c.colour, Mark::Line(width_of(i, compact))))
             .collect()
     });
+    if fig.panels.iter().any(|p| residual_and_floor(p, fig.noise).is_some()) {
+        let last = fig.panels.first().and_then(|p| p.curves.last()).map_or(String::new(), |c| c.label.clone());
+        legend.push(LegendEntry::new(format!("residual |model - measured| ({last})"), RESIDUAL, Mark::Line(1)));
+        legend.push(LegendEntry::new("noise floor (noise x |measured|)", NOISE_FLOOR, Mark::Styled(1, Dash::Dashed)));
+    }
     if fig.ticks_hz.iter().any(|&t| axis.shows(t)) {
         legend.push(LegendEntry::new("updating lines (ticks on the axis)", MEASURED, Mark::Tick));
+    }
+    if fig.panels.iter().any(|p| p.coherence.is_some()) {
+        legend.push(LegendEntry::new("coherence (panel below the phase)", COHERENCE_TRACE, Mark::Line(1)));
     }
     let threshold = fig.coherence_threshold;
     let levels: Vec<u8> = fig
@@ -160,10 +198,13 @@ struct Style {
 const LARGE: Style = Style { compact: false, label: 13, desc: 15, y_area: 72, x_labels: 12 };
 const SMALL: Style = Style { compact: true, label: 11, desc: 12, y_area: 54, x_labels: 7 };
 
-/// Draws one channel's magnitude into `top` and phase into `bottom`.
+/// Draws one channel's magnitude into `top`, its phase into `bottom` and,
+/// when given an area and the data carry it, its coherence into
+/// `coherence` (which then carries the frequency labels).
 fn draw_channel(
     top: &Area<'_>,
     bottom: &Area<'_>,
+    coherence: Option<&Area<'_>>,
     fig: &FrfFigure<'_>,
     panel: &FrfPanel<'_>,
     axis: FreqAxis,
@@ -184,13 +225,19 @@ fn draw_channel(
     let phase: Vec<Vec<f64>> = reference.into_iter().chain(others).collect();
     let visible =
         |v: &[f64]| -> Vec<f64> { v.iter().zip(&shown).filter(|(_, x)| x.is_finite()).map(|(y, _)| *y).collect() };
-    let (y0, y1) = range(db.iter().flat_map(|c| visible(c)), (-100.0, 0.0));
+    let floors = residual_and_floor(panel, fig.noise);
+    let (y0, y1) = range(
+        db.iter()
+            .flat_map(|c| visible(c))
+            .chain(floors.iter().flat_map(|(r, n)| visible(r).into_iter().chain(visible(n)))),
+        (-100.0, 0.0),
+    );
     let (y0, y1) = ((y0 / 10.0).floor() * 10.0, (y1 / 10.0).ceil() * 10.0);
     let phase_axis = PhaseAxis::over(phase.iter().flat_map(|c| visible(c)));
     let spans = panel.coherence.map(|c| coherence_spans(f, c, fig.coherence_threshold, &axis)).unwrap_or_default();
     let shade = |level: u8| if level == 2 { COHERENCE_DARK } else { COHERENCE_SHADE };
     let x_label = |v: &f64| axis.label(v);
-    let y_desc = if style.compact { "dB".to_string() } else { format!("Magnitude (dB re 1 {})", unit(fig.kind)) };
+    let y_desc = if style.compact { "dB".to_string() } else { format!("Magnitude (dB re 1 {})", fig.unit) };
 
     let mut chart = ChartBuilder::on(top)
         .margin_left(if style.compact { 6 } else { 12 })
@@ -215,6 +262,18 @@ fn draw_channel(
         mesh.x_label_formatter(&blank);
     }
     mesh.draw()?;
+    // the residual and the noise floor under the curves: where the residual
+    // sits on the floor, the model is as good as the data allow
+    if let Some((residual, floor)) = &floors {
+        for seg in segments(&shown, residual, None) {
+            let seg = per_pixel_column(&seg, |p| chart.backend_coord(p));
+            chart.draw_series(LineSeries::new(seg, RESIDUAL.stroke_width(1)))?;
+        }
+        for seg in segments(&shown, floor, None) {
+            let seg = per_pixel_column(&seg, |p| chart.backend_coord(p));
+            draw_line(&mut chart, seg, Look { colour: NOISE_FLOOR, dash: Dash::Dashed }, 1)?;
+        }
+    }
     for (i, c) in panel.curves.iter().enumerate() {
         let line = c.colour.stroke_width(width_of(i, style.compact));
         for seg in segments(&shown, &db[i], None) {
@@ -236,27 +295,33 @@ fn draw_channel(
         ticks.iter().map(|&t| PathElement::new(vec![(t, y0), (t, y0 + tick_height)], MEASURED.stroke_width(1))),
     )?;
 
+    // the panel at the bottom carries the frequency labels
+    let trace = coherence.zip(panel.coherence);
+    let labelled = if style.compact { 34 } else { 44 };
     let mut chart = ChartBuilder::on(bottom)
         .margin_left(if style.compact { 6 } else { 12 })
         .margin_right(if style.compact { 12 } else { 24 })
         .margin_top(if style.compact { 4 } else { 8 })
-        .x_label_area_size(if style.compact { 34 } else { 44 })
+        .x_label_area_size(if trace.is_some() { 4 } else { labelled })
         .y_label_area_size(style.y_area)
         .build_cartesian_2d(axis, phase_axis)?;
     let drawn = spans_per_pixel(&spans, |x| chart.backend_coord(&(x, phase_axis.lo)).0);
     chart.draw_series(
         drawn.iter().map(|&(a, b, l)| Rectangle::new([(a, phase_axis.lo), (b, phase_axis.hi)], shade(l).filled())),
     )?;
-    chart
-        .configure_mesh()
-        .x_desc(axis.describe())
-        .y_desc(if style.compact { "deg" } else { "Phase (deg)" })
+    let mut mesh = chart.configure_mesh();
+    mesh.y_desc(if style.compact { "deg" } else { "Phase (deg)" })
         .x_label_formatter(&x_label)
         .y_label_formatter(&tick)
         .house_style(style.label, style.desc)
         .x_labels(style.x_labels)
-        .y_labels(if style.compact { 4 } else { 9 })
-        .draw()?;
+        .y_labels(if style.compact { 4 } else { 9 });
+    if trace.is_some() {
+        mesh.x_label_formatter(&blank);
+    } else {
+        mesh.x_desc(axis.describe());
+    }
+    mesh.draw()?;
     for (i, c) in panel.curves.iter().enumerate() {
         let line = c.colour.stroke_width(width_of(i, style.compact));
         // a jump of more than half a turn is a model crossing the measured
@@ -266,6 +331,51 @@ fn draw_channel(
             chart.draw_series(LineSeries::new(seg, line))?;
         }
     }
+    if let Some((area, values)) = trace {
+        draw_coherence(area, fig, values, &spans, axis, style)?;
+    }
+    Ok(())
+}
+
+/// The coherence of one channel from 0 to 1 against frequency, the case's
+/// threshold dashed, the poor lines shaded as in the panels above.
+fn draw_coherence(
+    area: &Area<'_>,
+    fig: &FrfFigure<'_>,
+    values: &[f64],
+    spans: &[(f64, f64, u8)],
+    axis: FreqAxis,
+    style: &Style,
+) -> DrawResult {
+    let shown: Vec<f64> = fig.frequencies_hz.iter().map(|&x| if axis.shows(x) { x } else { f64::NAN }).collect();
+    let x_label = |v: &f64| axis.label(v);
+    let mut chart = ChartBuilder::on(area)
+        .margin_left(if style.compact { 6 } else { 12 })
+        .margin_right(if style.compact { 12 } else { 24 })
+        .margin_top(4)
+        .x_label_area_size(if style.compact { 34 } else { 44 })
+        .y_label_area_size(style.y_area)
+        .build_cartesian_2d(axis, 0.0..1.05)?;
+    let drawn = spans_per_pixel(spans, |x| chart.backend_coord(&(x, 0.0)).0);
+    let shade = |level: u8| if level == 2 { COHERENCE_DARK } else { COHERENCE_SHADE };
+    chart.draw_series(drawn.iter().map(|&(a, b, l)| Rectangle::new([(a, 0.0), (b, 1.05)], shade(l).filled())))?;
+    chart
+        .configure_mesh()
+        .x_desc(axis.describe())
+        .y_desc(if style.compact { "coh." } else { "Coherence" })
+        .x_label_formatter(&x_label)
+        .y_label_formatter(&tick)
+        .house_style(style.label, style.desc)
+        .x_labels(style.x_labels)
+        .y_labels(3)
+        .draw()?;
+    let (f0, f1) = axis.ends();
+    let t = fig.coherence_threshold;
+    draw_line(&mut chart, vec![(f0, t), (f1, t)], Look { colour: COHERENCE_TRACE, dash: Dash::Dashed }, 1)?;
+    for seg in segments(&shown, values, None) {
+        let seg = per_pixel_column(&seg, |p| chart.backend_coord(p));
+        chart.draw_series(LineSeries::new(seg, COHERENCE_TRACE.stroke_width(1)))?;
+    }
     Ok(())
 }
 
@@ -273,14 +383,21 @@ fn draw_channel(
 pub(crate) fn frf_overlay(fig: &FrfFigure<'_>) -> Result<String, PlotError> {
     let axis = FreqAxis::new(fig.frequencies_hz, fig.scale);
     let legend = legend(fig, &axis, false);
-    svg(&fig.title, 660, |root| {
+    let height = if fig.panels.first().is_some_and(|p| p.coherence.is_some()) { 800 } else { 660 };
+    svg(&fig.title, height, |root| {
         let body = frame(root, &fig.title, &legend)?;
         let Some(panel) = fig.panels.first() else {
             return Ok(());
         };
         let h = body.dim_in_pixel().1;
-        let (top, bottom) = body.split_vertically(h * 62 / 100);
-        draw_channel(&top, &bottom, fig, panel, axis, &LARGE)
+        if panel.coherence.is_some() {
+            let (top, rest) = body.split_vertically(h * 52 / 100);
+            let (bottom, trace) = rest.split_vertically(h * 29 / 100);
+            draw_channel(&top, &bottom, Some(&trace), fig, panel, axis, &LARGE)
+        } else {
+            let (top, bottom) = body.split_vertically(h * 62 / 100);
+            draw_channel(&top, &bottom, None, fig, panel, axis, &LARGE)
+        }
     })
 }
 
@@ -290,7 +407,9 @@ pub(crate) fn frf_multiples(fig: &FrfFigure<'_>) -> Result<String, PlotError> {
     let axis = FreqAxis::new(fig.frequencies_hz, fig.scale);
     let legend = legend(fig, &axis, true);
     let rows = fig.panels.len().div_ceil(COLUMNS).max(1);
-    let height = 44 + super::legend_height(&legend) + rows as u32 * PANEL_HEIGHT;
+    let coherent = fig.panels.iter().any(|p| p.coherence.is_some());
+    let panel_height = if coherent { PANEL_HEIGHT + PANEL_HEIGHT / 4 } else { PANEL_HEIGHT };
+    let height = 44 + super::legend_height(&legend) + rows as u32 * panel_height;
     svg(&fig.title, height, |root| {
         let body = frame(root, &fig.title, &legend)?;
         let cells = body.split_evenly((rows, COLUMNS));
@@ -306,8 +425,14 @@ pub(crate) fn frf_multiples(fig: &FrfFigure<'_>) -> Result<String, PlotError> {
             cell.draw(&Text::new(title, (12, 6), (FONT, 13).into_font().style(FontStyle::Bold).color(&BLACK)))?;
             let (_, rest) = cell.split_vertically(24);
             let h = rest.dim_in_pixel().1;
-            let (top, bottom) = rest.split_vertically(h * 58 / 100);
-            draw_channel(&top, &bottom, fig, panel, axis, &SMALL)?;
+            if panel.coherence.is_some() {
+                let (top, rest) = rest.split_vertically(h * 47 / 100);
+                let (bottom, trace) = rest.split_vertically(h * 28 / 100);
+                draw_channel(&top, &bottom, Some(&trace), fig, panel, axis, &SMALL)?;
+            } else {
+                let (top, bottom) = rest.split_vertically(h * 58 / 100);
+                draw_channel(&top, &bottom, None, fig, panel, axis, &SMALL)?;
+            }
         }
         Ok(())
     })
@@ -337,11 +462,12 @@ mod tests {
         let svg = frf_overlay(&FrfFigure {
             title: "H(3:uy,3:uy) <driving point>".into(),
             frequencies_hz: &f,
-            kind: FrfKind::Accelerance,
+            unit: "m/s\u{b2}/N".into(),
             panels: vec![FrfPanel { title: String::new(), curves: curves(&x, &a), coherence: None }],
             ticks_hz: &[2.0],
             coherence_threshold: 0.8,
             scale: FrequencyScale::Linear,
+            noise: None,
         })
         .unwrap();
         assert!(svg.starts_with("<svg"));
@@ -362,11 +488,12 @@ mod tests {
             frf_overlay(&FrfFigure {
                 title: "H(3:uy,3:uy)".into(),
                 frequencies_hz: &f,
-                kind: FrfKind::Receptance,
+                unit: "m/N".into(),
                 panels: vec![FrfPanel { title: String::new(), curves: curves(&x, &x), coherence: None }],
                 ticks_hz: ticks,
                 coherence_threshold: 0.8,
                 scale: FrequencyScale::Linear,
+                noise: None,
             })
             .unwrap()
         };
@@ -392,11 +519,12 @@ mod tests {
         let svg = frf_multiples(&FrfFigure {
             title: "every channel".into(),
             frequencies_hz: &f,
-            kind: FrfKind::Receptance,
+            unit: "m/N".into(),
             panels,
             ticks_hz: &[],
             coherence_threshold: 0.8,
             scale: FrequencyScale::Auto,
+            noise: None,
         })
         .unwrap();
         for k in 0..5 {
@@ -429,7 +557,7 @@ mod tests {
             frf_overlay(&FrfFigure {
                 title: "H(2:uy,11:uy)".into(),
                 frequencies_hz: f,
-                kind: FrfKind::Receptance,
+                unit: "m/N".into(),
                 panels: vec![FrfPanel {
                     title: String::new(),
                     curves: vec![FrfCurve { label: "measured".into(), colour: MEASURED, values: x }],
@@ -438,11 +566,12 @@ mod tests {
                 ticks_hz: &[],
                 coherence_threshold: 0.8,
                 scale: FrequencyScale::Linear,
+                noise: None,
             })
             .unwrap()
         };
-        // the measurement is drawn 3 px wide: its magnitude, then its phase
-        let drawn = polylines(&figure(&f, &x), "stroke-width=\"3\"");
+        // the measurement is drawn 5 px wide: its magnitude, then its phase
+        let drawn = polylines(&figure(&f, &x), "stroke-width=\"5\"");
         assert_eq!(drawn.len(), 2);
         for line in &drawn {
             assert!(most_per_column(line) <= 4, "{} points in a pixel column", most_per_column(line));
@@ -458,7 +587,7 @@ mod tests {
         keep.sort_unstable();
         keep.dedup();
         let (fs, xs): (Vec<f64>, Vec<C64>) = keep.iter().map(|&k| (f[k], x[k])).unzip();
-        let sparse = polylines(&figure(&fs, &xs), "stroke-width=\"3\"");
+        let sparse = polylines(&figure(&fs, &xs), "stroke-width=\"5\"");
         assert_eq!(sparse[0].len(), keep.len());
         // drawn y grows downwards: the peak is the least y, the lowest point the greatest
         let highest = |l: &[(i32, i32)]| l.iter().map(|p| p.1).min();
@@ -475,7 +604,7 @@ mod tests {
         let svg = frf_overlay(&FrfFigure {
             title: "H(3:uy,3:uy)".into(),
             frequencies_hz: &f,
-            kind: FrfKind::Receptance,
+            unit: "m/N".into(),
             panels: vec![FrfPanel {
                 title: String::new(),
                 curves: vec![FrfCurve { label: "measured".into(), colour: MEASURED, values: &x }],
@@ -484,6 +613,7 @@ mod tests {
             ticks_hz: &[],
             coherence_threshold: 0.8,
             scale: FrequencyScale::Linear,
+            noise: None,
         })
         .unwrap();
         let fill = |c: RGBColor| format!("fill=\"#{:02X}{:02X}{:02X}\"", c.0, c.1, c.2);

@@ -18,11 +18,11 @@ pub(crate) fn convergence(
     let title = "Misfit per iteration";
     let mut legend = vec![LegendEntry::new(format!("{residual_label} at the updating lines"), UPDATED, Mark::Line(2))];
     if all_lines_db.is_some() {
-        legend.push(LegendEntry::new("RMS magnitude error over the measured band", INITIAL, Mark::Line(2)));
+        legend.push(LegendEntry::new("RMS dB error over the measured band", INITIAL, Mark::Line(2)));
     }
     let n = residual.len().max(all_lines_db.map_or(0, <[f64]>::len)).max(2);
     let panels: Vec<(&str, RGBColor, &[f64])> = std::iter::once((residual_label, UPDATED, residual))
-        .chain(all_lines_db.map(|d| ("RMS error over the band (dB)", INITIAL, d)))
+        .chain(all_lines_db.map(|d| ("RMS dB error over the band", INITIAL, d)))
         .collect();
     let height = if panels.len() == 2 { 600 } else { 380 };
     svg(title, height, |root| {

@@ -198,16 +198,69 @@ pub(crate) fn stabilisation(
             let style = if filled { colour.filled() } else { colour.stroke_width(1) };
             Circle::new((p.frequency_hz, p.order as f64), r, style)
         }))?;
-        let style = (FONT, 12).into_font().color(&MEASURED).pos(Pos::new(HPos::Center, VPos::Bottom));
-        for (k, &f) in modes_hz.iter().enumerate().filter(|(_, f)| axis.shows(**f)) {
-            chart.draw_series(std::iter::once(Text::new(format!("{}", k + 1), (f, y_top), style.clone())))?;
+        // the mode numbers along the top, each in the first row where it
+        // clears the labels already placed: close modes get staggered rows
+        // instead of numbers printed over each other
+        let style = (FONT, 12).into_font().color(&MEASURED).pos(Pos::new(HPos::Center, VPos::Top));
+        let (_, top_px) = chart.backend_coord(&(axis.ends().0, y_top));
+        let (_, bottom_px) = chart.backend_coord(&(axis.ends().0, 0.0));
+        let per_px = y_top / f64::from((bottom_px - top_px).max(1));
+        let placed =
+            label_rows(modes_hz.iter().map(|&f| axis.shows(f).then(|| chart.backend_coord(&(f, y_top)).0)).collect());
+        for (k, (&f, row)) in modes_hz.iter().zip(placed).enumerate() {
+            let Some(row) = row else { continue };
+            let y = y_top - per_px * (6.0 + f64::from(LABEL_ROW_PX) * row as f64);
+            chart.draw_series(std::iter::once(Text::new(format!("{}", k + 1), (f, y), style.clone())))?;
         }
         Ok(())
     })
 }
 
+/// Height of a row of mode numbers (px).
+const LABEL_ROW_PX: i32 = 14;
+
+/// Width a mode number needs clear on each side of its place (px).
+const LABEL_HALF_WIDTH: i32 = 9;
+
+/// The row of each mode number drawn at pixel column `x` (`None`: not
+/// shown): the first row in which it clears every number already placed in
+/// that row, in order.
+fn label_rows(x: Vec<Option<i32>>) -> Vec<Option<usize>> {
+    let mut last_in_row: Vec<i32> = Vec::new();
+    x.into_iter()
+        .map(|x| {
+            let x = x?;
+            let row = last_in_row.iter().position(|&l| x - l >= 2 * LABEL_HALF_WIDTH).unwrap_or(last_in_row.len());
+            if row == last_in_row.len() {
+                last_in_row.push(x);
+            } else {
+                last_in_row[row] = x;
+            }
+            Some(row)
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
+    /// Numbers far apart share the first row; close ones step down a row
+    /// each, and a later one returns to the first row once it is clear.
+    #[test]
+    fn close_mode_numbers_are_staggered_and_never_overlap() {
+        let rows = label_rows(vec![Some(100), Some(104), Some(110), None, Some(160), Some(300)]);
+        assert_eq!(rows, vec![Some(0), Some(1), Some(2), None, Some(0), Some(0)]);
+        // every pair in one row is at least a label apart
+        let x = [100, 104, 110, 160, 300];
+        let r: Vec<usize> = rows.into_iter().flatten().collect();
+        for i in 0..x.len() {
+            for j in 0..i {
+                if r[i] == r[j] {
+                    assert!(x[i] - x[j] >= 2 * LABEL_HALF_WIDTH, "{} and {}", x[j], x[i]);
+                }
+            }
+        }
+    }
+
     use super::*;
 
     #[test]

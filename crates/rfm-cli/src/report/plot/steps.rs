@@ -22,7 +22,7 @@ pub(crate) fn misfit_steps(
     let title = "Misfit after each step";
     let legend = vec![
         LegendEntry {
-            label: "misfit (RMS of ln(model/measured) per value)".into(),
+            label: "misfit (RMS of |ln(model/measured)| per complex value)".into(),
             colour: UPDATED,
             mark: Mark::Line(2),
         },

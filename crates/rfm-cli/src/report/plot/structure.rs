@@ -1,5 +1,6 @@
-//! The structure drawn to scale: beams, supports, joints, springs and
-//! masses, the measured DOFs as arrows, and highlighted places (the
+//! The structure drawn to scale: beams, supports, joints, springs, masses
+//! and resonators (a mass on a spring beside its node), the measured DOFs
+//! as arrows, and highlighted places (the
 //! effects the loop added); and mode shapes drawn on it, deformed over
 //! undeformed.
 //!
@@ -209,6 +210,8 @@ pub(crate) enum HighlightKind {
     Mass,
     /// A change over elements: a broad band along them.
     Patch,
+    /// A resonator at a node (a mass on a spring): a ring around its mass.
+    Resonator,
 }
 
 /// A place on the structure to point at, numbered in the figure.
@@ -221,11 +224,75 @@ pub(crate) struct Highlight {
     pub(crate) nodes: Vec<u32>,
     /// Element ids where it acts.
     pub(crate) elements: Vec<u32>,
+    /// Its number on the drawing and in the legend (`None`: its place in
+    /// the list, from 1): the step that added it, or its rank.
+    pub(crate) number: Option<usize>,
 }
 
-/// Draws the beams, supports, springs and masses of `model` in `view`.
+/// How far from its node a resonator's mass is drawn (pixels).
+const RESONATOR_OFFSET: f64 = 32.0;
+
+/// A resonator as a case's `[[resonators]]` builds it: a mass on a node of
+/// its own, coincident with a node of the structure, joined to it by one
+/// spring and nothing else (its other DOFs held). Drawn as a mass on a
+/// spring beside the node, not as a joint and a support where it sits.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Resonator {
+    /// The structure's node it hangs on.
+    base: NodeId,
+    /// The mass's own node.
+    node: NodeId,
+    /// Its spring's index in `Model::springs`.
+    spring: usize,
+    /// Pixel direction from the base to the mass: the spring's first
+    /// translation (up for a vertical spring).
+    dir: (f64, f64),
+}
+
+/// The resonators of `model` (see [`Resonator`]).
+fn resonators(model: &Model) -> Vec<Resonator> {
+    let dim = model.dimension();
+    let mut out = Vec::new();
+    for m in model.masses() {
+        let n = m.node;
+        if model.beams().iter().any(|b| b.nodes.contains(&n)) {
+            continue;
+        }
+        let touching: Vec<usize> =
+            model.springs().iter().enumerate().filter(|(_, s)| s.a == n || s.b == Some(n)).map(|(i, _)| i).collect();
+        let [i] = touching[..] else { continue };
+        let s = &model.springs()[i];
+        let Some(other) = (if s.a == n { s.b } else { Some(s.a) }) else { continue };
+        let (Some(p), Some(q)) = (node_xy(model, n), node_xy(model, other)) else { continue };
+        if (p.0 - q.0).abs() + (p.1 - q.1).abs() > 1e-9 * (1.0 + p.0.abs() + p.1.abs()) {
+            continue;
+        }
+        let Some(dir) = dim.translations().iter().find(|&&d| s.k[d] != 0.0).and_then(|&d| dof_dir(d)) else {
+            continue;
+        };
+        out.push(Resonator { base: other, node: n, spring: i, dir });
+    }
+    out
+}
+
+/// A mass on a spring from `p` along `dir` (pixels); returns where the
+/// mass is.
+fn draw_resonator(
+    area: &Area<'_>,
+    p: (i32, i32),
+    dir: (f64, f64),
+    colour: RGBColor,
+) -> Result<(i32, i32), Box<dyn std::error::Error>> {
+    let end = add(p, dir, RESONATOR_OFFSET);
+    draw_zigzag(area, p, add(p, dir, RESONATOR_OFFSET - 6.0), colour)?;
+    area.draw(&Rectangle::new([(end.0 - 6, end.1 - 6), (end.0 + 6, end.1 + 6)], colour.filled()))?;
+    Ok(end)
+}
+
+/// Draws the beams, supports, springs, masses and resonators of `model` in `view`.
 fn draw_model(area: &Area<'_>, model: &Model, view: &View, colour: RGBColor, width: u32, symbols: bool) -> DrawResult {
     let at = |id: NodeId| node_xy(model, id).map(|(x, y)| view.px(x, y));
+    let resonators = resonators(model);
     for b in model.beams() {
         if let (Some(p), Some(q)) = (at(b.nodes[0]), at(b.nodes[1])) {
             area.draw(&PathElement::new(vec![p, q], colour.stroke_width(width)))?;
@@ -242,6 +309,10 @@ fn draw_model(area: &Area<'_>, model: &Model, view: &View, colour: RGBColor, wid
         return Ok(());
     }
     for s in model.supports() {
+        // a resonator's mass is held in the DOFs its spring leaves free
+        if resonators.iter().any(|r| r.node == s.node) {
+            continue;
+        }
         let Some(p) = at(s.node) else { continue };
         let away = pixel_dir(beam_direction(model, s.node));
         let away = (-away.0, -away.1);
@@ -258,7 +329,10 @@ fn draw_model(area: &Area<'_>, model: &Model, view: &View, colour: RGBColor, wid
             draw_ground(area, add(base, away, 2.0), away, 12.0)?;
         }
     }
-    for s in model.springs() {
+    for (i, s) in model.springs().iter().enumerate() {
+        if resonators.iter().any(|r| r.spring == i) {
+            continue;
+        }
         let Some(p) = at(s.a) else { continue };
         match s.b.and_then(at) {
             // coincident nodes: a joint, drawn as a hinge
@@ -278,8 +352,16 @@ fn draw_model(area: &Area<'_>, model: &Model, view: &View, colour: RGBColor, wid
         }
     }
     for m in model.masses() {
+        if resonators.iter().any(|r| r.node == m.node) {
+            continue;
+        }
         if let Some(p) = at(m.node) {
             area.draw(&Rectangle::new([(p.0 - 6, p.1 - 6), (p.0 + 6, p.1 + 6)], BEAM.filled()))?;
+        }
+    }
+    for r in &resonators {
+        if let Some(p) = at(r.base) {
+            draw_resonator(area, p, r.dir, BEAM)?;
         }
     }
     Ok(())
@@ -314,7 +396,8 @@ pub(crate) fn structure(
         legend.push(LegendEntry::new("excitation", EXCITATION, Mark::Line(3)));
     }
     for (i, h) in highlights.iter().enumerate() {
-        legend.push(LegendEntry::new(format!("{}: {}", i + 1, h.label), HIGHLIGHTS[i % HIGHLIGHTS.len()], Mark::Dot));
+        let n = h.number.unwrap_or(i + 1);
+        legend.push(LegendEntry::new(format!("{n}: {}", h.label), HIGHLIGHTS[i % HIGHLIGHTS.len()], Mark::Dot));
     }
     let height = drawing_height(aspect(model)) + 40 + super::legend_height(&legend);
     svg(title, height, |root| {
@@ -322,6 +405,7 @@ pub(crate) fn structure(
         let (w, h) = body.dim_in_pixel();
         let view = View::fit(bbox(model), f64::from(w), f64::from(h), 56.0);
         let at = |id: u32| node_xy(model, NodeId(id)).map(|(x, y)| view.px(x, y));
+        let resonators = resonators(model);
         // patches under the beams, so that the beams stay visible on them
         for (i, h) in highlights.iter().enumerate() {
             if h.kind != HighlightKind::Patch {
@@ -381,6 +465,20 @@ pub(crate) fn structure(
                     .filter_map(|b| Some((at(b.nodes[0].0)?, at(b.nodes[1].0)?)))
                     .map(|(p, q)| ((p.0 + q.0) / 2, (p.1 + q.1) / 2))
                     .collect(),
+                // the mass of the model's resonator at the node, or one
+                // drawn there in the highlight's colour (a candidate the
+                // model does not hold yet)
+                HighlightKind::Resonator => {
+                    let mut points = Vec::new();
+                    for &n in &h.nodes {
+                        let Some(p) = at(n) else { continue };
+                        points.push(match resonators.iter().find(|r| r.base.0 == n || r.node.0 == n) {
+                            Some(r) => add(p, r.dir, RESONATOR_OFFSET),
+                            None => draw_resonator(&body, p, (0.0, -1.0), colour)?,
+                        });
+                    }
+                    points
+                }
                 _ => h.nodes.iter().filter_map(|&n| at(n)).collect(),
             };
             let Some(&first) = points.first() else { continue };
@@ -398,7 +496,7 @@ pub(crate) fn structure(
             } else {
                 first
             };
-            draw_badge(&body, (centre.0 + 22, centre.1 - 22), i + 1, colour)?;
+            draw_badge(&body, (centre.0 + 22, centre.1 - 22), h.number.unwrap_or(i + 1), colour)?;
         }
         Ok(())
     })
@@ -602,8 +700,20 @@ mod tests {
         let responses = [DofRef::new(3, Dof::Uy), DofRef::new(2, Dof::Ux)];
         let references = [DofRef::new(3, Dof::Uy)];
         let highlights = vec![
-            Highlight { label: "a joint".into(), kind: HighlightKind::Joint, nodes: vec![2], elements: vec![2] },
-            Highlight { label: "a patch".into(), kind: HighlightKind::Patch, nodes: vec![], elements: vec![1] },
+            Highlight {
+                label: "a joint".into(),
+                kind: HighlightKind::Joint,
+                nodes: vec![2],
+                elements: vec![2],
+                number: None,
+            },
+            Highlight {
+                label: "a patch".into(),
+                kind: HighlightKind::Patch,
+                nodes: vec![],
+                elements: vec![1],
+                number: None,
+            },
         ];
         let svg =
             structure("frame", &m, &Sensors { responses: &responses, references: &references }, &highlights).unwrap();
@@ -631,6 +741,7 @@ mod tests {
                 kind: *kind,
                 nodes: nodes.clone(),
                 elements: elements.clone(),
+                number: None,
             })
             .collect();
         let svg = structure("frame", &m, &Sensors { responses: &[], references: &[] }, &highlights).unwrap();
@@ -647,6 +758,59 @@ mod tests {
             svg.lines().any(|l| l.starts_with("<rect") && l.contains(&format!("fill=\"{}\"", hex(HIGHLIGHTS[2])))),
             "no square for the mass"
         );
+    }
+
+    /// The L-frame with a resonator at its tip as `[[resonators]]` builds
+    /// one: a coincident node, a vertical spring, a mass, the rest held.
+    fn l_frame_with_resonator() -> Model {
+        let mut m = l_frame();
+        let g = m.group_or_default("frame");
+        m.add_node(4, 0.5, 0.6).unwrap();
+        m.add_spring("fixture", 3, Some(4), [0.0, 2e4, 0.0], g).unwrap();
+        m.add_mass("fixture", 4, 0.3, [0.0; 3], g).unwrap();
+        m.add_support(4, &[Dof::Ux, Dof::Rz]).unwrap();
+        m
+    }
+
+    /// A resonator is found as built, and drawn as a mass on a spring
+    /// beside its node: a zigzag up from the tip and a square at its end,
+    /// neither the hinge of a joint nor the triangle of a support at the
+    /// tip; its highlight rings the drawn mass.
+    #[test]
+    fn a_resonator_is_drawn_as_a_mass_on_a_spring_beside_its_node() {
+        let plain = l_frame();
+        let m = l_frame_with_resonator();
+        assert!(resonators(&plain).is_empty());
+        let r = resonators(&m);
+        assert_eq!(r, [Resonator { base: NodeId(3), node: NodeId(4), spring: 0, dir: (0.0, -1.0) }]);
+        // a joint between coincident nodes of two beams is not a resonator
+        let mut joint = l_frame();
+        let g = joint.group_or_default("frame");
+        joint.add_node(5, 0.5, 0.6).unwrap();
+        joint.add_node(6, 1.0, 0.6).unwrap();
+        let (steel, sec) = (0, 0);
+        joint.add_beam(3, [5, 6], steel, sec, g).unwrap();
+        joint.add_spring("hinge", 3, Some(5), [1e9, 1e9, 1e3], g).unwrap();
+        assert!(resonators(&joint).is_empty());
+
+        let highlight =
+            |kind| Highlight { label: "a resonator".into(), kind, nodes: vec![3], elements: vec![], number: None };
+        let no_sensors = Sensors { responses: &[], references: &[] };
+        let without = structure("frame", &plain, &no_sensors, &[]).unwrap();
+        let with = structure("frame", &m, &no_sensors, &[highlight(HighlightKind::Resonator)]).unwrap();
+        let count = |svg: &str, what: &str| svg.lines().filter(|l| l.starts_with(what)).count();
+        // a square for the mass and no hinge ring, no support triangle
+        assert_eq!(count(&with, "<rect") - count(&without, "<rect"), 1, "one square: the mass");
+        assert_eq!(count(&with, "<polygon"), count(&without, "<polygon"), "a support drawn at the resonator");
+        let ring = format!("stroke=\"#{:02X}{:02X}{:02X}\"", HIGHLIGHTS[0].0, HIGHLIGHTS[0].1, HIGHLIGHTS[0].2);
+        assert!(
+            with.lines().any(|l| l.starts_with("<circle") && l.contains("r=\"15\"") && l.contains(&ring)),
+            "no ring in the highlight's colour"
+        );
+        // a candidate the model does not hold yet is drawn in its colour
+        let candidate = structure("frame", &plain, &no_sensors, &[highlight(HighlightKind::Resonator)]).unwrap();
+        let fill = format!("fill=\"#{:02X}{:02X}{:02X}\"", HIGHLIGHTS[0].0, HIGHLIGHTS[0].1, HIGHLIGHTS[0].2);
+        assert!(candidate.lines().any(|l| l.starts_with("<rect") && l.contains(&fill)), "no mass for the candidate");
     }
 
     #[test]

@@ -10,6 +10,9 @@ use super::DrawResult;
 
 /// Colour of measured data.
 pub(crate) const MEASURED: RGBColor = RGBColor(0, 0, 0);
+/// Colour of a measured FRF in an overlay: drawn wide and pale under the
+/// models, so that a model that matches runs visibly along its middle.
+pub(crate) const MEASURED_FRF: RGBColor = RGBColor(160, 160, 160);
 /// Colour of the initial model.
 pub(crate) const INITIAL: RGBColor = RGBColor(213, 94, 0);
 /// Colour of the updated model.
