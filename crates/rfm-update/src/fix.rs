@@ -680,6 +680,12 @@ pub fn prepare(
     opts: &FixOptions,
     progress: &mut impl FnMut(FixProgress<'_>),
 ) -> Result<Prepared, UpdateError> {
+    // what the diagnosis needs, said before the checks and the noise
+    // estimate need it too
+    let lines = measured.frequencies_hz().len();
+    if lines < 10 {
+        return Err(UpdateError::Data(format!("diagnosis needs at least 10 measured lines, the data have {lines}")));
+    }
     let nominal_sys = damping::DampedSystem::new(case.model.clone())?;
     let d_opts = &opts.diagnose;
     let noise = diagnose::estimate_noise_against_weighted(&nominal_sys, measured, d_opts.weights.as_deref())?

@@ -185,8 +185,10 @@ fn a_bad_damping_matrix_is_refused_at_its_line_and_column() {
     assert!(err.contains("table-frame-C.mtx:3:1:"), "{err}");
 }
 
-/// With the damping matrix's factor the only change in the truth, the
-/// diagnosis ranks the change of that matrix first, with its value.
+/// With the damping matrix's factor the only change in the truth, and the
+/// factor declared under `[update]`, the diagnosis updates it first (step
+/// 0) to its value, and nothing significant remains; without it declared,
+/// the diagnosis ranks the change of that matrix first, with its value.
 #[test]
 fn diagnose_names_a_change_of_an_imported_damping_matrix() {
     let dir = tempfile::tempdir().unwrap();
@@ -199,6 +201,17 @@ fn diagnose_names_a_change_of_an_imported_damping_matrix() {
     });
     let text = std::fs::read_to_string(&case).unwrap();
     let text = text.replace("\"group.frame.stiffness\" = 0.94\n", "").replace("\"group.frame.alpha\" = 3.0e-6\n", "");
+    std::fs::write(&case, text).unwrap();
+    let out = rfm(&["diagnose", case.to_str().unwrap(), "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let d: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let declared = d["declared"]["parameters"].as_array().expect("a step 0");
+    let factor = declared.iter().find(|p| p["name"] == "group.frame.damping").expect("the factor updated at step 0");
+    assert!((factor["updated"].as_f64().unwrap() / 1.6 - 1.0).abs() < 0.01, "{factor}");
+    assert_eq!(d["ranking"][0]["significant"], false, "{}", d["ranking"][0]);
+
+    // not declared: the change of the matrix is what the diagnosis names
+    let text = std::fs::read_to_string(&case).unwrap().replace(", \"group.frame.damping\"]", "]");
     std::fs::write(&case, text).unwrap();
     let out = rfm(&["diagnose", case.to_str().unwrap(), "--json"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));

@@ -73,6 +73,10 @@ const COMPARABLE: f64 = 0.95;
 /// A channel's misfit must fall at least this many times for a correction.
 const FALL: f64 = 4.0;
 
+/// A channel taken for one measured at another DOF must leave at least this
+/// multiple of the median channel's misfit against its own DOF.
+const OUTLIER: f64 = 2.0;
+
 /// A channel with at least this share of its lines a quarter turn or more
 /// off the model is inverted ...
 const INVERTED_SHARE: f64 = 0.7;
@@ -590,7 +594,13 @@ fn judge(fits: &[ChannelFit], opts: &CheckOptions) -> Vec<Finding> {
         // would be a swap, found above, or a duplicate)
         let measured_elsewhere =
             |d: DofRef| fits.iter().any(|o| o.channel.reference == f.channel.reference && o.channel.response == d);
+        // and the channel stands out from the others: a sensor elsewhere
+        // spoils its own channel, a model error spoils them all, and one of
+        // many channels spoilt alike can fit a neighbour's DOF better by
+        // chance (the table frame's loose corner: 31:uy "at 30:uy")
+        let stands_out = rms(f.own_cost(), f.own.weight()) > OUTLIER * typical;
         if let Some((d, neg, cost)) = f.best_other
+            && stands_out
             && !measured_elsewhere(d)
             && better(f, cost)
             && (!inverted || cost * 2.0 < minus)

@@ -18,6 +18,7 @@ mod per_direction;
 mod resonators;
 mod sensitivity;
 mod setup_checks;
+mod singular_lines;
 mod study;
 mod trust;
 mod truths;

@@ -89,9 +89,14 @@ fn resonator(ctx: &Ctx<'_>, node: u32, dofs: Vec<Dof>, hz: f64, non_viscous: boo
         bounds: Some((1e-7 * total, 10.0 * total)),
         plausible: (0.0, 0.25 * total, "more than a quarter of the structure's mass"),
     }];
-    // springs from a tuning far below the band to far above it, at any mass
-    // within the bounds; their plausibility is the tuning, judged with the mass
-    let (lo, hi) = (1e-7 * total * (0.01 * ctx.w_min).powi(2), 10.0 * total * (100.0 * ctx.w_max).powi(2));
+    // springs from a tuning far below the band to far above it; their
+    // plausibility is the tuning, judged with the mass. The floor is ten
+    // times the structure's mass tuned a hundred times below the band's
+    // lowest line (a 1 % mass at a third of it), not the mass's own floor:
+    // a spring the fit runs to 1e-7 of that leaves the mass free in its
+    // direction, and the case written with it is refused as a mechanism
+    // (the lab frame's two-direction resonator at node 11, `apply_every`)
+    let (lo, hi) = (10.0 * total * (0.01 * ctx.w_min).powi(2), 10.0 * total * (100.0 * ctx.w_max).powi(2));
     for &d in &dofs {
         fitted.push(Fitted {
             name: format!("spring.{name}.{}", ctx.dim.spring_key(d)),
