@@ -21,7 +21,19 @@ impl SupernodalLdlt {
     /// d_i|)`), and the second part is tested when a supernode's columns
     /// are complete, before its update leaves it.
     pub(crate) fn factorize(&self, num: &mut NumericSupernodal, values: &[C64]) -> Result<(), TinyPivot> {
-        let NumericSupernodal { values: l_val, d_inv, stack, work, local, rel, row_scale, subtracted, acc, .. } = num;
+        let NumericSupernodal {
+            values: l_val,
+            d_inv,
+            stack,
+            work,
+            local,
+            rel,
+            run_end,
+            row_scale,
+            subtracted,
+            acc,
+            ..
+        } = num;
         for (k, &c) in self.perm.iter().enumerate() {
             let (o0, o1) = (self.orig_col_ptr[c], self.orig_col_ptr[c + 1]);
             row_scale[k] = values[o0..o1].iter().fold(0.0, |m: f64, &v| m.max(l1(v)));
@@ -56,8 +68,8 @@ impl SupernodalLdlt {
             let (below, above) = stack.split_at_mut(top);
             for &c in children {
                 let (c_rows, c_update) = self.child_update(c as usize, below);
-                let rel = relative(c_rows, f, e, local, rel);
-                extend_add(c_update, rel, 0..c_rows.partition_point(|&g| (g as usize) < e), block, m, w);
+                let (rel, runs) = relative(c_rows, f, e, local, rel, run_end);
+                extend_add(c_update, rel, runs, 0..c_rows.partition_point(|&g| (g as usize) < e), block, m, w);
             }
 
             factor_columns(block, m, w, &mut d_inv[f..e], &row_scale[f..e], work)
@@ -91,9 +103,9 @@ impl SupernodalLdlt {
                 schur_update(block, m, w, update, work);
                 for &c in children {
                     let (c_rows, c_update) = self.child_update(c as usize, below);
-                    let rel = relative(c_rows, f, e, local, rel);
+                    let (rel, runs) = relative(c_rows, f, e, local, rel, run_end);
                     let split = c_rows.partition_point(|&g| (g as usize) < e);
-                    extend_add(c_update, rel, split..c_rows.len(), update, r, w);
+                    extend_add(c_update, rel, runs, split..c_rows.len(), update, r, w);
                 }
                 // down over the children's, column by column (the lower
                 // triangle is all that is read); each column moves down by
@@ -123,41 +135,66 @@ impl SupernodalLdlt {
 
 /// Positions in the front of supernode `f..e` of a child's rows: below `w =
 /// e - f` a column of the supernode, from `w` on `w` plus the row's place
-/// among the supernode's rows below (`local`).
+/// among the supernode's rows below (`local`); and for each row, the end of
+/// the run of rows from it whose positions are consecutive (the six DOFs of
+/// a node, whole blocks of a mesh's rows), which [`extend_add`] adds as
+/// slices.
 #[inline]
-fn relative<'a>(c_rows: &[u32], f: usize, e: usize, local: &[u32], rel: &'a mut [u32]) -> &'a [u32] {
-    let rel = &mut rel[..c_rows.len()];
+fn relative<'a>(
+    c_rows: &[u32],
+    f: usize,
+    e: usize,
+    local: &[u32],
+    rel: &'a mut [u32],
+    run_end: &'a mut [u32],
+) -> (&'a [u32], &'a [u32]) {
+    let rc = c_rows.len();
+    let (rel, run_end) = (&mut rel[..rc], &mut run_end[..rc]);
     for (p, &g) in rel.iter_mut().zip(c_rows) {
         let g = g as usize;
         *p = if g < e { (g - f) as u32 } else { local[g] };
     }
-    rel
+    for a in (0..rc).rev() {
+        run_end[a] = if a + 1 < rc && rel[a + 1] == rel[a] + 1 { run_end[a + 1] } else { a as u32 + 1 };
+    }
+    (rel, run_end)
 }
 
 /// Adds columns `cols` of a child's update matrix (`rc x rc`, lower
 /// triangle) into its parent's front: `rel[a]` is the position of the
 /// child's row `a` in the front, below `w` a column of the parent's block,
-/// from `w` on a row of the parent's update matrix (at `w` plus its row).
-/// The child's rows are ascending, so the columns of the update matrix that
-/// fall in the parent's block come first, then those in its update matrix:
-/// `dst` is the block (`ld = m` rows) for the first, the parent's update
-/// matrix (`ld = r`, positions shifted by `w`) for the second.
-fn extend_add(child: &[C64], rel: &[u32], cols: std::ops::Range<usize>, dst: &mut [C64], ld: usize, w: usize) {
+/// from `w` on a row of the parent's update matrix (at `w` plus its row),
+/// and rows `a..run_end[a]` have consecutive positions. The child's rows
+/// are ascending, so the columns of the update matrix that fall in the
+/// parent's block come first, then those in its update matrix: `dst` is
+/// the block (`ld = m` rows) for the first, the parent's update matrix (`ld
+/// = r`, positions shifted by `w`) for the second.
+fn extend_add(
+    child: &[C64],
+    rel: &[u32],
+    run_end: &[u32],
+    cols: std::ops::Range<usize>,
+    dst: &mut [C64],
+    ld: usize,
+    w: usize,
+) {
     let rc = rel.len();
     for b in cols {
-        let src = &child[b * rc + b..(b + 1) * rc];
-        let rel_b = &rel[b..];
+        let src = &child[b * rc..(b + 1) * rc];
         let cb = rel[b] as usize;
-        if cb < w {
-            let col = &mut dst[cb * ld..(cb + 1) * ld];
-            for (&p, &v) in rel_b.iter().zip(src) {
-                col[p as usize] += v;
-            }
+        let (col, shift) = if cb < w {
+            (&mut dst[cb * ld..(cb + 1) * ld], 0)
         } else {
-            let col = &mut dst[(cb - w) * ld..(cb - w + 1) * ld];
-            for (&p, &v) in rel_b.iter().zip(src) {
-                col[p as usize - w] += v;
+            (&mut dst[(cb - w) * ld..(cb - w + 1) * ld], w)
+        };
+        let mut a = b;
+        while a < rc {
+            let end = run_end[a] as usize;
+            let p = rel[a] as usize - shift;
+            for (d, &v) in col[p..p + end - a].iter_mut().zip(&src[a..end]) {
+                *d += v;
             }
+            a = end;
         }
     }
 }

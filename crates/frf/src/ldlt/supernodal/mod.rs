@@ -101,8 +101,10 @@ pub(crate) struct NumericSupernodal {
     work: Vec<C64>,
     /// Position of each row of the current supernode in its front.
     local: Vec<u32>,
-    /// A child's rows' positions in its parent's front.
+    /// A child's rows' positions in its parent's front, and the end of the
+    /// run of consecutive positions from each.
     rel: Vec<u32>,
+    run_end: Vec<u32>,
     /// Per row: the largest entry of its row of `Z`, and the sum of the
     /// terms subtracted from its pivot (`|re| + |im|` norms).
     row_scale: Vec<f64>,
@@ -178,6 +180,7 @@ impl SupernodalLdlt {
             work: vec![ZERO; self.max_rows_cols.max(self.max_cols * self.max_cols)],
             local: vec![u32::MAX; self.n],
             rel: vec![0; self.max_rows],
+            run_end: vec![0; self.max_rows],
             row_scale: vec![0.0; self.n],
             subtracted: vec![0.0; self.n],
             acc: vec![0.0; self.max_rows + self.max_cols],
