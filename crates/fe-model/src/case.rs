@@ -39,8 +39,8 @@ pub use build::MAX_LINE_ELEMENTS;
 pub use dof_list::{parse_dof_list, parse_dof_range};
 pub use edit::CaseEditor;
 pub use measurement::{
-    Calibration, CalibrationTarget, ChannelMap, DEFAULT_COHERENCE_THRESHOLD, FittedGain, GainKey, Gains, MaskRule,
-    MeasurementSpec, PairingSpec,
+    Calibration, CalibrationTarget, ChannelCorrection, ChannelMap, DEFAULT_COHERENCE_THRESHOLD, FittedGain, GainKey,
+    Gains, MaskRule, MeasurementSpec, PairingSpec,
 };
 pub use spec::{
     BandWeight, CheckSpec, DiagnosisCheck, EFFECT_KINDS, FrequencyChoice, HistoryEntry, PaperSpec, RUN_STATUSES,

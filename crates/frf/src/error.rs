@@ -203,6 +203,15 @@ pub enum MismatchError {
         /// The channel.
         channel: Channel,
     },
+    /// [`FrfSet::rename_channels`](crate::FrfSet::rename_channels) given another
+    /// number of names than the set has channels.
+    #[error("{names} channel names for a set of {channels} channels")]
+    ChannelCount {
+        /// Names given.
+        names: usize,
+        /// Channels of the set.
+        channels: usize,
+    },
     /// [`FrfSet::merge_channels`](crate::FrfSet::merge_channels) was given no set.
     #[error("no FRF set to merge")]
     NothingToMerge,

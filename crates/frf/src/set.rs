@@ -223,6 +223,22 @@ impl FrfSet {
         FrfSet { frequencies_hz: self.frequencies_hz.clone(), channels, kind: self.kind, data, coherence }
     }
 
+    /// Gives the channels other names (one per channel, in order;
+    /// distinct), the values unchanged: a channel whose sensor measured
+    /// another DOF than its name says, renamed. Refused, and the set left
+    /// as it was, when the names are not one per channel or repeat.
+    pub fn rename_channels(&mut self, channels: Vec<Channel>) -> Result<(), FrfError> {
+        if channels.len() != self.channels.len() {
+            return Err(MismatchError::ChannelCount { names: channels.len(), channels: self.channels.len() }.into());
+        }
+        let mut seen = HashSet::with_capacity(channels.len());
+        if let Some(c) = channels.iter().find(|&&c| !seen.insert(c)) {
+            return Err(MismatchError::RepeatedChannel { channel: *c }.into());
+        }
+        self.channels = channels;
+        Ok(())
+    }
+
     /// Distinct reference DOFs, in order of first appearance.
     pub fn references(&self) -> Vec<DofRef> {
         let mut out: Vec<DofRef> = Vec::new();

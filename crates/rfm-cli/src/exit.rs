@@ -18,7 +18,7 @@ use crate::output::OutputError;
 
 /// How a run of `rfm` ended, as its exit code.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Exit {
+pub enum Exit {
     /// The command did what was asked (an update converged).
     Success,
     /// An error rfm did not foresee: a bug, please report it.
@@ -59,7 +59,7 @@ pub(crate) enum Exit {
 impl Exit {
     /// Every code with its meaning, in order: printed by `rfm --help` and
     /// copied in `docs/reliability.md`.
-    pub(crate) const TABLE: [(Exit, &'static str); 14] = [
+    pub const TABLE: [(Exit, &'static str); 14] = [
         (Exit::Success, "success (for update: the fit converged)"),
         (Exit::Internal, "internal error (a bug in rfm; please report it)"),
         (Exit::Usage, "wrong command line"),
@@ -83,7 +83,7 @@ impl Exit {
     ];
 
     /// The process exit code.
-    pub(crate) fn code(self) -> u8 {
+    pub fn code(self) -> u8 {
         match self {
             Exit::Success => 0,
             Exit::Internal => 1,
@@ -103,12 +103,12 @@ impl Exit {
     }
 
     /// What the code means, from [`Exit::TABLE`].
-    pub(crate) fn meaning(self) -> &'static str {
+    pub fn meaning(self) -> &'static str {
         Exit::TABLE.iter().find(|(e, _)| *e == self).map_or("", |(_, m)| m)
     }
 
     /// The code for how an updating run ended: 0 only when it converged.
-    pub(crate) fn of_status(status: &Status) -> Exit {
+    pub fn of_status(status: &Status) -> Exit {
         match status {
             Status::Converged => Exit::Success,
             Status::MaxIterations => Exit::NotConverged,
@@ -122,7 +122,7 @@ impl Exit {
 
     /// The code for an update's outcome: a run that made the misfit worse
     /// than the start's is never a success, whatever its status.
-    pub(crate) fn of_outcome(outcome: &rfm_update::UpdateOutcome) -> Exit {
+    pub fn of_outcome(outcome: &rfm_update::UpdateOutcome) -> Exit {
         match Exit::of_status(&outcome.status) {
             Exit::Success if outcome.worse_than_start => Exit::WorseThanStart,
             exit => exit,
@@ -130,7 +130,7 @@ impl Exit {
     }
 
     /// The table as `rfm --help` shows it.
-    pub(crate) fn help() -> String {
+    pub fn help() -> String {
         let mut text = String::from("Exit codes:\n");
         for (exit, meaning) in Exit::TABLE {
             text.push_str(&format!("  {:>3}  {meaning}\n", exit.code()));
@@ -141,16 +141,16 @@ impl Exit {
 
 /// Why a command failed, with the exit code that tells a script so.
 #[derive(Debug)]
-pub(crate) struct Failure {
+pub struct Failure {
     /// The exit code.
-    pub(crate) exit: Exit,
+    pub exit: Exit,
     /// The message for standard error.
-    pub(crate) message: String,
+    pub message: String,
 }
 
 impl Failure {
     /// A failure of the given kind.
-    pub(crate) fn new(exit: Exit, message: impl Into<String>) -> Failure {
+    pub fn new(exit: Exit, message: impl Into<String>) -> Failure {
         Failure { exit, message: message.into() }
     }
 
@@ -224,7 +224,7 @@ impl From<OutputError> for Failure {
 }
 
 /// A failed print: standard output is full or broken (a closed pipe is
-/// handled before, see [`crate::print_line`]).
+/// handled before, see `print_line` in `lib.rs`).
 impl From<std::io::Error> for Failure {
     fn from(e: std::io::Error) -> Self {
         Failure::new(Exit::Output, format!("standard output: cannot write: {e}"))
@@ -291,6 +291,7 @@ mod tests {
     fn outcome(status: Status, worse_than_start: bool) -> rfm_update::UpdateOutcome {
         rfm_update::UpdateOutcome {
             method: "rfm".into(),
+            iteration_end: status.clone(),
             status,
             parameters: Vec::new(),
             history: Vec::new(),

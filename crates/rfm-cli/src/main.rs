@@ -1,29 +1,12 @@
 //! `rfm`: compare, update and simulate FE models of damped structures against
 //! measured FRFs. Run `rfm --help`.
 
-/// `println!` through [`print_line`]: a closed standard output does not
-/// panic, and other write errors (a full disk) are handed back with `?`.
-macro_rules! outln {
-    ($($arg:tt)*) => {
-        crate::print_line(format_args!($($arg)*))?
-    };
-}
-
-mod commands;
-mod exit;
-mod output;
-mod report;
-mod table;
-
-use std::io::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Mutex, MutexGuard, PoisonError};
 
 use clap::{CommandFactory as _, FromArgMatches as _, Parser, Subcommand};
 
-use exit::Exit;
+use rfm_cli::{Exit, FrequencyScale, ReportOptions};
 
 /// FE model updating of damped structures from measured FRFs (response
 /// function method with exponential non-viscous damping).
@@ -80,7 +63,7 @@ enum Command {
         bands: String,
         /// Frequency axis of the report's figures: auto (logarithmic for bands of a decade or more), log or linear.
         #[arg(long, value_enum, default_value = "auto")]
-        frequency_axis: report::plot::axes::FrequencyScale,
+        frequency_axis: FrequencyScale,
     },
     /// Find which physical effect is missing: fit every candidate effect and rank them.
     Diagnose {
@@ -121,7 +104,7 @@ enum Command {
         json: bool,
         /// Frequency axis of the report's figures: auto (logarithmic for bands of a decade or more), log or linear.
         #[arg(long, value_enum, default_value = "auto")]
-        frequency_axis: report::plot::axes::FrequencyScale,
+        frequency_axis: FrequencyScale,
     },
     /// List what a measurement file holds (UFF dataset 58 or CSV): channels,
     /// function types, units, frequency lines, data types; skipped datasets.
@@ -153,66 +136,16 @@ enum Command {
         iterations: Option<usize>,
         /// Frequency axis of the report's figures: auto (logarithmic for bands of a decade or more), log or linear.
         #[arg(long, value_enum, default_value = "auto")]
-        frequency_axis: report::plot::axes::FrequencyScale,
+        frequency_axis: FrequencyScale,
     },
-}
-
-/// Set by a command that has files to write (`--out`, `--apply`).
-static FILES_TO_WRITE: AtomicBool = AtomicBool::new(false);
-
-/// Tells [`print_line`] that the command has files to write.
-pub(crate) fn files_to_write() {
-    FILES_TO_WRITE.store(true, Ordering::Relaxed);
-}
-
-/// Prints a line on standard output. When the reader has gone (`rfm ... |
-/// head`), a command with files to write goes on without printing, and any
-/// other stops at once and quietly: nothing would be lost.
-pub(crate) fn print_line(args: std::fmt::Arguments<'_>) -> std::io::Result<()> {
-    match writeln!(std::io::stdout().lock(), "{args}") {
-        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {
-            if FILES_TO_WRITE.load(Ordering::Relaxed) {
-                Ok(())
-            } else {
-                std::process::exit(0)
-            }
-        }
-        other => other,
-    }
-}
-
-/// Held while a command writes its outputs.
-static WRITING: Mutex<()> = Mutex::new(());
-
-/// Set when a command's output phase has ended.
-static WRITTEN: AtomicBool = AtomicBool::new(false);
-
-/// The output phase of a command, from [`writing`] until dropped.
-pub(crate) struct Writing {
-    _guard: MutexGuard<'static, ()>,
-}
-
-impl Drop for Writing {
-    fn drop(&mut self) {
-        WRITTEN.store(true, Ordering::Relaxed);
-    }
-}
-
-/// Marks the output phase of a command (the commit of its
-/// [`output::Outputs`]): an interrupt (Ctrl-C, SIGTERM, SIGHUP) waits until
-/// the guard is dropped, so that a run stops either before its outputs move
-/// into place or after, never while they do.
-pub(crate) fn writing() -> Writing {
-    Writing { _guard: WRITING.lock().unwrap_or_else(PoisonError::into_inner) }
 }
 
 fn main() -> ExitCode {
     // Without a handler the signal would end the process at once, leaving
     // its staging folder behind for the next run to clean.
     let interrupt = ctrlc::set_handler(|| {
-        let _held = WRITING.lock().unwrap_or_else(PoisonError::into_inner);
-        output::abandon_all();
-        if WRITTEN.load(Ordering::Relaxed) {
+        let (_held, written) = rfm_cli::interrupt_outputs();
+        if written {
             eprintln!("interrupted after this run's outputs were written");
         } else {
             eprintln!("interrupted: the outputs of this run were not written (earlier ones are untouched)");
@@ -234,7 +167,7 @@ fn main() -> ExitCode {
     // the default hook has printed where it happened (unwinding has removed
     // any staging folder on the way).
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(cli))).unwrap_or_else(|_| {
-        Err(exit::Failure::new(
+        Err(rfm_cli::Failure::new(
             Exit::Internal,
             "internal error (a bug in rfm): please report it with the command and its input files",
         ))
@@ -248,10 +181,10 @@ fn main() -> ExitCode {
     }
 }
 
-fn run(cli: Cli) -> commands::Result<Exit> {
+fn run(cli: Cli) -> rfm_cli::Result<Exit> {
     match cli.command {
         Command::Simulate { case, out, truth, noise, seed, kind, binary, json } => {
-            commands::simulate(&commands::SimulateArgs {
+            rfm_cli::simulate(&rfm_cli::SimulateArgs {
                 case: &case,
                 out: &out,
                 truth,
@@ -262,16 +195,16 @@ fn run(cli: Cli) -> commands::Result<Exit> {
                 json,
             })
         }
-        Command::Compare { case, measured, out, json, bands, frequency_axis } => commands::compare(
+        Command::Compare { case, measured, out, json, bands, frequency_axis } => rfm_cli::compare(
             &case,
             &measured,
             out.as_deref(),
             json,
             &bands,
-            &report::ReportOptions { frequency_scale: frequency_axis, ..Default::default() },
+            &ReportOptions { frequency_scale: frequency_axis, ..Default::default() },
         ),
         Command::Diagnose { case, measured, json, apply, out, top, verbose } => {
-            commands::diagnose(&commands::DiagnoseArgs {
+            rfm_cli::diagnose(&rfm_cli::DiagnoseArgs {
                 case: &case,
                 measured: measured.as_deref(),
                 json,
@@ -281,20 +214,20 @@ fn run(cli: Cli) -> commands::Result<Exit> {
                 verbose,
             })
         }
-        Command::Fix { case, out, steps, json, frequency_axis } => commands::fix(&commands::FixArgs {
+        Command::Fix { case, out, steps, json, frequency_axis } => rfm_cli::fix(&rfm_cli::FixArgs {
             case: &case,
             out: &out,
             steps: steps as usize,
             json,
-            report: report::ReportOptions { frequency_scale: frequency_axis, ..Default::default() },
+            report: ReportOptions { frequency_scale: frequency_axis, ..Default::default() },
         }),
-        Command::Inspect { file, json } => commands::inspect(&file, json),
-        Command::Update { case, out, json, method, lines, iterations, frequency_axis } => commands::update(
+        Command::Inspect { file, json } => rfm_cli::inspect(&file, json),
+        Command::Update { case, out, json, method, lines, iterations, frequency_axis } => rfm_cli::update(
             &case,
             out.as_deref(),
             json,
-            &commands::UpdateOverrides { method, lines, max_iterations: iterations },
-            &report::ReportOptions { frequency_scale: frequency_axis, ..Default::default() },
+            &rfm_cli::UpdateOverrides { method, lines, max_iterations: iterations },
+            &ReportOptions { frequency_scale: frequency_axis, ..Default::default() },
         ),
     }
 }

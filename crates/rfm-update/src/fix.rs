@@ -1,47 +1,72 @@
-//! Closing the loop: diagnose, add the recommended effect, update every
-//! added parameter, and again, until nothing significant remains.
+//! Closing the loop: check the data, update the case's own parameters,
+//! then diagnose, add an effect, update everything, and again, while the
+//! evidence asks for it.
 //!
-//! This is what `rfm fix` runs. Each step
+//! This is what `rfm fix` runs. One rule decides every step:
 //!
-//! 1. diagnoses the current model against the data ([`crate::diagnose`]),
-//! 2. adds the recommended effect (the first significant, plausible one) at
-//!    its fitted values ([`Diagnosis::apply`]),
-//! 3. updates, by output error on the diagnosis's lines, every parameter of
-//!    the case's `[update]`, which now holds the parameters of every effect
-//!    added so far: an effect fitted while another was still missing is
-//!    biased, and the joint update removes that bias,
+//! > **each step keeps the model that the evidence prefers over the
+//! > previous one, with every parameter counted, and nothing else.**
 //!
-//! and records the misfit after 2 and after 3 in the case's history. When
-//! the best single effect leaves far more than the noise, two effects fitted
-//! together may be added as two steps instead ([`fix`], `pairs.rs`). The
-//! loop stops when no candidate is significant (the model is consistent
-//! with the data), when the significant ones are all implausible (the
-//! missing effect is not among the candidates), when an update does not
-//! lower the misfit, or after the given number of steps. When it then
-//! leaves more than 1.5 times the noise, the form of each effect is revised
-//! with the others in place (its other variants, a kind that stands in for
-//! it, or nothing; `fix/revise.rs`), and if the misfit still stays above that,
-//! each effect but the last, and each
-//! pair of effects, is left out in turn and the data diagnosed again
-//! without them, adding as many effects as were left out: an effect added
-//! early may only have mimicked the missing one, and another added later
-//! may only have made up for it (`fix/swap.rs`). The best replacement is kept
-//! when it lowers the misfit (last steps that name what they replaced).
-//! A last diagnosis of the final model says what, if anything, still stands
-//! out.
+//! The evidence is the change of the information criterion
+//! ([`diagnose::delta_bic`]) from the model before the step to the model
+//! after it, both updated, judged against what the model after leaves (the
+//! noise, or a lack of fit that no candidate explains) and counting every
+//! parameter the step adds; a step is kept when that is below the
+//! diagnosis's significance (-10), the values its update reaches are
+//! plausible (none at or past the limits of its effect's plausible range),
+//! and its update reached a stationary point. Steps are tried in this order:
+//!
+//! 0. **The data's own errors.** The channels are checked for what test
+//!    set-ups get wrong ([`crate::checks`]: an inverted sensor, swapped
+//!    cables, a sensor at another node or axis, a wrong sensitivity, and
+//!    measured modes the model lacks). A correction found is applied to the
+//!    data and written into the case (`[[measurement.corrections]]`): the
+//!    model is fitted to the corrected data, and nothing is blamed on it
+//!    that the set-up made.
+//! 1. **The case's declared parameters.** When the case lists parameters
+//!    under `[update]`, they are updated first (step 0 of the report): an
+//!    effect is blamed on missing physics only after the user's own
+//!    uncertain parameters have had their chance.
+//! 2. **One effect at a time.** The current model is diagnosed; each of a
+//!    few distinct leaders (significant and plausible, of different kinds
+//!    or places) is added and every parameter updated jointly; the best by
+//!    its own evidence is kept. When several leaders at different places
+//!    are as good as each other (their evidence within the significance of
+//!    each other), the loop stops and lists them: the data cannot tell them
+//!    apart. Two leaders may also be kept together, as two steps, when
+//!    neither alone explains the data (two effects that mislead one at a
+//!    time): the pair is kept only when each of the two passes the rule
+//!    against the model with the other alone.
+//! 3. **Revisions.** When the effects leave more than the noise, each is
+//!    revised with the others in place (its other forms, a kind that stands
+//!    in for it, or nothing; `fix/revise.rs`), and effects added early are
+//!    left out and replaced (`fix/swap.rs`): each replacement is a step kept
+//!    by the same rule.
+//!
+//! The loop stops when no step passes the rule: with the data explained to
+//! their noise ([`FixStop::NothingSignificant`]), or with something the
+//! candidates cannot explain, described in the user's terms (an extra mode,
+//! a channel, a band, a damping form: [`FixOutcome::remains`];
+//! [`FixStop::ModelInadequate`]), or when several effects explain the data
+//! equally well ([`FixStop::Ambiguous`]).
 
 use fe_model::{CaseEditor, CaseFile, HistoryEntry};
 use frf::FrfSet;
 
-use crate::diagnose::{self, DiagnoseOptions, Diagnosis, Ranked};
+use crate::checks::{self, CheckOptions, Finding, FindingKind};
+use crate::diagnose::{self, DiagnoseOptions, Diagnosis, MisfitStats, Ranked};
 use crate::error::UpdateError;
 use crate::status::Status;
 use crate::study::{ParameterReport, Study};
 use crate::uncertainty::UncertaintyReport;
 
+mod judge;
 mod pairs;
+mod remains;
 mod revise;
 mod swap;
+
+use judge::Evidence;
 
 /// Options of the loop.
 #[derive(Clone, Debug)]
@@ -56,12 +81,42 @@ pub struct FixOptions {
     /// the cases of the steps read them from there, without the truth
     /// ([`Diagnosis::apply_with_data`]).
     pub data: Option<std::path::PathBuf>,
+    /// Check the data for set-up errors first and fit the corrected data
+    /// ([`crate::checks`]); on by default.
+    pub check_data: bool,
 }
 
 impl Default for FixOptions {
     fn default() -> Self {
-        FixOptions { max_steps: 3, diagnose: DiagnoseOptions::default(), update_iterations: 100, data: None }
+        FixOptions {
+            max_steps: 3,
+            diagnose: DiagnoseOptions::default(),
+            update_iterations: 100,
+            data: None,
+            check_data: true,
+        }
     }
+}
+
+/// Step 0: the case's own `[update]` parameters updated before any effect is added.
+#[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct DeclaredStep {
+    /// The misfit before (the case as given, on the corrected data).
+    pub misfit_before: f64,
+    /// The misfit after the update.
+    pub misfit_updated: f64,
+    /// The evidence for the updated values over the given ones.
+    pub delta_bic: f64,
+    /// How the update ended.
+    pub status: Status,
+    /// The updated parameters.
+    pub parameters: Vec<ParameterReport>,
+    /// Their uncertainty.
+    pub uncertainty: Option<UncertaintyReport>,
+    /// The case after it.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    pub case: CaseEditor,
 }
 
 /// One step of the loop: the effect added and the update after it.
@@ -75,16 +130,20 @@ pub struct FixStep {
     pub misfit_added: f64,
     /// The misfit after the update.
     pub misfit_updated: f64,
+    /// The step's own evidence: the change of the information criterion
+    /// from the model before the step to the model after it, both updated,
+    /// every parameter counted ([`diagnose::delta_bic`]).
+    pub delta_bic: f64,
+    /// Parameters the model has after the step (the case's `[update]`).
+    pub parameter_count: usize,
     /// How the update ended.
     pub status: Status,
     /// The updated parameters (every effect added so far, and the case's own).
     pub parameters: Vec<ParameterReport>,
     /// Their uncertainty.
     pub uncertainty: Option<UncertaintyReport>,
-    /// The best pair fitted together and the first effects tried by looking
-    /// one step ahead (when the best single effect left more than three
-    /// times the noise), with the misfit each left after its best follower
-    /// (both updated jointly); empty when there was no need.
+    /// The other effects tried at this step, each added and updated, with
+    /// the evidence for it and why it was not kept.
     pub alternatives: Vec<LookAhead>,
     /// The effects of earlier steps this one replaced, with any that follow
     /// it (left out, the others kept, and these added instead; see [`fix`]),
@@ -94,44 +153,59 @@ pub struct FixStep {
     /// it no longer paid for its parameters (`fix/revise.rs`); `misfit_added`
     /// and `misfit_updated` are both the misfit without it, updated.
     pub removed: bool,
+    /// The misfit after the data found wrong once this step was kept were
+    /// corrected and every parameter updated again (see [`FixOutcome::findings`],
+    /// `found_after_step`); `case`, `parameters` and `status` are then that
+    /// update's.
+    pub corrected_misfit: Option<f64>,
     /// The case after this step (write it with [`CaseEditor::text_at`]).
     #[cfg_attr(feature = "serde", serde(skip))]
     pub case: CaseEditor,
 }
 
 impl FixStep {
-    fn of(a: Added, alternatives: Vec<LookAhead>, replaced: Option<String>) -> FixStep {
+    fn of(a: Added, delta_bic: f64, alternatives: Vec<LookAhead>, replaced: Option<String>) -> FixStep {
         FixStep {
             misfit_added: a.effect.misfit,
             effect: a.effect,
-            misfit_updated: a.misfit_updated,
+            misfit_updated: a.stats.misfit,
+            delta_bic,
+            parameter_count: a.outcome.parameters.len(),
             status: a.outcome.status,
             parameters: a.outcome.parameters,
             uncertainty: a.outcome.uncertainty,
             alternatives,
             replaced,
             removed: false,
+            corrected_misfit: None,
             case: a.editor,
         }
     }
 }
 
-/// A first effect tried by looking one step ahead.
+/// An effect (or a pair) tried at a step: added, every parameter updated,
+/// and judged.
 #[derive(Clone, Debug)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct LookAhead {
     /// The effect.
     pub effect: String,
-    /// The misfit after it, its update and its best follower (NaN when it
-    /// could not be added and updated, see `failed`).
+    /// The misfit after it and its update (NaN when it could not be added
+    /// and updated, see `failed`).
     pub misfit_ahead: f64,
+    /// The evidence for it over the model before the step (NaN when it
+    /// could not be added).
+    pub delta_bic: f64,
     /// Why adding and updating it failed (an update that drove a spring to
     /// zero and left a mechanism, say), when it did.
     pub failed: Option<String>,
-    /// The second effect, when this is a pair fitted together: `effect` and
-    /// it were added and updated jointly, and `misfit_ahead` is the misfit
-    /// they leave (no follower diagnosed).
+    /// Why it was not kept, when it passed nothing or lost to another
+    /// (`None` for the step kept).
+    pub rejected: Option<String>,
+    /// The second effect, when this is a pair fitted together.
     pub with: Option<String>,
+    /// As good as the effect kept: the data cannot tell the two apart.
+    pub equally_good: bool,
 }
 
 /// Why the loop stopped.
@@ -139,18 +213,20 @@ pub struct LookAhead {
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum FixStop {
-    /// No candidate explains the remaining misfit beyond the noise.
+    /// The model explains the data down to their noise, and no candidate is
+    /// significant.
     NothingSignificant,
-    /// Significant candidates remain, but none at plausible values: the
-    /// missing effect is not among the candidates.
-    NoPlausibleCandidate,
-    /// The last update did not lower the misfit.
-    NoImprovement,
+    /// More than the noise remains, and no candidate passes the rule
+    /// (significant on its own, plausible after its update, updated to a
+    /// stationary point): what remains is described in
+    /// [`FixOutcome::remains`].
+    ModelInadequate,
+    /// Several effects at different places explain the data equally well
+    /// (listed in [`FixOutcome::equally_good`]): the data cannot tell them
+    /// apart, and none is added.
+    Ambiguous,
     /// The number of steps asked for was done; something significant may remain.
     StepsDone,
-    /// No leading effect could be added and updated: each update left a
-    /// model that cannot be evaluated (a spring driven to zero, say).
-    CannotAdd,
     /// The diagnosis of the model after the last step failed (see
     /// [`FixOutcome::diagnosis_error`]); the steps before it stand.
     DiagnosisFailed,
@@ -160,15 +236,15 @@ impl FixStop {
     /// Plain-language reason.
     pub fn describe(self) -> &'static str {
         match self {
-            FixStop::NothingSignificant => "nothing significant remains: the model is consistent with the data",
-            FixStop::NoPlausibleCandidate => {
-                "significant effects remain, but none at plausible values: the missing effect may not be among the candidates"
+            FixStop::NothingSignificant => "nothing significant remains: the model explains the data to their noise",
+            FixStop::ModelInadequate => {
+                "the model is inadequate: more than the noise remains and no candidate effect explains it on its own \
+                 evidence"
             }
-            FixStop::NoImprovement => "the last update did not lower the misfit",
+            FixStop::Ambiguous => {
+                "several effects at different places explain the data equally well; the data cannot tell them apart"
+            }
             FixStop::StepsDone => "the number of steps asked for is done",
-            FixStop::CannotAdd => {
-                "no leading effect could be added and updated: each update left a model that cannot be evaluated"
-            }
             FixStop::DiagnosisFailed => "the diagnosis of the model after the last step failed",
         }
     }
@@ -180,32 +256,54 @@ impl FixStop {
 pub struct FixOutcome {
     /// The data's estimated relative noise (RMS per value).
     pub noise: f64,
-    /// The nominal model's misfit.
+    /// The nominal model's misfit (on the data as measured).
     pub nominal_misfit: f64,
+    /// What the checks found wrong with the data, corrected before the
+    /// model was fitted when they propose a correction (see [`crate::checks`]).
+    pub findings: Vec<Finding>,
+    /// The nominal model's misfit on the corrected data (equal to
+    /// `nominal_misfit` when nothing was corrected).
+    pub corrected_misfit: f64,
+    /// Step 0: the case's own `[update]` parameters, updated first.
+    pub declared: Option<DeclaredStep>,
     /// The steps, in order.
     pub steps: Vec<FixStep>,
     /// The effects in the final model, in the order they were added.
     pub effects: Vec<Ranked>,
     /// Why the loop stopped.
     pub stop: FixStop,
+    /// The reason in full: the stop's meaning and what decided it.
+    pub stop_reason: String,
+    /// What the final model leaves unexplained, in the user's terms (an
+    /// extra mode at f Hz, a channel, a band, a damping form); empty when
+    /// it explains the data to their noise.
+    pub remains: Vec<String>,
+    /// Effects at different places as good as each other, each with its
+    /// evidence: at the stop [`FixStop::Ambiguous`] (none added), or at an
+    /// earlier step when the loop ends without explaining the data (the
+    /// first listed was kept; nothing after told them apart).
+    pub equally_good: Vec<LookAhead>,
     /// The diagnosis of the final model (top of its ranking only).
     pub remaining: Vec<Ranked>,
     /// Whether something significant remains in the final diagnosis (true
     /// when that diagnosis failed: nothing says the model is consistent).
     pub significant_remains: bool,
-    /// Why the diagnosis of the final model failed, when it did: the steps
-    /// and their cases stand, but what remains is not known. An update can
-    /// leave a spring the data do not determine so stiff against the rest
-    /// that the solver calls a line singular (held-out trial 34 of the full
-    /// study: a joint's ky at 4e14 N/m beside 1e8).
+    /// Why the diagnosis of the final model failed, when it did.
     pub diagnosis_error: Option<String>,
 }
 
 impl FixOutcome {
-    /// The misfit after every stage: the nominal model, then per step with
-    /// the effect added and after the update, labelled.
+    /// The misfit after every stage: the nominal model, the corrected data,
+    /// step 0, then per step with the effect added and after the update,
+    /// labelled.
     pub fn stages(&self) -> Vec<(String, f64)> {
         let mut v = vec![("nominal".to_string(), self.nominal_misfit)];
+        if self.findings.iter().any(|f| !f.corrections.is_empty()) {
+            v.push(("nominal, on the corrected data".to_string(), self.corrected_misfit));
+        }
+        if let Some(d) = &self.declared {
+            v.push(("the case's own parameters updated (step 0)".to_string(), d.misfit_updated));
+        }
         for (k, s) in self.steps.iter().enumerate() {
             let label = match &s.replaced {
                 _ if s.removed => format!("- {}", s.effect.description),
@@ -214,19 +312,47 @@ impl FixOutcome {
             };
             v.push((label, s.misfit_added));
             v.push((format!("updated after step {}", k + 1), s.misfit_updated));
+            if let Some(m) = s.corrected_misfit {
+                v.push((format!("data corrected after step {} and updated", k + 1), m));
+            }
         }
         v
     }
 
     /// The final misfit.
     pub fn final_misfit(&self) -> f64 {
-        self.steps.last().map_or(self.nominal_misfit, |s| s.misfit_updated)
+        match (self.steps.last(), &self.declared) {
+            (Some(s), _) => s.corrected_misfit.unwrap_or(s.misfit_updated),
+            (None, Some(d)) => d.misfit_updated,
+            (None, None) => self.corrected_misfit,
+        }
+    }
+
+    /// The model explains the data to their noise: the final misfit within
+    /// [`CONSISTENT`] times the noise and nothing significant left.
+    pub fn explained(&self) -> bool {
+        self.stop == FixStop::NothingSignificant && self.final_misfit() <= CONSISTENT * self.noise
+    }
+
+    /// The case the loop ends with: the last step's, or step 0's.
+    pub fn final_case(&self) -> Option<&CaseEditor> {
+        self.steps.last().map(|s| &s.case).or(self.declared.as_ref().map(|d| &d.case))
     }
 }
 
 /// What the loop reports as it goes.
 #[derive(Clone, Debug)]
 pub enum FixProgress<'a> {
+    /// The data were checked for set-up errors.
+    Checked {
+        /// What was found (corrected when a correction is given).
+        findings: &'a [Finding],
+    },
+    /// The case's own parameters were updated (step 0).
+    Declared {
+        /// The step.
+        step: &'a DeclaredStep,
+    },
     /// A diagnosis is done.
     Diagnosed {
         /// Effects added before it.
@@ -234,14 +360,14 @@ pub enum FixProgress<'a> {
         /// The diagnosis.
         diagnosis: &'a Diagnosis,
     },
-    /// A first effect was tried by looking one step ahead.
+    /// An effect (or a pair) was tried: added, updated and judged.
     LookedAhead {
         /// Effects added before it.
         step: usize,
-        /// The effect and the misfit after it and its best follower.
+        /// The effect, the misfit after it and the verdict.
         ahead: &'a LookAhead,
     },
-    /// The update after adding an effect is done.
+    /// A step was kept.
     Updated {
         /// Effects added before this one.
         step: usize,
@@ -262,108 +388,162 @@ pub enum FixProgress<'a> {
 pub const CONSISTENT: f64 = 1.5;
 
 /// Above this multiple of the noise, the misfit the best single effect
-/// leaves suggests that more than one effect is missing, and the first is
-/// chosen by looking one step ahead.
-const LOOK_AHEAD_ABOVE: f64 = 3.0;
+/// leaves suggests that more than one effect is missing, and pairs of
+/// leaders are fitted together.
+const PAIRS_ABOVE: f64 = 3.0;
 
-/// How many distinct first effects the look-ahead tries.
-const LOOK_AHEAD_WIDTH: usize = 5;
+/// How many distinct leaders are added and updated at each step.
+const WIDTH: usize = 5;
 
 /// An effect added to a case and every parameter updated.
+#[derive(Clone)]
 struct Added {
     effect: Ranked,
     /// Its rank in the diagnosis it came from.
     rank: usize,
     editor: CaseEditor,
     case: CaseFile,
-    misfit_updated: f64,
+    stats: MisfitStats,
     outcome: crate::study::UpdateOutcome,
 }
 
-/// Adds ranked effect `rank` of `d` to `current` and updates every parameter
-/// of the case's `[update]` by output error on the diagnosis's lines; the
-/// updated values and the misfit go into the case's history as step `step`.
-/// `last`: the model is the loop's answer, and its update restarts (see
-/// [`update_case`]).
-fn add_and_update(
-    current: &CaseFile,
-    d: &Diagnosis,
-    rank: usize,
-    measured: &FrfSet,
-    opts: &FixOptions,
-    step: usize,
-    last: bool,
-) -> Result<Added, UpdateError> {
-    let editor = d.apply_with_data(current, rank, opts.data.as_deref())?;
-    let (editor, case, misfit_updated, outcome) = update_case(current, editor, d, measured, opts, step, last)?;
-    Ok(Added { effect: d.ranking[rank - 1].clone(), rank, editor, case, misfit_updated, outcome })
+/// The loop's state shared by its parts: the data, options and evidence.
+struct Loop<'a> {
+    /// The data the models are fitted to (corrected).
+    data: FrfSet,
+    opts: &'a FixOptions,
+    evidence: Evidence,
 }
 
-/// Updates every parameter of the `[update]` of the case `editor` holds by
-/// output error on the diagnosis's lines; returns the editor with the
-/// updated values and the misfit in the case's history (as step `step`),
-/// the case it now holds, the misfit and the outcome. `last`: the model is
-/// the loop's answer, and its fit restarts when it leaves more than the noise.
-fn update_case(
-    current: &CaseFile,
-    mut editor: CaseEditor,
-    d: &Diagnosis,
-    measured: &FrfSet,
-    opts: &FixOptions,
-    step: usize,
-    last: bool,
-) -> Result<(CaseEditor, CaseFile, f64, crate::study::UpdateOutcome), UpdateError> {
-    let lines = opts.diagnose.lines;
-    let added = CaseFile::parse(&current.path, &editor.text_at(&current.path)?)?;
-    let mut study = Study::with_measured(added, measured.clone())?;
-    if study.case().update.is_some() {
-        // the lines the misfit is measured on (see `diagnose::log_misfit`)
-        study.set_update_frequencies(fe_model::case::FrequencyChoice::List(diagnose::informative_lines(
-            measured, lines,
-        )))?;
+impl Loop<'_> {
+    /// Adds ranked effect `rank` of `d` to `current` and updates every
+    /// parameter of the case's `[update]` by output error on the diagnosis's
+    /// lines; the updated values and the misfit go into the case's history
+    /// as step `step`. `last`: the model is the loop's answer, and its
+    /// update restarts (see [`Loop::update_case`]).
+    fn add_and_update(
+        &self,
+        current: &CaseFile,
+        d: &Diagnosis,
+        rank: usize,
+        step: usize,
+        last: bool,
+    ) -> Result<Added, UpdateError> {
+        let editor = d.apply_with_data(current, rank, self.opts.data.as_deref())?;
+        let (editor, case, stats, outcome) = self.update_case(current, editor, step, last)?;
+        Ok(Added { effect: d.ranking[rank - 1].clone(), rank, editor, case, stats, outcome })
     }
-    let mut oe_opts = study.output_error_options()?;
-    oe_opts.max_iterations = opts.update_iterations;
-    // the loop decides from the misfit against the noise; restarting each
-    // intermediate (knowingly incomplete) model would only cost time. The
-    // last step's model is the answer: when its fit leaves more than the
-    // noise, restarts tell an optimiser stuck in a local minimum (they find
-    // a lower one) from a model that lacks something (they do not).
-    if !last {
-        oe_opts.restarts = 0;
-    }
-    let outcome = study.run_output_error(&oe_opts, |_| {})?;
-    let weights = opts.diagnose.weights.as_deref();
-    let misfit_updated = diagnose::log_misfit_with(&outcome.system, measured, lines, d.gains, weights)?;
-    let values = crate::params::quantity_values(study.parameters(), outcome.system.model());
-    editor.set_values(&values, &format!("updated by rfm fix, step {step}"))?;
-    editor.push_history(&HistoryEntry {
-        step: format!("updated after step {step}"),
-        misfit: misfit_updated,
-        noise: Some(d.noise),
-        ..HistoryEntry::default()
-    })?;
-    let case = CaseFile::parse(&current.path, &editor.text_at(&current.path)?)?;
-    Ok((editor, case, misfit_updated, outcome))
-}
 
-/// The diagnosis of `current`'s model, reported as that of step `step`.
-fn diagnosed(
-    current: &CaseFile,
-    measured: &FrfSet,
-    opts: &FixOptions,
-    step: usize,
-    progress: &mut impl FnMut(FixProgress<'_>),
-) -> Result<Diagnosis, UpdateError> {
-    let d = diagnose::diagnose(&current.model, measured, &opts.diagnose)?;
-    progress(FixProgress::Diagnosed { step, diagnosis: &d });
-    Ok(d)
+    /// Updates every parameter of the `[update]` of the case `editor` holds
+    /// by output error on the diagnosis's lines; returns the editor with the
+    /// updated values and the misfit in the case's history (as step
+    /// `step`), the case it now holds, the misfit's statistics and the
+    /// outcome. An update that ends short of a stationary point is run
+    /// again with the parameters it could not determine held at their
+    /// start; the outcome says how the last run ended. `last`: the model is
+    /// the loop's answer, and its fit restarts when it leaves more than the
+    /// noise.
+    fn update_case(
+        &self,
+        current: &CaseFile,
+        editor: CaseEditor,
+        step: usize,
+        last: bool,
+    ) -> Result<(CaseEditor, CaseFile, MisfitStats, crate::study::UpdateOutcome), UpdateError> {
+        let first = self.update_once(current, editor.clone(), step, last)?;
+        if judge::stationary(&first.3) {
+            return Ok(first);
+        }
+        // hold what the data do not determine, and try once more
+        let loose = judge::undetermined(&first.3);
+        if loose.is_empty() || loose.len() == first.3.parameters.len() {
+            return Ok(first);
+        }
+        let added = CaseFile::parse(&current.path, &editor.text_at(&current.path)?)?;
+        let Some(update) = added.update.as_ref() else { return Ok(first) };
+        let kept: Vec<String> =
+            update.parameters.iter().map(|p| p.name.clone()).filter(|n| !loose.contains(n)).collect();
+        let method = update.method.as_ref().map_or("output-error", |(m, _)| m.as_str());
+        let mut held = editor;
+        held.set_update(&kept, method)?;
+        match self.update_once(current, held, step, last) {
+            Ok(again) if judge::stationary(&again.3) => Ok(again),
+            _ => Ok(first),
+        }
+    }
+
+    /// One output-error update of the case `editor` holds (see [`Loop::update_case`]).
+    fn update_once(
+        &self,
+        current: &CaseFile,
+        mut editor: CaseEditor,
+        step: usize,
+        last: bool,
+    ) -> Result<(CaseEditor, CaseFile, MisfitStats, crate::study::UpdateOutcome), UpdateError> {
+        let opts = self.opts;
+        let lines = opts.diagnose.lines;
+        let added = CaseFile::parse(&current.path, &editor.text_at(&current.path)?)?;
+        let mut study = Study::with_measured(added, self.data.clone())?;
+        if study.case().update.is_some() {
+            // the lines the misfit is measured on (see `diagnose::log_misfit`)
+            study.set_update_frequencies(fe_model::case::FrequencyChoice::List(diagnose::informative_lines(
+                &self.data, lines,
+            )))?;
+        }
+        let mut oe_opts = study.output_error_options()?;
+        oe_opts.max_iterations = opts.update_iterations;
+        // the loop decides from the evidence; restarting each intermediate
+        // (knowingly incomplete) model would only cost time. The last
+        // step's model is the answer: when its fit leaves more than the
+        // noise, restarts tell an optimiser stuck in a local minimum (they
+        // find a lower one) from a model that lacks something (they do not).
+        if !last {
+            oe_opts.restarts = 0;
+        }
+        let outcome = study.run_output_error(&oe_opts, |_| {})?;
+        let stats = self.stats(&outcome.system)?;
+        let values = crate::params::quantity_values(study.parameters(), outcome.system.model());
+        editor.set_values(&values, &format!("updated by rfm fix, step {step}"))?;
+        editor.push_history(&HistoryEntry {
+            step: if step == 0 {
+                "the case's own parameters updated".into()
+            } else {
+                format!("updated after step {step}")
+            },
+            misfit: stats.misfit,
+            noise: Some(self.evidence.noise),
+            ..HistoryEntry::default()
+        })?;
+        let case = CaseFile::parse(&current.path, &editor.text_at(&current.path)?)?;
+        Ok((editor, case, stats, outcome))
+    }
+
+    /// The misfit statistics of a model on the diagnosis's lines.
+    fn stats(&self, sys: &damping::DampedSystem) -> Result<MisfitStats, UpdateError> {
+        let d = &self.opts.diagnose;
+        diagnose::misfit_stats(sys, &self.data, d.lines, d.gains, d.weights.as_deref())
+    }
+
+    /// The diagnosis of `current`'s model, reported as that of step `step`,
+    /// with resonators tried at the modes the data hold and the model lacks.
+    fn diagnosed(
+        &self,
+        current: &CaseFile,
+        extra_modes_hz: &[f64],
+        step: usize,
+        progress: &mut impl FnMut(FixProgress<'_>),
+    ) -> Result<Diagnosis, UpdateError> {
+        let mut opts = self.opts.diagnose.clone();
+        opts.candidates.resonator_hz = extra_modes_hz.to_vec();
+        let d = diagnose::diagnose(&current.model, &self.data, &opts)?;
+        progress(FixProgress::Diagnosed { step, diagnosis: &d });
+        Ok(d)
+    }
 }
 
 /// The ranks of up to `width` recommendable effects (significant and
 /// plausible, fully fitted or screened) that differ from each other in kind
-/// or place, best first: the full fits cover only the best of each kind, and
-/// when two effects hide at once the right first one can be a screened one.
+/// or place, best first.
 fn distinct_leaders(d: &Diagnosis, model: &fe_model::Model, width: usize) -> Vec<usize> {
     let mut out: Vec<usize> = Vec::new();
     for (i, r) in d.ranking.iter().enumerate() {
@@ -385,19 +565,164 @@ fn distinct_leaders(d: &Diagnosis, model: &fe_model::Model, width: usize) -> Vec
     out
 }
 
-/// Runs the loop on a case against its measured receptances (all lines).
-/// The case's own `[update]` parameters, if any, are updated together with
-/// the added effects' at every step.
-///
-/// When the best single effect would leave more than three times the noise
-/// (two effects may hide at once, and a single candidate that mimics both
-/// may lead), every pair of a few distinct leaders is added and updated
-/// jointly (`fix/pairs.rs`); unless the best pair reaches the noise, the first
-/// effect is also sought by looking one step ahead: each of a few distinct
-/// leaders is added and updated, the data diagnosed again, and its best
-/// follower added and everything updated jointly. The best pair is added as
-/// two steps when it leaves less than every leader with its follower, else
-/// the best leader as one.
+/// A move tried at a step: one effect, or a pair kept as two steps.
+struct Move {
+    /// The steps it makes (one or two), each with its own evidence.
+    steps: Vec<(Added, f64)>,
+    /// What it reads as in the report.
+    record: LookAhead,
+}
+
+impl Move {
+    /// The model the move ends with.
+    fn last(&self) -> &Added {
+        &self.steps.last().expect("a move makes a step").0
+    }
+}
+
+/// The model a step starts from: its misfit and parameter count.
+#[derive(Clone, Copy, Debug)]
+struct State {
+    misfit: f64,
+    k: usize,
+}
+
+/// What the loop starts from once the data are checked and the case's own
+/// parameters updated (steps 0 and 1 of the module docs): what `rfm fix`
+/// runs first, and what `rfm diagnose` diagnoses.
+#[derive(Clone, Debug)]
+pub struct Prepared {
+    /// The data's estimated relative noise (RMS per value).
+    pub noise: f64,
+    /// The nominal model's misfit on the data as measured.
+    pub nominal_misfit: f64,
+    /// The nominal model's misfit on the corrected data.
+    pub corrected_misfit: f64,
+    /// What the checks found (see [`crate::checks`]).
+    pub findings: Vec<Finding>,
+    /// The data, corrected as the findings say.
+    pub data: FrfSet,
+    /// The case with the corrections written and its own parameters updated.
+    pub case: CaseFile,
+    /// Step 0, when the case declares parameters.
+    pub declared: Option<DeclaredStep>,
+    /// Frequencies (Hz) of measured modes the model lacks.
+    pub extra_modes_hz: Vec<f64>,
+    /// The model's misfit and parameter count after these steps.
+    state: State,
+}
+
+/// Checks the data for set-up errors and corrects them, then updates the
+/// case's own `[update]` parameters (see the module docs).
+pub fn prepare(
+    case: &CaseFile,
+    measured: &FrfSet,
+    opts: &FixOptions,
+    progress: &mut impl FnMut(FixProgress<'_>),
+) -> Result<Prepared, UpdateError> {
+    let nominal_sys = damping::DampedSystem::new(case.model.clone())?;
+    let d_opts = &opts.diagnose;
+    let noise = diagnose::estimate_noise_against_weighted(&nominal_sys, measured, d_opts.weights.as_deref())?
+        .ok_or_else(|| UpdateError::Data("too few usable measured values to estimate the noise level".into()))?;
+    let nominal =
+        diagnose::misfit_stats(&nominal_sys, measured, d_opts.lines, d_opts.gains, d_opts.weights.as_deref())?;
+    let evidence = Evidence { noise, significance: d_opts.significance };
+    // the data's own errors first
+    let mut findings: Vec<Finding> = Vec::new();
+    let mut data = measured.clone();
+    let mut current = case.clone();
+    if opts.check_data {
+        findings = checks::check(&nominal_sys, measured, &check_options(opts, noise))?;
+        progress(FixProgress::Checked { findings: &findings });
+        if findings.iter().any(|f| !f.corrections.is_empty()) {
+            data = checks::corrected(measured, &findings)?;
+            current = with_corrections(case, &findings, opts)?;
+        }
+    }
+    let fl = Loop { data, opts, evidence };
+    let corrected = if fl.data == *measured { nominal } else { fl.stats(&nominal_sys)? };
+    let mut state = State { misfit: corrected.misfit, k: 0 };
+    // the case's own parameters next
+    let mut declared = None;
+    if current.update.as_ref().is_some_and(|u| !u.parameters.is_empty()) {
+        let (editor, case_after, stats, outcome) = fl.update_case(&current, current.editor()?, 0, false)?;
+        let k = outcome.parameters.len();
+        // the user's own parameters are kept unless their update made things worse
+        if stats.misfit <= state.misfit {
+            let step = DeclaredStep {
+                misfit_before: state.misfit,
+                misfit_updated: stats.misfit,
+                delta_bic: diagnose::delta_bic(state.misfit, 0, &stats, k, noise),
+                status: outcome.status.clone(),
+                parameters: outcome.parameters.clone(),
+                uncertainty: outcome.uncertainty.clone(),
+                case: editor,
+            };
+            progress(FixProgress::Declared { step: &step });
+            declared = Some(step);
+            current = case_after;
+            state = State { misfit: stats.misfit, k };
+            // the modes the case's own model lacks, once its own parameters are updated
+            if opts.check_data {
+                findings.retain(|f| f.kind != FindingKind::ExtraMode);
+                findings.extend(checks::extra_modes(&outcome.system, &fl.data)?);
+            }
+        }
+    }
+    Ok(Prepared {
+        noise,
+        nominal_misfit: nominal.misfit,
+        corrected_misfit: corrected.misfit,
+        extra_modes_hz: findings.iter().filter_map(|f| f.frequency_hz).collect(),
+        findings,
+        data: fl.data,
+        case: current,
+        declared,
+        state,
+    })
+}
+
+/// What `rfm diagnose` reports: the findings about the data, step 0 (the
+/// case's own parameters updated), and the diagnosis of the model after
+/// them, as one JSON object (the diagnosis's fields at its top level).
+#[derive(Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct CheckedDiagnosis<'a> {
+    /// What the checks found about the data (corrected before the diagnosis).
+    pub findings: &'a [Finding],
+    /// Step 0, when the case declares parameters.
+    pub declared: Option<&'a DeclaredStep>,
+    /// The diagnosis of the model after them, on the corrected data.
+    #[cfg_attr(feature = "serde", serde(flatten))]
+    pub diagnosis: &'a Diagnosis,
+}
+
+/// The diagnosis `rfm diagnose` makes: the data checked and corrected, the
+/// case's own parameters updated ([`prepare`]), then the model diagnosed
+/// against the corrected data, resonators tried at the modes it lacks.
+/// `stage` hears of each stage of the diagnosis.
+pub fn diagnose_prepared(
+    case: &CaseFile,
+    measured: &FrfSet,
+    opts: &FixOptions,
+    progress: &mut impl FnMut(FixProgress<'_>),
+    stage: impl FnMut(&str),
+) -> Result<(Prepared, Diagnosis), UpdateError> {
+    let p = prepare(case, measured, opts, progress)?;
+    let mut d_opts = opts.diagnose.clone();
+    d_opts.candidates.resonator_hz = p.extra_modes_hz.clone();
+    let d = diagnose::diagnose_with(&p.case.model, &p.data, &d_opts, stage)?;
+    Ok((p, d))
+}
+
+/// The checks' options for the loop's data.
+fn check_options(opts: &FixOptions, noise: f64) -> CheckOptions {
+    let d = &opts.diagnose;
+    CheckOptions { lines: d.lines, gains: d.gains, weights: d.weights.clone(), noise }
+}
+
+/// Runs the loop on a case against its measured receptances (all lines);
+/// see the module docs.
 pub fn fix(
     case: &CaseFile,
     measured: &FrfSet,
@@ -407,160 +732,225 @@ pub fn fix(
     if opts.max_steps == 0 {
         return Err(UpdateError::Method("the loop needs at least one step".into()));
     }
-    let mut current = case.clone();
+    let p = prepare(case, measured, opts, &mut progress)?;
+    let d_opts = &opts.diagnose;
+    let noise = p.noise;
+    let mut fl = Loop { data: p.data, opts, evidence: Evidence { noise, significance: d_opts.significance } };
+    let (nominal, corrected) = (p.nominal_misfit, p.corrected_misfit);
+    let mut findings = p.findings;
+    let mut extra_hz = p.extra_modes_hz;
+    let declared = p.declared;
+    let mut current = p.case;
+    let mut state = p.state;
+
+    // the case every effect is added to: corrected, its own parameters updated
+    let mut base = current.clone();
     let mut steps: Vec<FixStep> = Vec::new();
-    let (mut noise, mut nominal_misfit) = (f64::NAN, f64::NAN);
-    let mut next: Option<Diagnosis> = None;
     // the diagnosis and rank of each effect added, to rebuild without one
     let mut applied: Vec<(Diagnosis, usize)> = Vec::new();
-    // the loop ends with the last diagnosis when it has one (`None`: the
-    // final model is still to be diagnosed), or with why it failed
+    let mut equally_good: Vec<LookAhead> = Vec::new();
+    // the first step at which effects elsewhere were as good as the one kept
+    let mut undecided: Vec<LookAhead> = Vec::new();
+    let mut last_diagnosis: Option<Result<Diagnosis, String>>;
+    let mut rejected_all: Vec<LookAhead> = Vec::new();
     let stop = loop {
-        let d = match next.take() {
-            Some(d) => d,
-            None => match diagnosed(&current, measured, opts, steps.len(), &mut progress) {
-                Ok(d) => d,
-                // the nominal model's failure is the user's to see; a later
-                // one must not discard the steps done
-                Err(e) if !steps.is_empty() => break (FixStop::DiagnosisFailed, Some(Err(e.to_string()))),
-                Err(e) => return Err(e),
-            },
+        let d = match fl.diagnosed(&current, &extra_hz, steps.len(), &mut progress) {
+            Ok(d) => d,
+            Err(e) if !steps.is_empty() || declared.is_some() => {
+                last_diagnosis = Some(Err(e.to_string()));
+                break FixStop::DiagnosisFailed;
+            }
+            Err(e) => return Err(e),
         };
-        if steps.is_empty() {
-            (noise, nominal_misfit) = (d.noise, d.nominal_misfit);
-        }
-        let Some(rank) = d.recommended else {
-            let stop = if d.consistent() { FixStop::NothingSignificant } else { FixStop::NoPlausibleCandidate };
-            break (stop, Some(Ok(d)));
-        };
-        if steps.len() == opts.max_steps {
-            break (FixStop::StepsDone, Some(Ok(d)));
+        let leaders = distinct_leaders(&d, &current.model, WIDTH);
+        if leaders.is_empty() || steps.len() == opts.max_steps {
+            let stop = if !leaders.is_empty() {
+                FixStop::StepsDone
+            } else if state.misfit <= CONSISTENT * noise {
+                FixStop::NothingSignificant
+            } else {
+                FixStop::ModelInadequate
+            };
+            last_diagnosis = Some(Ok(d));
+            break stop;
         }
         let step = steps.len() + 1;
-        let leader_misfit = d.ranking[rank - 1].misfit;
-        let mut alternatives = Vec::new();
-        let added: Vec<(Added, Diagnosis)> = if leader_misfit > LOOK_AHEAD_ABOVE * noise
-            && steps.len() + 2 <= opts.max_steps
-        {
-            // pairs of distinct leaders fitted together first: when the best
-            // reaches the noise, nothing is left to look ahead for
-            let leaders = distinct_leaders(&d, &current.model, pairs::PAIR_WIDTH);
-            let pair = pairs::best_pair(&current, &d, &leaders, measured, opts, step);
-            if let Some(p) = &pair {
-                alternatives.push(LookAhead {
-                    effect: d.ranking[p.ranks.0 - 1].description.clone(),
-                    misfit_ahead: p.misfit,
-                    failed: None,
-                    with: Some(d.ranking[p.ranks.1 - 1].description.clone()),
-                });
-                progress(FixProgress::LookedAhead { step: steps.len(), ahead: alternatives.last().expect("pushed") });
-            }
-            let mut best: Option<(f64, Added, Diagnosis)> = None;
-            let singles = if pair.as_ref().is_none_or(|p| p.misfit > swap::SWAP_ABOVE * noise) {
-                distinct_leaders(&d, &current.model, LOOK_AHEAD_WIDTH)
-            } else {
-                Vec::new()
-            };
-            for r in singles {
-                // one alternative that cannot be added (its update left a
-                // mechanism, say) must not end the loop: the others can
-                let tried =
-                    add_and_update(&current, &d, r, measured, opts, step, step >= opts.max_steps).and_then(|a| {
-                        let ahead = diagnose::diagnose(&a.case.model, measured, &opts.diagnose)?;
-                        // the follower added and everything updated jointly,
-                        // as the pairs are: a first effect that absorbed part
-                        // of the other is corrected by the joint update
-                        let joint = ahead
-                            .recommended
-                            .and_then(|r| add_and_update(&a.case, &ahead, r, measured, opts, step + 1, false).ok());
-                        Ok((a, ahead, joint.map(|j| j.misfit_updated)))
-                    });
-                let (a, ahead, joint) = match tried {
-                    Ok(x) => x,
-                    Err(e) => {
-                        let effect = d.ranking[r - 1].description.clone();
-                        alternatives.push(LookAhead {
-                            effect,
-                            misfit_ahead: f64::NAN,
-                            failed: Some(e.to_string()),
-                            with: None,
-                        });
-                        progress(FixProgress::LookedAhead {
-                            step: steps.len(),
-                            ahead: alternatives.last().expect("pushed"),
-                        });
-                        continue;
+        let last = step >= opts.max_steps;
+        let mut moves: Vec<Move> = Vec::new();
+        let mut singles: Vec<(usize, Added)> = Vec::new();
+        let mut tried: Vec<LookAhead> = Vec::new();
+        for (i, &r) in leaders.iter().enumerate() {
+            let name = d.ranking[r - 1].description.clone();
+            match fl.add_and_update(&current, &d, r, step, last) {
+                Ok(a) => {
+                    let verdict = fl.evidence.judge(state, &a, &applied_with(&applied, &d, r));
+                    let record = LookAhead {
+                        effect: name,
+                        misfit_ahead: a.stats.misfit,
+                        delta_bic: verdict.delta_bic,
+                        failed: None,
+                        rejected: verdict.rejected.clone(),
+                        with: None,
+                        equally_good: false,
+                    };
+                    progress(FixProgress::LookedAhead { step: steps.len(), ahead: &record });
+                    let reaches = a.stats.misfit <= CONSISTENT * noise;
+                    if verdict.rejected.is_none() {
+                        moves.push(Move { steps: vec![(a.clone(), verdict.delta_bic)], record });
+                    } else {
+                        tried.push(record);
                     }
-                };
-                let alone = ahead.leader().map_or(a.misfit_updated, |l| l.misfit.min(a.misfit_updated));
-                let score = joint.map_or(alone, |j| j.min(alone));
-                alternatives.push(LookAhead {
-                    effect: a.effect.description.clone(),
-                    misfit_ahead: score,
-                    failed: None,
-                    with: None,
-                });
-                progress(FixProgress::LookedAhead { step: steps.len(), ahead: alternatives.last().expect("pushed") });
-                if best.as_ref().is_none_or(|(b, ..)| score < *b) {
-                    best = Some((score, a, ahead));
+                    singles.push((r, a));
+                    // the first leader reaching the noise on its own evidence
+                    // needs no rival unless the diagnosis saw one as good
+                    if i == 0
+                        && reaches
+                        && moves.len() == 1
+                        && !close_rival(&d, &leaders, &current.model, fl.evidence.significance)
+                    {
+                        break;
+                    }
+                }
+                Err(e) => {
+                    let record = LookAhead {
+                        effect: name,
+                        misfit_ahead: f64::NAN,
+                        delta_bic: f64::NAN,
+                        failed: Some(e.to_string()),
+                        rejected: Some(format!("it could not be added and updated: {e}")),
+                        with: None,
+                        equally_good: false,
+                    };
+                    progress(FixProgress::LookedAhead { step: steps.len(), ahead: &record });
+                    tried.push(record);
                 }
             }
-            // the pair, when it beats every single effect with its follower:
-            // its first effect is a step of its own, then the second is added
-            let pair = pair.filter(|p| best.as_ref().is_none_or(|(b, ..)| p.misfit < *b));
-            let both = pair.and_then(|p| {
-                let (a, b) = p.ranks;
-                let first = add_and_update(&current, &d, a, measured, opts, step, false).ok()?;
-                let last = step + 1 >= opts.max_steps;
-                let second = add_and_update(&first.case, &d, b, measured, opts, step + 1, last).ok()?;
-                Some([first, second])
-            });
-            match (both, best) {
-                (Some([first, second]), _) => vec![(first, d.clone()), (second, d)],
-                (None, Some((_, a, ahead))) => {
-                    next = Some(ahead);
-                    vec![(a, d)]
+        }
+        // two effects that mislead one at a time, fitted together
+        let best_single = moves.iter().map(|m| m.steps[0].0.stats.misfit).fold(f64::INFINITY, f64::min);
+        if best_single > PAIRS_ABOVE * noise && steps.len() + 2 <= opts.max_steps {
+            let pair_leaders = distinct_leaders(&d, &current.model, pairs::PAIR_WIDTH);
+            if let Some(m) = pairs::best_pair(&fl, &current, &d, &pair_leaders, &singles, state, (step, last), &applied)
+            {
+                progress(FixProgress::LookedAhead { step: steps.len(), ahead: &m.record });
+                if m.record.rejected.is_none() {
+                    moves.push(m);
+                } else {
+                    tried.push(m.record);
                 }
-                (None, None) => break (FixStop::CannotAdd, Some(Ok(d))),
             }
-        } else {
-            // the recommended effect, else the next distinct leaders in turn
-            // when adding and updating one fails
-            let added = std::iter::once(rank)
-                .chain(distinct_leaders(&d, &current.model, LOOK_AHEAD_WIDTH))
-                .find_map(|r| add_and_update(&current, &d, r, measured, opts, step, step >= opts.max_steps).ok());
-            let Some(a) = added else {
-                break (FixStop::CannotAdd, Some(Ok(d)));
+        }
+        if moves.is_empty() {
+            rejected_all = tried;
+            last_diagnosis = Some(Ok(d));
+            break if state.misfit <= CONSISTENT * noise {
+                FixStop::NothingSignificant
+            } else {
+                FixStop::ModelInadequate
             };
-            vec![(a, d)]
+        }
+        // the best move by the criterion against one variance for all: what
+        // the best of them leaves (each move's own dBIC is against its own)
+        let v = moves.iter().map(|m| m.last().stats.lack_of_fit(noise)).fold(f64::INFINITY, f64::min);
+        let score = |m: &Move| {
+            let a = m.last();
+            let n = a.stats.n as f64;
+            n * a.stats.misfit.powi(2) / v + a.outcome.parameters.len() as f64 * n.ln()
         };
-        let mut improved = true;
-        for (k, (added, d)) in added.into_iter().enumerate() {
+        moves.sort_by(|a, b| score(a).total_cmp(&score(b)));
+        let best = moves.remove(0);
+        // alternatives at other places that the evidence cannot tell from the best
+        let first = best.last();
+        let mut alternatives: Vec<LookAhead> = Vec::new();
+        for m in moves {
+            let other = m.last();
+            let mut rec = m.record.clone();
+            let elsewhere = !near(&d, first, other, &current.model);
+            let between = fl.evidence.between(first, other);
+            if elsewhere && between < -fl.evidence.significance {
+                rec.equally_good = true;
+                rec.rejected = Some(format!(
+                    "as good as {} (the evidence between them {between:.1}, not below {})",
+                    best.record.effect, fl.evidence.significance
+                ));
+            } else {
+                rec.rejected = Some(format!(
+                    "{} is better (the evidence for it over this one {:.1})",
+                    best.record.effect, -between
+                ));
+            }
+            alternatives.push(rec);
+        }
+        if alternatives.iter().any(|a| a.equally_good) {
+            let mut listed = vec![best.record.clone()];
+            listed[0].equally_good = true;
+            listed.extend(alternatives.iter().filter(|a| a.equally_good).cloned());
+            // where the best would be the last effect (it explains the data
+            // to their noise) the data cannot choose, and none is added;
+            // before that, later steps and the revisions may tell them apart,
+            // and the list is kept for the end
+            if first.stats.misfit <= CONSISTENT * noise {
+                equally_good = listed;
+                last_diagnosis = Some(Ok(d));
+                break FixStop::Ambiguous;
+            }
+            if undecided.is_empty() {
+                undecided = listed;
+            }
+        }
+        alternatives.extend(tried);
+        for (k, (added, delta_bic)) in best.steps.into_iter().enumerate() {
             progress(FixProgress::Updated {
                 step: steps.len(),
                 effect: &added.effect.description,
                 removed: false,
-                misfit: added.misfit_updated,
+                misfit: added.stats.misfit,
                 status: &added.outcome.status,
             });
             current = added.case.clone();
-            improved = added.misfit_updated < steps.last().map_or(nominal_misfit, |s: &FixStep| s.misfit_updated);
-            applied.push((d, added.rank));
-            let tried = if k == 0 { std::mem::take(&mut alternatives) } else { Vec::new() };
-            steps.push(FixStep::of(added, tried, None));
+            state = State { misfit: added.stats.misfit, k: added.outcome.parameters.len() };
+            applied.push((d.clone(), added.rank));
+            let alts = if k == 0 { std::mem::take(&mut alternatives) } else { Vec::new() };
+            steps.push(FixStep::of(added, delta_bic, alts, None));
         }
-        if let Some(ahead) = &next {
-            progress(FixProgress::Diagnosed { step: steps.len(), diagnosis: ahead });
-        }
-        if !improved {
-            break (FixStop::NoImprovement, next.take().map(Ok));
+        // the data's own errors again, against the model the evidence now
+        // prefers: a large model error can hide a misplaced or miscalibrated
+        // sensor from the first check; and the modes it still lacks (a
+        // resonator added explains its mode, which is not offered again)
+        if opts.check_data {
+            let sys = damping::DampedSystem::new(current.model.clone())?;
+            extra_hz = checks::extra_modes(&sys, &fl.data)?.iter().filter_map(|f| f.frequency_hz).collect();
+            let late: Vec<Finding> = checks::check_channels(&sys, &fl.data, &check_options(opts, noise))?
+                .into_iter()
+                .filter(|f| !f.corrections.is_empty())
+                .map(|mut f| {
+                    f.found_after_step = steps.len();
+                    f
+                })
+                .collect();
+            if !late.is_empty() {
+                progress(FixProgress::Checked { findings: &late });
+                fl.data = checks::corrected(&fl.data, &late)?;
+                current = with_corrections(&current, &late, opts)?;
+                base = with_corrections(&base, &late, opts)?;
+                let (editor, case_after, stats, outcome) =
+                    fl.update_case(&current, current.editor()?, steps.len(), steps.len() >= opts.max_steps)?;
+                current = case_after;
+                state = State { misfit: stats.misfit, k: outcome.parameters.len() };
+                let s = steps.last_mut().expect("a step was kept");
+                s.corrected_misfit = Some(stats.misfit);
+                s.case = editor;
+                s.parameters = outcome.parameters;
+                s.uncertainty = outcome.uncertainty;
+                s.status = outcome.status;
+                findings.extend(late);
+            }
         }
     };
-    let (stop, mut last) = stop;
     let mut effects: Vec<Ranked> = steps.iter().map(|s| s.effect.clone()).collect();
-    let mut misfit = steps.last().map_or(nominal_misfit, |s| s.misfit_updated);
-    if !applied.is_empty() && misfit > CONSISTENT * noise {
-        let (kept, revised) = revise::revise(case, &applied, &current, measured, opts, (misfit, noise));
+    // revisions and replacements, each kept by the same rule
+    if !applied.is_empty() && state.misfit > CONSISTENT * noise && stop != FixStop::Ambiguous {
+        let (kept, revised) = revise::revise(&fl, &base, &applied, &current, state);
         if !kept.is_empty() {
             for r in kept {
                 let effect = if r.removed {
@@ -572,37 +962,38 @@ pub fn fix(
                     step: steps.len(),
                     effect: &effect,
                     removed: r.removed,
-                    misfit: r.added.misfit_updated,
+                    misfit: r.added.stats.misfit,
                     status: &r.added.outcome.status,
                 });
                 current = r.added.case.clone();
-                misfit = r.added.misfit_updated;
+                state = State { misfit: r.added.stats.misfit, k: r.added.outcome.parameters.len() };
                 if r.removed {
                     effects.remove(r.index);
-                    let mut s = FixStep::of(r.added, Vec::new(), None);
+                    let mut s = FixStep::of(r.added, r.delta_bic, Vec::new(), None);
                     // nothing was added: the misfit without it is the updated one
                     s.misfit_added = s.misfit_updated;
                     s.removed = true;
                     steps.push(s);
                 } else {
                     effects[r.index] = r.added.effect.clone();
-                    steps.push(FixStep::of(r.added, Vec::new(), Some(r.replaced)));
+                    steps.push(FixStep::of(r.added, r.delta_bic, Vec::new(), Some(r.replaced)));
                 }
             }
             applied = revised;
-            last = None;
+            last_diagnosis = None;
         }
     }
     if applied.len() >= 2
-        && misfit > swap::SWAP_ABOVE * noise
-        && let Some((outs, added)) = swap::swap(case, &applied, measured, opts, misfit)
+        && state.misfit > CONSISTENT * noise
+        && stop != FixStop::Ambiguous
+        && let Some((outs, added)) = swap::swap(&fl, &base, &applied, state)
     {
         let removed: Vec<String> = outs.iter().map(|&i| effects[i].description.clone()).collect();
         for &i in outs.iter().rev() {
             effects.remove(i);
         }
         let replaced = removed.join(" and ");
-        for (k, a) in added.into_iter().enumerate() {
+        for (k, (a, delta_bic)) in added.into_iter().enumerate() {
             let effect = if k == 0 {
                 format!("{} instead of {replaced}", a.effect.description)
             } else {
@@ -612,29 +1003,107 @@ pub fn fix(
                 step: steps.len(),
                 effect: &effect,
                 removed: false,
-                misfit: a.misfit_updated,
+                misfit: a.stats.misfit,
                 status: &a.outcome.status,
             });
             effects.push(a.effect.clone());
             current = a.case.clone();
-            steps.push(FixStep::of(a, Vec::new(), (k == 0).then(|| replaced.clone())));
+            state = State { misfit: a.stats.misfit, k: a.outcome.parameters.len() };
+            steps.push(FixStep::of(a, delta_bic, Vec::new(), (k == 0).then(|| replaced.clone())));
         }
-        last = None;
+        last_diagnosis = None;
     }
-    let last = last
-        .unwrap_or_else(|| diagnosed(&current, measured, opts, steps.len(), &mut progress).map_err(|e| e.to_string()));
+    let last = last_diagnosis
+        .unwrap_or_else(|| fl.diagnosed(&current, &extra_hz, steps.len(), &mut progress).map_err(|e| e.to_string()));
     let (last, diagnosis_error) = match last {
         Ok(d) => (Some(d), None),
         Err(e) => (None, Some(e)),
     };
+    // a stop decided before revisions that mended the model is decided again
+    let stop = match stop {
+        FixStop::ModelInadequate | FixStop::StepsDone | FixStop::NothingSignificant
+            if state.misfit <= CONSISTENT * noise && last.as_ref().is_some_and(Diagnosis::consistent) =>
+        {
+            FixStop::NothingSignificant
+        }
+        FixStop::NothingSignificant if state.misfit > CONSISTENT * noise => FixStop::ModelInadequate,
+        s => s,
+    };
+    // effects as good as each other at a step, not told apart by the end
+    if equally_good.is_empty() && !(state.misfit <= CONSISTENT * noise && stop == FixStop::NothingSignificant) {
+        equally_good = undecided;
+    }
+    let final_sys = damping::DampedSystem::new(current.model.clone())?;
+    let remains = if state.misfit > CONSISTENT * noise {
+        remains::describe(&final_sys, &fl.data, d_opts, noise, &findings)
+    } else {
+        Vec::new()
+    };
+    let stop_reason =
+        remains::stop_reason(stop, &rejected_all, &equally_good, diagnosis_error.as_deref(), state.misfit, noise);
     Ok(FixOutcome {
         noise,
-        nominal_misfit,
+        nominal_misfit: nominal,
+        findings,
+        corrected_misfit: corrected,
+        declared,
         effects,
         steps,
         stop,
+        stop_reason,
+        remains,
+        equally_good,
         significant_remains: last.as_ref().is_none_or(|d| !d.consistent()),
         remaining: last.map_or(Vec::new(), |d| d.ranking.into_iter().filter(|r| r.fully_fitted).take(5).collect()),
         diagnosis_error,
     })
+}
+
+/// Whether the diagnosis ranks another distinct leader, elsewhere, as good
+/// as the first (their dBIC within the significance of each other): then
+/// the first is not kept without updating the other too.
+fn close_rival(d: &Diagnosis, leaders: &[usize], model: &fe_model::Model, significance: f64) -> bool {
+    let first = &d.ranking[leaders[0] - 1];
+    leaders[1..].iter().any(|&r| {
+        let o = &d.ranking[r - 1];
+        o.delta_bic - first.delta_bic < -significance
+            && !d.candidates[o.candidate].near(model, &first.nodes, &first.elements)
+    })
+}
+
+/// Whether two effects tried at one step act at the same place (one node
+/// or element of slack), whatever their kinds.
+fn near(d: &Diagnosis, a: &Added, b: &Added, model: &fe_model::Model) -> bool {
+    let cand =
+        |x: &Added| d.ranking.get(x.rank - 1).filter(|r| r.description == x.effect.description).map(|r| r.candidate);
+    match cand(b) {
+        Some(c) => d.candidates[c].near(model, &a.effect.nodes, &a.effect.elements),
+        None => {
+            a.effect.nodes.iter().any(|n| b.effect.nodes.contains(n))
+                || a.effect.elements.iter().any(|e| b.effect.elements.contains(e))
+        }
+    }
+}
+
+/// The effects applied so far and the one tried now (diagnosis and rank).
+fn applied_with<'a>(applied: &'a [(Diagnosis, usize)], d: &'a Diagnosis, r: usize) -> Vec<(&'a Diagnosis, usize)> {
+    applied.iter().map(|(d, r)| (d, *r)).chain(std::iter::once((d, r))).collect()
+}
+
+/// The case with the findings' corrections written into its
+/// `[[measurement.corrections]]` (reading its data from the file the loop
+/// writes, when it synthesises them from a truth); the case as it is when
+/// it has no data file to correct.
+fn with_corrections(case: &CaseFile, findings: &[Finding], opts: &FixOptions) -> Result<CaseFile, UpdateError> {
+    let mut editor = case.editor()?;
+    let has_data = case.measurement.as_ref().is_some_and(|m| m.data.is_some());
+    match (&opts.data, case.truth.is_some()) {
+        (Some(path), true) => editor.use_data(path),
+        _ if has_data => {}
+        _ => return Ok(case.clone()),
+    }
+    for f in findings {
+        f.write(&mut editor)?;
+    }
+    Ok(CaseFile::parse(&case.path, &editor.text_at(&case.path)?)?)
 }

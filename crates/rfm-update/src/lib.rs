@@ -87,6 +87,7 @@
 //! assert!(after.correlation.total.log_misfit < 0.1 * before.correlation.total.log_misfit);
 //! ```
 
+pub mod checks;
 pub mod comparison;
 pub mod diagnose;
 pub mod error;
@@ -112,5 +113,17 @@ pub use error::UpdateError;
 #[cfg(feature = "serde")]
 pub(crate) fn serialize_display<T: std::fmt::Display, S: serde::Serializer>(v: &T, s: S) -> Result<S::Ok, S::Error> {
     s.collect_str(v)
+}
+
+/// Serialises an optional value through its `Display` form (`null` when absent).
+#[cfg(feature = "serde")]
+pub(crate) fn serialize_option_display<T: std::fmt::Display, S: serde::Serializer>(
+    v: &Option<T>,
+    s: S,
+) -> Result<S::Ok, S::Error> {
+    match v {
+        Some(v) => s.collect_str(v),
+        None => s.serialize_none(),
+    }
 }
 pub use study::{Method, ParameterReport, Study, UpdateOutcome};

@@ -38,7 +38,11 @@ pub fn read_measured_for(
             frf::io::load_measured_opts(path, &ReadOptions { map, mask, channel, dimension })?
         }
     };
-    let mut measured = measured.check_channels(path, system.assembly().dofs(), mask)?;
+    let mut measured = match spec {
+        Some(s) if !s.corrections.is_empty() => correct(measured, path, s)?,
+        _ => measured,
+    };
+    measured = measured.check_channels(path, system.assembly().dofs(), mask)?;
     if let Some(s) = spec {
         calibrate(&mut measured, path, s)?;
         measured = restrict(measured, path, s)?;
@@ -109,6 +113,54 @@ fn read_paired(
     ));
     measured.pairing = paired;
     Ok(frf::io::check_not_empty(path, measured)?)
+}
+
+/// Applies the case's corrections of set-up errors
+/// (`[[measurement.corrections]]`): each matched channel multiplied by its
+/// sign and scale, and moved to the DOF its sensor measured. A correction
+/// that matches no channel, or moves one onto a channel the data hold
+/// already, is refused where it is written.
+fn correct(mut measured: Measured, path: &Path, spec: &MeasurementSpec) -> Result<Measured, UpdateError> {
+    // matched by the names the data give them, whatever an earlier
+    // correction renamed (two swapped channels name each other)
+    let original: Vec<frf::Channel> = measured.set.channels().to_vec();
+    let mut names = original.clone();
+    for fix in &spec.corrections {
+        let hits: Vec<usize> =
+            (0..original.len()).filter(|&c| fix.applies_to(original[c].response, original[c].reference)).collect();
+        if hits.is_empty() {
+            return Err(UpdateError::Case(fix.place.with_message(format!(
+                "the correction of `{}` applies to no channel of {}",
+                fix.response,
+                path.display()
+            ))));
+        }
+        for &c in &hits {
+            for v in measured.set.channel_mut(c) {
+                *v *= fix.sign * fix.scale;
+            }
+            names[c].response = fix.corrected_response();
+        }
+        let what: Vec<String> = [
+            (fix.sign < 0.0).then(|| "sign inverted".to_string()),
+            (fix.scale != 1.0).then(|| format!("scaled by {}", fix.scale)),
+            fix.measured_at.map(|d| format!("moved to {d}, where its sensor was")),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        measured.notes.push(format!(
+            "{} channel(s) at {} corrected as the case says: {}",
+            hits.len(),
+            fix.response,
+            what.join(", ")
+        ));
+    }
+    measured.set.rename_channels(names).map_err(|e| {
+        let first = spec.corrections.iter().find(|c| c.measured_at.is_some()).unwrap_or(&spec.corrections[0]);
+        UpdateError::Case(first.place.with_message(format!("after the corrections, {}: {e}", path.display())))
+    })?;
+    Ok(measured)
 }
 
 /// Multiplies per-volt channels by the sensitivity of the force gauge the

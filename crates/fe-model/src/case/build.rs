@@ -1,7 +1,7 @@
 //! The model a case file describes: materials, sections, groups, nodes,
-//! lines of elements, beams, springs, joints, masses, supports, ties and
-//! group assignments, built in that order through the checked `Model::add_*`
-//! methods, each error placed at the entry that caused it.
+//! lines of elements, beams, springs, joints, masses, supports, ties, group
+//! assignments and resonators, built in that order through the checked
+//! `Model::add_*` methods, each error placed at the entry that caused it.
 
 use std::ops::Range;
 
@@ -9,7 +9,7 @@ use toml::Spanned;
 
 use super::Ctx;
 use super::lookup::{group_ref, material_ref, section_ref};
-use super::raw::{RawCase, RawGroup, RawJoint, RawLine, RawMass, RawMaterial, RawSection, RawSpring};
+use super::raw::{RawCase, RawGroup, RawJoint, RawLine, RawMass, RawMaterial, RawResonator, RawSection, RawSpring};
 use crate::dof::{Dimension, Dof, PerDof};
 use crate::error::CaseError;
 use crate::model::{Group, Model, NodeId, Section};
@@ -206,6 +206,11 @@ pub(super) fn build_model(ctx: &Ctx<'_>, raw: &RawCase, model: &mut Model) -> Re
     if let Some(imported) = &raw.imported {
         super::imported::hold_unlisted(model, &listed, &node_file).map_err(|e| ctx.model_err(imported.span(), e))?;
     }
+    // resonators last: the node each makes (by default the largest id + 1)
+    // then shifts no id that a line or joint without its own takes
+    for r in &raw.resonators {
+        add_resonator(ctx, model, r)?;
+    }
     if model.beams.is_empty() && model.springs.is_empty() && model.imported().is_empty() {
         return Err(ctx.whole("the case defines no beams, lines, springs or imported matrices"));
     }
@@ -398,6 +403,53 @@ fn add_joint(ctx: &Ctx<'_>, model: &mut Model, entries: &[&Spanned<RawJoint>]) -
         model.add_spring(&e.get_ref().name, r.node, Some(new_id), k, g).map_err(|err| ctx.model_err(e.span(), err))?;
     }
     Ok(())
+}
+
+/// A resonator (`[[resonators]]`): a new node coincident with `node`, a
+/// spring named as the entry between the two in the translations given a
+/// stiffness, a lumped mass `m` of the same name on the new node, both in
+/// the entry's group (whose alpha, and mu, damp the spring), and a support
+/// of the new node's other DOFs, so that the mass moves only where its
+/// spring holds it and no DOF is left without stiffness.
+pub(super) fn add_resonator(ctx: &Ctx<'_>, model: &mut Model, s: &Spanned<RawResonator>) -> Result<(), CaseError> {
+    let r = s.get_ref();
+    let dim = model.dimension();
+    let what = format!("resonator `{}`", r.name);
+    let keys: Vec<&str> = dim.translations().iter().map(|&d| dim.spring_key(d)).collect();
+    // a mass without rotary inertia on a rotational spring would move in
+    // no direction: a resonator acts in translations
+    if let Some((key, v)) = r.stiffnesses().into_iter().skip(3).find_map(|(key, v)| Some((key, v?))) {
+        return Err(ctx.err(
+            v.span(),
+            format!("{what}: `{key}`: a resonator's spring acts in translations ({})", keys.join(", ")),
+        ));
+    }
+    let mut k = PerDof::default();
+    for (d, v) in stiffnesses(ctx, dim, &what, r.stiffnesses())? {
+        k[d] = v;
+    }
+    let acts = k.non_zero(dim.translations());
+    if acts.is_empty() {
+        return Err(ctx.err(
+            s.span(),
+            format!("{what}: give the stiffness of its spring in the directions it acts in ({})", keys.join(", ")),
+        ));
+    }
+    let at = model
+        .node(NodeId(r.node))
+        .map(|n| n.position())
+        .ok_or_else(|| ctx.err(s.span(), format!("{what}: node {} does not exist", r.node)))?;
+    let id = match r.new_node {
+        Some(id) => id,
+        None => model.max_node_id().checked_add(1).ok_or_else(|| ctx.err(s.span(), "node ids are exhausted"))?,
+    };
+    let g = group_ref(ctx, model, &r.group)?;
+    let held: Vec<Dof> = dim.dofs().iter().copied().filter(|d| !acts.contains(d)).collect();
+    let err = |e| ctx.model_err(s.span(), e);
+    model.add_node_at(id, at).map_err(err)?;
+    model.add_spring(&r.name, r.node, Some(id), k, g).map_err(err)?;
+    model.add_mass(&r.name, id, r.m, [0.0; 3], g).map_err(err)?;
+    model.add_support(id, &held).map_err(err)
 }
 
 pub(super) fn add_mass(ctx: &Ctx<'_>, model: &mut Model, m: &Spanned<RawMass>) -> Result<usize, CaseError> {

@@ -16,6 +16,7 @@ use std::path::{Component, Path, PathBuf};
 use toml_edit::{ArrayOfTables, DocumentMut, Item, Table, value};
 
 use super::{CaseFile, FittedGain, Gains, HistoryEntry};
+use crate::dof::DofRef;
 use crate::error::CaseError;
 
 /// An edit of a case file's text; see the module docs.
@@ -166,6 +167,50 @@ impl CaseEditor {
         }
         m.insert("fitted_gains", value(t));
         Ok(())
+    }
+
+    /// Appends a correction of a set-up error to `[[measurement.corrections]]`
+    /// (see [`super::ChannelCorrection`]): the channel at `response` (of
+    /// `reference`, or of every reference), its `sign`, `scale` and the DOF
+    /// its sensor `measured_at`, each written only when it changes
+    /// something, and `why` as the entry's reason.
+    pub fn add_correction(
+        &mut self,
+        response: DofRef,
+        reference: Option<DofRef>,
+        sign: f64,
+        scale: f64,
+        measured_at: Option<DofRef>,
+        why: &str,
+    ) -> Result<(), CaseError> {
+        let mut t = Table::new();
+        t.insert("response", value(response.to_string()));
+        if let Some(r) = reference {
+            t.insert("reference", value(r.to_string()));
+        }
+        if sign != 1.0 {
+            t.insert("sign", value(sign));
+        }
+        if scale != 1.0 {
+            t.insert("scale", value(scale));
+        }
+        if let Some(d) = measured_at {
+            t.insert("measured_at", value(d.to_string()));
+        }
+        t.insert("why", value(why));
+        let err = self.error("`measurement.corrections` is not a list of [[measurement.corrections]] tables".into());
+        let m = self.table("measurement")?;
+        match m.entry("corrections").or_insert(Item::ArrayOfTables(ArrayOfTables::new())) {
+            Item::ArrayOfTables(a) => {
+                if a.is_empty() {
+                    t.decor_mut()
+                        .set_prefix("\n# Set-up errors of the test, corrected after reading (written by rfm)\n");
+                }
+                a.push(t);
+                Ok(())
+            }
+            _ => Err(err),
+        }
     }
 
     /// Appends an entry to the `[[history]]` of the misfit.

@@ -9,6 +9,7 @@
 
 mod calibration;
 mod channel_map;
+mod correction;
 mod gains;
 mod mask;
 
@@ -26,10 +27,12 @@ use crate::model::Model;
 
 pub use calibration::{Calibration, CalibrationTarget};
 pub use channel_map::ChannelMap;
+pub use correction::ChannelCorrection;
 pub use gains::{FittedGain, GainKey, Gains};
 pub use mask::MaskRule;
 
 use calibration::{calibration_target, sensitivity};
+use correction::{RawCorrection, parse_corrections};
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -55,6 +58,8 @@ pub(super) struct RawMeasurement {
     coherence_threshold: Option<Spanned<f64>>,
     #[serde(default)]
     fitted_gains: BTreeMap<String, Spanned<Vec<f64>>>,
+    #[serde(default)]
+    corrections: Vec<Spanned<RawCorrection>>,
 }
 
 #[derive(Deserialize)]
@@ -111,6 +116,31 @@ pub struct MeasurementSpec {
     pub coherence_threshold: f64,
     /// Gains an earlier update fitted (written by rfm, read for reports).
     pub fitted_gains: Vec<FittedGain>,
+    /// Set-up errors of the test corrected after reading
+    /// (`[[measurement.corrections]]`: an inverted sensor, a wrong
+    /// sensitivity, a sensor at another DOF).
+    pub corrections: Vec<ChannelCorrection>,
+}
+
+impl MeasurementSpec {
+    /// The channels the case's data hold once corrected: every reference
+    /// with every response, a response moved to the DOF a correction says
+    /// its sensor measured.
+    pub fn channels(&self) -> Vec<(DofRef, DofRef)> {
+        self.references
+            .iter()
+            .flat_map(|&r| {
+                self.responses.iter().map(move |&resp| {
+                    let at = self
+                        .corrections
+                        .iter()
+                        .find(|c| c.applies_to(resp, r))
+                        .map_or(resp, |c| c.corrected_response());
+                    (at, r)
+                })
+            })
+            .collect()
+    }
 }
 
 /// Coherence below which a line counts as poor, unless the case says.
@@ -267,12 +297,15 @@ pub(super) fn parse_measurement(
             }
         }
     }
+    let corrections =
+        parse_corrections(&|span, message| ctx.err(span, message), &r.corrections, model, &responses, &references)?;
     if r.data.is_none() {
-        let data_only: [(&str, Option<Range<usize>>); 4] = [
+        let data_only: [(&str, Option<Range<usize>>); 5] = [
             ("band", r.band.as_ref().map(Spanned::span)),
             ("exclude", r.exclude.first().map(Spanned::span)),
             ("calibration", r.calibration.values().next().map(Spanned::span)),
             ("pair", r.pair.as_ref().map(Spanned::span)),
+            ("corrections", r.corrections.first().map(Spanned::span)),
         ];
         if let Some((key, Some(span))) = data_only.into_iter().find(|(_, s)| s.is_some()) {
             return Err(
@@ -298,6 +331,7 @@ pub(super) fn parse_measurement(
         geometry,
         coherence_threshold,
         fitted_gains,
+        corrections,
     })
 }
 
@@ -437,6 +471,45 @@ responses = ["2..5:uy"]
         assert!(e.contains("`tolerance` applies to `pair = \"coordinates\"`"), "{e}");
         let e = err("data = \"m.uff\"\npair = \"positions\"\n");
         assert!(e.contains("unknown pairing `positions`"), "{e}");
+    }
+
+    #[test]
+    fn corrections_of_set_up_errors_are_read_and_move_the_case_channels() {
+        let m = parse(
+            "data = \"m.csv\"\n[[measurement.corrections]]\nresponse = \"3:uy\"\nsign = -1\nwhy = \"upside down\"\n\
+             [[measurement.corrections]]\nresponse = \"4:uy\"\nreference = \"5:uy\"\nmeasured_at = \"4:ux\"\nscale = 1.25\n",
+        )
+        .unwrap();
+        let c = &m.corrections;
+        assert_eq!(c.len(), 2);
+        assert_eq!((c[0].response, c[0].reference, c[0].sign, c[0].scale), (DofRef::new(3, Dof::Uy), None, -1.0, 1.0));
+        assert_eq!(c[0].why.as_deref(), Some("upside down"));
+        assert_eq!((c[1].sign, c[1].scale, c[1].measured_at), (1.0, 1.25, Some(DofRef::new(4, Dof::Ux))));
+        assert!(c[1].applies_to(DofRef::new(4, Dof::Uy), DofRef::new(5, Dof::Uy)));
+        assert!(!c[1].applies_to(DofRef::new(4, Dof::Uy), DofRef::new(2, Dof::Uy)));
+        // the case's channels: the moved one at the DOF its sensor measured
+        let uy = |n| DofRef::new(n, Dof::Uy);
+        let want = vec![(uy(2), uy(5)), (uy(3), uy(5)), (DofRef::new(4, Dof::Ux), uy(5)), (uy(5), uy(5))];
+        assert_eq!(m.channels(), want);
+
+        let bad = |entry: &str| err(&format!("data = \"m.csv\"\n[[measurement.corrections]]\n{entry}"));
+        let e = bad("response = \"1:uy\"\nsign = -1\n");
+        assert!(e.contains(":25:12:") && e.contains("not one of the measurement's responses"), "{e}");
+        let e = bad("response = \"3:uy\"\nreference = \"2:uy\"\nsign = -1\n");
+        assert!(e.contains("`2:uy` is not one of the measurement's references"), "{e}");
+        let e = bad("response = \"3:uy\"\nsign = 2\n");
+        assert!(e.contains(":26:8:") && e.contains("sign must be 1 or -1"), "{e}");
+        let e = bad("response = \"3:uy\"\nscale = 0\n");
+        assert!(e.contains("scale must be positive and finite"), "{e}");
+        let e = bad("response = \"3:uy\"\n");
+        assert!(e.contains("needs `sign`, `scale` or `measured_at`"), "{e}");
+        let e = bad("response = \"3:uy\"\nmeasured_at = \"9:uy\"\n");
+        assert!(e.contains("node 9 does not exist"), "{e}");
+        let e = bad("response = \"3:uy\"\nsign = -1\n[[measurement.corrections]]\nresponse = \"3:uy\"\nscale = 2\n");
+        assert!(e.contains("corrected twice"), "{e}");
+        // only with a data file
+        let e = err("frequencies = [10.0]\n[[measurement.corrections]]\nresponse = \"3:uy\"\nsign = -1\n[truth]\n");
+        assert!(e.contains("`corrections` applies to a measured `data` file"), "{e}");
     }
 
     #[test]

@@ -43,6 +43,8 @@ pub(super) struct RawCase {
     #[serde(default)]
     pub(super) assign: Vec<Spanned<RawAssign>>,
     #[serde(default)]
+    pub(super) resonators: Vec<Spanned<RawResonator>>,
+    #[serde(default)]
     pub(super) set: BTreeMap<String, Spanned<f64>>,
     pub(super) measurement: Option<Spanned<RawMeasurement>>,
     pub(super) truth: Option<Spanned<RawTruth>>,
@@ -293,6 +295,40 @@ impl RawJoint {
     }
 }
 
+/// `[[resonators]]`: a mass on a spring attached at a node (read in `build.rs`).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawResonator {
+    pub(super) name: String,
+    pub(super) node: u32,
+    pub(super) new_node: Option<u32>,
+    pub(super) m: f64,
+    pub(super) kx: Option<Spanned<f64>>,
+    pub(super) ky: Option<Spanned<f64>>,
+    pub(super) kz: Option<Spanned<f64>>,
+    /// Rotational stiffnesses, read only to be refused where written.
+    pub(super) kr: Option<Spanned<f64>>,
+    pub(super) krx: Option<Spanned<f64>>,
+    pub(super) kry: Option<Spanned<f64>>,
+    pub(super) krz: Option<Spanned<f64>>,
+    pub(super) group: Spanned<String>,
+}
+
+impl RawResonator {
+    /// The stiffnesses as written, by key.
+    pub(super) fn stiffnesses(&self) -> [(&'static str, Option<&Spanned<f64>>); 7] {
+        [
+            ("kx", self.kx.as_ref()),
+            ("ky", self.ky.as_ref()),
+            ("kz", self.kz.as_ref()),
+            ("kr", self.kr.as_ref()),
+            ("krx", self.krx.as_ref()),
+            ("kry", self.kry.as_ref()),
+            ("krz", self.krz.as_ref()),
+        ]
+    }
+}
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawTruth {
@@ -310,6 +346,8 @@ pub(super) struct RawTruth {
     pub(super) masses: Vec<Spanned<RawMass>>,
     #[serde(default)]
     pub(super) joints: Vec<Spanned<RawJoint>>,
+    #[serde(default)]
+    pub(super) resonators: Vec<Spanned<RawResonator>>,
     #[serde(default)]
     pub(super) groups: BTreeMap<String, Spanned<RawGroup>>,
 }

@@ -112,7 +112,7 @@ pub struct HistoryEntry {
 
 /// The kinds of effect a history entry may name (the names of
 /// `rfm_update::diagnose::EffectKind`, whose tests keep the two lists equal).
-pub const EFFECT_KINDS: [&str; 7] = [
+pub const EFFECT_KINDS: [&str; 8] = [
     "flexible_support",
     "flexible_joint",
     "lumped_mass",
@@ -120,6 +120,7 @@ pub const EFFECT_KINDS: [&str; 7] = [
     "mass_change",
     "viscous_damping",
     "non_viscous_damping",
+    "resonator",
 ];
 
 /// How an updating run may end, as its results name it (the statuses of

@@ -514,3 +514,68 @@ fn a_truth_group_that_replaces_a_model_group_is_checked_as_the_model_group_is() 
     assert_eq!(c.model.groups()[0].alpha, 1e-5);
     assert_eq!(c.truth.unwrap().model.groups()[0].alpha, 2e-5);
 }
+
+/// A `[[resonators]]` entry is the node, spring, mass and supports a user
+/// would write by hand (the case below, with the lines numbered
+/// explicitly), made after the lines wherever it is written, so that the
+/// lines' nodes keep their ids; what it cannot be is refused where written.
+#[test]
+fn a_resonator_is_a_mass_on_a_spring_at_a_new_node_held_in_its_other_dofs() {
+    let entry =
+        "[groups.tmd]\nalpha = 2e-4\n[[resonators]]\nname = \"tmd\"\nnode = 5\nm = 0.3\nky = 4e4\ngroup = \"tmd\"\n";
+    // written before the line, without a node id: made last all the same
+    let (head, tail) = BEAM.split_at(BEAM.find("[[lines]]").unwrap());
+    let c = parse(&format!("{head}{entry}{tail}")).unwrap();
+    let by_hand = parse(&format!(
+        "nodes = [[1, 0.0, 0.0], [6, 1.0, 0.0]]\n{}\n[groups.tmd]\nalpha = 2e-4\n\
+         [[springs]]\nname = \"tmd\"\nnodes = [5, 6]\nky = 4e4\ngroup = \"tmd\"\n\
+         [[masses]]\nname = \"tmd\"\nnode = 6\nm = 0.3\ngroup = \"tmd\"\n\
+         [[supports]]\nnode = 6\ndofs = [\"ux\", \"rz\"]\n",
+        BEAM.replace("from = [0.0, 0.0]", "from = 1\nfirst_node = 2")
+    ))
+    .unwrap();
+    let (a, b) = (&c.model, &by_hand.model);
+    assert_eq!(a.node(NodeId(6)).unwrap().position(), [1.0, 0.0, 0.0]);
+    for id in 1..=6 {
+        assert_eq!(a.node(NodeId(id)).unwrap().position(), b.node(NodeId(id)).unwrap().position(), "node {id}");
+    }
+    assert_eq!(a.springs().len(), 1);
+    let (sa, sb) = (&a.springs()[0], &b.springs()[0]);
+    assert_eq!((sa.a, sa.b, sa.k, &a.groups()[sa.group]), (sb.a, sb.b, sb.k, &b.groups()[sb.group]));
+    assert_eq!(a.masses().len(), 1);
+    let (ma, mb) = (&a.masses()[0], &b.masses()[0]);
+    assert_eq!((ma.node, ma.m, ma.j), (mb.node, mb.m, mb.j));
+    assert_eq!(a.groups()[ma.group].name, "tmd");
+    let held: Vec<&crate::model::Support> = a.supports().iter().filter(|s| s.node == NodeId(6)).collect();
+    assert_eq!(held.len(), 1);
+    assert_eq!(held[0].dofs, vec![Dof::Ux, Dof::Rz]);
+    // the mass node left free only in uy, held by the spring there
+    crate::Assembly::new(a).unwrap();
+    for name in ["mass.tmd.m", "spring.tmd.ky", "group.tmd.alpha"] {
+        a.quantity(name).unwrap();
+    }
+    // in both directions, at a chosen id
+    let both = parse(&format!("{BEAM}{}", entry.replace("ky = 4e4", "kx = 3e4\nky = 4e4\nnew_node = 40"))).unwrap();
+    let s = both.model.supports().iter().find(|s| s.node == NodeId(40)).unwrap();
+    assert_eq!(s.dofs, vec![Dof::Rz]);
+    crate::Assembly::new(&both.model).unwrap();
+    // a truth may add one too
+    let measurement = "[measurement]\nfrequencies = [10.0]\nreferences = [\"5:uy\"]\nresponses = [\"5:uy\"]\n";
+    let truth = format!(
+        "{BEAM}{measurement}[truth.groups.tmd]\nalpha = 2e-4\n\
+         [[truth.resonators]]\nname = \"tmd\"\nnode = 5\nm = 0.3\nky = 4e4\ngroup = \"tmd\"\n"
+    );
+    let t = parse(&truth).unwrap().truth.unwrap();
+    assert_eq!(t.model.masses()[0].node, NodeId(6));
+    for (text, line, words) in [
+        (entry.replace("ky = 4e4", "kr = 4e4"), "kr = 4e4", "`kr`: a resonator's spring acts in translations (kx, ky)"),
+        (entry.replace("ky = 4e4", "kx = 0.0"), "[[resonators]]", "give the stiffness of its spring in the directions"),
+        (entry.replace("node = 5", "node = 9"), "[[resonators]]", "resonator `tmd`: node 9 does not exist"),
+        (entry.replace("m = 0.3", "m = -0.3"), "[[resonators]]", "must be zero or positive"),
+    ] {
+        let text = format!("{BEAM}{text}");
+        let e = parse(&text).unwrap_err();
+        assert!(e.message.contains(words), "{line}: {e}");
+        assert_eq!(line_of(&text, &e), line, "{e}");
+    }
+}

@@ -168,7 +168,9 @@ fn merge(sets: Vec<(PathBuf, FrfSet)>) -> Result<FrfSet> {
     })
 }
 
-pub(crate) fn compare(
+/// `rfm compare`: prints the tables (or `--json`) and with `--out` writes
+/// the report.
+pub fn compare(
     case_path: &Path,
     measured_files: &[PathBuf],
     out: Option<&Path>,
@@ -176,66 +178,20 @@ pub(crate) fn compare(
     bands: &str,
     opts: &ReportOptions,
 ) -> Result<Exit> {
-    let spec = parse_bands(bands)?;
+    parse_bands(bands)?;
     let case = load_case(case_path)?;
-    let mut inputs = case.inputs();
-    inputs.extend(measured_files.iter().cloned());
-    let output = out.map(|dir| Outputs::folder(dir, &inputs, &["compare.json", "report.html"])).transpose()?;
-    let system = DampedSystem::new(case.model.clone())?;
-    let MeasuredData { case, set: measured, source, masked, notes, gains } =
-        measured_data(case, &system, measured_files)?;
-    print_notes(&notes, json)?;
-    print_masked(&masked, json)?;
-    // the model's FRFs in the data's kind, times the gains that bring them
-    // closest to the data (closed form), weighted as the fits weight them:
-    // by the measured coherence when the data carry it
-    let weights = rfm_update::study::line_weights_for(&case, &measured)?;
-    let source_of_gains = GainSource::Fit { setting: gains.0, weights: weights.as_deref() };
-    let compared = comparison::compare(&system, &measured, source_of_gains, &spec)?;
-    // a model singular at a line has no FRF there: the comparison is
-    // refused, naming the line (the reports of updates draw around it)
-    if let Some(&freq_hz) = compared.model.singular_hz.first() {
-        return Err(FrfError::Singular { freq_hz }.into());
-    }
-    let fitted = compared.model.fitted.clone().unwrap_or_else(|| FittedGains::none(measured.channels()));
-    let coherent = (0..measured.channels().len()).any(|c| measured.coherence(c).is_some());
-    let mut notes = notes;
-    if coherent && gains.0 != Gains::None && weights.is_some() {
-        notes.push("the gains are fitted with each line weighted by its measured coherence".into());
-    }
-    let comparison =
-        comparison::compare_modes(&system, &measured, &compared.model.gains, MIN_MAC).map_err(|e| e.to_string());
-    let model = ModelFrfs {
-        label: "model".into(),
-        colour: plot::UPDATED,
-        frfs: compared.model.frfs,
-        correlation: compared.correlation,
-    };
-    let (modes, modes_error) = match comparison.as_ref().map(rows) {
-        Ok(m) => (Some(m), None),
-        Err(e) => (None, Some(e.clone())),
-    };
-    let doc = CompareJson {
-        case: case_path.display().to_string(),
-        title: case.model.title.clone(),
-        measured: source.clone(),
-        model: "the case's model (initial values)".into(),
-        bands: bands.to_string(),
-        kind: measured.kind().to_string(),
-        correlation: &model.correlation,
-        gain_setting: format!("{} ({})", gains.0, gains.1),
-        gains: fitted.reports(),
-        modes,
-        modes_error,
-        masked,
-        notes,
-    };
+    let inputs = CompareRun::inputs(&case, measured_files);
+    let output = out.map(|dir| Outputs::folder(dir, &inputs, &CompareRun::OUTPUTS)).transpose()?;
+    let run = CompareRun::new(case_path, case, measured_files, bands)?;
+    print_notes(&run.read_notes, json)?;
+    print_masked(&run.masked, json)?;
+    let doc = run.doc();
     if json {
         outln!("{}", serde_json::to_string_pretty(&doc)?);
     } else {
-        print_tables(&case, &measured, &source, &model.correlation)?;
+        print_tables(&run.case, &run.measured, &run.source, &run.model.correlation)?;
         print_gains(&doc.gains)?;
-        match &comparison {
+        match &run.comparison {
             Ok(_) => {
                 let m = doc.modes.as_ref().expect("the rows of a comparison");
                 let (header, rows) = mode_table_rows(m);
@@ -248,27 +204,172 @@ pub(crate) fn compare(
             Err(e) => outln!("\nmodes not compared: {e}"),
         }
     }
-    if let Some(mut output) = output {
-        let path = output.write("compare.json", serde_json::to_string_pretty(&doc)?.as_bytes())?;
-        let mut report = Report::new(format!("{}: model against measurement", case.model.title));
-        report.subtitle = Some(format!("rfm compare, case file {}", case_path.display()));
-        report.sections = report_sections(
-            &case,
-            &measured,
-            &source,
-            &model,
-            comparison.as_ref(),
-            &doc,
-            &opts.for_case(&case),
-            &mut output,
-        )?;
-        let html = output.write("report.html", report.render().as_bytes())?;
-        let written = output.commit()?;
+    if let Some(output) = output {
+        let (path, html, written) = run.write(output, opts)?;
         if !json {
             outln!("\nwrote {}, {} and {} figures", path.display(), html.display(), written.len() - 2);
         }
     }
     Ok(Exit::Success)
+}
+
+/// What `rfm compare` finds, before anything is printed or written: the
+/// case's model against the measured FRFs (the case's data, or files given
+/// as `--measured` gives them), with what `--json` prints ([`CompareRun::json`])
+/// and the files `--out` writes ([`CompareRun::save`]).
+pub struct CompareRun {
+    case_path: PathBuf,
+    case: CaseFile,
+    measured: FrfSet,
+    source: String,
+    bands: String,
+    model: ModelFrfs,
+    comparison: std::result::Result<frf::ModalComparison, String>,
+    gain_setting: String,
+    gains: Vec<GainReport>,
+    masked: Vec<String>,
+    /// The notes of reading the data, as printed before the tables.
+    read_notes: Vec<String>,
+    /// Those and what the comparison adds, as the JSON holds them.
+    notes: Vec<String>,
+}
+
+impl CompareRun {
+    /// The files `--out` writes besides the figures.
+    const OUTPUTS: [&str; 2] = ["compare.json", "report.html"];
+
+    /// The inputs of a comparison, which no output may replace.
+    fn inputs(case: &CaseFile, measured_files: &[PathBuf]) -> Vec<PathBuf> {
+        let mut inputs = case.inputs();
+        inputs.extend(measured_files.iter().cloned());
+        inputs
+    }
+
+    /// Compares the model of `case` (read from `case_path`, the path the
+    /// JSON names) with its measured data, or with `measured_files`
+    /// instead when any are given; `bands` as `--bands` takes them.
+    pub fn new(case_path: &Path, case: CaseFile, measured_files: &[PathBuf], bands: &str) -> Result<CompareRun> {
+        let spec = parse_bands(bands)?;
+        let system = DampedSystem::new(case.model.clone())?;
+        let MeasuredData { case, set: measured, source, masked, notes, gains } =
+            measured_data(case, &system, measured_files)?;
+        let read_notes = notes.clone();
+        // the model's FRFs in the data's kind, times the gains that bring them
+        // closest to the data (closed form), weighted as the fits weight them:
+        // by the measured coherence when the data carry it
+        let weights = rfm_update::study::line_weights_for(&case, &measured)?;
+        let source_of_gains = GainSource::Fit { setting: gains.0, weights: weights.as_deref() };
+        let compared = comparison::compare(&system, &measured, source_of_gains, &spec)?;
+        // a model singular at a line has no FRF there: the comparison is
+        // refused, naming the line (the reports of updates draw around it)
+        if let Some(&freq_hz) = compared.model.singular_hz.first() {
+            return Err(FrfError::Singular { freq_hz }.into());
+        }
+        let fitted = compared.model.fitted.clone().unwrap_or_else(|| FittedGains::none(measured.channels()));
+        let coherent = (0..measured.channels().len()).any(|c| measured.coherence(c).is_some());
+        let mut notes = notes;
+        if coherent && gains.0 != Gains::None && weights.is_some() {
+            notes.push("the gains are fitted with each line weighted by its measured coherence".into());
+        }
+        let comparison =
+            comparison::compare_modes(&system, &measured, &compared.model.gains, MIN_MAC).map_err(|e| e.to_string());
+        let model = ModelFrfs {
+            label: "model".into(),
+            colour: plot::UPDATED,
+            frfs: compared.model.frfs,
+            correlation: compared.correlation,
+        };
+        Ok(CompareRun {
+            case_path: case_path.to_path_buf(),
+            case,
+            measured,
+            source,
+            bands: bands.to_string(),
+            model,
+            comparison,
+            gain_setting: format!("{} ({})", gains.0, gains.1),
+            gains: fitted.reports(),
+            masked,
+            read_notes,
+            notes,
+        })
+    }
+
+    /// The document `--json` prints and `compare.json` holds.
+    fn doc(&self) -> CompareJson<'_> {
+        let (modes, modes_error) = match self.comparison.as_ref().map(rows) {
+            Ok(m) => (Some(m), None),
+            Err(e) => (None, Some(e.clone())),
+        };
+        CompareJson {
+            case: self.case_path.display().to_string(),
+            title: self.case.model.title.clone(),
+            measured: self.source.clone(),
+            model: "the case's model (initial values)".into(),
+            bands: self.bands.clone(),
+            kind: self.measured.kind().to_string(),
+            correlation: &self.model.correlation,
+            gain_setting: self.gain_setting.clone(),
+            gains: self.gains.clone(),
+            modes,
+            modes_error,
+            masked: self.masked.clone(),
+            notes: self.notes.clone(),
+        }
+    }
+
+    /// The measured FRFs compared, in the kind they were measured in.
+    pub fn measured(&self) -> &FrfSet {
+        &self.measured
+    }
+
+    /// The model's FRFs on the measured channels and lines, in the same
+    /// kind, times the fitted gains.
+    pub fn model_frfs(&self) -> &FrfSet {
+        &self.model.frfs
+    }
+
+    /// The measured modes against the model's (with the MAC matrix), or
+    /// why they could not be compared.
+    pub fn modes(&self) -> std::result::Result<&frf::ModalComparison, &str> {
+        self.comparison.as_ref().map_err(String::as_str)
+    }
+
+    /// What `rfm compare --json` prints.
+    pub fn json(&self) -> Result<String> {
+        Ok(serde_json::to_string_pretty(&self.doc())?)
+    }
+
+    /// Writes what `rfm compare --out DIR` writes (`compare.json`,
+    /// `report.html` and the figures), all or nothing; returns the files.
+    pub fn save(&self, dir: &Path, opts: &ReportOptions) -> Result<Vec<PathBuf>> {
+        let inputs = CompareRun::inputs(&self.case, &[]);
+        let output = Outputs::folder(dir, &inputs, &CompareRun::OUTPUTS)?;
+        Ok(self.write(output, opts)?.2)
+    }
+
+    /// Writes the outputs and commits them: the JSON's and the report's
+    /// paths, and every file written.
+    fn write(&self, mut output: Outputs, opts: &ReportOptions) -> Result<(PathBuf, PathBuf, Vec<PathBuf>)> {
+        let doc = self.doc();
+        let case = &self.case;
+        let path = output.write("compare.json", serde_json::to_string_pretty(&doc)?.as_bytes())?;
+        let mut report = Report::new(format!("{}: model against measurement", case.model.title));
+        report.subtitle = Some(format!("rfm compare, case file {}", self.case_path.display()));
+        report.sections = report_sections(
+            case,
+            &self.measured,
+            &self.source,
+            &self.model,
+            self.comparison.as_ref(),
+            &doc,
+            &opts.for_case(case),
+            &mut output,
+        )?;
+        let html = output.write("report.html", report.render().as_bytes())?;
+        let written = output.commit()?;
+        Ok((path, html, written))
+    }
 }
 
 /// The report's sections, in order.

@@ -2,10 +2,13 @@
 
 use std::path::{Path, PathBuf};
 
+use fe_model::CaseFile;
 use fe_model::case::Gains;
+use frf::FrfSet;
 use indicatif::ProgressBar;
 use rfm_update::Study;
-use rfm_update::diagnose::{Diagnosis, diagnose_with};
+use rfm_update::diagnose::Diagnosis;
+use rfm_update::fix::{CheckedDiagnosis, FixOptions, FixProgress, Prepared, diagnose_prepared};
 use rfm_update::study::{describe_masked, read_measured_for};
 
 use super::{Result, WithNotes, print_masked, print_notes};
@@ -14,60 +17,34 @@ use crate::output::Outputs;
 use crate::table::{Table, num, percent};
 
 /// Options of the diagnose command.
-pub(crate) struct DiagnoseArgs<'a> {
-    pub(crate) case: &'a Path,
-    pub(crate) measured: Option<&'a Path>,
-    pub(crate) json: bool,
-    pub(crate) apply: Option<usize>,
-    pub(crate) out: Option<&'a Path>,
-    pub(crate) top: usize,
-    pub(crate) verbose: bool,
+pub struct DiagnoseArgs<'a> {
+    /// The case file.
+    pub case: &'a Path,
+    /// Measured FRFs instead of the case's.
+    pub measured: Option<&'a Path>,
+    /// Print JSON instead of tables.
+    pub json: bool,
+    /// Write the case with the effect of this rank added.
+    pub apply: Option<usize>,
+    /// The new case file of `apply`.
+    pub out: Option<&'a Path>,
+    /// Rows of the ranking to print.
+    pub top: usize,
+    /// Print each stage with its time.
+    pub verbose: bool,
 }
 
-pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
+/// `rfm diagnose`: prints the ranking (or `--json`) and with `--apply`
+/// writes the case with an effect added.
+pub fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
     let mut study = Study::load(args.case)?;
-    let mut inputs = study.case().inputs();
-    inputs.extend(args.measured.map(Path::to_path_buf));
-    let mut output = match (args.apply, args.out) {
-        (Some(_), Some(out)) => Some(Outputs::file(out, &inputs)?),
+    let mut outputs = match (args.apply, args.out) {
+        (Some(_), Some(out)) => Some(apply_outputs(&study, args.measured, out)?),
         _ => None,
     };
-    // A case whose data come from its [truth] cannot keep the truth once an
-    // effect is added: a truth that adds the same joint or mass would add
-    // it twice. The new case gets the synthesised data beside it instead
-    // (as every step of `rfm fix` does), written before the case.
-    let synthesised = args.measured.is_none()
-        && study.case().measurement.as_ref().is_some_and(|m| m.data.is_none())
-        && study.case().truth.is_some();
-    let mut data_output = match (args.apply, args.out) {
-        (Some(_), Some(out)) if synthesised => {
-            let path = data_beside(out);
-            Some((Outputs::file(&path, &inputs)?, path))
-        }
-        _ => None,
-    };
-    let (measured, notes) = match args.measured {
-        Some(path) => {
-            let read = read_measured_for(study.system(), path, study.case().measurement.as_ref())?;
-            study.set_gains_for(&read)?;
-            let mut notes = read.notes.clone();
-            if study.gains() != Gains::None {
-                notes.push(format!(
-                    "model FRFs are multiplied by fitted gains ({}): {}",
-                    study.gains(),
-                    study.gains_reason()
-                ));
-            }
-            print_notes(&notes, args.json)?;
-            print_masked(&describe_masked(&read.masked), args.json)?;
-            (read.set.to_receptance(), notes)
-        }
-        None => {
-            print_notes(study.notes(), args.json)?;
-            print_masked(&describe_masked(study.masked()), args.json)?;
-            (study.measured().clone(), study.notes().to_vec())
-        }
-    };
+    let (measured, notes, masked) = diagnosis_data(&mut study, args.measured)?;
+    print_notes(&notes, args.json)?;
+    print_masked(&masked, args.json)?;
     if !args.json {
         outln!("{}", study.case().model.title);
         outln!(
@@ -82,40 +59,166 @@ pub(crate) fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
     let bar = if args.json { ProgressBar::hidden() } else { ProgressBar::new_spinner() };
     bar.enable_steady_tick(std::time::Duration::from_millis(120));
     let start = std::time::Instant::now();
-    let opts = study.diagnose_options(&measured)?;
-    let d = diagnose_with(&study.case().model, &measured, &opts, |stage| {
-        let line = format!("{stage} ({:.2} s)", start.elapsed().as_secs_f64());
-        if args.verbose {
-            bar.suspend(|| eprintln!("{line}"));
-        }
-        bar.set_message(line);
-    })?;
+    let json = args.json;
+    let data_file = outputs.as_ref().and_then(|(_, data)| data.as_ref().map(|(_, path)| path.clone()));
+    let (prepared, d) = run_diagnosis(
+        &study,
+        &measured,
+        data_file,
+        &mut |p| {
+            if let FixProgress::Declared { step } = p
+                && !json
+            {
+                let line = format!(
+                    "step 0: updated the case's own [update] parameters first ({}); misfit {:.4e} -> {:.4e}",
+                    step.status.name(),
+                    step.misfit_before,
+                    step.misfit_updated
+                );
+                bar.suspend(|| eprintln!("{line}"));
+            }
+        },
+        |stage| {
+            let line = format!("{stage} ({:.2} s)", start.elapsed().as_secs_f64());
+            if args.verbose {
+                bar.suspend(|| eprintln!("{line}"));
+            }
+            bar.set_message(line);
+        },
+    )?;
     bar.finish_and_clear();
     if args.json {
-        outln!("{}", serde_json::to_string_pretty(&WithNotes { notes: &notes, result: &d })?);
+        outln!("{}", diagnosis_json(&notes, &prepared, &d)?);
     } else {
+        print_checks(&prepared)?;
         print_diagnosis(&d, args.top)?;
     }
     if let Some(rank) = args.apply {
         let out = args.out.ok_or("--apply needs --out FILE for the new case file")?;
-        let data = data_output.as_ref().map(|(_, path)| path.clone());
-        let editor = d.apply_with_data(study.case(), rank, data.as_deref())?;
-        if let Some((mut data, path)) = data_output.take() {
-            data.write_file(frf::io::csv::to_csv_string(study.measured()).as_bytes())?;
-            data.commit()?;
-            if !args.json {
+        let outputs = outputs.take().ok_or("--apply needs --out FILE for the new case file")?;
+        let data = write_apply(&study, &prepared.case, &d, rank, out, outputs)?;
+        if !args.json {
+            if let Some(path) = data {
                 outln!("\nwrote {} with the data synthesised from the case's [truth]", path.display());
             }
-        }
-        let text = editor.text_at(out)?;
-        let mut output = output.take().ok_or("--apply needs --out FILE for the new case file")?;
-        output.write_file(text.as_bytes())?;
-        output.commit()?;
-        if !args.json {
             outln!("\nwrote {} with effect {rank} added", out.display());
         }
     }
     Ok(Exit::Success)
+}
+
+/// The diagnosis `rfm diagnose` makes of `study` against `data` (see
+/// [`rfm_update::fix::diagnose_prepared`]): the data checked for set-up
+/// errors and corrected, the case's own `[update]` parameters updated
+/// (step 0), then the model after them diagnosed. `data_file`: where the
+/// data of a case that synthesises them from its `[truth]` will be written,
+/// so that the corrections found can be written into the case that reads
+/// them. `progress` hears of the checks and step 0, `stage` of each stage
+/// of the diagnosis.
+pub fn run_diagnosis(
+    study: &Study,
+    data: &FrfSet,
+    data_file: Option<PathBuf>,
+    progress: &mut impl FnMut(FixProgress<'_>),
+    stage: impl FnMut(&str),
+) -> Result<(Prepared, Diagnosis)> {
+    let opts = FixOptions { diagnose: study.diagnose_options(data)?, data: data_file, ..FixOptions::default() };
+    Ok(diagnose_prepared(study.case(), data, &opts, progress, stage)?)
+}
+
+/// What `rfm diagnose --json` prints: the notes on reading the data, the
+/// findings about them, step 0 and the diagnosis.
+pub fn diagnosis_json(notes: &[String], prepared: &Prepared, d: &Diagnosis) -> Result<String> {
+    let report = CheckedDiagnosis { findings: &prepared.findings, declared: prepared.declared.as_ref(), diagnosis: d };
+    Ok(serde_json::to_string_pretty(&WithNotes { notes, result: &report })?)
+}
+
+/// The measured receptances `rfm diagnose` fits: the file `measured` as
+/// `--measured` reads it (the study's gains decided again for it), or the
+/// study's own data; with the notes on reading them and what the case's
+/// mask left out.
+pub fn diagnosis_data(study: &mut Study, measured: Option<&Path>) -> Result<(FrfSet, Vec<String>, Vec<String>)> {
+    Ok(match measured {
+        Some(path) => {
+            let read = read_measured_for(study.system(), path, study.case().measurement.as_ref())?;
+            study.set_gains_for(&read)?;
+            let mut notes = read.notes.clone();
+            if study.gains() != Gains::None {
+                notes.push(format!(
+                    "model FRFs are multiplied by fitted gains ({}): {}",
+                    study.gains(),
+                    study.gains_reason()
+                ));
+            }
+            (read.set.to_receptance(), notes, describe_masked(&read.masked))
+        }
+        None => (study.measured().clone(), study.notes().to_vec(), describe_masked(study.masked())),
+    })
+}
+
+/// The outputs of `--apply` into `out`, opened before the diagnosis: the
+/// case, and where the study's data come from its `[truth]` (and not from
+/// `measured`), the data beside it.
+fn apply_outputs(study: &Study, measured: Option<&Path>, out: &Path) -> Result<(Outputs, Option<(Outputs, PathBuf)>)> {
+    let mut inputs = study.case().inputs();
+    inputs.extend(measured.map(Path::to_path_buf));
+    let output = Outputs::file(out, &inputs)?;
+    // A case whose data come from its [truth] cannot keep the truth once an
+    // effect is added: a truth that adds the same joint or mass would add
+    // it twice. The new case gets the synthesised data beside it instead
+    // (as every step of `rfm fix` does), written before the case.
+    let synthesised = measured.is_none()
+        && study.case().measurement.as_ref().is_some_and(|m| m.data.is_none())
+        && study.case().truth.is_some();
+    let data = if synthesised {
+        let path = data_beside(out);
+        Some((Outputs::file(&path, &inputs)?, path))
+    } else {
+        None
+    };
+    Ok((output, data))
+}
+
+/// Writes the case `base` (the study's case as the diagnosis saw it:
+/// corrected, its own parameters updated) with the effect of `rank` added
+/// as `out`, and the synthesised data beside it when it needs them;
+/// returns their path.
+fn write_apply(
+    study: &Study,
+    base: &CaseFile,
+    d: &Diagnosis,
+    rank: usize,
+    out: &Path,
+    (mut output, data_output): (Outputs, Option<(Outputs, PathBuf)>),
+) -> Result<Option<PathBuf>> {
+    let data = data_output.as_ref().map(|(_, path)| path.clone());
+    let editor = d.apply_with_data(base, rank, data.as_deref())?;
+    if let Some((mut data, _)) = data_output {
+        data.write_file(frf::io::csv::to_csv_string(study.measured()).as_bytes())?;
+        data.commit()?;
+    }
+    let text = editor.text_at(out)?;
+    output.write_file(text.as_bytes())?;
+    output.commit()?;
+    Ok(data)
+}
+
+/// Writes what `rfm diagnose --apply RANK --out CASE` writes for the
+/// diagnosis `d` of `study` (made from the study's own data when `measured`
+/// is `None`, else from that file; `base` the case it was made of, see
+/// [`run_diagnosis`]): the case with the effect of rank `rank` added, and
+/// when the study's data come from its `[truth]`, those data beside it
+/// (`CASE-measured.csv`, whose path is returned), each file all or nothing.
+pub fn write_applied(
+    study: &Study,
+    base: &CaseFile,
+    d: &Diagnosis,
+    rank: usize,
+    measured: Option<&Path>,
+    out: &Path,
+) -> Result<Option<PathBuf>> {
+    let outputs = apply_outputs(study, measured, out)?;
+    write_apply(study, base, d, rank, out, outputs)
 }
 
 /// `NEW-measured.csv` beside the new case `NEW.toml`.
@@ -152,6 +255,29 @@ fn unfitted_lines(d: &Diagnosis) -> Vec<String> {
     out
 }
 
+/// What was found about the data and corrected, and step 0, before the ranking.
+fn print_checks(p: &Prepared) -> Result<()> {
+    if !p.findings.is_empty() {
+        outln!("findings about the data (corrected before the diagnosis when a correction is given):");
+        for f in &p.findings {
+            let fix = if f.corrections.is_empty() { "" } else { " [corrected]" };
+            outln!("  - {}{fix}\n    {}", f.summary, f.evidence);
+        }
+        outln!("");
+    }
+    if let Some(d) = &p.declared {
+        outln!(
+            "the case's own [update] parameters were updated first (step 0, {}): misfit {:.2} % -> {:.2} % (RMS relative); \
+             the diagnosis below is of the updated model",
+            d.status.name(),
+            100.0 * d.misfit_before,
+            100.0 * d.misfit_updated
+        );
+        outln!("");
+    }
+    Ok(())
+}
+
 fn print_diagnosis(d: &Diagnosis, top: usize) -> Result<()> {
     outln!(
         "noise level estimated from the data: {:.2} %; nominal model misfit: {:.2} % (RMS relative)",
@@ -162,6 +288,10 @@ fn print_diagnosis(d: &Diagnosis, top: usize) -> Result<()> {
         outln!(
             "(both, and every fit, weigh the lines as the update does: by the measured coherence and any band weights)"
         );
+    }
+    if !d.singular_hz.is_empty() {
+        let list = d.singular_hz.iter().map(|f| format!("{f} Hz")).collect::<Vec<_>>().join(", ");
+        outln!("left out: {list}, where the model's dynamic stiffness is singular (an undamped mode on the line)");
     }
     outln!("");
     if d.gains != Gains::None {
@@ -288,6 +418,7 @@ mod tests {
             gains: Gains::None,
             weighted: false,
             unfitted,
+            singular_hz: Vec::new(),
             candidates: Vec::new(),
         }
     }

@@ -10,7 +10,8 @@ use super::Result;
 use crate::exit::Exit;
 use crate::table::{Table, num};
 
-pub(crate) fn inspect(file: &Path, json: bool) -> Result<Exit> {
+/// `rfm inspect`: lists what a measurement file holds.
+pub fn inspect(file: &Path, json: bool) -> Result<Exit> {
     let report = match frf::io::detect_format(file)? {
         MeasuredFormat::Uff => uff_report(file)?,
         MeasuredFormat::Csv if json => return csv_json(file),

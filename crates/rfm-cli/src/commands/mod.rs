@@ -13,15 +13,15 @@ use fe_model::CaseFile;
 
 use crate::exit::Failure;
 
-pub(crate) use compare::compare;
-pub(crate) use diagnose::{DiagnoseArgs, diagnose};
-pub(crate) use fix::{FixArgs, fix};
-pub(crate) use inspect::inspect;
-pub(crate) use simulate::{SimulateArgs, simulate};
-pub(crate) use update::{Overrides as UpdateOverrides, update};
+pub use compare::{CompareRun, compare};
+pub use diagnose::{DiagnoseArgs, diagnose, diagnosis_data, diagnosis_json, run_diagnosis, write_applied};
+pub use fix::{FixArgs, fix, fix_exit, fix_options, progress_lines as fix_progress_lines, save_fix};
+pub use inspect::inspect;
+pub use simulate::{SimulateArgs, simulate, synthesised};
+pub use update::{Overrides as UpdateOverrides, UpdateSetup, finish_update, save_update, update, updated_case};
 
-/// A command's result: its exit code, or why it failed (see [`crate::exit`]).
-pub(crate) type Result<T> = std::result::Result<T, Failure>;
+/// A command's result: its exit code, or why it failed (see [`Failure`]).
+pub type Result<T> = std::result::Result<T, Failure>;
 
 pub(crate) fn load_case(path: &Path) -> Result<CaseFile> {
     Ok(CaseFile::load(path)?)
@@ -56,8 +56,10 @@ pub(crate) fn print_masked(masked: &[String], json: bool) -> Result<()> {
 /// coordinates, ...) under `notes`, as `results.json` and `compare --json`
 /// have them.
 #[derive(serde::Serialize)]
-pub(crate) struct WithNotes<'a, T: serde::Serialize> {
+pub struct WithNotes<'a, T: serde::Serialize> {
+    /// The notes on reading the measured data.
     pub notes: &'a [String],
+    /// The result.
     #[serde(flatten)]
     pub result: &'a T,
 }

@@ -5,8 +5,9 @@
 use std::path::Path;
 
 use damping::DampedSystem;
+use fe_model::CaseFile;
 use frf::io::uff::{Encoding, UffWriteOptions};
-use frf::{Channel, FrfKind, NoiseModel};
+use frf::{Channel, FrfKind, FrfSet, NoiseModel};
 use serde::Serialize;
 
 use super::{Result, load_case};
@@ -14,15 +15,23 @@ use crate::exit::{Exit, Failure};
 use crate::output::Outputs;
 
 /// Options of the simulate command.
-pub(crate) struct SimulateArgs<'a> {
-    pub(crate) case: &'a Path,
-    pub(crate) out: &'a Path,
-    pub(crate) truth: bool,
-    pub(crate) noise: f64,
-    pub(crate) seed: u64,
-    pub(crate) kind: &'a str,
-    pub(crate) binary: bool,
-    pub(crate) json: bool,
+pub struct SimulateArgs<'a> {
+    /// The case file.
+    pub case: &'a Path,
+    /// The output file.
+    pub out: &'a Path,
+    /// Synthesise the truth's FRFs instead of the model's.
+    pub truth: bool,
+    /// Relative complex noise level.
+    pub noise: f64,
+    /// Seed of the noise.
+    pub seed: u64,
+    /// FRF kind written.
+    pub kind: &'a str,
+    /// UFF 58b instead of ASCII.
+    pub binary: bool,
+    /// Print JSON.
+    pub json: bool,
 }
 
 /// The file format of `--out`, from its extension.
@@ -51,6 +60,32 @@ fn out_format(out: &Path, binary: bool) -> std::result::Result<OutFormat, String
     Ok(format)
 }
 
+/// The FRFs `rfm simulate` writes, in memory: the model's (or with
+/// `truth`, the case's truth's) at the case's measurement lines and
+/// channels, with `noise` (relative, seeded by `seed`), in `kind`.
+pub fn synthesised(case_file: &CaseFile, truth: bool, noise: f64, seed: u64, kind: FrfKind) -> Result<FrfSet> {
+    let spec =
+        case_file.measurement.as_ref().ok_or("the case has no [measurement] section (which channels and lines?)")?;
+    if spec.frequencies_hz.is_empty() {
+        return Err(format!(
+            "{}: the case's [measurement] gives no `frequencies`: simulate needs the lines to synthesise",
+            case_file.path.display()
+        )
+        .into());
+    }
+    let model = if truth {
+        case_file.truth.as_ref().ok_or("the case has no [truth] section")?.model.clone()
+    } else {
+        case_file.model.clone()
+    };
+    let sys = DampedSystem::new(model)?;
+    let channels: Vec<Channel> =
+        spec.references.iter().flat_map(|&r| spec.responses.iter().map(move |&m| Channel::new(m, r))).collect();
+    let mut set = frf::synthesize(&sys, &channels, &spec.frequencies_hz)?;
+    NoiseModel { relative: noise, floor: 0.0, seed }.apply(&mut set);
+    Ok(set.converted(kind))
+}
+
 /// What `--json` prints.
 #[derive(Serialize)]
 struct SimulateJson {
@@ -66,7 +101,8 @@ struct SimulateJson {
     seed: u64,
 }
 
-pub(crate) fn simulate(args: &SimulateArgs<'_>) -> Result<Exit> {
+/// `rfm simulate`: writes the FRFs and says what it wrote.
+pub fn simulate(args: &SimulateArgs<'_>) -> Result<Exit> {
     if !(args.noise.is_finite() && args.noise >= 0.0) {
         return Err(Failure::new(
             Exit::Usage,
@@ -80,26 +116,7 @@ pub(crate) fn simulate(args: &SimulateArgs<'_>) -> Result<Exit> {
     // an input named as the output is refused first, whatever its extension
     let mut output = Outputs::file(args.out, &case_file.inputs())?;
     let format = out_format(args.out, args.binary).map_err(|e| Failure::new(Exit::Usage, e))?;
-    let spec =
-        case_file.measurement.as_ref().ok_or("the case has no [measurement] section (which channels and lines?)")?;
-    if spec.frequencies_hz.is_empty() {
-        return Err(format!(
-            "{}: the case's [measurement] gives no `frequencies`: simulate needs the lines to synthesise",
-            args.case.display()
-        )
-        .into());
-    }
-    let model = if args.truth {
-        case_file.truth.as_ref().ok_or("the case has no [truth] section")?.model.clone()
-    } else {
-        case_file.model.clone()
-    };
-    let sys = DampedSystem::new(model)?;
-    let channels: Vec<Channel> =
-        spec.references.iter().flat_map(|&r| spec.responses.iter().map(move |&m| Channel::new(m, r))).collect();
-    let mut set = frf::synthesize(&sys, &channels, &spec.frequencies_hz)?;
-    NoiseModel { relative: args.noise, floor: 0.0, seed: args.seed }.apply(&mut set);
-    let set = set.converted(kind);
+    let set = synthesised(&case_file, args.truth, args.noise, args.seed, kind)?;
     let bytes = match format {
         OutFormat::Csv => frf::io::csv::to_csv_string(&set).into_bytes(),
         OutFormat::Uff => {

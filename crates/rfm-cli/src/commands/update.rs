@@ -1,6 +1,6 @@
 //! `rfm update`: update the model's parameters against the measured FRFs.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use rfm_update::{Method, Study, UpdateOutcome};
@@ -20,16 +20,18 @@ fn db(x: f64) -> f64 {
 
 /// Command-line overrides of the case's `[update]` settings.
 #[derive(Default)]
-pub(crate) struct Overrides {
+pub struct Overrides {
     /// Method name.
-    pub(crate) method: Option<String>,
+    pub method: Option<String>,
     /// Fit this many lines spread over the band.
-    pub(crate) lines: Option<usize>,
+    pub lines: Option<usize>,
     /// Iteration limit.
-    pub(crate) max_iterations: Option<usize>,
+    pub max_iterations: Option<usize>,
 }
 
-pub(crate) fn update(
+/// `rfm update`: prints the iterations and the results (or `--json`) and
+/// with `--out` writes them.
+pub fn update(
     case: &Path,
     out: Option<&Path>,
     json: bool,
@@ -37,30 +39,9 @@ pub(crate) fn update(
     report: &crate::report::ReportOptions,
 ) -> Result<Exit> {
     let mut study = Study::load(case)?;
-    let mut output = out
-        .map(|dir| Outputs::folder(dir, &study.case().inputs(), &["results.json", "updated.toml", "report.html"]))
-        .transpose()?;
-    if over.lines == Some(0) {
-        return Err(Failure::new(Exit::Usage, "--lines 0: give at least one measured line to fit"));
-    }
-    if let Some(n) = over.lines
-        && study.case().update.is_some()
-    {
-        study.set_update_frequencies(fe_model::case::FrequencyChoice::Lines(n))?;
-    }
-    let method = over.method.as_deref();
-    if study.case().update.is_none() {
-        return Err("the case has no [update] section".into());
-    }
-    let method = match method {
-        Some(m) => Method::parse(m).ok_or_else(|| format!("unknown method `{m}` (available: rfm, output-error)"))?,
-        None => study.checked_method().map_err(|e| e.to_string())?,
-    };
-    let lines = study.lines_for(method)?;
-    let max_iterations = over.max_iterations.unwrap_or(match method {
-        Method::Rfm => study.rfm_options().max_iterations,
-        Method::OutputError => study.output_error_options()?.max_iterations,
-    });
+    let mut output = out.map(|dir| Outputs::folder(dir, &study.case().inputs(), &UPDATE_OUTPUTS)).transpose()?;
+    let setup = UpdateSetup::new(&mut study, over)?;
+    let (method, lines, max_iterations) = (setup.method, &setup.lines, setup.max_iterations);
     print_notes(study.notes(), json)?;
     print_masked(&rfm_update::study::describe_masked(study.masked()), json)?;
     if !json {
@@ -103,18 +84,103 @@ pub(crate) fn update(
         bar.set_position(r.iteration as u64);
         bar.set_message(format!("misfit {:.3e}", r.residual));
     };
-    let mut outcome = match method {
-        Method::Rfm => {
-            let opts = RfmOptions { max_iterations, ..study.rfm_options() };
-            study.run_rfm(&opts, on_iteration)?
-        }
-        Method::OutputError => {
-            let mut opts = study.output_error_options()?;
-            opts.max_iterations = max_iterations;
-            study.run_output_error(&opts, on_iteration)?
-        }
-    };
+    let mut outcome = setup.run(&study, on_iteration)?;
     bar.finish_and_clear();
+    let step = finish_update(&study, &mut outcome)?;
+    if json {
+        outln!("{}", serde_json::to_string_pretty(&outcome)?);
+    } else {
+        print_outcome(&outcome)?;
+        if !study.case().history.is_empty() {
+            outln!("the fall of the misfit, from the case's history to this update:");
+            print_history(&[study.case().history.clone(), vec![step.clone()]].concat())?;
+            if let (Some(ratio), true) = (outcome.noise_ratio, outcome.residual_noise != outcome.noise_estimate) {
+                outln!(
+                    "(misfits over the band, weighted as the fit weighs its lines; the status, from the fit's \
+                     residual on its own lines: {ratio:.2} times the noise)"
+                );
+            }
+        }
+    }
+    if let Some(output) = output.take() {
+        let [path, updated, report] = write_update(&study, &outcome, &step, output, case, report)?;
+        if !json {
+            outln!("\nwrote {} and {}", path.display(), updated.display());
+            outln!("wrote {} (figures beside it)", report.display());
+        }
+    }
+    let exit = Exit::of_outcome(&outcome);
+    if exit != Exit::Success {
+        eprintln!("exit code {}: {}", exit.code(), exit.meaning());
+    }
+    Ok(exit)
+}
+
+/// The files `rfm update --out` writes besides the figures.
+const UPDATE_OUTPUTS: [&str; 3] = ["results.json", "updated.toml", "report.html"];
+
+/// An update as `rfm update` sets it up: the method, the updating lines and
+/// the iteration limit, the case's or the command line's.
+pub struct UpdateSetup {
+    /// The updating method.
+    pub method: Method,
+    /// The updating lines (Hz).
+    pub lines: Vec<f64>,
+    /// The iteration limit.
+    pub max_iterations: usize,
+}
+
+impl UpdateSetup {
+    /// Sets up the update of `study` with the overrides of the command
+    /// line (the study's lines change when `over` gives their number).
+    pub fn new(study: &mut Study, over: &Overrides) -> Result<UpdateSetup> {
+        if over.lines == Some(0) {
+            return Err(Failure::new(Exit::Usage, "--lines 0: give at least one measured line to fit"));
+        }
+        if let Some(n) = over.lines
+            && study.case().update.is_some()
+        {
+            study.set_update_frequencies(fe_model::case::FrequencyChoice::Lines(n))?;
+        }
+        let method = over.method.as_deref();
+        if study.case().update.is_none() {
+            return Err("the case has no [update] section".into());
+        }
+        let method = match method {
+            Some(m) => {
+                Method::parse(m).ok_or_else(|| format!("unknown method `{m}` (available: rfm, output-error)"))?
+            }
+            None => study.checked_method().map_err(|e| e.to_string())?,
+        };
+        let lines = study.lines_for(method)?;
+        let max_iterations = over.max_iterations.unwrap_or(match method {
+            Method::Rfm => study.rfm_options().max_iterations,
+            Method::OutputError => study.output_error_options()?.max_iterations,
+        });
+        Ok(UpdateSetup { method, lines, max_iterations })
+    }
+
+    /// Runs the update, calling `on_iteration` after every iteration.
+    pub fn run(&self, study: &Study, on_iteration: impl FnMut(&IterationRecord)) -> Result<UpdateOutcome> {
+        Ok(match self.method {
+            Method::Rfm => {
+                let opts = RfmOptions { max_iterations: self.max_iterations, ..study.rfm_options() };
+                study.run_rfm(&opts, on_iteration)?
+            }
+            Method::OutputError => {
+                let mut opts = study.output_error_options()?;
+                opts.max_iterations = self.max_iterations;
+                study.run_output_error(&opts, on_iteration)?
+            }
+        })
+    }
+}
+
+/// What `rfm update` adds to an update's outcome before printing it: the
+/// misfit over the whole band against the initial model's (an update that
+/// made it worse is marked so), and the entry of the case's history the
+/// updated case gets, which it returns.
+pub fn finish_update(study: &Study, outcome: &mut UpdateOutcome) -> Result<fe_model::HistoryEntry> {
     // the misfit the case's history speaks of, after this update, weighted
     // as the diagnosis weighs it (the fit's line weights)
     let weights = study.line_weights(study.measured())?;
@@ -132,49 +198,46 @@ pub(crate) fn update(
              {misfit:.3e}): the updated model is not an improvement"
         ));
     }
-    let step = fe_model::HistoryEntry {
+    Ok(fe_model::HistoryEntry {
         step: format!("updated ({})", outcome.method),
         misfit,
         noise,
         ..fe_model::HistoryEntry::default()
-    };
-    if json {
-        outln!("{}", serde_json::to_string_pretty(&outcome)?);
-    } else {
-        print_outcome(&outcome)?;
-        if !study.case().history.is_empty() {
-            outln!("the fall of the misfit, from the case's history to this update:");
-            print_history(&[study.case().history.clone(), vec![step.clone()]].concat())?;
-            if let (Some(ratio), true) = (outcome.noise_ratio, outcome.residual_noise != outcome.noise_estimate) {
-                outln!(
-                    "(misfits over the band, weighted as the fit weighs its lines; the status, from the fit's \
-                     residual on its own lines: {ratio:.2} times the noise)"
-                );
-            }
-        }
-    }
-    if let Some(mut output) = output.take() {
-        let path = output.write("results.json", serde_json::to_string_pretty(&outcome)?.as_bytes())?;
-        let updated = write_updated_model(&study, &outcome, &step, &mut output)?;
-        let report = crate::report::update_report::write(
-            &study,
-            &outcome,
-            &step,
-            &mut output,
-            case,
-            &report.for_case(study.case()),
-        )?;
-        output.commit()?;
-        if !json {
-            outln!("\nwrote {} and {}", path.display(), updated.display());
-            outln!("wrote {} (figures beside it)", report.display());
-        }
-    }
-    let exit = Exit::of_outcome(&outcome);
-    if exit != Exit::Success {
-        eprintln!("exit code {}: {}", exit.code(), exit.meaning());
-    }
-    Ok(exit)
+    })
+}
+
+/// Writes the outputs of `rfm update --out` and commits them; returns the
+/// paths of `results.json`, `updated.toml` and `report.html`.
+fn write_update(
+    study: &Study,
+    outcome: &UpdateOutcome,
+    step: &fe_model::HistoryEntry,
+    mut output: Outputs,
+    case: &Path,
+    report: &crate::report::ReportOptions,
+) -> Result<[PathBuf; 3]> {
+    let path = output.write("results.json", serde_json::to_string_pretty(&outcome)?.as_bytes())?;
+    let updated = write_updated_model(study, outcome, step, &mut output)?;
+    let report =
+        crate::report::update_report::write(study, outcome, step, &mut output, case, &report.for_case(study.case()))?;
+    output.commit()?;
+    Ok([path, updated, report])
+}
+
+/// Writes what `rfm update --out DIR` writes for `outcome` (finished by
+/// [`finish_update`], which gave `step`) into `dir`, all or nothing:
+/// `results.json`, `updated.toml`, `report.html` and the figures. `case`
+/// is the case file's path as the report names it.
+pub fn save_update(
+    study: &Study,
+    outcome: &UpdateOutcome,
+    step: &fe_model::HistoryEntry,
+    case: &Path,
+    dir: &Path,
+    report: &crate::report::ReportOptions,
+) -> Result<[PathBuf; 3]> {
+    let output = Outputs::folder(dir, &study.case().inputs(), &UPDATE_OUTPUTS)?;
+    write_update(study, outcome, step, output, case, report)
 }
 
 /// Writes the case with the updated values as `DIR/updated.toml`.
@@ -184,6 +247,18 @@ fn write_updated_model(
     step: &fe_model::HistoryEntry,
     output: &mut Outputs,
 ) -> Result<std::path::PathBuf> {
+    let editor = updated_case(study, outcome, step)?;
+    let text = editor.text_at(&output.path("updated.toml"))?;
+    Ok(output.write("updated.toml", text.as_bytes())?)
+}
+
+/// The case `rfm update` writes as `updated.toml`: the updated values with
+/// a comment on the run, the gains it estimated, and `step` in its history.
+pub fn updated_case(
+    study: &Study,
+    outcome: &UpdateOutcome,
+    step: &fe_model::HistoryEntry,
+) -> Result<fe_model::case::CaseEditor> {
     let values = rfm_update::params::quantity_values(study.parameters(), outcome.system.model());
     let times = outcome.noise_ratio.map_or(String::new(), |r| format!(", {r:.2} times the noise"));
     let mut comment = format!(
@@ -206,8 +281,7 @@ fn write_updated_model(
         editor.set_gains(study.gains(), &fitted)?;
     }
     editor.push_history(step)?;
-    let text = editor.text_at(&output.path("updated.toml"))?;
-    Ok(output.write("updated.toml", text.as_bytes())?)
+    Ok(editor)
 }
 
 /// A band misfit this many times the initial model's is worse than the

@@ -44,6 +44,7 @@ pub(crate) fn short_effect(kind: Option<EffectKind>, nodes: &[u32], elements: &[
         Some(EffectKind::StiffnessChange) => "stiffness",
         Some(EffectKind::MassChange) => "mass change",
         Some(EffectKind::ViscousDamping | EffectKind::NonViscousDamping) => "damping",
+        Some(EffectKind::Resonator) => "resonator",
         None => "effect",
     };
     let span = |ids: &[u32], one: &str, many: &str| match (ids.iter().min(), ids.iter().max()) {

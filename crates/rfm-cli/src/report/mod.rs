@@ -41,12 +41,12 @@ impl Outputs {
 
 /// How a report draws what the command line and the case choose.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct ReportOptions {
+pub struct ReportOptions {
     /// Scale of every frequency axis.
-    pub(crate) frequency_scale: FrequencyScale,
+    pub frequency_scale: FrequencyScale,
     /// Lines of measured coherence below it are shaded in the FRF figures
-    /// (the case's `[measurement] coherence_threshold`, see [`Self::for_case`]).
-    pub(crate) coherence_threshold: f64,
+    /// (the case's `[measurement] coherence_threshold`, see `ReportOptions::for_case`).
+    pub coherence_threshold: f64,
 }
 
 impl Default for ReportOptions {

@@ -66,6 +66,23 @@ pub fn informative_lines(measured: &FrfSet, n: usize) -> Vec<f64> {
     lines.to_vec()
 }
 
+/// The correlation between adjacent lines of channel-major residuals
+/// (`nf` lines per channel; `None` values skipped), real and imaginary
+/// parts pooled: `sum r_k r_k+1 / sum r_k^2`, clamped to `0..=0.95` (a
+/// negative one is noise, and one of 1 would count no line as independent).
+pub(crate) fn lag_correlation(r: &[Option<num_complex::Complex64>], nf: usize) -> f64 {
+    let (mut lag, mut all) = (0.0, 0.0);
+    for channel in r.chunks(nf.max(1)) {
+        for pair in channel.windows(2) {
+            if let (Some(a), Some(b)) = (pair[0], pair[1]) {
+                lag += a.re * b.re + a.im * b.im;
+            }
+        }
+        all += channel.iter().flatten().map(|e| e.norm_sqr()).sum::<f64>();
+    }
+    if all > 0.0 { (lag / all).clamp(0.0, 0.95) } else { 0.0 }
+}
+
 /// A line set with the nominal model's cost on it.
 pub(crate) struct LineSet {
     pub(crate) data: FrfSet,
@@ -77,6 +94,10 @@ pub(crate) struct LineSet {
     pub(crate) gains: Gains,
     /// Residual weights at these lines, channel-major (`None`: all 1).
     pub(crate) weights: Option<Vec<f64>>,
+    /// The correlation of the nominal model's weighted residuals between
+    /// adjacent lines of a channel (real and imaginary parts alike): about
+    /// 0 for noise, towards 1 for the smooth residual of a model error.
+    pub(crate) lag_correlation: f64,
 }
 
 impl LineSet {
@@ -106,16 +127,25 @@ impl LineSet {
             fitted.apply(&mut model);
         }
         let (mut cost, mut n) = (0.0, 0);
+        let nf = data.n_freq();
+        // weighted residuals, `None` where a value does not count
+        let mut r: Vec<Option<num_complex::Complex64>> = Vec::with_capacity(data.values().len());
         for (i, (h, m)) in model.values().iter().zip(data.values()).enumerate() {
             let w = weights.as_ref().map_or(1.0, |w| w[i]);
-            if m.norm() > 0.0 && w > 0.0 {
-                cost += w * w * (h / m).ln().norm_sqr();
+            // a line where the model is singular has no receptance to compare
+            // (see `synthesize_regular`): it is left out, as a zero measurement is
+            if m.norm() > 0.0 && w > 0.0 && h.re.is_finite() && h.im.is_finite() {
+                let e = w * (h / m).ln();
+                cost += e.norm_sqr();
                 n += 2;
+                r.push(Some(e));
+            } else {
+                r.push(None);
             }
         }
         if !cost.is_finite() {
             return Err(UpdateError::Data("the nominal model's misfit is not finite at the measured lines".into()));
         }
-        Ok(LineSet { data, cost0: cost, n, gains, weights })
+        Ok(LineSet { data, cost0: cost, n, gains, weights, lag_correlation: lag_correlation(&r, nf) })
     }
 }

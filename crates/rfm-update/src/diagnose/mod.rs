@@ -1,22 +1,32 @@
 //! Diagnosis: which physical effect is missing from the model.
 //!
-//! Every candidate effect ([`candidates`]) is fitted to the measured FRFs by
+//! Every candidate effect ([`candidates`]; attached resonators only where
+//! [`CandidateOptions::resonator_hz`] names the frequencies of measured
+//! modes the model lacks) is fitted to the measured FRFs by
 //! the output-error estimator on the complex-log misfit `ln(H / M)`, which
 //! stays well behaved when a resonance is shifted by more than its width
 //! (one linearised step from the nominal model does not: it ranks a 40 %
 //! stiffness loss behind unrelated masses). Candidates are compared by the
-//! Bayesian information criterion with the noise variance estimated from the
-//! data themselves:
+//! Bayesian information criterion against what each candidate leaves:
 //!
 //! ```text
-//! dBIC_c = (cost_c - cost_0) / s^2 + k_c ln(n)
+//! dBIC_c = (cost_c - cost_0) / s_c^2 + k_c ln(n)
 //! ```
 //!
 //! `cost` is the sum of squared real residuals (`cost_0` for the nominal
 //! model), `k_c` the candidate's number of parameters, `n` the number of real
-//! residuals, `s^2` the noise variance per real residual. An effect is
-//! *significant* when `dBIC < -10` (very strong evidence); when none is, the
-//! model is consistent with the data.
+//! residuals, and `s_c^2` the variance per real residual that a change of
+//! the cost is judged against: the noise's, estimated from the data, or,
+//! where the candidate leaves more than the noise, what it leaves, times the
+//! lines per independent one that the residual's correlation between
+//! adjacent lines makes ([`MisfitStats::lack_of_fit`]; the nominal model's
+//! correlation stands for the candidate's). With the data at the noise this
+//! is the plain criterion; where something no candidate explains dominates
+//! (a real structure, a set-up error), a candidate must explain a share of
+//! what remains, not of the noise, to count. An effect is *significant*
+//! when `dBIC < -10` (very strong evidence); when none is, the model is
+//! consistent with the data. `rfm fix` keeps a step by the same rule
+//! ([`delta_bic`]).
 //!
 //! The noise level comes from the roughness of the measured FRFs: on a line
 //! grid fine enough to resolve the structure's response, the second
@@ -169,7 +179,8 @@ pub fn estimate_noise_against_weighted(
     weights: Option<&[f64]>,
 ) -> Result<Option<f64>, UpdateError> {
     let freqs = noise_lines(measured);
-    let model = frf::synthesize(sys, measured.channels(), &freqs)?;
+    // a triplet with a line where the model is singular is left out
+    let (model, _) = frf::synthesize_regular(sys, measured.channels(), &freqs)?;
     Ok(noise_against(measured, weights, &model))
 }
 
@@ -426,6 +437,10 @@ pub struct Diagnosis {
     /// what the data do not determine, or here (or both, when it is ranked
     /// by an earlier stage's fit).
     pub unfitted: Vec<Unfitted>,
+    /// Lines (Hz) left out because the model's dynamic stiffness is
+    /// singular there (a lightly damped mode on the line): no receptance of
+    /// the model exists to compare.
+    pub singular_hz: Vec<f64>,
     /// The candidates (same indices as [`Ranked::candidate`]).
     #[cfg_attr(feature = "serde", serde(skip))]
     pub candidates: Vec<Candidate>,
@@ -462,10 +477,72 @@ pub fn log_misfit_with(
     gains: Gains,
     weights: Option<&[f64]>,
 ) -> Result<f64, UpdateError> {
+    Ok(misfit_stats(sys, measured, lines, gains, weights)?.misfit)
+}
+
+/// What the evidence reads of a model's misfit on a line set: the misfit
+/// (RMS of `ln(H / M)` per complex value, after the best gains, weighted),
+/// the number of real residuals, and the correlation of the residuals
+/// between adjacent lines (see [`MisfitStats::lack_of_fit`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct MisfitStats {
+    /// RMS of `ln(H / M)` per complex value.
+    pub misfit: f64,
+    /// Real residuals.
+    pub n: usize,
+    /// Correlation of the residuals between adjacent lines, `0..=0.95`.
+    pub lag_correlation: f64,
+}
+
+impl MisfitStats {
+    /// The variance per complex value against which a change of the misfit
+    /// is judged: the noise's, or, where the model leaves more than the
+    /// noise, what it leaves, times the lines per independent one that the
+    /// residual's correlation makes (`(1 + rho) / (1 - rho)`). A smooth
+    /// residual of a model error varies far less from line to line than
+    /// noise, so that the lines it is read on are not independent; and an
+    /// effect that lowers a misfit dominated by something no candidate
+    /// explains must lower it by a share of that, not by a share of the
+    /// noise, to count as evidence.
+    pub fn lack_of_fit(&self, noise: f64) -> f64 {
+        let rho = self.lag_correlation;
+        (noise * noise).max(self.misfit * self.misfit * (1.0 + rho) / (1.0 - rho))
+    }
+}
+
+/// The change of the information criterion from a model of misfit `before`
+/// with `k_before` parameters to one of misfit `after` with `k_after`,
+/// against data of relative noise `noise`:
+/// `n (m_after^2 - m_before^2) / v + (k_after - k_before) ln n`, with `v`
+/// the variance [`MisfitStats::lack_of_fit`] of the model after. Negative
+/// favours the model after; below the diagnosis's significance (-10) the
+/// evidence for it is very strong. The one rule by which the diagnosis
+/// calls a candidate significant and `rfm fix` keeps a step.
+pub fn delta_bic(before: f64, k_before: usize, after: &MisfitStats, k_after: usize, noise: f64) -> f64 {
+    let n = after.n as f64;
+    n * (after.misfit * after.misfit - before * before) / after.lack_of_fit(noise)
+        + (k_after as f64 - k_before as f64) * n.ln()
+}
+
+/// [`log_misfit_with`] and what else the evidence reads of the misfit
+/// ([`MisfitStats`]).
+pub fn misfit_stats(
+    sys: &DampedSystem,
+    measured: &FrfSet,
+    lines: usize,
+    gains: Gains,
+    weights: Option<&[f64]>,
+) -> Result<MisfitStats, UpdateError> {
     let at = informative_lines(measured, lines);
-    let model = frf::synthesize(sys, measured.channels(), &at)?;
+    // a line where the model is singular is left out of the misfit
+    let (model, _) = frf::synthesize_regular(sys, measured.channels(), &at)?;
     let set = LineSet::with_model(measured, lines, gains, &model, weights)?;
-    Ok((set.cost0 / (set.n as f64 / 2.0)).sqrt())
+    Ok(MisfitStats {
+        misfit: (set.cost0 / (set.n as f64 / 2.0)).sqrt(),
+        n: set.n,
+        lag_correlation: set.lag_correlation,
+    })
 }
 
 /// Diagnoses a model against measured receptances (all measured lines; the
@@ -512,6 +589,9 @@ fn diagnose_in(
             lines.len()
         )));
     }
+    if let Some(&f) = opts.candidates.resonator_hz.iter().find(|f| !(f.is_finite() && **f > 0.0)) {
+        return Err(UpdateError::Data(format!("a resonator's frequency must be positive and finite, got {f} Hz")));
+    }
     let nominal = DampedSystem::new(model.clone())?;
     // the nominal model at every line read below, in one synthesis (on a
     // 96k-DOF frame, 2 s saved against one per line set)
@@ -521,7 +601,23 @@ fn diagnose_in(
     }
     read.sort_by(f64::total_cmp);
     read.dedup();
-    let at_lines = frf::synthesize(&nominal, measured.channels(), &read)?;
+    let (at_lines, singular) = frf::synthesize_regular(&nominal, measured.channels(), &read)?;
+    // a lightly damped model evaluated on its own resonance is singular
+    // there: that line is left out of the diagnosis (and said), not the
+    // diagnosis stopped
+    let (reduced, reduced_weights);
+    let (measured, weights) = if singular.is_empty() {
+        (measured, weights)
+    } else {
+        let nf = measured.n_freq();
+        let keep: Vec<usize> = (0..nf).filter(|&k| !singular.contains(&lines[k])).collect();
+        reduced = measured.select_lines(&keep)?;
+        reduced_weights = weights.map(|w| {
+            (0..measured.channels().len()).flat_map(|c| keep.iter().map(move |&k| w[c * nf + k])).collect::<Vec<f64>>()
+        });
+        (&reduced, reduced_weights.as_deref())
+    };
+    let lines = measured.frequencies_hz();
     let noise = noise_against(measured, weights, &at_lines)
         .ok_or_else(|| UpdateError::Data("too few usable measured values to estimate the noise level".into()))?;
     // a noise floor for noise-free data keeps the criterion finite
@@ -532,19 +628,29 @@ fn diagnose_in(
     let mut pool = Pool::new(model, &nominal, s2, copts.band_hz);
     prepare(&mut pool);
     search::search(&mut pool, measured, &at_lines, &full, opts, &copts, progress)?;
-    Ok(rank(pool, noise, &full, opts))
+    let mut d = rank(pool, noise, &full, opts);
+    d.singular_hz = singular;
+    Ok(d)
 }
 
 /// The ranking of a finished search.
 fn rank(pool: Pool<'_>, noise: f64, full: &LineSet, opts: &DiagnoseOptions) -> Diagnosis {
+    // each candidate judged against what it leaves (see `delta_bic`), with
+    // the correlation of the nominal model's residual standing for its own
+    let evidence = |f: &search::Fit, k: usize| {
+        let after =
+            MisfitStats { misfit: (f.cost / (f.n as f64 / 2.0)).sqrt(), n: f.n, lag_correlation: full.lag_correlation };
+        delta_bic((f.cost0 / (f.n as f64 / 2.0)).sqrt(), 0, &after, k, noise)
+    };
     let ranked = |i: usize, f: &search::Fit, fully: bool| {
         let c = &pool.candidates[i];
-        let delta_bic = pool.bic(f, c.parameters.len());
+        let delta_bic = evidence(f, c.parameters.len());
         let implausible_reason = c.implausible(&f.values, &f.determined);
         Ranked {
             kind: c.kind,
             gains: f.gains.clone(),
-            description: c.description.clone(),
+            // at its fitted values: a resonator's names its fitted tuning
+            description: c.description_at(&f.values),
             nodes: c.nodes.clone(),
             elements: c.elements.clone(),
             dof: c.dofs.iter().map(|d| d.to_string()).collect(),
@@ -573,21 +679,25 @@ fn rank(pool: Pool<'_>, noise: f64, full: &LineSet, opts: &DiagnoseOptions) -> D
     let fully = pool.by_full_fit();
     let mut ranking: Vec<Ranked> =
         fully.iter().map(|&i| ranked(i, pool.full[i].as_ref().expect("fully fitted"), true)).collect();
+    // stable: candidates of equal evidence keep the search's order
+    ranking.sort_by(|a, b| a.delta_bic.total_cmp(&b.delta_bic));
     let rest: Vec<usize> =
         (0..pool.candidates.len()).filter(|&i| pool.full[i].is_none() && !pool.superseded[i]).collect();
     ranking.extend(
         pool.by_screening(&rest).into_iter().map(|i| ranked(i, pool.screened[i].as_ref().expect("screened"), false)),
     );
     let recommended = ranking.iter().position(|r| r.fully_fitted && r.significant && r.plausible).map(|r| r + 1);
-    let ranked: std::collections::HashSet<usize> = ranking.iter().map(|r| r.candidate).collect();
+    // a ranked candidate is listed under the description it is ranked with
+    let ranked: std::collections::HashMap<usize, &str> =
+        ranking.iter().map(|r| (r.candidate, r.description.as_str())).collect();
     let unfitted = (0..pool.candidates.len())
         .filter_map(|i| {
             let (stage, reason) = pool.failure[i].clone()?;
             Some(Unfitted {
-                description: pool.candidates[i].description.clone(),
+                description: ranked.get(&i).map_or_else(|| pool.candidates[i].description.clone(), |d| d.to_string()),
                 reason,
                 stage,
-                ranked: ranked.contains(&i),
+                ranked: ranked.contains_key(&i),
             })
         })
         .collect();
@@ -602,6 +712,7 @@ fn rank(pool: Pool<'_>, noise: f64, full: &LineSet, opts: &DiagnoseOptions) -> D
         gains: full.gains,
         weighted: full.weights.is_some(),
         unfitted,
+        singular_hz: Vec::new(),
         candidates: pool.candidates,
     }
 }

@@ -619,7 +619,8 @@ pub(crate) fn search(
 /// the nominal mass) or lumped mass, with its rotary inertia or without
 /// (0.3 % to 10 % of the structure's mass, beside its own 0.1 %), spread
 /// over the plausible range so that one of them starts in the basin of the
-/// truth; none for other candidates.
+/// truth; a resonator's own ([`Candidate::other_starts`]); none for other
+/// candidates.
 fn factor_starts(c: &Candidate) -> Vec<Vec<f64>> {
     let start = c.start_values();
     let scales: &[f64] = match c.roles.as_slice() {
@@ -627,7 +628,7 @@ fn factor_starts(c: &Candidate) -> Vec<Vec<f64>> {
         [Role::MassFactor] => &[1.5, 2.0],
         // a mass with its rotary inertia: both scaled together
         [Role::Mass] | [Role::Mass, Role::Inertia] => &[3.0, 10.0, 30.0, 100.0],
-        _ => &[],
+        _ => return c.other_starts(),
     };
     scales.iter().map(|f| start.iter().map(|v| v * f).collect()).collect()
 }

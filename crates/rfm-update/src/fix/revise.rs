@@ -15,16 +15,15 @@
 //! replaced by each of the few best other candidates of the diagnosis it
 //! came from that act at its place (any kind: a mass change of two
 //! elements is a lumped mass's neighbour), the others kept, and everything
-//! updated jointly. A replacement is kept when the information criterion
-//! says it is better, `n (m1^2 - m0^2) / s^2 + (k1 - k0) ln n < -10` with
-//! `n` values, misfits `m`, noise `s` and `k` parameters, as the
-//! diagnosis judges candidates; the next effect is then revised with it in
-//! place.
+//! updated jointly. A replacement (or the effect's removal) is kept by the
+//! loop's one rule (`fix/judge.rs`): the evidence for the model with it over
+//! the model before, every parameter counted, plausible values and an
+//! update that reached a stationary point; the next effect is then revised
+//! with it in place.
 
 use fe_model::{CaseEditor, CaseFile};
-use frf::FrfSet;
 
-use super::{Added, FixOptions, update_case};
+use super::{Added, Loop, State};
 use crate::diagnose::{self, Diagnosis, EffectKind, Ranked};
 use crate::error::UpdateError;
 
@@ -33,9 +32,6 @@ const REVISE_WIDTH: usize = 6;
 
 /// Passes over the effects, at most.
 const PASSES: usize = 2;
-
-/// The change of the information criterion a replacement must beat.
-const REVISE_BIC: f64 = -10.0;
 
 /// One replacement kept: effect `index` of the loop's effects (as revised
 /// so far), and the case with its replacement, updated; or, when
@@ -47,6 +43,8 @@ pub(super) struct Replacement {
     pub added: Added,
     /// The description of the effect it replaced.
     pub replaced: String,
+    /// Its evidence over the model before it.
+    pub delta_bic: f64,
 }
 
 /// Kinds that stand in for one another: a joint and a short stiffness
@@ -57,6 +55,8 @@ fn family(kind: EffectKind) -> u8 {
         EffectKind::LumpedMass | EffectKind::MassChange => 1,
         EffectKind::ViscousDamping | EffectKind::NonViscousDamping => 2,
         EffectKind::FlexibleSupport => 3,
+        // a mode of its own: nothing else stands in for it
+        EffectKind::Resonator => 4,
     }
 }
 
@@ -113,17 +113,17 @@ fn neighbours(d: &Diagnosis, own: &Ranked, model: &fe_model::Model) -> Vec<usize
 /// effect just put in, which start from its diagnosed values): the effects
 /// kept were updated together, and starting them there spares the update
 /// the way back from their first, biased fits.
-fn build(
+pub(super) fn build(
     nominal: &CaseFile,
     applied: &[(&Diagnosis, usize)],
     warm: Option<&fe_model::Model>,
     fresh: &[String],
-    opts: &FixOptions,
+    fl: &Loop<'_>,
 ) -> Result<(CaseFile, CaseEditor), UpdateError> {
     let mut case = nominal.clone();
     let mut editor = None;
     for (d, r) in applied {
-        let e = d.apply_with_data(&case, *r, opts.data.as_deref())?;
+        let e = d.apply_with_data(&case, *r, fl.opts.data.as_deref())?;
         case = CaseFile::parse(&nominal.path, &e.text_at(&nominal.path)?)?;
         editor = Some(e);
     }
@@ -144,17 +144,18 @@ fn build(
 /// [`build`] and every parameter updated (no restarts unless `last`); the
 /// added effect reported is the one at `index`.
 fn with_effects(
+    fl: &Loop<'_>,
     nominal: &CaseFile,
     applied: &[(&Diagnosis, usize)],
     index: usize,
     warm: Option<&fe_model::Model>,
     fresh: &[String],
-    (measured, opts, step, last): (&FrfSet, &FixOptions, usize, bool),
+    (step, last): (usize, bool),
 ) -> Result<Added, UpdateError> {
-    let (case, editor) = build(nominal, applied, warm, fresh, opts)?;
+    let (case, editor) = build(nominal, applied, warm, fresh, fl)?;
     let (d, rank) = applied[index];
-    let (editor, case, misfit_updated, outcome) = update_case(&case, editor, d, measured, opts, step, last)?;
-    Ok(Added { effect: d.ranking[rank - 1].clone(), rank, editor, case, misfit_updated, outcome })
+    let (editor, case, stats, outcome) = fl.update_case(&case, editor, step, last)?;
+    Ok(Added { effect: d.ranking[rank - 1].clone(), rank, editor, case, stats, outcome })
 }
 
 /// The effects as references.
@@ -162,30 +163,23 @@ fn refs(a: &[(Diagnosis, usize)]) -> Vec<(&Diagnosis, usize)> {
     a.iter().map(|(d, r)| (d, *r)).collect()
 }
 
-/// The number of parameters the effects add.
-fn parameter_count(applied: &[(&Diagnosis, usize)]) -> usize {
-    applied.iter().map(|(d, r)| d.ranking[r - 1].parameters.len()).sum()
-}
-
 /// Revises the effects `applied` (diagnosis and rank of each, in the order
-/// added), which leave `misfit` in the case `current`, against data of
-/// noise `noise`; see the module docs. Returns the replacements kept, in
-/// order (each updated with the ones before it in place; the last again
-/// with restarts, as the loop's answer), and the effects as revised.
+/// added to `nominal`), which leave the model `before` in the case
+/// `current`; see the module docs. Returns the replacements kept, in order
+/// (each updated with the ones before it in place; the last again with
+/// restarts, as the loop's answer), and the effects as revised.
 pub(super) fn revise(
+    fl: &Loop<'_>,
     nominal: &CaseFile,
     applied: &[(Diagnosis, usize)],
     current: &CaseFile,
-    measured: &FrfSet,
-    opts: &FixOptions,
-    (misfit, noise): (f64, f64),
+    before: State,
 ) -> (Vec<Replacement>, Vec<(Diagnosis, usize)>) {
     let mut applied: Vec<(Diagnosis, usize)> = applied.to_vec();
     let mut warm = current.model.clone();
-    let mut misfit = misfit;
+    let mut state = before;
     let mut kept: Vec<Replacement> = Vec::new();
-    let n = (2 * measured.channels().len() * diagnose::informative_lines(measured, opts.diagnose.lines).len()) as f64;
-    let step = opts.max_steps.max(applied.len() + 1);
+    let step = fl.opts.max_steps.max(applied.len() + 1);
     // a second pass when the first changed something: an effect revised
     // early was revised against others not yet mended (trial 27: the mass
     // before the damping window)
@@ -204,51 +198,51 @@ pub(super) fn revise(
         // call for at its place with the others in
         let mut without = refs(&applied);
         without.remove(index);
-        let before = parameter_count(&refs(&applied)) as f64;
-        let score = |m: f64, k: f64| n * (m * m - misfit * misfit) / (noise * noise) + (k - before) * n.ln();
         let mut best: Option<(f64, Option<usize>, Added)> = None;
         // built once: updated for the effect taken out, diagnosed for its
         // replacements
-        let without_built = build(nominal, &without, Some(&warm), &[], opts);
+        let without_built = if without.is_empty() {
+            Err(UpdateError::Method("no effect left".into()))
+        } else {
+            build(nominal, &without, Some(&warm), &[], fl)
+        };
         // taken out: an effect added to make up for a wrong form of
         // another may not be needed once that is mended (trial 25: a stiff
         // in-line joint beside the corner joint)
         if let Ok((case, editor)) = &without_built
-            && let Ok((editor, case, m, outcome)) =
-                update_case(case, editor.clone(), without[0].0, measured, opts, step, false)
-            && m.is_finite()
+            && let Ok((editor, case, stats, outcome)) = fl.update_case(case, editor.clone(), step, false)
+            && stats.misfit.is_finite()
         {
-            let bic = score(m, parameter_count(&without) as f64);
-            if bic < REVISE_BIC {
-                let a = Added { effect: own.clone(), rank: applied[index].1, editor, case, misfit_updated: m, outcome };
-                best = Some((bic, None, a));
+            let a = Added { effect: own.clone(), rank: applied[index].1, editor, case, stats, outcome };
+            let v = fl.evidence.judge(state, &a, &without);
+            if v.rejected.is_none() {
+                best = Some((v.delta_bic, None, a));
             }
         }
         let d = without_built
-            .and_then(|(case, _)| diagnose::diagnose(&case.model, measured, &opts.diagnose).map(|d| (d, case)));
+            .and_then(|(case, _)| diagnose::diagnose(&case.model, &fl.data, &fl.opts.diagnose).map(|d| (d, case)));
         if let Ok((d, without_case)) = &d {
             for other in neighbours(d, &own, &without_case.model) {
                 let mut tried = refs(&applied);
                 tried[index] = (d, other);
                 let fresh: Vec<String> = d.ranking[other - 1].parameters.iter().map(|p| p.name.clone()).collect();
-                let Ok(a) = with_effects(nominal, &tried, index, Some(&warm), &fresh, (measured, opts, step, false))
-                else {
+                let Ok(a) = with_effects(fl, nominal, &tried, index, Some(&warm), &fresh, (step, false)) else {
                     continue;
                 };
-                let bic = score(a.misfit_updated, parameter_count(&tried) as f64);
-                if a.misfit_updated.is_finite() && bic < REVISE_BIC && best.as_ref().is_none_or(|(b, ..)| bic < *b) {
-                    best = Some((bic, Some(other), a));
+                let v = fl.evidence.judge(state, &a, &tried);
+                if v.rejected.is_none() && best.as_ref().is_none_or(|(b, ..)| v.delta_bic < *b) {
+                    best = Some((v.delta_bic, Some(other), a));
                 }
             }
         }
-        let Some((_, other, added)) = best else {
+        let Some((delta_bic, other, added)) = best else {
             index += 1;
             continue;
         };
         warm = added.case.model.clone();
-        misfit = added.misfit_updated;
+        state = State { misfit: added.stats.misfit, k: added.outcome.parameters.len() };
         pass_changed = true;
-        kept.push(Replacement { index, removed: other.is_none(), added, replaced: own.description.clone() });
+        kept.push(Replacement { index, removed: other.is_none(), added, replaced: own.description.clone(), delta_bic });
         match (other, d) {
             (Some(other), Ok((d, _))) => {
                 applied[index] = (d, other);
@@ -262,12 +256,12 @@ pub(super) fn revise(
     // the last replacement's model is the loop's answer: its fit restarts
     // when it leaves more than the noise
     if let Some(last) = kept.last_mut()
-        && let Ok((case, editor)) = build(nominal, &refs(&applied), Some(&warm), &[], opts)
-        && let Ok((editor, case, m, outcome)) = update_case(&case, editor, &applied[0].0, measured, opts, step, true)
-        && m <= last.added.misfit_updated
+        && !applied.is_empty()
+        && let Ok((case, editor)) = build(nominal, &refs(&applied), Some(&warm), &[], fl)
+        && let Ok((editor, case, stats, outcome)) = fl.update_case(&case, editor, step, true)
+        && stats.misfit <= last.added.stats.misfit
     {
-        (last.added.editor, last.added.case, last.added.misfit_updated, last.added.outcome) =
-            (editor, case, m, outcome);
+        (last.added.editor, last.added.case, last.added.stats, last.added.outcome) = (editor, case, stats, outcome);
     }
     (kept, applied)
 }

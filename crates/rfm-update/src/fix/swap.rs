@@ -10,19 +10,10 @@
 //! three elements (held-out trial 29 of the hidden-effect test).
 
 use fe_model::CaseFile;
-use frf::FrfSet;
 
-use super::{Added, FixOptions, add_and_update, distinct_leaders, update_case};
+use super::{Added, Loop, State, distinct_leaders};
 use crate::diagnose::{self, Diagnosis};
 use crate::error::UpdateError;
-
-/// Above this multiple of the noise after the loop, the effects added are
-/// tried left out and replaced ([`swap`]).
-pub(super) const SWAP_ABOVE: f64 = 1.5;
-
-/// A replacement is kept when it leaves less than this fraction of the
-/// loop's final misfit.
-const SWAP_GAIN: f64 = 0.9;
 
 /// The sets of effects (indices of `n` added in turn) to leave out: each
 /// but the last alone (left out alone, the last one would only come back),
@@ -43,6 +34,13 @@ fn left_out_sets(n: usize) -> Vec<Vec<usize>> {
 /// are tried as the first replacement.
 const SWAP_WIDTH: usize = 3;
 
+/// A model after an effect was added, with the effect's own evidence
+/// (dBIC over the model before it).
+type Judged = (Added, f64);
+
+/// An effect kept: the diagnosis it came from and its rank there.
+type Effect<'d> = (&'d Diagnosis, usize);
+
 /// For each set of [`left_out_sets`], the other effects are added to the
 /// nominal case as they were diagnosed and everything is updated; then the
 /// data are diagnosed again and an effect added and updated, as many times
@@ -54,79 +52,98 @@ const SWAP_WIDTH: usize = 3;
 /// window (held-out trial 25: a viscous joint where the data, with the
 /// mass beside it, call for the non-viscous one). Later replacements are
 /// the recommended effect of each new diagnosis. Returns the effects left
-/// out (ascending) and the replacements in the order added, for the set
-/// and first replacement that leave the least misfit, when that is below
-/// [`SWAP_GAIN`] times `misfit`.
+/// out (ascending) and the replacements in the order added, each with its
+/// own evidence over the model before it, for the set and first
+/// replacement whose final model the evidence prefers most over `before`,
+/// when it prefers one (by the loop's rule: every replacement kept by it
+/// in turn, and the final model by it against `before`).
 pub(super) fn swap(
+    fl: &Loop<'_>,
     nominal: &CaseFile,
     applied: &[(Diagnosis, usize)],
-    measured: &FrfSet,
-    opts: &FixOptions,
-    misfit: f64,
-) -> Option<(Vec<usize>, Vec<Added>)> {
-    let step = opts.max_steps.max(applied.len() + 1);
-    let mut best: Option<(Vec<usize>, Vec<Added>)> = None;
+    before: State,
+) -> Option<(Vec<usize>, Vec<Judged>)> {
+    let step = fl.opts.max_steps.max(applied.len() + 1);
+    let mut best: Option<(f64, Vec<usize>, Vec<Judged>)> = None;
     for outs in left_out_sets(applied.len()) {
-        let Ok(kept) = kept_case(nominal, applied, &outs, measured, opts, step) else { continue };
-        let Ok(first) = diagnose::diagnose(&kept.model, measured, &opts.diagnose) else { continue };
+        let Ok((kept, kept_state, kept_effects)) = kept_case(fl, nominal, applied, &outs, step) else { continue };
+        let Ok(first) = diagnose::diagnose(&kept.model, &fl.data, &fl.opts.diagnose) else { continue };
         for r in distinct_leaders(&first, &kept.model, SWAP_WIDTH) {
-            let Ok(added) = replace(&kept, &first, r, outs.len(), measured, opts, step) else { continue };
-            let end = added.last().expect("not empty").misfit_updated;
-            if end < SWAP_GAIN * misfit
-                && best.as_ref().is_none_or(|(_, b)| end < b.last().expect("not empty").misfit_updated)
-            {
-                best = Some((outs.clone(), added));
+            let Ok(added) = replace(fl, &kept, kept_state, &kept_effects, &first, r, outs.len(), step) else {
+                continue;
+            };
+            let end = &added.last().expect("not empty").0;
+            let mut effects: Vec<(&Diagnosis, usize)> = kept_effects.clone();
+            effects.push((&first, r));
+            let v = fl.evidence.judge(before, end, &effects);
+            if v.rejected.is_none() && best.as_ref().is_none_or(|(b, ..)| v.delta_bic < *b) {
+                best = Some((v.delta_bic, outs.clone(), added));
             }
         }
     }
-    best
+    best.map(|(_, outs, added)| (outs, added))
 }
 
 /// The nominal case with the effects of `applied` but those at `outs`
 /// added as they were diagnosed, and everything updated (no restarts: the
-/// model without the effects is knowingly incomplete).
-fn kept_case(
+/// model without the effects is knowingly incomplete); with its state and
+/// the effects kept.
+fn kept_case<'d>(
+    fl: &Loop<'_>,
     nominal: &CaseFile,
-    applied: &[(Diagnosis, usize)],
+    applied: &'d [(Diagnosis, usize)],
     outs: &[usize],
-    measured: &FrfSet,
-    opts: &FixOptions,
     step: usize,
-) -> Result<CaseFile, UpdateError> {
-    let mut case = nominal.clone();
-    let mut editor = None;
-    for (j, (d, r)) in applied.iter().enumerate().filter(|(j, _)| !outs.contains(j)) {
-        let e = d.apply_with_data(&case, *r, opts.data.as_deref())?;
-        case = CaseFile::parse(&nominal.path, &e.text_at(&nominal.path)?)?;
-        editor = Some((e, j));
-    }
-    let (e, j) = editor.expect("at least one effect kept");
-    let (_, kept, ..) = update_case(&case, e, &applied[j].0, measured, opts, step, false)?;
-    Ok(kept)
+) -> Result<(CaseFile, State, Vec<Effect<'d>>), UpdateError> {
+    let effects: Vec<(&Diagnosis, usize)> =
+        applied.iter().enumerate().filter(|(j, _)| !outs.contains(j)).map(|(_, (d, r))| (d, *r)).collect();
+    let (case, editor) = super::revise::build(nominal, &effects, None, &[], fl)?;
+    let (_, kept, stats, outcome) = fl.update_case(&case, editor, step, false)?;
+    Ok((kept, State { misfit: stats.misfit, k: outcome.parameters.len() }, effects))
 }
 
 /// `count` replacements added to `kept` and updated in turn: ranked effect
 /// `rank` of `first` (the diagnosis of `kept`), then the recommended effect
-/// of each new diagnosis (fewer when nothing significant remains).
+/// of each new diagnosis (fewer when nothing significant remains), each
+/// kept only by the loop's rule against the model before it.
+#[allow(clippy::too_many_arguments)]
 fn replace(
+    fl: &Loop<'_>,
     kept: &CaseFile,
+    kept_state: State,
+    kept_effects: &[(&Diagnosis, usize)],
     first: &Diagnosis,
     rank: usize,
     count: usize,
-    measured: &FrfSet,
-    opts: &FixOptions,
     step: usize,
-) -> Result<Vec<Added>, UpdateError> {
+) -> Result<Vec<Judged>, UpdateError> {
     // the last replacement's model is the answer: its fit restarts
-    let a = add_and_update(kept, first, rank, measured, opts, step, count == 1)?;
+    let a = fl.add_and_update(kept, first, rank, step, count == 1)?;
+    let mut effects: Vec<(&Diagnosis, usize)> = kept_effects.to_vec();
+    effects.push((first, rank));
+    let v = fl.evidence.judge(kept_state, &a, &effects);
+    if let Some(why) = v.rejected {
+        return Err(UpdateError::Method(why));
+    }
+    let mut state = State { misfit: a.stats.misfit, k: a.outcome.parameters.len() };
     let mut current = a.case.clone();
-    let mut added = vec![a];
+    let mut added = vec![(a, v.delta_bic)];
+    let mut diagnoses: Vec<Diagnosis> = Vec::new();
     for round in 1..count {
-        let d = diagnose::diagnose(&current.model, measured, &opts.diagnose)?;
+        let d = diagnose::diagnose(&current.model, &fl.data, &fl.opts.diagnose)?;
         let Some(rank) = d.recommended else { break };
-        let a = add_and_update(&current, &d, rank, measured, opts, step + round, round + 1 == count)?;
+        let a = fl.add_and_update(&current, &d, rank, step + round, round + 1 == count)?;
+        diagnoses.push(d);
+        let d = diagnoses.last().expect("pushed");
+        let mut with: Vec<(&Diagnosis, usize)> = effects.clone();
+        with.push((d, rank));
+        let v = fl.evidence.judge(state, &a, &with);
+        if v.rejected.is_some() {
+            break;
+        }
+        state = State { misfit: a.stats.misfit, k: a.outcome.parameters.len() };
         current = a.case.clone();
-        added.push(a);
+        added.push((a, v.delta_bic));
     }
     Ok(added)
 }

@@ -27,6 +27,33 @@ impl Study {
         Ok(lines)
     }
 
+    /// `lines` without those where the initial model's dynamic stiffness is
+    /// singular (a lightly damped or undamped model evaluated on its own
+    /// resonance: no receptance exists there to compare with), and a note
+    /// that says which were left out and why; refused when every line is.
+    pub fn regular_lines(&self, lines: Vec<f64>) -> Result<(Vec<f64>, Option<String>), UpdateError> {
+        let channels = self.measured.channels();
+        let (_, singular) = frf::synthesize_regular(&self.system, &channels[..channels.len().min(1)], &lines)?;
+        if singular.is_empty() {
+            return Ok((lines, None));
+        }
+        let kept: Vec<f64> = lines.iter().copied().filter(|f| !singular.contains(f)).collect();
+        let list = singular.iter().map(|f| format!("{f} Hz")).collect::<Vec<_>>().join(", ");
+        if kept.is_empty() {
+            return Err(UpdateError::Numerics(format!(
+                "the initial model's dynamic stiffness is singular at every updating line ({list})"
+            )));
+        }
+        Ok((
+            kept,
+            Some(format!(
+                "{} updating line(s) left out, where the initial model's dynamic stiffness is singular (an undamped \
+                 mode on the line): {list}",
+                singular.len()
+            )),
+        ))
+    }
+
     /// The measured lines a frequency choice designates.
     pub fn choose_lines(&self, choice: &FrequencyChoice) -> Result<Vec<f64>, UpdateError> {
         let lines = self.measured.frequencies_hz();

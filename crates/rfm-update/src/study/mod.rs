@@ -114,7 +114,7 @@ impl PairingReport {
 }
 
 fn channels_of(m: &MeasurementSpec) -> Vec<Channel> {
-    m.references.iter().flat_map(|&r| m.responses.iter().map(move |&resp| Channel::new(resp, r))).collect()
+    m.channels().into_iter().map(|(resp, r)| Channel::new(resp, r)).collect()
 }
 
 impl Study {

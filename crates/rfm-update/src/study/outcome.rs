@@ -36,8 +36,14 @@ impl ParameterReport {
 pub struct UpdateOutcome {
     /// Method used.
     pub method: String,
-    /// How the iteration ended.
+    /// How the run ended, judged against the noise (see [`crate::verdict`]).
     pub status: Status,
+    /// How the iteration itself ended, before that judgement:
+    /// [`Status::Converged`] at a stationary point (whatever its misfit),
+    /// [`Status::Stalled`] where no step lowered the misfit short of one,
+    /// [`Status::MaxIterations`] or [`Status::Failed`]. `rfm fix` keeps a
+    /// step only when its update reached a stationary point.
+    pub iteration_end: Status,
     /// Per-parameter values.
     pub parameters: Vec<ParameterReport>,
     /// Iteration history.

@@ -50,7 +50,7 @@ impl Study {
         if self.parameters.is_empty() {
             return Err(UpdateError::NoParameters);
         }
-        let lines = self.lines_for(Method::OutputError)?;
+        let (lines, singular_note) = self.regular_lines(self.lines_for(Method::OutputError)?)?;
         let measured = self.measured.at_frequencies(&lines)?;
         self.check_initial(&measured)?;
         let weights = self.weights(&measured)?;
@@ -129,6 +129,7 @@ impl Study {
         Ok(UpdateOutcome {
             method: "output-error".into(),
             status,
+            iteration_end: result.status.clone(),
             parameters: self.reports(&result.values),
             residual,
             history,
@@ -139,7 +140,7 @@ impl Study {
             noise_estimate: crate::diagnose::estimate_noise_against(&sys, &self.measured)?,
             residual_noise: noise,
             masked: describe_masked(&self.masked),
-            notes: self.notes.clone(),
+            notes: self.notes.iter().cloned().chain(singular_note).collect(),
             warnings: Vec::new(),
             noise_ratio,
             restarts,

@@ -43,7 +43,7 @@ impl Study {
                 self.gains, self.gains_reason
             )));
         }
-        let lines = self.lines_for(Method::Rfm)?;
+        let (lines, singular_note) = self.regular_lines(self.lines_for(Method::Rfm)?)?;
         let measured = self.measured.at_frequencies(&lines)?;
         self.check_initial(&measured)?;
         let mut sys = self.system.clone();
@@ -104,7 +104,7 @@ impl Study {
             // the RFM's equations carry no line weights
             residual_noise: noise,
             masked: describe_masked(&self.masked),
-            notes: self.notes.clone(),
+            notes: self.notes.iter().cloned().chain(singular_note).collect(),
             warnings,
             noise_ratio,
             restarts: Vec::new(),
@@ -114,6 +114,7 @@ impl Study {
             pairing: self.pairing.clone(),
             method: "rfm".into(),
             status,
+            iteration_end: result.status.clone(),
             parameters: self.reports(&result.values),
             history: result.history,
             residual: result.residual,

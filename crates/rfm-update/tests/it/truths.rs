@@ -19,6 +19,10 @@
 //! draw is checked to be physically plausible and visible above the noise,
 //! and redrawn otherwise; a [`Truth`] counts its redraws.
 //!
+//! [`crate::lab`] builds on its structures and writer (the items it uses
+//! are `pub(crate)`), for trials with set-up errors and physics outside
+//! these families.
+//!
 //! The tests at the end check the generator itself: the texts parse and
 //! assemble, the true values read back from the parsed models, every effect
 //! is visible, a null truth is its nominal, draws are reproducible, and an
@@ -42,7 +46,7 @@ pub(crate) const VISIBLE: f64 = 0.10;
 
 /// The lowest natural frequency a truth may have (Hz): below it a support or
 /// joint is so soft that the structure is close to a mechanism.
-const LOWEST_MODE_HZ: f64 = 0.5;
+pub(crate) const LOWEST_MODE_HZ: f64 = 0.5;
 
 /// How far, in half-power peak widths `2 zeta f` of the nominal model, a
 /// joint or splice must move at least one mode in the band: its rotational
@@ -54,7 +58,7 @@ const JOINT_SHIFT_WIDTHS: f64 = 3.0;
 const MAX_REDRAWS: u32 = 500;
 
 /// First id of the nodes a truth adds (above every nominal node id).
-const FIRST_EXTRA_NODE: u32 = 101;
+pub(crate) const FIRST_EXTRA_NODE: u32 = 101;
 
 /// The nominal structures.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -215,47 +219,47 @@ impl Truth {
 
 /// A coordinate rounded to a picometre, so that a case file shows `0.15`
 /// rather than `0.15000000000000002`.
-fn round(x: f64) -> f64 {
+pub(crate) fn round(x: f64) -> f64 {
     (x * 1e12).round() / 1e12
 }
 
 /// A straight run of elements along the chain, axis-aligned.
-struct Member {
+pub(crate) struct Member {
     /// Node ids from one end to the other.
-    nodes: Vec<u32>,
+    pub(crate) nodes: Vec<u32>,
     /// Element ids, element `elements[i]` joins `nodes[i]` and `nodes[i + 1]`.
-    elements: Vec<u32>,
+    pub(crate) elements: Vec<u32>,
     /// Whether the member lies along x (else along y).
-    along_x: bool,
+    pub(crate) along_x: bool,
 }
 
 /// A nominal structure: its properties, members and measurement.
-struct Geometry {
-    structure: Structure,
-    title: &'static str,
-    e: f64,
-    rho: f64,
-    b: f64,
-    h: f64,
-    alpha: f64,
-    beta: f64,
+pub(crate) struct Geometry {
+    pub(crate) structure: Structure,
+    pub(crate) title: &'static str,
+    pub(crate) e: f64,
+    pub(crate) rho: f64,
+    pub(crate) b: f64,
+    pub(crate) h: f64,
+    pub(crate) alpha: f64,
+    pub(crate) beta: f64,
     /// Node coordinates, in id order.
-    nodes: Vec<(u32, f64, f64)>,
+    pub(crate) nodes: Vec<(u32, f64, f64)>,
     /// Members in order along the chain from the clamp.
-    members: Vec<Member>,
-    clamp: u32,
+    pub(crate) members: Vec<Member>,
+    pub(crate) clamp: u32,
     /// Response DOFs (over one reference).
-    responses: Vec<DofRef>,
-    reference: DofRef,
+    pub(crate) responses: Vec<DofRef>,
+    pub(crate) reference: DofRef,
     /// Measured band: from, to, step (Hz).
-    band: (f64, f64, f64),
+    pub(crate) band: (f64, f64, f64),
     /// The frequency (Hz) at which damping effects are sized by their loss
     /// factor: the middle of the band's modes.
-    f_ref: f64,
+    pub(crate) f_ref: f64,
 }
 
 impl Geometry {
-    fn of(structure: Structure) -> Geometry {
+    pub(crate) fn of(structure: Structure) -> Geometry {
         match structure {
             Structure::Cantilever => {
                 let n = 20;
@@ -309,31 +313,31 @@ impl Geometry {
         }
     }
 
-    fn area(&self) -> f64 {
+    pub(crate) fn area(&self) -> f64 {
         self.b * self.h
     }
 
-    fn inertia(&self) -> f64 {
+    pub(crate) fn inertia(&self) -> f64 {
         self.b * self.h.powi(3) / 12.0
     }
 
     /// Element length of a member.
-    fn le(&self, member: &Member) -> f64 {
+    pub(crate) fn le(&self, member: &Member) -> f64 {
         let (a, b) = (self.node(member.nodes[0]), self.node(*member.nodes.last().unwrap()));
         (b.1 - a.1).hypot(b.2 - a.2) / member.elements.len() as f64
     }
 
-    fn node(&self, id: u32) -> (u32, f64, f64) {
+    pub(crate) fn node(&self, id: u32) -> (u32, f64, f64) {
         *self.nodes.iter().find(|n| n.0 == id).expect("a nominal node")
     }
 
-    fn total_mass(&self) -> f64 {
+    pub(crate) fn total_mass(&self) -> f64 {
         let length: f64 = self.members.iter().map(|m| self.le(m) * m.elements.len() as f64).sum();
         self.rho * self.area() * length
     }
 
     /// Position along the chain from the clamp, in elements.
-    fn position(&self, node: u32) -> usize {
+    pub(crate) fn position(&self, node: u32) -> usize {
         let mut pos = 0;
         for m in &self.members {
             if let Some(i) = m.nodes.iter().position(|&n| n == node) {
@@ -344,7 +348,7 @@ impl Geometry {
         panic!("node {node} is not on the chain")
     }
 
-    fn element_nodes(&self, element: u32) -> [u32; 2] {
+    pub(crate) fn element_nodes(&self, element: u32) -> [u32; 2] {
         for m in &self.members {
             if let Some(i) = m.elements.iter().position(|&e| e == element) {
                 return [m.nodes[i], m.nodes[i + 1]];
@@ -353,18 +357,18 @@ impl Geometry {
         panic!("element {element} is not on the chain")
     }
 
-    fn lines(&self) -> Vec<f64> {
+    pub(crate) fn lines(&self) -> Vec<f64> {
         let (from, to, step) = self.band;
         let n = ((to - from) / step).round() as usize;
         (0..=n).map(|k| from + step * k as f64).collect()
     }
 
-    fn channels(&self) -> Vec<Channel> {
+    pub(crate) fn channels(&self) -> Vec<Channel> {
         self.responses.iter().map(|&r| Channel::new(r, self.reference)).collect()
     }
 
     /// The nominal model as a frame to write.
-    fn frame(&self) -> Frame {
+    pub(crate) fn frame(&self) -> Frame {
         let mut beams = Vec::new();
         for m in &self.members {
             for (i, &id) in m.elements.iter().enumerate() {
@@ -388,88 +392,95 @@ impl Geometry {
             springs: Vec::new(),
             masses: Vec::new(),
             supports: vec![self.clamp],
+            partial_supports: Vec::new(),
+            ties: Vec::new(),
         }
     }
 }
 
 // ------------------------------------------------------------- case writer
 
-enum SectionText {
+pub(crate) enum SectionText {
     Rectangle { b: f64, h: f64 },
     AreaInertia { a: f64, i: f64 },
 }
 
-struct GroupText {
-    name: String,
-    alpha: f64,
-    beta: f64,
-    mu: Option<f64>,
+pub(crate) struct GroupText {
+    pub(crate) name: String,
+    pub(crate) alpha: f64,
+    pub(crate) beta: f64,
+    pub(crate) mu: Option<f64>,
 }
 
-struct BeamText {
-    id: u32,
-    nodes: [u32; 2],
-    material: String,
-    section: String,
-    group: String,
+pub(crate) struct BeamText {
+    pub(crate) id: u32,
+    pub(crate) nodes: [u32; 2],
+    pub(crate) material: String,
+    pub(crate) section: String,
+    pub(crate) group: String,
 }
 
-struct SpringText {
-    name: String,
+pub(crate) struct SpringText {
+    pub(crate) name: String,
     /// Two nodes, or one node to ground (`b` is `None`).
-    a: u32,
-    b: Option<u32>,
-    k: [f64; 3],
-    group: String,
+    pub(crate) a: u32,
+    pub(crate) b: Option<u32>,
+    pub(crate) k: [f64; 3],
+    pub(crate) group: String,
 }
 
-struct MassText {
-    name: String,
-    node: u32,
-    m: f64,
-    j: f64,
-    group: String,
+pub(crate) struct MassText {
+    pub(crate) name: String,
+    pub(crate) node: u32,
+    pub(crate) m: f64,
+    pub(crate) j: f64,
+    pub(crate) group: String,
 }
 
 /// A float as case-file text: the shortest text that reads back to the
 /// same number (so that read-back tests can compare exactly), in exponent
 /// form when it is large or small.
-fn num(x: f64) -> String {
+pub(crate) fn num(x: f64) -> String {
     if x != 0.0 && !(1e-3..1e5).contains(&x.abs()) { format!("{x:e}") } else { format!("{x:?}") }
 }
 
 /// A model being written as a case file, item by item.
-struct Frame {
-    comment: String,
-    title: String,
-    nodes: Vec<(u32, f64, f64)>,
-    materials: Vec<(String, f64, f64)>,
-    sections: Vec<(String, SectionText)>,
-    groups: Vec<GroupText>,
-    beams: Vec<BeamText>,
-    springs: Vec<SpringText>,
-    masses: Vec<MassText>,
-    supports: Vec<u32>,
+pub(crate) struct Frame {
+    pub(crate) comment: String,
+    pub(crate) title: String,
+    pub(crate) nodes: Vec<(u32, f64, f64)>,
+    pub(crate) materials: Vec<(String, f64, f64)>,
+    pub(crate) sections: Vec<(String, SectionText)>,
+    pub(crate) groups: Vec<GroupText>,
+    pub(crate) beams: Vec<BeamText>,
+    pub(crate) springs: Vec<SpringText>,
+    pub(crate) masses: Vec<MassText>,
+    pub(crate) supports: Vec<u32>,
+    /// Nodes held in some DOFs only (an added node whose unused DOFs
+    /// nothing else holds).
+    pub(crate) partial_supports: Vec<(u32, Vec<Dof>)>,
+    /// Pairs of coincident nodes that share some DOFs.
+    pub(crate) ties: Vec<([u32; 2], Vec<Dof>)>,
 }
 
 impl Frame {
-    fn beam_mut(&mut self, id: u32) -> &mut BeamText {
+    pub(crate) fn beam_mut(&mut self, id: u32) -> &mut BeamText {
         self.beams.iter_mut().find(|b| b.id == id).expect("a nominal element")
     }
 
-    fn coordinates(&self, id: u32) -> (f64, f64) {
+    pub(crate) fn coordinates(&self, id: u32) -> (f64, f64) {
         let n = self.nodes.iter().find(|n| n.0 == id).expect("a node");
         (n.1, n.2)
     }
 
     /// Adds a node at the place of an existing one.
-    fn add_coincident(&mut self, of: u32, id: u32) {
+    pub(crate) fn add_coincident(&mut self, of: u32, id: u32) {
         let (x, y) = self.coordinates(of);
         self.nodes.push((id, x, y));
     }
 
     /// The case-file text.
-    fn to_toml(&self) -> String {
+    pub(crate) fn to_toml(&self) -> String {
         let mut s = String::new();
         let w = &mut s;
         writeln!(w, "# {}", self.comment).unwrap();
@@ -530,6 +541,14 @@ impl Frame {
         for n in &self.supports {
             writeln!(w, "\n[[supports]]\nnode = {n}").unwrap();
         }
+        for (n, dofs) in &self.partial_supports {
+            let dofs: Vec<String> = dofs.iter().map(|d| format!("\"{d}\"")).collect();
+            writeln!(w, "\n[[supports]]\nnode = {n}\ndofs = [{}]", dofs.join(", ")).unwrap();
+        }
+        for ([a, b], dofs) in &self.ties {
+            let dofs: Vec<String> = dofs.iter().map(|d| format!("\"{d}\"")).collect();
+            writeln!(w, "\n[[ties]]\nnodes = [{a}, {b}]\ndofs = [{}]", dofs.join(", ")).unwrap();
+        }
         s
     }
 }
@@ -538,14 +557,14 @@ impl Frame {
 
 /// Damping of one group: `C = alpha K` with the kernel `mu / (mu + j w)`.
 #[derive(Clone, Copy, Debug)]
-struct Damp {
-    alpha: f64,
-    mu: Option<f64>,
+pub(crate) struct Damp {
+    pub(crate) alpha: f64,
+    pub(crate) mu: Option<f64>,
 }
 
 /// How the springs of a support or joint are written.
 #[derive(Clone, Copy, Debug)]
-enum Layout {
+pub(crate) enum Layout {
     /// One spring with kx, ky and kr, in one group.
     Single(Damp),
     /// One spring per direction, each in its own group (x, y, r).
@@ -554,7 +573,7 @@ enum Layout {
 
 /// A drawn effect: everything needed to write it into a frame.
 #[derive(Clone, Debug)]
-enum Recipe {
+pub(crate) enum Recipe {
     Support {
         node: u32,
         /// Global kx, ky, kr.
@@ -591,7 +610,7 @@ enum Recipe {
     },
 }
 
-fn log_uniform(rng: &mut ChaCha8Rng, lo: f64, hi: f64) -> f64 {
+pub(crate) fn log_uniform(rng: &mut ChaCha8Rng, lo: f64, hi: f64) -> f64 {
     rng.random_range(lo.ln()..hi.ln()).exp()
 }
 
@@ -600,7 +619,7 @@ fn log_uniform(rng: &mut ChaCha8Rng, lo: f64, hi: f64) -> f64 {
 /// `alpha w mu^2 / (mu^2 + w^2)`. A relaxation far below `f_ref` would need
 /// a large alpha, which also stiffens the group by `alpha mu` at high
 /// frequencies; that stiffening is capped at half of the group's stiffness.
-fn damp_for_loss(eta: f64, mu: Option<f64>, f_ref: f64) -> Damp {
+pub(crate) fn damp_for_loss(eta: f64, mu: Option<f64>, f_ref: f64) -> Damp {
     let w = 2.0 * PI * f_ref;
     match mu {
         None => Damp { alpha: eta / w, mu: None },
@@ -649,7 +668,7 @@ fn distance(a: &[usize], b: &[usize]) -> usize {
 
 /// Draws an effect of a family on a structure, at least 3 elements from the
 /// positions in `avoid`; `None` when no place is far enough.
-fn draw_recipe(rng: &mut ChaCha8Rng, geo: &Geometry, family: Family, avoid: &[usize]) -> Option<Recipe> {
+pub(crate) fn draw_recipe(rng: &mut ChaCha8Rng, geo: &Geometry, family: Family, avoid: &[usize]) -> Option<Recipe> {
     let far = |p: &[usize]| avoid.is_empty() || distance(p, avoid) >= 3;
     let ei = geo.e * geo.inertia();
     let ea = geo.e * geo.area();
@@ -763,16 +782,16 @@ fn draw_recipe(rng: &mut ChaCha8Rng, geo: &Geometry, family: Family, avoid: &[us
 }
 
 /// The ids of the nodes a truth adds, in the order it adds them.
-struct Extra {
+pub(crate) struct Extra {
     next_node: u32,
 }
 
 impl Extra {
-    fn new() -> Self {
+    pub(crate) fn new() -> Self {
         Extra { next_node: FIRST_EXTRA_NODE }
     }
 
-    fn node(&mut self) -> u32 {
+    pub(crate) fn node(&mut self) -> u32 {
         self.next_node += 1;
         self.next_node - 1
     }
@@ -803,7 +822,7 @@ fn add_springs(frame: &mut Frame, name: &str, a: u32, b: Option<u32>, k: [f64; 3
 impl Recipe {
     /// Writes the effect into a frame that holds the nominal model (and
     /// possibly another effect at least 3 elements away).
-    fn apply(&self, frame: &mut Frame, extra: &mut Extra) {
+    pub(crate) fn apply(&self, frame: &mut Frame, extra: &mut Extra) {
         match self {
             &Recipe::Support { node, k, layout, ground_node } => {
                 frame.supports.retain(|&n| n != node);
@@ -869,7 +888,7 @@ impl Recipe {
         }
     }
 
-    fn family(&self) -> Family {
+    pub(crate) fn family(&self) -> Family {
         match self {
             Recipe::Support { .. } => Family::Support,
             Recipe::Joint { family, .. } => *family,
@@ -880,7 +899,7 @@ impl Recipe {
     }
 
     /// The effect as the test sees it.
-    fn effect(&self) -> HiddenEffect {
+    pub(crate) fn effect(&self) -> HiddenEffect {
         let named = |v: &[(&str, f64)]| v.iter().map(|&(n, x)| (n.to_string(), x)).collect::<Vec<_>>();
         let spring_damping = |layout: &Layout| {
             let mut d = Vec::new();
@@ -936,7 +955,7 @@ impl Recipe {
     }
 
     /// The effect in words.
-    fn describe(&self) -> String {
+    pub(crate) fn describe(&self) -> String {
         let damp = |d: &Damp| match d.mu {
             Some(mu) => format!("non-viscous, mu = 2 pi x {:.0} Hz", mu / (2.0 * PI)),
             None => "viscous".into(),
@@ -995,7 +1014,7 @@ fn nominal_frfs(structure: Structure) -> &'static FrfSet {
 }
 
 /// The damped system of a case-file text.
-fn system(text: &str) -> Result<DampedSystem, String> {
+pub(crate) fn system(text: &str) -> Result<DampedSystem, String> {
     let case = CaseFile::parse(Path::new("truth.toml"), text).map_err(|e| e.to_string())?;
     DampedSystem::new(case.model).map_err(|e| e.to_string())
 }
@@ -1015,7 +1034,7 @@ fn misfit_of(structure: Structure, sys: &DampedSystem) -> Result<f64, String> {
 }
 
 /// RMS of `|a - b| / |a|` over every value.
-fn relative_rms(a: &FrfSet, b: &FrfSet) -> f64 {
+pub(crate) fn relative_rms(a: &FrfSet, b: &FrfSet) -> f64 {
     let n = a.values().len() as f64;
     (a.values().iter().zip(b.values()).map(|(x, y)| ((x - y) / x.norm()).norm_sqr()).sum::<f64>() / n).sqrt()
 }
@@ -1043,7 +1062,7 @@ fn largest_shift_in_widths(geo: &Geometry, truth_hz: &[f64]) -> f64 {
 /// does not assemble, is not positive definite, has a mode below
 /// [`LOWEST_MODE_HZ`], is not visible above the noise, or (when `joint`)
 /// moves no mode by [`JOINT_SHIFT_WIDTHS`] peak widths.
-fn check(structure: Structure, text: &str, joint: bool) -> Result<f64, String> {
+pub(crate) fn check(structure: Structure, text: &str, joint: bool) -> Result<f64, String> {
     let sys = system(text)?;
     let modes = normal_modes(sys.assembly()).map_err(|e| e.to_string())?;
     let lowest = modes.frequencies_hz.first().copied().unwrap_or(0.0);
@@ -1063,7 +1082,7 @@ fn check(structure: Structure, text: &str, joint: bool) -> Result<f64, String> {
     Ok(misfit)
 }
 
-fn truth_text(geo: &Geometry, recipes: &[Recipe]) -> String {
+pub(crate) fn truth_text(geo: &Geometry, recipes: &[Recipe]) -> String {
     let mut frame = geo.frame();
     let mut extra = Extra::new();
     for r in recipes {

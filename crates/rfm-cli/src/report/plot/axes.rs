@@ -16,7 +16,7 @@ use super::C64;
 
 /// How the frequency axis of a figure is scaled.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
-pub(crate) enum FrequencyScale {
+pub enum FrequencyScale {
     /// Logarithmic when the band spans a decade or more, else linear.
     #[default]
     Auto,

@@ -1,6 +1,6 @@
 //! The change a candidate makes, applied to a model and written into a case file.
 
-use fe_model::{CaseEditor, CaseError, Dimension, Dof, ElementId, Group, Model, ModelError, PerDof};
+use fe_model::{CaseEditor, CaseError, Dimension, Dof, ElementId, Group, Model, ModelError, NodeId, PerDof};
 
 use super::EffectKind;
 
@@ -45,6 +45,21 @@ pub(crate) enum Edit {
         dim: Dimension,
         per_direction: bool,
     },
+    /// A resonator: a new node `new_node` coincident with `node`, joined
+    /// to it by a spring `k` in the translations `dofs`, carrying a lumped
+    /// mass `m`, held in its other DOFs; the spring and the mass are named
+    /// `name` and are in `group` of their own, whose alpha (and mu) damp
+    /// the spring. Written as a case's `[[resonators]]` entry.
+    Resonator {
+        node: u32,
+        new_node: u32,
+        dofs: Vec<Dof>,
+        name: String,
+        group: Group,
+        m: f64,
+        k: PerDof,
+        dim: Dimension,
+    },
     /// Nothing added: the parameters exist in the nominal model.
     Set,
     /// Elements `first..=last` moved to a new group.
@@ -82,6 +97,11 @@ fn springs(
             (n, kd, g)
         })
         .collect()
+}
+
+/// The natural frequency (Hz) of a mass `m` on a spring `k`.
+fn tuned_hz(k: f64, m: f64) -> f64 {
+    (k / m).sqrt() / (2.0 * std::f64::consts::PI)
 }
 
 fn range_name(first: u32, last: u32) -> String {
@@ -130,6 +150,23 @@ impl Edit {
                     m.add_spring(&name, *node, Some(*new_node), k, g)?;
                 }
             }
+            Edit::Resonator { node, new_node, dofs, name, group, m: mass, k, dim } => {
+                let at = m
+                    .node(NodeId(*node))
+                    .ok_or_else(|| ModelError::UnknownNode { id: *node, context: format!("resonator `{name}`") })?
+                    .position();
+                let g = m.add_group(group.clone())?;
+                m.add_node_at(*new_node, at)?;
+                let mut acting = PerDof::default();
+                for &d in dofs {
+                    acting[d] = k[d];
+                }
+                m.add_spring(name, *node, Some(*new_node), acting, g)?;
+                m.add_mass(name, *new_node, *mass, [0.0; 3], g)?;
+                // held where it does not act: no DOF of the new node is left without stiffness
+                let held: Vec<Dof> = dim.dofs().iter().copied().filter(|d| !dofs.contains(d)).collect();
+                m.add_support(*new_node, &held)?;
+            }
             Edit::Set => {}
             Edit::Region { first, last, group } => {
                 let g = m.add_group(group.clone())?;
@@ -149,6 +186,7 @@ impl Edit {
             Edit::Support { released, .. } => released.contains(&d),
             Edit::Joint { sprung, .. } => sprung.contains(&d),
             Edit::Mass { j, .. } => d.is_translation() || *j > 0.0,
+            Edit::Resonator { dofs, .. } => dofs.contains(&d),
             _ => true,
         }
     }
@@ -195,9 +233,37 @@ impl Edit {
                 let what = if *in_line { "flexible, lossy in-line joint" } else { "flexible, lossy joint" };
                 format!("{what} at node {node} ({which}; {}; {})", springs(sprung, dim), damping(group, *per_direction))
             }
+            Edit::Resonator { node, dofs, group, m, k, .. } => {
+                let tuned: Vec<f64> = dofs.iter().map(|&d| tuned_hz(k[d], *m)).collect();
+                let names: Vec<&str> = dofs.iter().map(|d| d.name()).collect();
+                // one frequency when its springs are tuned alike (to a tenth of a hertz)
+                let shown: Vec<String> = tuned.iter().map(|f| format!("{f:.1} Hz")).collect();
+                let tuning = if shown.iter().all(|f| *f == shown[0]) {
+                    format!("{}; {}", names.join(", "), shown[0])
+                } else {
+                    names.iter().zip(&shown).map(|(d, f)| format!("{d} {f}")).collect::<Vec<_>>().join(", ")
+                };
+                format!("resonator at node {node} ({tuning}; {})", damping(group, false))
+            }
             Edit::Region { first, last, .. } => format!("{} in {}", kind.label(), range_name(*first, *last)),
             Edit::Set => kind.label().to_string(),
         }
+    }
+
+    /// The change with the fitted `values` of its parameters (`names`, as
+    /// [`Edit::write`] takes them) in place of its starting values, for
+    /// the quantities a description shows (a resonator's mass and springs,
+    /// which make its frequency); other changes as they are.
+    pub(crate) fn at_values(&self, names: &[String], values: &[f64]) -> Edit {
+        let fitted = |name: String| names.iter().zip(values).find(|(n, _)| **n == name).map(|(_, &v)| v);
+        let mut edit = self.clone();
+        if let Edit::Resonator { name, m, k, dofs, dim, .. } = &mut edit {
+            *m = fitted(format!("mass.{name}.m")).unwrap_or(*m);
+            for &d in dofs.iter() {
+                k[d] = fitted(format!("spring.{name}.{}", dim.spring_key(d))).unwrap_or(k[d]);
+            }
+        }
+        edit
     }
 
     /// Writes the change into a case being edited, with the parameters at
@@ -318,6 +384,18 @@ impl Edit {
                     .collect();
                 s.push_str(&entries.join("\n"));
                 s
+            }
+            Edit::Resonator { node, new_node, dofs, name, group, m, k, dim } => {
+                let mut acting = PerDof::default();
+                for &d in dofs {
+                    acting[d] = k[d];
+                }
+                format!(
+                    "{}\n[[resonators]]\nname = \"{name}\"\nnode = {node}\nnew_node = {new_node}                 # its mass's node, coincident with node {node}\nm = {:e}\n{}",
+                    group_table(group),
+                    fitted(format!("mass.{name}.m")).unwrap_or(*m),
+                    spring_lines(name, &acting, group, dim)
+                )
             }
             Edit::Region { first, last, group } => {
                 format!(

@@ -18,6 +18,11 @@
 //! geometry) gets what needs none: its supports released, a spring to
 //! ground at each of its free nodes, a mass at each node, and the changes of
 //! each group (`imported.rs`).
+//!
+//! Resonators are candidates only where the caller names the frequencies
+//! of measured modes the model lacks
+//! ([`CandidateOptions::resonator_hz`]): one tuned to each, at every node
+//! that can move (`resonators.rs`).
 
 use std::collections::{HashMap, HashSet};
 
@@ -26,6 +31,8 @@ use rayon::prelude::*;
 
 mod points;
 use points::{existing_joints, ground_spring, imported_stiffness_nodes, joint, mass, mass_nodes, supports};
+mod resonators;
+pub(crate) use resonators::RESONATOR_MASS_STARTS;
 pub(crate) mod twins;
 
 use super::edit::Edit;
@@ -460,6 +467,16 @@ pub fn generate(model: &Model, opts: &CandidateOptions) -> Vec<Candidate> {
     }
     for (group, nodes) in super::imported::imported_groups(model) {
         specs.extend(super::imported::group_changes(model, group, &nodes, |n| ctx.alpha(n), |n| ctx.mu(n)));
+    }
+    // resonators tuned to each extra mode; two frequencies that a
+    // description cannot tell apart are one
+    let mut tuned: Vec<String> = Vec::new();
+    for &hz in &opts.resonator_hz {
+        let shown = format!("{hz:.1}");
+        if !tuned.contains(&shown) {
+            tuned.push(shown);
+            specs.extend(resonators::resonators(&ctx, hz));
+        }
     }
 
     // windows: on small models single elements at every offset and longer

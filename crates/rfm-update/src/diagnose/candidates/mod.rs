@@ -10,19 +10,22 @@
 //! | viscous damping | the same windows | alpha of the window |
 //! | non-viscous damping | the same windows | alpha and mu of the window |
 //! | stiffness, mass or damping change of an imported group | each group with imported matrices | its factor, or its alpha (and mu) |
+//! | attached resonator | each node free in a translation, for each frequency of [`CandidateOptions::resonator_hz`] (none by default): in each translation, and in x and y at once on a planar model | a mass on a spring to a new coincident node: the mass, a spring per direction, its own damping group: alpha (viscous) or alpha and mu |
 //!
 //! Each candidate is a change of the nominal model, the effect inserted at a
 //! starting value that changes little (a very stiff spring, a tiny mass, a
 //! factor of one), the parameters to fit, wide search bounds, and a
 //! plausible range: a sensor mass of a quarter of the structure's mass, or a
-//! joint stiffer than the member it connects, explains data only in a way
-//! no engineer would accept, and the ranking says so.
+//! joint stiffer than the member it connects, or a resonator tuned far
+//! outside the measured band, explains data only in a way no engineer
+//! would accept, and the ranking says so.
 //!
 //! What the data cannot determine is held rather than fitted to a bound
 //! (`Candidate::holding`): a support or joint spring the measured
 //! directions do not see (the axial spring of a clamp measured in bending)
 //! is made rigid again, and the candidate is fitted without it (with one
-//! group per direction, without that spring's group either).
+//! group per direction, without that spring's group either); a resonator
+//! acting in a direction the data do not see is held in it.
 //!
 //! A candidate does not carry a copy of the whole model: a large model has
 //! thousands of candidates. It carries the recipe of its change (`Edit`),
@@ -62,11 +65,15 @@ pub enum EffectKind {
     ViscousDamping,
     /// Local non-viscous (exponential kernel) damping.
     NonViscousDamping,
+    /// An attached resonator: a mass on a spring and damper at a node (a
+    /// tuned-mass damper, a loose appendage, a cable, a sensor mount),
+    /// which adds a mode of its own.
+    Resonator,
 }
 
 impl EffectKind {
     /// Every kind.
-    pub const ALL: [EffectKind; 7] = [
+    pub const ALL: [EffectKind; 8] = [
         EffectKind::FlexibleSupport,
         EffectKind::FlexibleJoint,
         EffectKind::LumpedMass,
@@ -74,6 +81,7 @@ impl EffectKind {
         EffectKind::MassChange,
         EffectKind::ViscousDamping,
         EffectKind::NonViscousDamping,
+        EffectKind::Resonator,
     ];
 
     /// The name in JSON and in a case's `[[history]]` (`flexible_joint`).
@@ -86,6 +94,7 @@ impl EffectKind {
             EffectKind::MassChange => "mass_change",
             EffectKind::ViscousDamping => "viscous_damping",
             EffectKind::NonViscousDamping => "non_viscous_damping",
+            EffectKind::Resonator => "resonator",
         }
     }
 
@@ -104,6 +113,7 @@ impl EffectKind {
             EffectKind::MassChange => "mass change",
             EffectKind::ViscousDamping => "viscous damping",
             EffectKind::NonViscousDamping => "non-viscous damping",
+            EffectKind::Resonator => "attached resonator",
         }
     }
 }
@@ -113,13 +123,13 @@ impl EffectKind {
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum Role {
-    /// A spring stiffness of a support or joint, in one DOF.
+    /// A spring stiffness of a support, joint or resonator, in one DOF.
     Spring(#[cfg_attr(feature = "serde", serde(serialize_with = "crate::serialize_display"))] Dof),
     /// The stiffness-proportional damping coefficient of the effect's group.
     Alpha,
     /// The relaxation parameter of the effect's group.
     Mu,
-    /// A lumped mass.
+    /// A lumped mass (also a resonator's).
     Mass,
     /// A lumped rotary inertia.
     Inertia,
@@ -183,11 +193,15 @@ pub struct CandidateOptions {
     pub per_element_limit: usize,
     /// Band of the data (Hz), to scale damping starting values.
     pub band_hz: (f64, f64),
+    /// Frequencies (Hz) of measured modes the model lacks: at each, an
+    /// attached resonator tuned to it is a candidate at every node that can
+    /// move. Empty (the default): no resonator candidates.
+    pub resonator_hz: Vec<f64>,
 }
 
 impl Default for CandidateOptions {
     fn default() -> Self {
-        CandidateOptions { region_size: 4, per_element_limit: 40, band_hz: (1.0, 1000.0) }
+        CandidateOptions { region_size: 4, per_element_limit: 40, band_hz: (1.0, 1000.0), resonator_hz: Vec::new() }
     }
 }
 
@@ -287,23 +301,57 @@ impl Candidate {
         &self.nominal_part
     }
 
-    /// The damping form of the effect's own group, for joints, supports and
-    /// damping windows: `viscous` or `non-viscous`.
+    /// The damping form of the effect's own group, for joints, supports,
+    /// resonators and damping windows: `viscous` or `non-viscous`.
     pub fn damping(&self) -> Option<&'static str> {
         match &self.edit {
-            Edit::Support { group, .. } | Edit::Joint { group, .. } | Edit::Region { group, .. } => {
-                Some(if group.mu.is_some() { "non-viscous" } else { "viscous" })
-            }
+            Edit::Support { group, .. }
+            | Edit::Joint { group, .. }
+            | Edit::Region { group, .. }
+            | Edit::Resonator { group, .. } => Some(if group.mu.is_some() { "non-viscous" } else { "viscous" }),
             _ => None,
         }
+    }
+
+    /// The description of the candidate at fitted `values` of its
+    /// parameters: a resonator's names the frequency its fitted mass and
+    /// springs tune it to (its [`Candidate::description`], which names the
+    /// candidate in a diagnosis, the one it was started at); the others'
+    /// do not depend on their values.
+    pub fn description_at(&self, values: &[f64]) -> String {
+        match &self.edit {
+            Edit::Resonator { .. } => self.edit.at_values(&self.parameters, values).describe(self.kind),
+            _ => self.description.clone(),
+        }
+    }
+
+    /// Starting values besides [`Self::start_values`] that a screening fit
+    /// tries as well, spread over the plausible range: a resonator's mass
+    /// (and its springs with it, so that it stays tuned) at the other
+    /// fractions of the structure's mass of
+    /// [`generate::RESONATOR_MASS_STARTS`]. None for other candidates.
+    pub(crate) fn other_starts(&self) -> Vec<Vec<f64>> {
+        let Edit::Resonator { .. } = self.edit else { return Vec::new() };
+        let start = self.start_values();
+        let [_, own, _] = generate::RESONATOR_MASS_STARTS;
+        let others = generate::RESONATOR_MASS_STARTS.into_iter().filter(|&f| f != own);
+        others
+            .map(|f| {
+                let scale = f / own;
+                let scaled =
+                    |(v, r): (&f64, &Role)| if matches!(r, Role::Mass | Role::Spring(_)) { v * scale } else { *v };
+                start.iter().zip(&self.roles).map(scaled).collect()
+            })
+            .collect()
     }
 
     /// The candidate without the parameters at `held` (indices), held at
     /// their rigid or nominal value: a support spring becomes the rigid
     /// support again in its DOF, a joint's translational spring a tie, a
-    /// rotary inertia zero; a spring with a damping group of its own (one
-    /// group per direction) takes the group's alpha and mu along, so that
-    /// nothing undetermined is left free. `None` when none of them can be held (a
+    /// resonator's spring a support of its mass in that direction (it no
+    /// longer acts there), a rotary inertia zero; a spring with a damping
+    /// group of its own (one group per direction) takes the group's alpha
+    /// and mu along, so that nothing undetermined is left free. `None` when none of them can be held (a
     /// damping parameter, a joint's rotational spring) or nothing would be
     /// left to fit; the caller then reports them as not determined.
     pub(crate) fn holding(&self, model: &Model, held: &[usize]) -> Option<Candidate> {
@@ -323,6 +371,11 @@ impl Candidate {
                 }
                 (Edit::Mass { j, .. }, Role::Inertia) => {
                     *j = 0.0;
+                    true
+                }
+                (Edit::Resonator { dofs, k, .. }, Role::Spring(d)) => {
+                    dofs.retain(|&x| x != d);
+                    k[d] = 0.0;
                     true
                 }
                 _ => false,
@@ -348,8 +401,9 @@ impl Candidate {
         if dropped.is_empty() || dropped.len() == self.parameters.len() {
             return None;
         }
-        if let Edit::Support { released, .. } = &edit
-            && released.is_empty()
+        // a support released nowhere, or a resonator acting nowhere, is no candidate
+        if let Edit::Support { released: dofs, .. } | Edit::Resonator { dofs, .. } = &edit
+            && dofs.is_empty()
         {
             return None;
         }
@@ -402,11 +456,31 @@ impl Candidate {
     /// 1.2 at 400 Hz (held-out trial 0 of the full study: the right support,
     /// found with its true alpha, was set aside for that). It is implausible
     /// only above 1 over the whole band, where the spring would hold nothing
-    /// the damper does not.
+    /// the damper does not. A resonator's damper is judged the same way;
+    /// its springs by the frequency they tune its mass to, which must lie
+    /// within the band widened [`RESONATOR_REACH`] times either way: a
+    /// resonator far outside it acts in the band as a mass or a spring
+    /// alone, which the other candidates say more simply.
     pub fn implausible(&self, values: &[f64], determined: &[bool]) -> Option<String> {
-        let springs = matches!(self.edit, Edit::Support { .. } | Edit::Joint { .. });
+        let springs = matches!(self.edit, Edit::Support { .. } | Edit::Joint { .. } | Edit::Resonator { .. });
         (0..self.parameters.len()).filter(|&i| determined[i]).find_map(|i| {
             let v = values[i];
+            if let (Edit::Resonator { .. }, Role::Spring(_)) = (&self.edit, self.roles[i]) {
+                let m = self.roles.iter().position(|&r| r == Role::Mass).map(|p| values[p])?;
+                let (lo, hi) = (self.band_rad.0 / RESONATOR_REACH, self.band_rad.1 * RESONATOR_REACH);
+                let w = (v / m).sqrt();
+                let hz = |w: f64| w / (2.0 * std::f64::consts::PI);
+                return (!(lo..=hi).contains(&w)).then(|| {
+                    format!(
+                        "{} = {v:.4e} is not plausible: with the mass of {m:.4e} kg it tunes the resonator to \
+                         {:.1} Hz, outside {:.1} .. {:.1} Hz (the band widened {RESONATOR_REACH} times either way)",
+                        self.parameters[i],
+                        hz(w),
+                        hz(lo),
+                        hz(hi)
+                    )
+                });
+            }
             if self.roles[i] == Role::Alpha {
                 // the relaxation parameter of the same group
                 let mu_name = self.parameters[i].strip_suffix(".alpha").map(|g| format!("{g}.mu"));
@@ -464,6 +538,10 @@ impl Candidate {
                 .any(|&n| model.beams_at(NodeId(n)).into_iter().any(|i| elements.contains(&model.beams()[i].id.0)))
     }
 }
+
+/// How far outside the band (a factor either way) a resonator may be tuned
+/// and still be plausible.
+pub const RESONATOR_REACH: f64 = 2.0;
 
 /// The smallest and the largest loss factor of damping `alpha` (with
 /// relaxation parameter `mu`, viscous when `None`) over the band

@@ -231,3 +231,287 @@ fn effect_kind_names_are_their_json_names_and_read_back() {
     // the names a case's history may use are these, in this order
     assert_eq!(EffectKind::ALL.map(EffectKind::name), fe_model::case::EFFECT_KINDS);
 }
+
+/// The resonators of `model` tuned to `hz` over the band 1-400 Hz.
+fn resonators_of(model: &Model, hz: &[f64]) -> Vec<Candidate> {
+    let opts = CandidateOptions { band_hz: (1.0, 400.0), resonator_hz: hz.to_vec(), ..CandidateOptions::default() };
+    generate(model, &opts).into_iter().filter(|c| c.kind == EffectKind::Resonator).collect()
+}
+
+/// `model`'s receptances at `channels` and `lines` (Hz).
+fn receptances(model: &Model, channels: &[frf::Channel], lines: &[f64]) -> frf::FrfSet {
+    frf::synthesize(&damping::DampedSystem::new(model.clone()).unwrap(), channels, lines).unwrap()
+}
+
+/// `Z(w)` of a model at `f` Hz by the pair of DOFs of each entry of its
+/// pattern (in order), so that two models numbered apart compare.
+fn z_by_dofs(
+    model: &Model,
+    f: f64,
+) -> std::collections::HashMap<(fe_model::DofRef, fe_model::DofRef), num_complex::Complex64> {
+    let sys = damping::DampedSystem::new(model.clone()).unwrap();
+    let z = sys.z_values(2.0 * std::f64::consts::PI * f);
+    let (pattern, dofs) = (sys.assembly().pattern(), sys.assembly().dofs());
+    let mut out = std::collections::HashMap::new();
+    for col in 0..pattern.n() {
+        for (k, &row) in pattern.rows(col).iter().enumerate() {
+            let (a, b) = (dofs.dof_of(row), dofs.dof_of(col));
+            out.insert((a.min(b), a.max(b)), z[pattern.col_ptr()[col] + k]);
+        }
+    }
+    out
+}
+
+/// The whole model of `c` with its parameters at `values`.
+fn whole_at(model: &Model, c: &Candidate, values: &[f64]) -> Model {
+    let mut m = c.model(model).unwrap();
+    for (p, &v) in c.parameters_in(&m).unwrap().iter().zip(values) {
+        for &q in &p.quantities {
+            m.set(q, v).unwrap();
+        }
+    }
+    m
+}
+
+/// Without frequencies to tune to there is no resonator; with some, a
+/// resonator tuned to each (two a description cannot tell apart are one)
+/// at every node free in a translation, in each free translation and, in a
+/// plane, in both, viscous and non-viscous: its mass 2 % of the
+/// structure's, its springs tuned to the frequency, its damper losing 5 %
+/// there. Each applies to the whole model, which passes the kinematic
+/// check (its mass node held where it does not act), with its parameters
+/// at the same start in its part.
+#[test]
+fn resonators_are_tuned_to_each_extra_mode_at_every_node_that_can_move() {
+    let mut model = l_frame();
+    assert!(!generate(&model, &CandidateOptions::default()).iter().any(|c| c.kind == EffectKind::Resonator));
+    // a roller at the tip: free in ux alone
+    model.add_support(5, &[Dof::Uy]).unwrap();
+    let all = resonators_of(&model, &[106.2, 106.24, 40.0]);
+    // nodes 2, 3, 4: ux, uy and both; node 5: ux; viscous and not; two frequencies
+    assert_eq!(all.len(), (3 * 3 + 1) * 2 * 2);
+    assert!(all.iter().filter(|c| c.nodes == [5]).all(|c| c.dofs == [Dof::Ux]));
+    let total = model.total_mass();
+    for c in &all {
+        check(&model, c);
+        let v = c.start_values();
+        let Edit::Resonator { dofs, .. } = &c.edit else { panic!("{}", c.description) };
+        let m = v[0];
+        assert_eq!((c.roles[0], m / total), (Role::Mass, 0.02), "{}", c.description);
+        let hz = if c.description.contains("106.2 Hz") { 106.2 } else { 40.0 };
+        let w = 2.0 * std::f64::consts::PI * hz;
+        for (i, d) in dofs.iter().enumerate() {
+            assert_eq!(c.roles[1 + i], Role::Spring(*d));
+            assert!(((v[1 + i] / m).sqrt() / w - 1.0).abs() < 1e-12, "{}", c.description);
+        }
+        let alpha = v[1 + dofs.len()];
+        let mu = c.roles.contains(&Role::Mu).then(|| v[v.len() - 1]);
+        let eta = alpha * w * mu.map_or(1.0, |mu| mu * mu / (mu * mu + w * w));
+        assert!((eta - 0.05).abs() < 1e-12, "{}: loss factor {eta}", c.description);
+        assert_eq!(c.damping(), Some(if mu.is_some() { "non-viscous" } else { "viscous" }));
+    }
+    for d in ["resonator at node 3 (uy; 106.2 Hz; viscous)", "resonator at node 4 (ux, uy; 40.0 Hz; non-viscous)"] {
+        assert!(all.iter().any(|c| c.description == d), "no {d}");
+    }
+    // in space: one per translation, none in two at once
+    let space = samples::space_portal();
+    let all = resonators_of(&space, &[50.0]);
+    assert!(all.iter().all(|c| c.dofs.len() == 1) && all.iter().any(|c| c.dofs == [Dof::Uz]));
+    for c in &all {
+        check(&space, c);
+    }
+}
+
+/// A resonator's driving-point receptances are the bare structure's
+/// coupled with the dynamic stiffness of a mass on a complex spring in each
+/// direction it acts in, `z = k* - k*^2 / (k* - w^2 m)` with `k* = k (1 +
+/// j w h(w) alpha)`: `H = (I + H_0 Z)^-1 H_0` over the node's translations,
+/// `Z = diag(z)`, for every variant, away from the starting values and
+/// across the tuning frequency.
+#[test]
+fn a_resonators_driving_point_is_the_structure_coupled_with_its_dynamic_stiffness() {
+    use num_complex::Complex64 as C64;
+    let model = samples::cantilever(8);
+    let tip = 9;
+    let (ux, uy) = (fe_model::DofRef::new(tip, Dof::Ux), fe_model::DofRef::new(tip, Dof::Uy));
+    let channels: Vec<frf::Channel> =
+        [(ux, ux), (uy, ux), (ux, uy), (uy, uy)].into_iter().map(|(r, f)| frf::Channel::new(r, f)).collect();
+    let lines = [5.0, 61.0, 90.0, 95.5, 104.0, 311.0];
+    let bare = receptances(&model, &channels, &lines);
+    let candidates: Vec<Candidate> = resonators_of(&model, &[90.0]).into_iter().filter(|c| c.nodes == [tip]).collect();
+    assert_eq!(candidates.len(), 6);
+    for c in &candidates {
+        // heavier, detuned, damped otherwise
+        let values: Vec<f64> = c
+            .roles
+            .iter()
+            .zip(c.start_values())
+            .map(|(r, v)| match r {
+                Role::Mass => 1.3 * v,
+                Role::Spring(Dof::Ux) => 0.8 * v,
+                Role::Spring(_) => 1.1 * v,
+                Role::Alpha => 2.0 * v,
+                _ => 0.7 * v,
+            })
+            .collect();
+        let got = receptances(&whole_at(&model, c, &values), &channels, &lines);
+        let value = |r: Role| c.roles.iter().position(|&x| x == r).map(|i| values[i]);
+        let m = value(Role::Mass).unwrap();
+        let alpha = value(Role::Alpha).unwrap();
+        for (k, &f) in lines.iter().enumerate() {
+            let w = 2.0 * std::f64::consts::PI * f;
+            let jw = C64::new(0.0, w);
+            let h = value(Role::Mu).map_or(C64::new(1.0, 0.0), |mu| C64::new(mu, 0.0) / (mu + jw));
+            let z = |d: Dof| {
+                value(Role::Spring(d)).map_or(C64::new(0.0, 0.0), |kd| {
+                    let ks = kd * (1.0 + jw * h * alpha);
+                    ks - ks * ks / (ks - w * w * m)
+                })
+            };
+            let (zx, zy) = (z(Dof::Ux), z(Dof::Uy));
+            // H_0 over (ux, uy) of the tip, and A = I + H_0 Z
+            let h0 = [[bare.get(0, k), bare.get(2, k)], [bare.get(1, k), bare.get(3, k)]];
+            let a = [[1.0 + h0[0][0] * zx, h0[0][1] * zy], [h0[1][0] * zx, 1.0 + h0[1][1] * zy]];
+            let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+            let inv = [[a[1][1] / det, -a[0][1] / det], [-a[1][0] / det, a[0][0] / det]];
+            let want = |i: usize, j: usize| inv[i][0] * h0[0][j] + inv[i][1] * h0[1][j];
+            for (ch, (i, j)) in [(0, 0), (1, 0), (0, 1), (1, 1)].into_iter().enumerate() {
+                let (g, e) = (got.get(ch, k), want(i, j));
+                assert!(
+                    (g - e).norm() <= 1e-9 * e.norm().max(1e-12 * h0[1][1].norm()),
+                    "{}: {f} Hz, channel {ch}: {g} vs {e}",
+                    c.description
+                );
+            }
+        }
+    }
+}
+
+/// A resonator is plausible with a mass up to a quarter of the
+/// structure's, tuned within the band widened twice either way, and with a
+/// damper judged as a joint's (implausible only above a loss factor of 1
+/// over the whole band); a spring the data do not determine is not judged.
+#[test]
+fn a_resonator_is_plausible_with_a_light_mass_tuned_near_the_band() {
+    let model = samples::cantilever(8);
+    let c = resonators_of(&model, &[90.0]).into_iter().find(|c| c.damping() == Some("viscous")).unwrap();
+    let (total, start) = (model.total_mass(), c.start_values());
+    let judge = |m: f64, hz: f64, alpha: f64, determined: bool| {
+        let k = m * (2.0 * std::f64::consts::PI * hz).powi(2);
+        let mut values = vec![m];
+        values.extend(std::iter::repeat_n(k, c.parameters.len() - 2));
+        values.push(alpha);
+        let mut det = vec![true; values.len()];
+        det[1] = determined;
+        c.implausible(&values, &det)
+    };
+    let alpha = *start.last().unwrap();
+    assert_eq!(judge(0.02 * total, 90.0, alpha, true), None, "{}", c.description);
+    let heavy = judge(0.26 * total, 90.0, alpha, true).expect("more than a quarter of the structure");
+    assert!(heavy.contains("more than a quarter of the structure's mass"), "{heavy}");
+    assert_eq!(judge(0.24 * total, 90.0, alpha, true), None);
+    for (hz, plausible) in [(0.49, false), (0.51, true), (790.0, true), (810.0, false)] {
+        let e = judge(0.02 * total, hz, alpha, true);
+        assert_eq!(e.is_none(), plausible, "{hz} Hz: {e:?}");
+        if let Some(e) = e {
+            assert!(e.contains("outside 0.5 .. 800.0 Hz (the band widened 2 times either way)"), "{e}");
+        }
+        // a spring the data do not determine says nothing
+        assert_eq!(judge(0.02 * total, hz, alpha, false), None);
+    }
+    // a damper losing 0.3 at 100 Hz is plausible (1.2 at 400 Hz), one losing above 1 everywhere is not
+    let w = |hz: f64| 2.0 * std::f64::consts::PI * hz;
+    assert_eq!(judge(0.02 * total, 90.0, 0.3 / w(100.0), true), None);
+    let lossy = judge(0.02 * total, 90.0, 1.1 / w(1.0), true).expect("above 1 over the band");
+    assert!(lossy.contains("over the whole band"), "{lossy}");
+}
+
+/// A resonator in x and y whose kx the data do not determine is the
+/// resonator in y alone, named and described as that candidate is; one
+/// left acting nowhere is no candidate.
+#[test]
+fn a_resonator_direction_the_data_do_not_see_is_dropped() {
+    let model = samples::cantilever(8);
+    let all = resonators_of(&model, &[90.0]);
+    for form in ["viscous", "non-viscous"] {
+        let at =
+            |dofs: &[Dof]| all.iter().find(|c| c.nodes == [9] && c.dofs == dofs && c.damping() == Some(form)).unwrap();
+        let (both, uy) = (at(&[Dof::Ux, Dof::Uy]), at(&[Dof::Uy]));
+        let kx = both.roles.iter().position(|&r| r == Role::Spring(Dof::Ux)).unwrap();
+        let h = both.holding(&model, &[kx]).expect("the resonator in y");
+        assert_eq!(
+            (&h.description, &h.parameters, &h.edit, &h.dofs),
+            (&uy.description, &uy.parameters, &uy.edit, &uy.dofs)
+        );
+        assert_eq!(h.held, vec![both.parameters[kx].clone()]);
+        check(&model, &h);
+        let ky = uy.roles.iter().position(|&r| r == Role::Spring(Dof::Uy)).unwrap();
+        assert!(uy.holding(&model, &[ky]).is_none());
+        // its damping and mass cannot be held
+        assert!(uy.holding(&model, &[0, uy.parameters.len() - 1]).is_none());
+    }
+}
+
+/// The description after a fit names the tuning of the fitted values; the
+/// candidate keeps the one it was started at.
+#[test]
+fn a_fitted_resonator_is_described_at_its_fitted_tuning() {
+    let model = samples::cantilever(8);
+    let all = resonators_of(&model, &[90.0]);
+    let c = all.iter().find(|c| c.nodes == [9] && c.dofs.len() == 2 && c.damping() == Some("viscous")).unwrap();
+    let mut v = c.start_values();
+    // kx to 81 Hz, ky to 99 Hz at the same mass
+    v[1] *= 0.81;
+    v[2] *= 1.21;
+    assert_eq!(c.description, "resonator at node 9 (ux, uy; 90.0 Hz; viscous)");
+    assert_eq!(c.description_at(&v), "resonator at node 9 (ux 81.0 Hz, uy 99.0 Hz; viscous)");
+    v[1] = v[2];
+    v[0] *= 1.21;
+    assert_eq!(c.description_at(&v), "resonator at node 9 (ux, uy; 90.0 Hz; viscous)");
+    // the other starts keep it tuned, at the other masses
+    for (s, f) in c.other_starts().iter().zip([0.005, 0.08]) {
+        let start = c.start_values();
+        assert!((s[0] / model.total_mass() - f).abs() < 1e-15);
+        assert_eq!(c.description_at(s), c.description);
+        assert_eq!(s[3..], start[3..]);
+    }
+}
+
+/// A resonator written into a case (`Edit::write`: a `[[resonators]]`
+/// entry and its group) at fitted values reads back as the model
+/// `Edit::apply` makes at those values: the same `Z(w)` entry by entry,
+/// the resonator's own DOFs included, and the same parameter values, for
+/// every variant; the snippet shown to the user is the same text.
+#[test]
+fn a_written_resonator_reads_back_as_the_applied_one() {
+    let text = "title = \"cantilever\"\n[materials.steel]\nE = 2e11\nrho = 7800\n[sections.bar]\nb = 0.04\nh = 0.008\n\
+                [groups.beam]\nalpha = 1e-5\nbeta = 0.5\n[[lines]]\nfrom = [0.0, 0.0]\nto = [1.0, 0.0]\nelements = 8\n\
+                material = \"steel\"\nsection = \"bar\"\ngroup = \"beam\"\n[[supports]]\nnode = 1\n";
+    let case = fe_model::CaseFile::parse(std::path::Path::new("beam.toml"), text).unwrap();
+    let model = &case.model;
+    let all: Vec<Candidate> = resonators_of(model, &[90.0]).into_iter().filter(|c| c.nodes == [6]).collect();
+    assert_eq!(all.len(), 6);
+    let lines = [3.0, 77.0, 89.0, 150.0];
+    for c in &all {
+        let values: Vec<f64> = c.start_values().iter().enumerate().map(|(i, v)| v * (1.0 + 0.1 * i as f64)).collect();
+        let mut editor = case.editor().unwrap();
+        c.edit.write(&mut editor, &c.parameters, &values, "a resonator").unwrap();
+        let written = editor.text_at(&case.path).unwrap();
+        assert!(written.contains(&c.edit.snippet(&c.parameters, &values).unwrap()), "{written}");
+        let back = fe_model::CaseFile::parse(&case.path, &written).unwrap().model;
+        for (name, &v) in c.parameters.iter().zip(&values) {
+            let p = back.parameter(name).unwrap();
+            assert_eq!(back.get(p.quantities[0]), v, "{name}");
+        }
+        let applied = whole_at(model, c, &values);
+        for f in lines {
+            let (a, b) = (z_by_dofs(&applied, f), z_by_dofs(&back, f));
+            assert_eq!(a.len(), b.len(), "{}: the patterns differ", c.description);
+            let scale = a.values().map(|v| v.norm()).fold(0.0, f64::max);
+            for (key, x) in &a {
+                let y = b.get(key).unwrap_or_else(|| panic!("{}: no entry {key:?} read back", c.description));
+                assert!((x - y).norm() <= 1e-14 * scale, "{}: Z{key:?} at {f} Hz: {x} vs {y}", c.description);
+            }
+        }
+    }
+}

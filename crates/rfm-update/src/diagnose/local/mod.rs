@@ -1,14 +1,15 @@
 //! Exact low-rank evaluation of candidates that change `Z` only locally.
 //!
 //! A candidate (a lumped mass, a stiffness or mass change of an element or
-//! region, damping of a region, a joint or support spring) changes `Z` only
-//! on the few equations `D` its elements, springs or masses touch:
-//! `Z(p) = Z_0 + E dZ(p) E^T` with `E` the columns of the identity at `D`.
-//! A candidate that adds equations of its own (a released support, the
-//! rotation of a split joint node), coupled to `D` only, has them condensed
-//! out exactly: with the local matrix `[[A, B], [B^T, C]]` over `D` and the
-//! added equations, `dZ = A - B C^-1 B^T`, and each parameter derivative
-//! condenses the same way, `T^T (dZ_ext/dp) T` with `T = [I; -C^-1 B^T]`.
+//! region, damping of a region, a joint or support spring, a resonator)
+//! changes `Z` only on the few equations `D` its elements, springs or
+//! masses touch: `Z(p) = Z_0 + E dZ(p) E^T` with `E` the columns of the
+//! identity at `D`. A candidate that adds equations of its own (a released
+//! support, the rotation of a split joint node, a resonator's mass node),
+//! coupled to `D` only, has them condensed out exactly: with the local
+//! matrix `[[A, B], [B^T, C]]` over `D` and the added equations, `dZ = A -
+//! B C^-1 B^T`, and each parameter derivative condenses the same way,
+//! `T^T (dZ_ext/dp) T` with `T = [I; -C^-1 B^T]`.
 //! With `H_0 = Z_0^-1`, `S = H_0[D, D]` and `X = H_0[D, W]` (`W`: the
 //! measured response and reference equations), the Woodbury identity gives
 //!
@@ -99,7 +100,8 @@ mod tests {
 
     /// Every local candidate's low-rank response equals its own model's
     /// receptances and sensitivities, away from the starting values,
-    /// including those that add equations (supports, joints).
+    /// including those that add equations (supports, joints, the mass
+    /// node of a resonator in every variant).
     #[test]
     fn low_rank_updates_equal_the_candidate_models() {
         let (mut kinds, mut new_joints) = (Vec::new(), 0);
@@ -124,6 +126,7 @@ mod tests {
             EffectKind::NonViscousDamping,
             EffectKind::FlexibleJoint,
             EffectKind::FlexibleSupport,
+            EffectKind::Resonator,
         ] {
             assert!(kinds.contains(&kind), "no local {kind:?} candidate was checked");
         }
@@ -137,7 +140,8 @@ mod tests {
         let mut channels: Vec<Channel> = uy.iter().step_by(2).map(|&r| Channel::new(r, uy[uy.len() - 1])).collect();
         channels.push(Channel::new(uy[uy.len() - 1], uy[0]));
         let lines = [3.0, 17.0, 41.0, 88.0];
-        let opts = CandidateOptions { band_hz: (1.0, 100.0), ..CandidateOptions::default() };
+        // resonators tuned between two lines, whose values below keep the tuning
+        let opts = CandidateOptions { band_hz: (1.0, 100.0), resonator_hz: vec![40.0], ..CandidateOptions::default() };
         let mut all = candidates::generate(model, &opts);
         // the fuller variants (a joint's translational springs, a mass's
         // rotary inertia) and those that hold a spring rigid

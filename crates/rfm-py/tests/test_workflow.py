@@ -1,0 +1,136 @@
+"""The workflow against the rfm command on the tutorial: the same JSON, the
+same files, the same leader, dBIC and final misfit."""
+
+from __future__ import annotations
+
+import json
+import logging
+
+import numpy as np
+import pytest
+
+import rfm
+from conftest import GUESS, TUTORIAL, assert_same, run_cli
+
+
+def files(folder):
+    return sorted(str(p.relative_to(folder)) for p in folder.rglob("*") if p.is_file() and not p.name.startswith("."))
+
+
+def test_compare_is_the_cli_json_and_writes_its_files(rfm_bin, tutorial, tmp_path) -> None:
+    result = rfm.compare(tutorial)
+    cli = json.loads(run_cli(rfm_bin, "compare", TUTORIAL, "--json", "--out", tmp_path / "cli").stdout)
+    assert_same(result.to_dict(), cli)
+    saved = result.save(tmp_path / "py")
+    assert files(tmp_path / "py") == files(tmp_path / "cli")
+    assert len(saved) == len(files(tmp_path / "cli"))
+    assert_same(json.loads((tmp_path / "py" / "compare.json").read_text()), cli)
+    # the arrays behind it: the measured and the model's FRFs on the same grid
+    m, x = result.measured, result.model
+    assert m.h.shape == x.h.shape == (599, 8, 1) and m.kind == "receptance"
+    assert result.misfit == cli["correlation"]["total"]["log_misfit"]
+
+
+def test_measured_data_given_as_frfdata_are_read_as_a_file(rfm_bin, tutorial, tmp_path) -> None:
+    # the truth's FRFs with 1 % noise, given in memory and as a file
+    data = rfm.load_case(TUTORIAL.with_name("l-frame-truth.toml")).simulate(truth=True, noise=0.01, seed=4)
+    data.write_csv(tmp_path / "m.csv")
+    from_file = rfm.compare(tutorial, measured=tmp_path / "m.csv").to_dict()
+    in_memory = rfm.compare(tutorial, measured=data).to_dict()
+    cli = json.loads(run_cli(rfm_bin, "compare", TUTORIAL, "--measured", tmp_path / "m.csv", "--json").stdout)
+    assert_same(from_file, cli)
+    # the same numbers; only the name of the file read differs
+    for doc in (from_file, in_memory):
+        doc.pop("measured")
+        doc["notes"] = []
+    assert_same(in_memory, from_file)
+
+
+def test_diagnose_names_the_clis_leader_with_its_dbic(rfm_bin, diagnosis) -> None:
+    cli = json.loads(run_cli(rfm_bin, "diagnose", TUTORIAL, "--json").stdout)
+    assert_same(diagnosis.to_dict(), cli)
+    lead = diagnosis.leader
+    assert lead.description == cli["ranking"][0]["description"]
+    assert "joint at node 13" in lead.description
+    assert abs(lead.delta_bic - cli["ranking"][0]["delta_bic"]) <= 1e-9 * abs(lead.delta_bic)
+    assert diagnosis.recommended is not None and diagnosis.recommended.rank == cli["recommended"]
+    assert lead.significant and lead.plausible and lead.kind == cli["ranking"][0]["kind"]
+    assert set(lead.values) == {p["name"] for p in cli["ranking"][0]["parameters"]}
+
+
+def test_apply_writes_the_case_the_cli_writes(rfm_bin, diagnosis, tmp_path) -> None:
+    rank = diagnosis.recommended.rank
+    run_cli(rfm_bin, "diagnose", TUTORIAL, "--apply", rank, "--out", tmp_path / "cli.toml")
+    diagnosis.save(tmp_path / "py.toml")
+    assert (tmp_path / "py.toml").read_text() == (tmp_path / "cli.toml").read_text()
+    applied = diagnosis.apply()
+    assert set(applied.parameters) >= set(diagnosis.recommended.values) - {"spring.corner.kx", "spring.corner.ky"}
+
+
+def test_fix_reaches_the_clis_final_misfit_and_writes_its_files(rfm_bin, fixed, tmp_path) -> None:
+    done = run_cli(rfm_bin, "fix", TUTORIAL, "--out", tmp_path / "cli", "--json", check=False)
+    assert done.returncode == fixed.exit_code == 0
+    cli = json.loads(done.stdout)
+    assert_same(fixed.to_dict(), cli)
+    assert fixed.final_misfit == pytest.approx(cli["steps"][-1]["misfit_updated"], rel=1e-9)
+    assert fixed.steps[0].effect.description == cli["steps"][0]["effect"]["description"]
+    assert fixed.final_misfit <= 1.5 * fixed.noise
+    fixed.save(tmp_path / "py")
+    assert files(tmp_path / "py") == files(tmp_path / "cli")
+    for name in ("step-1.toml", "results.json"):
+        if name.endswith(".json"):
+            assert_same(json.loads((tmp_path / "py" / name).read_text()), cli)
+        else:
+            assert (tmp_path / "py" / name).read_text() == (tmp_path / "cli" / name).read_text()
+    # the fixed case in memory is the last step's
+    assert fixed.case.to_toml() == fixed.steps[-1].case.to_toml()
+    assert [s for s, _ in fixed.stages][0] == "nominal"
+
+
+def test_update_is_the_cli_json_and_writes_its_files(rfm_bin, tmp_path, caplog) -> None:
+    case = rfm.load_case(GUESS)
+    messages = []
+    with caplog.at_level(logging.INFO, logger="rfm"):
+        result = rfm.update(case, progress=messages.append, check=False)
+    done = run_cli(rfm_bin, "update", GUESS, "--json", "--out", tmp_path / "cli", check=False)
+    assert done.returncode == result.exit_code
+    cli = json.loads(done.stdout)
+    assert_same(result.to_dict(), cli)
+    assert messages and messages[0].startswith("iteration")
+    assert [r.getMessage() for r in caplog.records if r.name == "rfm"] == messages
+    result.save(tmp_path / "py")
+    assert files(tmp_path / "py") == files(tmp_path / "cli")
+    assert (tmp_path / "py" / "updated.toml").read_text() == (tmp_path / "cli" / "updated.toml").read_text()
+    p = result.parameters
+    assert [x.name for x in p] == ["spring.corner.kr", "group.corner.alpha"]
+    for x, c in zip(p, cli["parameters"]):
+        assert x.value == c["updated"] and x.initial == c["initial"] and x.std is not None and x.std > 0
+    # the updated case holds the updated values, and reads the same data
+    updated = result.case
+    assert updated.parameters == case.parameters
+    assert "Updated by rfm" in updated.to_toml()
+    np.testing.assert_array_equal(updated.measured().h, case.measured().h)
+    assert not np.array_equal(updated.simulate().h, case.simulate().h)
+
+
+def test_thread_count_changes_nothing_but_the_threads(tutorial) -> None:
+    before = rfm.get_num_threads()
+    try:
+        rfm.set_num_threads(1)
+        assert rfm.get_num_threads() == 1
+        one = rfm.compare(tutorial).to_dict()
+        rfm.set_num_threads(2)
+        assert rfm.get_num_threads() == 2
+        two = rfm.compare(tutorial).to_dict()
+    finally:
+        rfm.set_num_threads(before)
+    assert_same(one, two)
+
+
+def test_a_case_from_a_dict_is_the_case_from_its_file(tutorial) -> None:
+    import tomllib
+
+    tables = tomllib.loads(TUTORIAL.read_text())
+    case = rfm.Case.from_dict(tables, path=TUTORIAL)
+    np.testing.assert_array_equal(case.simulate().h, tutorial.simulate().h)
+    assert case.title == tutorial.title
