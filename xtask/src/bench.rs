@@ -88,35 +88,56 @@ fn load_average() -> String {
         .unwrap_or_else(|_| "unknown".into())
 }
 
-/// The imported shell (e) against the beam of the same size (c): what a
-/// line costs per entry of the factor, split into the numeric
-/// factorisation (per multiply-add, which a shell needs tens of times more
-/// of per entry) and the rest (the solves and the sensitivity assembly, per
-/// entry). Returns the bounds missed: each part of the shell's cost within
-/// 1.5 times the beam's, so that an imported model costs what its factor
-/// says and nothing more.
+/// Largest wall time of one line of the imported shell (e) on one thread
+/// (ms): the issue's target, a line of 99k DOFs with a shell mesh's fill
+/// in half a second.
+const SHELL_LINE_MS: f64 = 500.0;
+
+/// The imported shell (e) against the beam of the same size (c), both on
+/// one thread: what a line costs in all and per entry of the factor, split
+/// into the numeric factorisation (per multiply-add, which a shell needs
+/// tens of times more of per entry) and the rest (making `Z`, the solves and
+/// the sensitivity assembly, per entry). Returns the bounds missed: the
+/// shell's line within [`SHELL_LINE_MS`] and within the beam's cost per
+/// factor entry, and each part within 1.5 times the beam's, so that an
+/// imported model costs what its factor says and nothing more.
 fn imported_against_beam(beam: &Point, shell: &Point) -> Vec<String> {
+    let line = |p: &Point| p.num("ms_per_freq");
     let per_entry = |p: &Point| 1e6 * p.num("ms_per_freq") / p.num("factor_nnz");
     let rest = |p: &Point| 1e6 * (p.num("ms_per_freq") - p.num("factor_ms_per_freq")) / p.num("factor_nnz");
     let per_madd = |p: &Point| 1e6 * p.num("factor_ms_per_freq") / p.num("factor_madds");
-    println!("\nper line, imported shell (e) against the beam (c), both 100k DOFs:");
-    println!("{:<34} {:>12} {:>12} {:>7}", "", "beam", "shell", "ratio");
+    println!("\nper line on one thread, imported shell (e) against the beam (c), both 100k DOFs:");
+    println!("{:<34} {:>12} {:>12} {:>7}  bound", "", "beam", "shell", "ratio");
     let mut missed = Vec::new();
-    for (what, f, bound) in [
-        ("ns per factor entry, in all", per_entry as fn(&Point) -> f64, None),
-        ("  solves and assembly, per entry", rest, Some(1.5)),
-        ("  factorisation, per multiply-add", per_madd, Some(1.5)),
+    type Measure = fn(&Point) -> f64;
+    for (what, f, relative, absolute) in [
+        ("ms per line", line as Measure, None, Some(SHELL_LINE_MS)),
+        ("ns per factor entry, in all", per_entry, Some(1.0), None),
+        ("  Z, solves and assembly, per entry", rest, Some(1.5), None),
+        ("  factorisation, per multiply-add", per_madd, Some(1.5), None),
     ] {
         let (b, s) = (f(beam), f(shell));
-        println!("{what:<34} {b:>12.4} {s:>12.4} {:>6.2}x", s / b);
-        if let Some(bound) = bound
-            && !(s <= bound * b)
+        let bound = match (relative, absolute) {
+            (Some(r), _) => format!("shell <= {r} x beam"),
+            (_, Some(a)) => format!("shell <= {a}"),
+            _ => String::new(),
+        };
+        println!("{what:<34} {b:>12.4} {s:>12.4} {:>6.2}x  {bound}", s / b);
+        if let Some(r) = relative
+            && !(s <= r * b)
         {
-            missed.push(format!("imported shell: {} {s:.4} ns, over {bound} x the beam's {b:.4}", what.trim()));
+            missed.push(format!("imported shell: {} {s:.4}, over {r} x the beam's {b:.4}", what.trim()));
+        }
+        if let Some(a) = absolute
+            && !(s <= a)
+        {
+            missed.push(format!("imported shell: {} {s:.1}, over its bound of {a}", what.trim()));
         }
     }
     println!(
-        "(multiply-adds per factor entry: beam {:.0}, shell {:.0})",
+        "(factor layouts: beam {}, shell {}; multiply-adds per factor entry: beam {:.0}, shell {:.0})",
+        beam.json["layout"].as_str().unwrap_or("?"),
+        shell.json["layout"].as_str().unwrap_or("?"),
         beam.num("factor_madds") / beam.num("factor_nnz"),
         shell.num("factor_madds") / shell.num("factor_nnz")
     );
@@ -150,6 +171,10 @@ pub(crate) fn bench(args: &[String]) -> Result<(), String> {
     // node, 30 non-zeros per inner row), against the beam of the same size
     let e = ["--model", "shell:128", "--freqs", "4", "--repeat", &r_c];
     rows.push(bench_point(&exe, "(e) 100k imported shell", &[&e[..], &common[..]].concat())?);
+    // (c) and (e) again on one thread, where a line's cost is its own
+    let one = ["--threads", "1"];
+    rows.push(bench_point(&exe, "(c) 100k beam, 1 thread", &[&c[..], &common[..], &one[..]].concat())?);
+    rows.push(bench_point(&exe, "(e) 100k shell, 1 thread", &[&e[..], &common[..], &one[..]].concat())?);
     let d = ["--model", "frame:10x11x15", "--params", "1000", "--measured", "20", "--freqs", "200", "--repeat", "1"];
     rows.push(bench_point(&exe, "(d) diagnosis frame", &d)?);
 
@@ -187,7 +212,7 @@ pub(crate) fn bench(args: &[String]) -> Result<(), String> {
     }
     let ratio = rows[2].num("ms_per_freq") / rows[1].num("ms_per_freq");
     println!("\n(b) dense / sparse time per line: {ratio:.0}x");
-    let shell_bounds = imported_against_beam(&rows[3], &rows[4]);
+    let shell_bounds = imported_against_beam(&rows[5], &rows[6]);
     // exponents from wall time and from CPU time (all threads), which a
     // busy machine disturbs less
     let fit = |points: &[Point], x: &str, y: &str| {
@@ -223,10 +248,11 @@ pub(crate) fn bench(args: &[String]) -> Result<(), String> {
         "configuration", "DOFs", "candidates", "lines", "total s", "peak MiB"
     );
     let mut wrong = Vec::new();
-    // the issue's bounds on two cores: the 3k-DOF frame within 3 s, the
-    // 10k-DOF frame within 10 s (interactive), the 100k-DOF frame within 60 s
+    // the issues' bounds on two cores: the 3k-DOF frame within 3 s, the
+    // 10k-DOF frame within 10 s (interactive), the 100k-DOF frame within
+    // 30 s (issue 35; 60 s before)
     let frames =
-        [("3x3x4", None), ("5x5x5", None), ("8x8x8", Some(3.0)), ("10x11x15", Some(10.0)), ("32x34x15", Some(60.0))];
+        [("3x3x4", None), ("5x5x5", None), ("8x8x8", Some(3.0)), ("10x11x15", Some(10.0)), ("32x34x15", Some(30.0))];
     for (frame, bound) in frames {
         let p = bench_point(&exe, &format!("frame {frame}"), &["--frame", frame])?;
         let right = p.json["found"].as_bool() == Some(true);

@@ -73,9 +73,9 @@ use fe_model::Pattern;
 use num_complex::Complex64 as C64;
 
 use crate::error::FrfError;
-pub use crate::factor_kind::FactorKind;
+pub use crate::factor_kind::{FactorKind, Layout};
 pub use crate::ldlt::mul_add;
-use crate::ldlt::{NOT_IN_COLUMN, NumericLdlt, SymbolicLdlt};
+use crate::ldlt::{Analysis, Factors, InverseScratch};
 
 const ZERO: C64 = C64 { re: 0.0, im: 0.0 };
 
@@ -90,14 +90,18 @@ pub const SINGULAR_AMPLIFICATION: f64 = 1e-2 / f64::EPSILON;
 #[derive(Clone, Debug)]
 pub struct ZSolver {
     pattern: SymbolicSparseColMat<usize>,
-    ldlt: SymbolicLdlt,
+    ldlt: Analysis,
     /// Symbolic LU for the fallback, made on first need.
     lu: OnceLock<Result<SymbolicLu<usize>, String>>,
 }
 
 /// Per-thread numeric factors and scratch memory.
 pub struct Workspace {
-    ldlt: NumericLdlt,
+    ldlt: Factors,
+    /// Row-interleaved right-hand sides in the internal order.
+    buf: Vec<C64>,
+    /// Internal rows of unit right-hand sides.
+    buf_rows: Vec<usize>,
     lu: Option<LuWorkspace>,
     kind: Option<FactorKind>,
     /// Largest `|Z_ij|` of the matrix factorised.
@@ -131,7 +135,22 @@ impl ZSolver {
     /// pair can bring fill, so the factor grows with the cliques
     /// ([`Self::factor_nnz`]); pairs already in `pattern` (the equations of
     /// one element) change nothing. With no cliques this is [`Self::new`].
+    ///
+    /// The factor's [`Layout`] is chosen from the analysis: supernodal when
+    /// one factorisation needs more than 16 multiply-adds per entry of `L`
+    /// (the long columns of shell and solid meshes), simplicial otherwise
+    /// (beams and frames, a few per entry).
     pub fn with_cliques(pattern: &Pattern, cliques: &[Vec<usize>]) -> Result<Self, FrfError> {
+        Self::analyse(pattern, cliques, None)
+    }
+
+    /// As [`Self::with_cliques`], in the given layout rather than the one
+    /// the analysis would choose: for comparisons and tests.
+    pub fn with_layout(pattern: &Pattern, cliques: &[Vec<usize>], layout: Layout) -> Result<Self, FrfError> {
+        Self::analyse(pattern, cliques, Some(layout))
+    }
+
+    fn analyse(pattern: &Pattern, cliques: &[Vec<usize>], layout: Option<Layout>) -> Result<Self, FrfError> {
         let n = pattern.n();
         for (clique, eqs) in cliques.iter().enumerate() {
             if let Some(&eq) = eqs.iter().find(|&&eq| eq >= n) {
@@ -140,7 +159,7 @@ impl ZSolver {
         }
         let symbolic =
             SymbolicSparseColMat::new_checked(n, n, pattern.col_ptr().to_vec(), None, pattern.row_idx().to_vec());
-        let ldlt = SymbolicLdlt::new(pattern, cliques).map_err(FrfError::Factorization)?;
+        let ldlt = Analysis::new(pattern, cliques, layout).map_err(FrfError::Factorization)?;
         Ok(ZSolver { pattern: symbolic, ldlt, lu: OnceLock::new() })
     }
 
@@ -149,16 +168,32 @@ impl ZSolver {
         self.ldlt.n()
     }
 
-    /// Number of entries of the factor `L` below its diagonal (the fill-in
-    /// measure that sets the cost of factorising and solving).
-    pub fn factor_nnz(&self) -> usize {
-        self.ldlt.nnz_l()
+    /// The layout of the `L D L^T` factor.
+    pub fn layout(&self) -> Layout {
+        self.ldlt.layout()
     }
 
-    /// Complex multiply-adds of one numeric `L D L^T` factorisation: the
-    /// part of a line's cost that grows with the square of the factor's
-    /// column counts (a shell's factor has columns tens of times fuller
-    /// than a beam's), where the solves grow with [`Self::factor_nnz`].
+    /// Number of entries of the factor `L` below its diagonal in the
+    /// elimination's pattern (the fill-in measure that sets the cost of
+    /// factorising and solving), whatever the layout.
+    pub fn factor_nnz(&self) -> usize {
+        self.ldlt.nnz_exact()
+    }
+
+    /// Number of entries of `L` below its diagonal as stored: at least
+    /// [`Self::factor_nnz`], more in the supernodal layout, which stores
+    /// explicit zeros where it merged small supernodes of nearly equal
+    /// patterns into one dense block. The selected inverse holds `Z^-1` on
+    /// the stored pattern (and the diagonal).
+    pub fn factor_stored(&self) -> usize {
+        self.ldlt.nnz_stored()
+    }
+
+    /// Complex multiply-adds of one numeric `L D L^T` factorisation in the
+    /// elimination's pattern: the part of a line's cost that grows with the
+    /// square of the factor's column counts (a shell's factor has columns
+    /// tens of times fuller than a beam's), where the solves grow with
+    /// [`Self::factor_nnz`].
     pub fn factor_multiply_adds(&self) -> u64 {
         self.ldlt.multiply_adds()
     }
@@ -171,7 +206,15 @@ impl ZSolver {
 
     /// A fresh workspace for one thread.
     pub fn workspace(&self) -> Workspace {
-        Workspace { ldlt: self.ldlt.numeric(), lu: None, kind: None, z_max: 0.0, freq_hz: f64::NAN }
+        Workspace {
+            ldlt: self.ldlt.numeric(),
+            buf: Vec::new(),
+            buf_rows: Vec::new(),
+            lu: None,
+            kind: None,
+            z_max: 0.0,
+            freq_hz: f64::NAN,
+        }
     }
 
     fn symbolic_lu(&self) -> Result<&SymbolicLu<usize>, FrfError> {
@@ -243,7 +286,7 @@ impl ZSolver {
             FactorKind::Ldlt => {
                 let k = rhs.ncols();
                 let perm = self.ldlt.perm();
-                let mut buf = std::mem::take(&mut ws.ldlt.buf);
+                let mut buf = std::mem::take(&mut ws.buf);
                 buf.clear();
                 buf.resize(n * k, ZERO);
                 for j in 0..k {
@@ -252,14 +295,14 @@ impl ZSolver {
                         buf[new * k + j] = col[old];
                     }
                 }
-                let finite = self.ldlt.solve_in_place(&ws.ldlt, &mut buf, k);
+                let finite = self.ldlt.solve_in_place(&mut ws.ldlt, &mut buf, k);
                 for j in 0..k {
                     let mut col = rhs.as_mut().col_mut(j);
                     for (new, &old) in perm.iter().enumerate() {
                         col[old] = buf[new * k + j];
                     }
                 }
-                ws.ldlt.buf = buf;
+                ws.buf = buf;
                 if finite { Ok(()) } else { Err(FrfError::Singular { freq_hz }) }
             }
             FactorKind::Lu => {
@@ -284,17 +327,17 @@ impl ZSolver {
         assert_eq!(x.len(), n * k, "right-hand sides must be n x k, row-interleaved");
         if ws.kind == Some(FactorKind::Ldlt) {
             let perm = self.ldlt.perm();
-            let mut buf = std::mem::take(&mut ws.ldlt.buf);
+            let mut buf = std::mem::take(&mut ws.buf);
             buf.clear();
             buf.reserve(n * k);
             for &old in perm {
                 buf.extend_from_slice(&x[old * k..old * k + k]);
             }
-            let finite = self.ldlt.solve_in_place(&ws.ldlt, &mut buf, k);
+            let finite = self.ldlt.solve_in_place(&mut ws.ldlt, &mut buf, k);
             for (new, &old) in perm.iter().enumerate() {
                 x[old * k..old * k + k].copy_from_slice(&buf[new * k..new * k + k]);
             }
-            ws.ldlt.buf = buf;
+            ws.buf = buf;
             return if finite { Ok(()) } else { Err(FrfError::Singular { freq_hz }) };
         }
         self.solve_lu_interleaved(ws, x, k, |i| i, freq_hz)
@@ -305,7 +348,7 @@ impl ZSolver {
     pub fn solve_ordered(&self, ws: &mut Workspace, x: &mut [C64], k: usize, freq_hz: f64) -> Result<(), FrfError> {
         assert_eq!(x.len(), self.n() * k, "right-hand sides must be n x k, row-interleaved");
         if ws.kind == Some(FactorKind::Ldlt) {
-            let finite = self.ldlt.solve_in_place(&ws.ldlt, x, k);
+            let finite = self.ldlt.solve_in_place(&mut ws.ldlt, x, k);
             return if finite { Ok(()) } else { Err(FrfError::Singular { freq_hz }) };
         }
         let perm_inv = self.ldlt.perm_inv();
@@ -344,11 +387,11 @@ impl ZSolver {
         let (n, k) = (self.n(), eqs.len());
         x.resize(n * k, ZERO);
         if ws.kind == Some(FactorKind::Ldlt) {
-            let mut rows = std::mem::take(&mut ws.ldlt.buf_rows);
+            let mut rows = std::mem::take(&mut ws.buf_rows);
             rows.clear();
             rows.extend(eqs.iter().map(|&e| self.position(e)));
             let finite = self.ldlt.solve_units(&mut ws.ldlt, &rows, x, visit);
-            ws.ldlt.buf_rows = rows;
+            ws.buf_rows = rows;
             return if finite { Ok(()) } else { Err(FrfError::Singular { freq_hz }) };
         }
         x.fill(ZERO);
@@ -406,13 +449,11 @@ impl ZSolver {
 /// frequency to the next: its storage is allocated on first use only.
 #[derive(Clone, Debug, Default)]
 pub struct SelectedInverse {
-    /// Diagonal, in the solver's internal order.
-    diag: Vec<C64>,
-    /// Below the diagonal, in the layout of the factor's columns.
-    lower: Vec<C64>,
-    /// Scratch of the recurrence: the position of each row in the column
-    /// being computed, or `NOT_IN_COLUMN`.
-    slot: Vec<u32>,
+    /// The entries, in the layout of the factor (the solver's internal
+    /// order; see `Analysis::inverse_position`).
+    values: Vec<C64>,
+    /// Scratch of the recurrence.
+    scratch: InverseScratch,
     /// Whether the values are those of the last successful inversion.
     ready: bool,
 }
@@ -437,22 +478,17 @@ impl ZSolver {
     /// [`FrfError::Singular`] when an entry is not finite. On error `out`
     /// holds nothing that can be read.
     pub fn selected_inverse(&self, ws: &Workspace, out: &mut SelectedInverse) -> Result<(), FrfError> {
-        let (n, nnz) = (self.n(), self.factor_nnz());
         out.ready = false;
         if ws.kind != Some(FactorKind::Ldlt) {
             return Err(FrfError::NoLdltFactors { held: ws.kind });
         }
         // every value is overwritten by the recurrence, so storage of the
         // right size is reused as it is
-        if out.diag.len() != n || out.lower.len() != nnz || out.slot.len() != n {
-            *out = SelectedInverse {
-                diag: vec![ZERO; n],
-                lower: vec![ZERO; nnz],
-                slot: vec![NOT_IN_COLUMN; n],
-                ready: false,
-            };
+        let len = self.ldlt.inverse_len();
+        if out.values.len() != len {
+            out.values = vec![ZERO; len];
         }
-        if !self.ldlt.selected_inverse(&ws.ldlt, &mut out.diag, &mut out.lower, &mut out.slot) {
+        if !self.ldlt.selected_inverse(&ws.ldlt, &mut out.values, &mut out.scratch) {
             return Err(FrfError::Singular { freq_hz: ws.freq_hz });
         }
         out.ready = true;
@@ -475,11 +511,7 @@ impl ZSolver {
 
     /// [`Self::inverse_entry`] once `inv` is known to be of this solver.
     fn entry(&self, inv: &SelectedInverse, i: usize, j: usize) -> Option<C64> {
-        let (p, q) = (self.position(i), self.position(j));
-        if p == q {
-            return Some(inv.diag[p]);
-        }
-        self.ldlt.lower_position(p.max(q), p.min(q)).map(|pos| inv.lower[pos])
+        self.ldlt.inverse_position(self.position(i), self.position(j)).map(|pos| inv.values[pos])
     }
 
     /// The dense block `Z^-1[D, D]` for the equations `D = eqs`, row-major
@@ -511,7 +543,7 @@ impl ZSolver {
     /// apart).
     fn check_inverse(&self, inv: &SelectedInverse) {
         assert!(
-            inv.ready && inv.diag.len() == self.n() && inv.lower.len() == self.factor_nnz(),
+            inv.ready && inv.values.len() == self.ldlt.inverse_len(),
             "no selected inverse of this solver (none made, or the last one failed)"
         );
     }

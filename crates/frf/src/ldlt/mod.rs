@@ -6,25 +6,31 @@
 //! Hermitian `L D L^H` and LU, but not this; it costs about half an LU and
 //! needs no row pivoting, so the sparsity structure is fixed once per pattern.
 //!
-//! - [`SymbolicLdlt`] (once per pattern): a fill-reducing ordering (faer's
-//!   approximate minimum degree), the elimination tree and the pattern of `L`
-//!   (faer's simplicial symbolic Cholesky), and the row structure of `L` for
-//!   the up-looking numeric factorisation below. Optional cliques of
-//!   equations are added to the pattern analysed (not to the values), so
-//!   that the selected inverse covers them.
-//! - [`NumericLdlt`] (per thread): the values of `L` and `D^-1`, a dense work
-//!   vector and a solve buffer, all reused from one frequency to the next.
+//! Two layouts of `L` share the ordering (faer's approximate minimum
+//! degree of the pattern, optional cliques of equations added to the
+//! pattern analysed so that the selected inverse covers them) and the
+//! pivot test, and [`Analysis`] picks one from the symbolic analysis:
 //!
-//! The numeric factorisation is up-looking (row `k` of `L` is a sparse
-//! triangular solve with the rows above it, along the precomputed row
-//! pattern), after T. A. Davis's LDL. Without pivoting it is only as stable
-//! as the pivots: a pivot that is tiny against the matrix entries of its row,
-//! or against the terms that were subtracted to form it, or that is not
-//! finite, aborts the factorisation with [`TinyPivot`], and the caller falls
-//! back to LU with partial pivoting.
+//! - **simplicial** ([`SymbolicLdlt`]): `L` by column, entry by entry;
+//!   the numeric factorisation is up-looking (row `k` of `L` is a sparse
+//!   triangular solve with the rows above it, along the precomputed row
+//!   pattern), after T. A. Davis's LDL. Best where columns are short (beams
+//!   and frames: a few multiply-adds per entry of `L`), where it has no
+//!   overhead to amortise.
+//! - **supernodal** ([`supernodal`]): runs of columns with one pattern
+//!   below them stored as dense blocks, factorised multifrontally with
+//!   dense kernels. Best where columns are long (shells and solids: hundreds
+//!   of multiply-adds per entry), where the dense kernels run several times
+//!   faster.
 //!
-//! [`SymbolicLdlt::selected_inverse`] computes `(P Z P^T)^-1` on the pattern
-//! of `L` plus the diagonal from the factors, by the Takahashi equations,
+//! Without pivoting the factorisation is only as stable as the pivots: a
+//! pivot that is tiny against the matrix entries of its row, or against the
+//! terms that were subtracted to form it, or that is not finite, aborts the
+//! factorisation with [`TinyPivot`], and the caller falls back to LU with
+//! partial pivoting.
+//!
+//! [`Analysis::selected_inverse`] computes `(P Z P^T)^-1` on the pattern of
+//! `L` plus the diagonal from the factors, by the Takahashi equations,
 //! for about the cost of the numeric factorisation.
 //!
 //! Right-hand sides are stored *row-interleaved* (`x[i * k + j]` is row `i`
@@ -32,25 +38,42 @@
 //! step then updates `k` contiguous values, which the compiler vectorises,
 //! instead of `k` strided ones.
 //!
-//! One file per operation: [`symbolic`] (ordering, elimination tree and the
-//! pattern of `L`), [`factor`] (the numeric factorisation), [`solve`] (the
-//! substitutions and their SIMD kernels) and [`selected_inverse`].
+//! One file per operation of the simplicial layout: [`symbolic`] (the
+//! shared ordering and elimination tree, and the pattern of `L`), [`factor`]
+//! (the numeric factorisation), [`solve`] (the substitutions and their SIMD
+//! kernels) and [`selected_inverse`]; the supernodal layout in [`supernodal`].
 
+use fe_model::Pattern;
 use num_complex::Complex64 as C64;
+
+use crate::factor_kind::Layout;
 
 mod factor;
 mod selected_inverse;
 mod solve;
+mod supernodal;
 mod symbolic;
 
 pub(crate) use selected_inverse::NOT_IN_COLUMN;
 pub use solve::mul_add;
+use supernodal::{NumericSupernodal, SupernodalLdlt};
 
 /// A pivot `d` is accepted when `|d| > PIVOT_TOLERANCE * scale`, where
 /// `scale` is the larger of the largest entry of its row of `Z` and the sum of
 /// the terms subtracted from the diagonal to form it (so at most about eight
 /// digits can be lost to cancellation in any pivot). Norms are `|re| + |im|`.
 pub(crate) const PIVOT_TOLERANCE: f64 = 1e-8;
+
+/// The supernodal layout is chosen when one factorisation needs more than
+/// this many multiply-adds per entry of `L` (see [`Analysis::new`]).
+/// Measured on one thread (`cargo run --release -p frf --example layouts`):
+/// the two layouts factorise and solve in the same time at 10 to 12
+/// multiply-adds per entry (plates of 72 and 120 DOFs); the supernodal one
+/// is 1.5 times faster at 16 to 22 (plates, frames with one element per
+/// member) and 2 to 3 times faster from 40 on (plates of 2,500 DOFs and
+/// more), the simplicial one 1.5 to 2.5 times faster at 4 to 9 (long beams,
+/// frames with several elements per member).
+pub(crate) const SUPERNODAL_MADDS_PER_ENTRY: f64 = 16.0;
 
 const ZERO: C64 = C64 { re: 0.0, im: 0.0 };
 
@@ -61,7 +84,218 @@ pub(crate) struct TinyPivot {
     pub(crate) index: usize,
 }
 
-/// Symbolic analysis of a symmetric pattern; see the module docs.
+/// The symbolic analysis in one of the two layouts; see the module docs.
+#[derive(Clone, Debug)]
+pub(crate) enum Analysis {
+    Simplicial(SymbolicLdlt),
+    Supernodal(SupernodalLdlt),
+}
+
+/// Numeric factors and buffers of one thread, in the layout of their
+/// [`Analysis`].
+#[derive(Clone, Debug)]
+pub(crate) enum Factors {
+    Simplicial(NumericLdlt),
+    Supernodal(NumericSupernodal),
+}
+
+/// Scratch of the selected inverse, grown on first use.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct InverseScratch {
+    /// Simplicial: `n` entries of [`NOT_IN_COLUMN`].
+    slot: Vec<u32>,
+    /// Supernodal: dense blocks and row positions.
+    work: Vec<C64>,
+    rel: Vec<u32>,
+}
+
+impl Analysis {
+    /// Orders and analyses a symmetric pattern (both triangles stored, rows
+    /// sorted, diagonal present) in the given layout, or in the one its
+    /// factor calls for: supernodal when a factorisation needs more than
+    /// [`SUPERNODAL_MADDS_PER_ENTRY`] multiply-adds per entry of `L` (the
+    /// columns are then long enough for dense kernels to pay), simplicial
+    /// otherwise.
+    ///
+    /// The ordering and the pattern of `L` are those of the pattern with
+    /// every pair of equations within each clique added (caller's numbering,
+    /// an index out of range is an error), so that `L + L^T` covers each
+    /// clique and the selected inverse holds every entry of `Z^-1` between
+    /// its equations. The added pairs are structural zeros: values are still
+    /// read on the original pattern.
+    pub(crate) fn new(pattern: &Pattern, cliques: &[Vec<usize>], layout: Option<Layout>) -> Result<Self, String> {
+        let ordering = symbolic::order(pattern, cliques)?;
+        let layout = layout.unwrap_or_else(|| {
+            let analysed = ordering.augmented.as_ref().unwrap_or(pattern);
+            let (ptr, rows, _) = symbolic::permuted_upper(analysed, &ordering.perm, &ordering.perm_inv);
+            let (_, counts) = symbolic::elimination_tree(pattern.n(), &ptr, &rows);
+            let (nnz, madds) = counts.iter().fold((0.0, 0.0), |(nnz, madds), &c| {
+                let below = c as f64 - 1.0;
+                (nnz + below, madds + below * (below + 3.0) / 2.0)
+            });
+            if madds > SUPERNODAL_MADDS_PER_ENTRY * nnz { Layout::Supernodal } else { Layout::Simplicial }
+        });
+        Ok(match layout {
+            Layout::Simplicial => Analysis::Simplicial(SymbolicLdlt::from_ordering(pattern, ordering)?),
+            Layout::Supernodal => Analysis::Supernodal(SupernodalLdlt::from_ordering(pattern, ordering)?),
+        })
+    }
+
+    /// The layout.
+    pub(crate) fn layout(&self) -> Layout {
+        match self {
+            Analysis::Simplicial(_) => Layout::Simplicial,
+            Analysis::Supernodal(_) => Layout::Supernodal,
+        }
+    }
+
+    /// Matrix dimension.
+    pub(crate) fn n(&self) -> usize {
+        match self {
+            Analysis::Simplicial(a) => a.n(),
+            Analysis::Supernodal(a) => a.n(),
+        }
+    }
+
+    /// Entries of `L` below the diagonal as stored (the supernodal layout
+    /// stores explicit zeros where it merged supernodes of nearly equal
+    /// patterns).
+    pub(crate) fn nnz_stored(&self) -> usize {
+        match self {
+            Analysis::Simplicial(a) => a.nnz_l(),
+            Analysis::Supernodal(a) => a.nnz_stored(),
+        }
+    }
+
+    /// Entries of `L` below the diagonal in the elimination's pattern.
+    pub(crate) fn nnz_exact(&self) -> usize {
+        match self {
+            Analysis::Simplicial(a) => a.nnz_l(),
+            Analysis::Supernodal(a) => a.nnz_exact(),
+        }
+    }
+
+    /// Complex multiply-adds of one numeric factorisation in the
+    /// elimination's pattern: column `j` of `L`, with `c` entries below the
+    /// diagonal, is scaled by its pivot (`c`) and updates the `c (c + 1) / 2`
+    /// entries of the trailing matrix its rows pair up (`c (c + 3) / 2` in
+    /// all). It grows with the square of the column counts, where
+    /// [`Self::nnz_exact`] grows with their sum.
+    pub(crate) fn multiply_adds(&self) -> u64 {
+        match self {
+            Analysis::Simplicial(a) => a.multiply_adds(),
+            Analysis::Supernodal(a) => a.multiply_adds(),
+        }
+    }
+
+    /// `perm[new] = old`.
+    pub(crate) fn perm(&self) -> &[usize] {
+        match self {
+            Analysis::Simplicial(a) => a.perm(),
+            Analysis::Supernodal(a) => a.perm(),
+        }
+    }
+
+    /// `perm_inv[old] = new`.
+    pub(crate) fn perm_inv(&self) -> &[usize] {
+        match self {
+            Analysis::Simplicial(a) => a.perm_inv(),
+            Analysis::Supernodal(a) => a.perm_inv(),
+        }
+    }
+
+    /// Empty numeric storage of the right sizes.
+    pub(crate) fn numeric(&self) -> Factors {
+        match self {
+            Analysis::Simplicial(a) => Factors::Simplicial(a.numeric()),
+            Analysis::Supernodal(a) => Factors::Supernodal(a.numeric()),
+        }
+    }
+
+    /// Factorises `Z` given as values on the original pattern. Allocates
+    /// nothing. On error, `num` holds no usable factorisation.
+    pub(crate) fn factorize(&self, num: &mut Factors, values: &[C64]) -> Result<(), TinyPivot> {
+        match (self, num) {
+            (Analysis::Simplicial(a), Factors::Simplicial(f)) => a.factorize(f, values),
+            (Analysis::Supernodal(a), Factors::Supernodal(f)) => a.factorize(f, values),
+            _ => unreachable!("factors of another layout"),
+        }
+    }
+
+    /// Solves `P Z P^T X = B` in place for `k` right-hand sides stored
+    /// row-interleaved in the internal order (`x.len() == n * k`). Returns
+    /// whether every entry of the solution is finite.
+    pub(crate) fn solve_in_place(&self, num: &mut Factors, x: &mut [C64], k: usize) -> bool {
+        match (self, num) {
+            (Analysis::Simplicial(a), Factors::Simplicial(f)) => a.solve_in_place(f, x, k),
+            (Analysis::Supernodal(a), Factors::Supernodal(f)) => a.solve_in_place(f, x, k),
+            _ => unreachable!("factors of another layout"),
+        }
+    }
+
+    /// As [`Self::solve_in_place`] for unit right-hand sides, which need not
+    /// be written beforehand: column `j` is the unit vector at internal row
+    /// `rows[j]`. Every entry of `x` is overwritten.
+    ///
+    /// `visit(r, &x[r * k..])` is called for each internal row `r`, from the
+    /// last to the first, as soon as rows `r..n` are final (while they are
+    /// still in cache).
+    pub(crate) fn solve_units<V: FnMut(usize, &[C64])>(
+        &self,
+        num: &mut Factors,
+        rows: &[usize],
+        x: &mut [C64],
+        visit: V,
+    ) -> bool {
+        match (self, num) {
+            (Analysis::Simplicial(a), Factors::Simplicial(f)) => a.solve_units(f, rows, x, visit),
+            (Analysis::Supernodal(a), Factors::Supernodal(f)) => a.solve_units(f, rows, x, visit),
+            _ => unreachable!("factors of another layout"),
+        }
+    }
+
+    /// Length of a selected inverse's values.
+    pub(crate) fn inverse_len(&self) -> usize {
+        match self {
+            Analysis::Simplicial(a) => a.n() + a.nnz_l(),
+            Analysis::Supernodal(a) => a.values_len(),
+        }
+    }
+
+    /// Position in a selected inverse's values of the entry `(p, q)`
+    /// (internal order, either triangle), or `None` when it is not stored.
+    pub(crate) fn inverse_position(&self, p: usize, q: usize) -> Option<usize> {
+        let (row, col) = (p.max(q), p.min(q));
+        match self {
+            Analysis::Simplicial(_) if row == col => Some(row),
+            Analysis::Simplicial(a) => a.lower_position(row, col).map(|pos| a.n() + pos),
+            Analysis::Supernodal(a) => a.position(row, col),
+        }
+    }
+
+    /// Selected inverse: `B^-1` (`B = P Z P^T`, factorised in `num`) on the
+    /// pattern of the factor, written to `out` (length
+    /// [`Self::inverse_len`], read through [`Self::inverse_position`]).
+    /// Allocates nothing once `scratch` has been used with this analysis.
+    /// Returns whether every entry is finite.
+    pub(crate) fn selected_inverse(&self, num: &Factors, out: &mut [C64], scratch: &mut InverseScratch) -> bool {
+        match (self, num) {
+            (Analysis::Simplicial(a), Factors::Simplicial(f)) => {
+                if scratch.slot.len() != a.n() {
+                    scratch.slot = vec![NOT_IN_COLUMN; a.n()];
+                }
+                let (diag, lower) = out.split_at_mut(a.n());
+                a.selected_inverse(f, diag, lower, &mut scratch.slot)
+            }
+            (Analysis::Supernodal(a), Factors::Supernodal(f)) => {
+                a.selected_inverse(f, out, &mut scratch.work, &mut scratch.rel)
+            }
+            _ => unreachable!("factors of another layout"),
+        }
+    }
+}
+
+/// Simplicial symbolic analysis of a symmetric pattern; see the module docs.
 #[derive(Clone, Debug)]
 pub(crate) struct SymbolicLdlt {
     n: usize,
@@ -87,18 +321,15 @@ pub(crate) struct SymbolicLdlt {
     lt_pos: Vec<usize>,
 }
 
-/// Numeric factors and buffers of one thread; see the module docs.
+/// Simplicial numeric factors and buffers of one thread; see the module
+/// docs.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct NumericLdlt {
     l_val: Vec<C64>,
     d_inv: Vec<C64>,
     y: Vec<C64>,
-    /// Row-interleaved right-hand sides in the internal order.
-    pub(crate) buf: Vec<C64>,
     /// Sorted unit right-hand sides of [`SymbolicLdlt::solve_units`].
-    pub(crate) units: Vec<(usize, usize)>,
-    /// Internal rows of unit right-hand sides (caller's scratch).
-    pub(crate) buf_rows: Vec<usize>,
+    units: Vec<(usize, usize)>,
 }
 
 impl SymbolicLdlt {
@@ -137,9 +368,7 @@ impl SymbolicLdlt {
             l_val: vec![ZERO; self.nnz_l()],
             d_inv: vec![ZERO; self.n],
             y: vec![ZERO; self.n],
-            buf: Vec::new(),
             units: Vec::new(),
-            buf_rows: Vec::new(),
         }
     }
 }

@@ -16,7 +16,7 @@ const FLUSH_BELOW: f64 = 1e-200;
 
 /// Sets parts of `row` smaller than [`FLUSH_BELOW`] to zero.
 #[inline(always)]
-fn flush_tiny(row: &mut [C64]) {
+pub(super) fn flush_tiny(row: &mut [C64]) {
     for v in row {
         if v.re.abs() < FLUSH_BELOW {
             v.re = 0.0;
@@ -145,7 +145,7 @@ impl<V: FnMut(usize, &[C64])> WithSimd for Substitution<'_, V> {
 
 /// `dst *= a`.
 #[inline(always)]
-fn scale<S: Simd>(simd: S, dst: &mut [C64], a: C64) {
+pub(super) fn scale<S: Simd>(simd: S, dst: &mut [C64], a: C64) {
     let av = simd.splat_c64s(a);
     let (dh, dt) = S::as_mut_simd_c64s(dst);
     for d in dh.iter_mut() {

@@ -1,8 +1,9 @@
 //! The symbolic analysis, once per pattern: a fill-reducing ordering
 //! (faer's approximate minimum degree) of the pattern with the cliques
-//! added, the elimination tree and the pattern of `L` (faer's simplicial
-//! symbolic Cholesky), and the row structure of `L` that the up-looking
-//! factorisation walks.
+//! added and the elimination tree, which both layouts share; for the
+//! simplicial layout, the pattern of `L` (faer's simplicial symbolic
+//! Cholesky) and the row structure of `L` that the up-looking factorisation
+//! walks.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::SymbolicSparseColMatRef;
@@ -11,6 +12,56 @@ use faer::sparse::linalg::cholesky::simplicial;
 use fe_model::Pattern;
 
 use super::SymbolicLdlt;
+
+/// A fill-reducing ordering of a pattern with its cliques added: `perm[new]
+/// = old`, `perm_inv[old] = new`, and the pattern analysed (`None` when
+/// there are no cliques: the pattern itself).
+pub(super) struct Ordering {
+    pub(super) perm: Vec<usize>,
+    pub(super) perm_inv: Vec<usize>,
+    pub(super) augmented: Option<Pattern>,
+}
+
+/// Orders a symmetric pattern (both triangles stored, rows sorted, diagonal
+/// present) with every pair of equations within each clique added (an
+/// index out of range is an error): faer's approximate minimum degree.
+pub(super) fn order(pattern: &Pattern, cliques: &[Vec<usize>]) -> Result<Ordering, String> {
+    let n = pattern.n();
+    if u32::try_from(n).is_err() {
+        return Err(format!("{n} equations exceed the solver's 32-bit row indices"));
+    }
+    let augmented = if cliques.is_empty() { None } else { Some(with_clique_pairs(pattern, cliques)?) };
+    let analysed = augmented.as_ref().unwrap_or(pattern);
+
+    // upper triangle of the analysed pattern, for the ordering
+    let mut up_ptr = Vec::with_capacity(n + 1);
+    let mut up_idx = Vec::with_capacity(analysed.nnz() / 2 + n);
+    up_ptr.push(0);
+    for c in 0..n {
+        let rows = &analysed.row_idx()[analysed.col_ptr()[c]..analysed.col_ptr()[c + 1]];
+        up_idx.extend(rows.iter().copied().take_while(|&r| r <= c));
+        up_ptr.push(up_idx.len());
+    }
+    let mut perm = vec![0usize; n];
+    let mut perm_inv = vec![0usize; n];
+    let upper = SymbolicSparseColMatRef::new_checked(n, n, &up_ptr, None, &up_idx);
+    let mut mem = MemBuffer::new(amd::order_scratch::<usize>(n, up_idx.len()));
+    amd::order(&mut perm, &mut perm_inv, upper, amd::Control::default(), MemStack::new(&mut mem))
+        .map_err(|e| format!("ordering failed: {e:?}"))?;
+    Ok(Ordering { perm, perm_inv, augmented })
+}
+
+/// The elimination tree (`-1` for a root) and the column counts of `L`,
+/// diagonal included, of the symmetric matrix whose upper triangle is
+/// given by column (rows sorted): faer's.
+pub(super) fn elimination_tree(n: usize, up_ptr: &[usize], up_rows: &[usize]) -> (Vec<isize>, Vec<usize>) {
+    let upper = SymbolicSparseColMatRef::new_checked(n, n, up_ptr, None, up_rows);
+    let mut etree = vec![0isize; n];
+    let mut counts = vec![0usize; n];
+    let mut mem = MemBuffer::new(simplicial::prefactorize_symbolic_cholesky_scratch::<usize>(n, up_rows.len()));
+    simplicial::prefactorize_symbolic_cholesky(&mut etree, &mut counts, upper, MemStack::new(&mut mem));
+    (etree, counts)
+}
 
 impl SymbolicLdlt {
     /// Orders and analyses a symmetric pattern (both triangles stored, rows
@@ -23,32 +74,15 @@ impl SymbolicLdlt {
     /// equations. The added pairs are structural zeros: values are still
     /// read on the original pattern. With no cliques this is the plain
     /// analysis of `pattern`.
+    #[cfg(test)]
     pub(crate) fn new(pattern: &Pattern, cliques: &[Vec<usize>]) -> Result<Self, String> {
-        let n = pattern.n();
-        if u32::try_from(n).is_err() {
-            return Err(format!("{n} equations exceed the solver's 32-bit row indices"));
-        }
-        let augmented = if cliques.is_empty() { None } else { Some(with_clique_pairs(pattern, cliques)?) };
-        let analysed = augmented.as_ref().unwrap_or(pattern);
+        Self::from_ordering(pattern, order(pattern, cliques)?)
+    }
 
-        // upper triangle of the analysed pattern, for the ordering
-        let mut up_ptr = Vec::with_capacity(n + 1);
-        let mut up_idx = Vec::with_capacity(analysed.nnz() / 2 + n);
-        up_ptr.push(0);
-        for c in 0..n {
-            let rows = &analysed.row_idx()[analysed.col_ptr()[c]..analysed.col_ptr()[c + 1]];
-            up_idx.extend(rows.iter().copied().take_while(|&r| r <= c));
-            up_ptr.push(up_idx.len());
-        }
-        let mut perm = vec![0usize; n];
-        let mut perm_inv = vec![0usize; n];
-        {
-            let upper = SymbolicSparseColMatRef::new_checked(n, n, &up_ptr, None, &up_idx);
-            let mut mem = MemBuffer::new(amd::order_scratch::<usize>(n, up_idx.len()));
-            amd::order(&mut perm, &mut perm_inv, upper, amd::Control::default(), MemStack::new(&mut mem))
-                .map_err(|e| format!("ordering failed: {e:?}"))?;
-        }
-        drop((up_ptr, up_idx));
+    /// The analysis of `pattern` in a given ordering (see [`order`]).
+    pub(super) fn from_ordering(pattern: &Pattern, ordering: Ordering) -> Result<Self, String> {
+        let n = pattern.n();
+        let Ordering { perm, perm_inv, augmented } = ordering;
 
         // the numeric factorisation reads the values of the original pattern
         let (a_col_ptr, a_row_usize, a_src) = permuted_upper(pattern, &perm, &perm_inv);
@@ -204,7 +238,11 @@ pub(super) fn with_clique_pairs(pattern: &Pattern, cliques: &[Vec<usize>]) -> Re
 /// New rows `i` are walked in order; each entry `(r, perm[i])` of `A` with
 /// `j = perm_inv[r] >= i` is `B[j, i] = B[i, j]` by symmetry, appended to
 /// column `j`, so every column receives its rows in ascending order.
-fn permuted_upper(pattern: &Pattern, perm: &[usize], perm_inv: &[usize]) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
+pub(super) fn permuted_upper(
+    pattern: &Pattern,
+    perm: &[usize],
+    perm_inv: &[usize],
+) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
     let n = pattern.n();
     let mut col_ptr = vec![0usize; n + 1];
     for i in 0..n {

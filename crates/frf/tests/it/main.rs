@@ -9,4 +9,5 @@ mod planar_in_space;
 mod properties;
 mod selected_inverse;
 mod solver;
+mod supernodal;
 mod uff;

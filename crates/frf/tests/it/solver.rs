@@ -3,7 +3,7 @@
 use damping::DampedSystem;
 use faer::Mat;
 use fe_model::{Model, Pattern, Quantity, samples};
-use frf::{C64, Channel, FactorKind, FrfError, ZSolver, synthesize};
+use frf::{C64, Channel, FactorKind, FrfError, Layout, ZSolver, synthesize};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -141,32 +141,35 @@ fn ldlt_equals_lu_on_random_complex_symmetric_sparse_matrices() {
     }
 }
 
+/// In both layouts of the factor.
 #[test]
 fn the_three_right_hand_side_layouts_agree() {
     let sys = DampedSystem::new(samples::frame_grid(2, 3, 2)).unwrap();
     let n = sys.n();
-    let solver = ZSolver::new(sys.assembly().pattern()).unwrap();
-    let mut ws = solver.workspace();
-    let z = sys.z_values(2.0 * std::f64::consts::PI * 40.0);
-    solver.factorize(&mut ws, &z, 40.0).unwrap();
-    let mut rng = ChaCha8Rng::seed_from_u64(1);
-    let k = 5;
-    let rhs = random_rhs(n, k, &mut rng);
-    let mut cols = rhs.clone();
-    solver.solve_in_place(&mut ws, cols.as_mut(), 40.0).unwrap();
-    let mut inter: Vec<C64> = (0..n * k).map(|t| rhs[(t / k, t % k)]).collect();
-    solver.solve_interleaved(&mut ws, &mut inter, k, 40.0).unwrap();
-    let mut ordered = vec![C64::new(0.0, 0.0); n * k];
-    for eq in 0..n {
-        for j in 0..k {
-            ordered[solver.position(eq) * k + j] = rhs[(eq, j)];
+    for layout in [Layout::Simplicial, Layout::Supernodal] {
+        let solver = ZSolver::with_layout(sys.assembly().pattern(), &[], layout).unwrap();
+        let mut ws = solver.workspace();
+        let z = sys.z_values(2.0 * std::f64::consts::PI * 40.0);
+        solver.factorize(&mut ws, &z, 40.0).unwrap();
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        let k = 5;
+        let rhs = random_rhs(n, k, &mut rng);
+        let mut cols = rhs.clone();
+        solver.solve_in_place(&mut ws, cols.as_mut(), 40.0).unwrap();
+        let mut inter: Vec<C64> = (0..n * k).map(|t| rhs[(t / k, t % k)]).collect();
+        solver.solve_interleaved(&mut ws, &mut inter, k, 40.0).unwrap();
+        let mut ordered = vec![C64::new(0.0, 0.0); n * k];
+        for eq in 0..n {
+            for j in 0..k {
+                ordered[solver.position(eq) * k + j] = rhs[(eq, j)];
+            }
         }
-    }
-    solver.solve_ordered(&mut ws, &mut ordered, k, 40.0).unwrap();
-    for eq in 0..n {
-        for j in 0..k {
-            assert_eq!(inter[eq * k + j], cols[(eq, j)]);
-            assert_eq!(ordered[solver.position(eq) * k + j], cols[(eq, j)]);
+        solver.solve_ordered(&mut ws, &mut ordered, k, 40.0).unwrap();
+        for eq in 0..n {
+            for j in 0..k {
+                assert_eq!(inter[eq * k + j], cols[(eq, j)], "{layout:?}");
+                assert_eq!(ordered[solver.position(eq) * k + j], cols[(eq, j)], "{layout:?}");
+            }
         }
     }
 }

@@ -5,6 +5,7 @@
 //! [`super::diagnose`] runs them in that order.
 
 use std::collections::HashSet;
+use std::sync::{Arc, Mutex, PoisonError};
 
 use damping::DampedSystem;
 use frf::FrfSet;
@@ -12,7 +13,7 @@ use rayon::prelude::*;
 
 use super::candidates::{self, Candidate, CandidateOptions, EffectKind, Role};
 use super::lines::LineSet;
-use super::local::{LocalCandidate, LocalData};
+use super::local::{LocalCandidate, LocalData, Slots};
 use super::{DiagnoseOptions, FitStage};
 use crate::error::UpdateError;
 use crate::output_error::{self, Misfit, OeData, OeOptions};
@@ -98,7 +99,9 @@ fn fit(
     let data = OeData { measured: &lines.data, weights: lines.weights.as_deref() };
     let r = match local {
         Some((ld, lc)) => {
-            let mut response = ld.response(lc, sys);
+            let Some(mut response) = ld.response(lc, sys, lines.data.frequencies_hz()) else {
+                return Err("the nominal model's low-rank data do not serve it".into());
+            };
             output_error::run_with(&mut response, now, &data, &opts, |_| {})
         }
         None => output_error::run(&mut sys, &params, &data, &opts, |_| {}),
@@ -140,6 +143,10 @@ pub(crate) struct Pool<'a> {
     s2: f64,
     /// Starting values of relaxation parameters tried in full fits (rad/s).
     mu_starts: Vec<f64>,
+    /// The low-rank data the next stages will need (see [`Pool::plan`]).
+    plan: Option<Plan>,
+    /// The low-rank data last gathered by the plan.
+    gathered: Mutex<Option<Arc<LocalData>>>,
     /// Makes the fits of the candidates it picks fail at a stage: the
     /// failures a real search meets (a singular low-rank and whole-model
     /// system at a line, a misfit that is not finite) hang on floating-point
@@ -164,6 +171,8 @@ impl<'a> Pool<'a> {
             superseded: Vec::new(),
             s2,
             mu_starts,
+            plan: None,
+            gathered: Mutex::new(None),
             #[cfg(test)]
             forced_failure: None,
         }
@@ -208,13 +217,51 @@ impl<'a> Pool<'a> {
         Ok(self.fit_on(stage, lines, &data, iterations, which, starts))
     }
 
+    /// Plans the low-rank data of the next stages: the candidates of
+    /// `which` on the lines of `sets`, gathered when a stage first asks for
+    /// data that they serve (see [`Pool::local_data`]). Each gathering costs
+    /// a factorisation of the nominal `Z` per line, the cost of a fit stage
+    /// on a large model (a 100k-DOF frame's fits took a second where its
+    /// factorisations took 20), while the stages ask for data on the same
+    /// lines again and again (the screening, the starts of the relaxation
+    /// parameters, the full fits and what follows them): one gathering per
+    /// plan serves them all.
+    pub(crate) fn plan(&mut self, sets: &[&LineSet], which: &[usize]) {
+        let mut lines: Vec<f64> = sets.iter().flat_map(|s| s.data.frequencies_hz().iter().copied()).collect();
+        lines.sort_by(f64::total_cmp);
+        lines.dedup();
+        let which = which.to_vec();
+        let slots = Slots::of(&self.forms(&which));
+        self.plan = Some(Plan { lines, which, slots });
+        // the data of an earlier plan are not needed again
+        *self.gathered.get_mut().unwrap_or_else(PoisonError::into_inner) = None;
+    }
+
+    fn forms(&self, which: &[usize]) -> Vec<&super::local::LocalForm> {
+        which.iter().filter_map(|&i| self.locals[i].as_ref().map(|l| &l.form)).collect()
+    }
+
     /// The nominal model's low-rank data on `lines` for the candidates of
-    /// `which`: a factorisation per line, the cost of a fit stage on a
-    /// large model, so that fits of the same candidates from several
-    /// starts share it.
-    fn local_data(&self, lines: &LineSet, which: &[usize]) -> Result<LocalData, UpdateError> {
-        let forms: Vec<_> = which.iter().filter_map(|&i| self.locals[i].as_ref().map(|l| &l.form)).collect();
-        LocalData::new(self.nominal, lines.data.channels(), lines.data.frequencies_hz(), &forms)
+    /// `which`: those gathered for the plan when they serve them (gathered
+    /// now if the plan serves them), else gathered for these alone.
+    fn local_data(&self, lines: &LineSet, which: &[usize]) -> Result<Arc<LocalData>, UpdateError> {
+        let forms = self.forms(which);
+        let (channels, freqs) = (lines.data.channels(), lines.data.frequencies_hz());
+        let mut gathered = self.gathered.lock().unwrap_or_else(PoisonError::into_inner);
+        if let Some(data) = gathered.as_ref()
+            && data.covers(freqs, &forms)
+        {
+            return Ok(Arc::clone(data));
+        }
+        if let Some(plan) = &self.plan
+            && freqs.iter().all(|f| plan.lines.contains(f))
+            && forms.iter().all(|f| plan.slots.find(&f.eqs).is_some())
+        {
+            let data = Arc::new(LocalData::new(self.nominal, channels, &plan.lines, &self.forms(&plan.which))?);
+            *gathered = Some(Arc::clone(&data));
+            return Ok(data);
+        }
+        Ok(Arc::new(LocalData::new(self.nominal, channels, freqs, &forms)?))
     }
 
     /// Fits `which` on `lines` by `data` (from [`Self::local_data`] for
@@ -578,6 +625,12 @@ pub(crate) fn search(
     // the alternative starts of stiffness and mass changes where there are
     // few candidates (a large model's screen keeps its time)
     let factor_starts = all.len() <= opts.prescreen_above;
+    // one gathering for the screening and the full fits of its leaders: the
+    // candidates screened and the best of each kind so far (the leaders
+    // come from them unless their screening fails)
+    let mut planned = to_screen.clone();
+    planned.extend(pool.leaders(&pool.by_screening(&all), opts.keep));
+    pool.plan(&[&coarse, full], &planned);
     pool.screen(FitStage::Screening, &coarse, opts.screen_iterations, &to_screen, factor_starts)?;
     trace(&format!("screened {} candidates on {} lines", to_screen.len(), coarse.data.n_freq()));
     let order = pool.by_screening(&all);
@@ -588,6 +641,11 @@ pub(crate) fn search(
     // around the leaders: fuller variants, and on large models finer windows
     let refined = pool.refine(copts, REFINED_LEADERS);
     if !refined.is_empty() {
+        // one gathering for the refined candidates and the variants and
+        // twins of every candidate fitted fully (on the same equations)
+        let mut planned = refined.clone();
+        planned.extend(pool.by_full_fit());
+        pool.plan(&[&coarse, full], &planned);
         pool.screen(FitStage::Screening, &coarse, opts.screen_iterations, &refined, factor_starts)?;
         let best: Vec<usize> = pool.by_screening(&refined).into_iter().take(REFINED_FITS).collect();
         pool.full_fit(full, &coarse, (opts.iterations, opts.screen_iterations), &best, None)?;
@@ -631,6 +689,14 @@ fn factor_starts(c: &Candidate) -> Vec<Vec<f64>> {
         _ => return c.other_starts(),
     };
     scales.iter().map(|f| start.iter().map(|v| v * f).collect()).collect()
+}
+
+/// The low-rank data planned for the next stages (see [`Pool::plan`]).
+struct Plan {
+    /// The lines of every line set the stages fit on.
+    lines: Vec<f64>,
+    which: Vec<usize>,
+    slots: Slots,
 }
 
 /// Twins of candidates added by [`Pool::twins`].

@@ -17,6 +17,11 @@ const CHUNK: usize = 32;
 
 /// What every local candidate needs from the nominal model at a set of
 /// lines: `H_0` at the channels, at `W` and on each distinct `D`.
+///
+/// A candidate is served by any slot whose equations include its `D` (its
+/// `S` is that slot's `S` on its equations), at any of the lines gathered
+/// (see [`LocalData::covers`]), so that one factorisation per line serves
+/// the fits of several stages on several line sets.
 pub(crate) struct LocalData {
     pub(super) lines: Vec<f64>,
     /// Distinct response and reference equations.
@@ -24,11 +29,52 @@ pub(crate) struct LocalData {
     /// Per channel: (index of its response, index of its reference) in `w_eqs`.
     pub(super) picks: Vec<(usize, usize)>,
     /// The distinct `D`s.
-    pub(super) slots: Vec<Vec<usize>>,
+    pub(super) slots: Slots,
     /// Row of each equation in [`Line::w_rows`] (`usize::MAX`: none).
     pub(super) row_of: Vec<usize>,
     /// Per line: the nominal receptances needed.
     pub(super) per_line: Vec<Line>,
+}
+
+/// Distinct sets of equations (each sorted), found by their equations: the
+/// set itself, or a set that contains it.
+pub(crate) struct Slots {
+    pub(super) eqs: Vec<Vec<usize>>,
+    exact: HashMap<Vec<usize>, usize>,
+    /// The slots holding each equation.
+    by_eq: HashMap<usize, Vec<usize>>,
+}
+
+impl Slots {
+    /// The distinct sets of `forms`, in their first order.
+    pub(crate) fn of(forms: &[&LocalForm]) -> Self {
+        let mut slots = Slots { eqs: Vec::new(), exact: HashMap::new(), by_eq: HashMap::new() };
+        for f in forms {
+            if !slots.exact.contains_key(&f.eqs) {
+                let slot = slots.eqs.len();
+                slots.exact.insert(f.eqs.clone(), slot);
+                for &e in &f.eqs {
+                    slots.by_eq.entry(e).or_default().push(slot);
+                }
+                slots.eqs.push(f.eqs.clone());
+            }
+        }
+        slots
+    }
+
+    /// A slot holding every equation of `eqs` (sorted): the set itself when
+    /// it is a slot, else the smallest that contains it.
+    pub(crate) fn find(&self, eqs: &[usize]) -> Option<usize> {
+        if let Some(&slot) = self.exact.get(eqs) {
+            return Some(slot);
+        }
+        let first = eqs.first()?;
+        let contains = |slot: usize| {
+            let have = &self.eqs[slot];
+            eqs.iter().all(|e| have.binary_search(e).is_ok())
+        };
+        self.by_eq.get(first)?.iter().copied().filter(|&s| contains(s)).min_by_key(|&s| self.eqs[s].len())
+    }
 }
 
 /// The nominal receptances at one line.
@@ -99,17 +145,14 @@ impl LocalData {
             let f = frf::equation_of(nominal, c.reference)?;
             picks.push((index(r), index(f)));
         }
-        let mut slots: Vec<Vec<usize>> = Vec::new();
-        for f in forms {
-            if !slots.contains(&f.eqs) {
-                slots.push(f.eqs.clone());
-            }
-        }
+        // (deduplicated by hash: the pre-screening of a 100k-DOF frame has
+        // 60,000 forms, and a search through the slots so far took seconds)
+        let slots = Slots::of(forms);
         // the rows of H_0[:, W] that some D needs, compactly
         let n = nominal.n();
         let mut row_of = vec![usize::MAX; n];
         let mut rows = 0;
-        for &e in slots.iter().flatten() {
+        for &e in slots.eqs.iter().flatten() {
             if row_of[e] == usize::MAX {
                 row_of[e] = rows;
                 rows += 1;
@@ -118,7 +161,7 @@ impl LocalData {
         // The symbolic analysis makes each D a clique of the factor, so that
         // the selected inverse holds every S = H_0[D, D] (about the cost of
         // the factorisation, where a solve per equation would cost N solves).
-        let solver = ZSolver::with_cliques(nominal.assembly().pattern(), &slots)?;
+        let solver = ZSolver::with_cliques(nominal.assembly().pattern(), &slots.eqs)?;
         let per_line: Vec<Line> = lines
             .par_iter()
             .map_init(
@@ -136,20 +179,32 @@ impl LocalData {
                         let p = solver.position(eq);
                         w_rows[row * k..row * k + k].copy_from_slice(&x[p * k..p * k + k]);
                     }
-                    let mut s: Vec<Vec<C64>> = slots.iter().map(|e| vec![ZERO; e.len() * e.len()]).collect();
+                    let mut s: Vec<Vec<C64>> = slots.eqs.iter().map(|e| vec![ZERO; e.len() * e.len()]).collect();
                     let selected = match solver.selected_inverse(ws, inv) {
-                        Ok(()) => slots.iter().zip(&mut s).all(|(eqs, s)| solver.inverse_block(inv, eqs, s)),
+                        Ok(()) => slots.eqs.iter().zip(&mut s).all(|(eqs, s)| solver.inverse_block(inv, eqs, s)),
                         // the LU fallback has no selected inverse
                         Err(frf::FrfError::NoLdltFactors { .. }) => false,
                         Err(e) => return Err(e),
                     };
                     if !selected {
-                        unit_solves(&solver, ws, &slots, x, f, &mut s)?;
+                        unit_solves(&solver, ws, &slots.eqs, x, f, &mut s)?;
                     }
                     Ok(Line { h0, w_rows, s })
                 },
             )
             .collect::<Result<_, frf::FrfError>>()?;
         Ok(LocalData { lines: lines.to_vec(), w_eqs, picks, slots, row_of, per_line })
+    }
+
+    /// The index of each of `lines` among the lines gathered, or `None`
+    /// when one was not gathered.
+    pub(super) fn line_indices(&self, lines: &[f64]) -> Option<Vec<usize>> {
+        lines.iter().map(|f| self.lines.iter().position(|g| g == f)).collect()
+    }
+
+    /// Whether these data serve every one of `forms` at every one of
+    /// `lines` (the channels are those they were gathered for).
+    pub(crate) fn covers(&self, lines: &[f64], forms: &[&LocalForm]) -> bool {
+        lines.iter().all(|f| self.lines.contains(f)) && forms.iter().all(|form| self.slots.find(&form.eqs).is_some())
     }
 }

@@ -50,8 +50,8 @@ mod response;
 use damping::DampedSystem;
 use num_complex::Complex64 as C64;
 
-pub(crate) use data::LocalData;
-use form::LocalForm;
+pub(crate) use data::{LocalData, Slots};
+pub(crate) use form::LocalForm;
 
 use super::Candidate;
 use crate::params::ParameterSet;
@@ -180,12 +180,12 @@ mod tests {
         let forms: Vec<&LocalForm> = locals.iter().flatten().map(|l| &l.form).collect();
         let data = LocalData::new(&nominal, &channels, &lines, &forms).unwrap();
         // S from the selected inverse equals S from unit solves (the fallback)
-        let solver = ZSolver::with_cliques(nominal.assembly().pattern(), &data.slots).unwrap();
+        let solver = ZSolver::with_cliques(nominal.assembly().pattern(), &data.slots.eqs).unwrap();
         let mut ws = solver.workspace();
         let z = nominal.z_values(2.0 * std::f64::consts::PI * lines[1]);
         solver.factorize(&mut ws, &z, lines[1]).unwrap();
-        let mut s: Vec<Vec<C64>> = data.slots.iter().map(|e| vec![ZERO; e.len() * e.len()]).collect();
-        unit_solves(&solver, &mut ws, &data.slots, &mut Vec::new(), lines[1], &mut s).unwrap();
+        let mut s: Vec<Vec<C64>> = data.slots.eqs.iter().map(|e| vec![ZERO; e.len() * e.len()]).collect();
+        unit_solves(&solver, &mut ws, &data.slots.eqs, &mut Vec::new(), lines[1], &mut s).unwrap();
         for (got, want) in data.per_line[1].s.iter().zip(&s) {
             let scale = want.iter().map(|v| v.norm()).fold(0.0, f64::max);
             assert!(got.iter().zip(want).all(|(g, w)| (g - w).norm() <= 1e-10 * scale), "S differs from unit solves");
@@ -200,7 +200,7 @@ mod tests {
             let params = ParameterSet::new(c.parameters_in(sys.model()).unwrap());
             // away from the start: masses and damping grow, stiffness falls
             let values: Vec<f64> = params.values(&sys).iter().map(|v| v * 1.7).collect();
-            let mut response = data.response(local, local.part.clone());
+            let mut response = data.response(local, local.part.clone(), &lines).unwrap();
             response.set(&values).unwrap();
             let (h, sens) = response.evaluate(&lines, true).unwrap();
             let mut truth = sys;
@@ -237,5 +237,59 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Data gathered on more lines and for larger sets of equations serve
+    /// a candidate exactly as data gathered for it alone: its `S` is the
+    /// larger set's on its own equations, its lines picked among the others.
+    /// Lines or equations not gathered serve nothing.
+    #[test]
+    fn data_for_more_lines_and_larger_sets_serve_a_candidate_exactly() {
+        let model = samples::frame_grid(1, 2, 2);
+        let nominal = DampedSystem::new(model.clone()).unwrap();
+        let uy: Vec<DofRef> =
+            (0..nominal.n()).map(|eq| nominal.assembly().dofs().dof_of(eq)).filter(|d| d.dof == Dof::Uy).collect();
+        let channels: Vec<Channel> = uy.iter().map(|&r| Channel::new(r, uy[uy.len() - 1])).collect();
+        let opts = CandidateOptions { band_hz: (1.0, 100.0), ..CandidateOptions::default() };
+        let all = candidates::generate(&model, &opts);
+        let locals: Vec<LocalCandidate> = all.iter().filter_map(|c| LocalCandidate::new(&nominal, c)).collect();
+        // the sets no other set contains, gathered on more lines than the fit's
+        let within = |a: &[usize], b: &[usize]| a.len() < b.len() && a.iter().all(|e| b.contains(e));
+        let largest: Vec<&LocalForm> =
+            locals.iter().map(|l| &l.form).filter(|f| !locals.iter().any(|o| within(&f.eqs, &o.form.eqs))).collect();
+        let lines = [17.0, 88.0];
+        let more = LocalData::new(&nominal, &channels, &[3.0, 17.0, 41.0, 88.0], &largest).unwrap();
+        let mut served_by_larger = 0;
+        for local in &locals {
+            let own = LocalData::new(&nominal, &channels, &lines, &[&local.form]).unwrap();
+            assert!(more.covers(&lines, &[&local.form]));
+            assert!(!more.covers(&[17.0, 50.0], &[&local.form]), "a line not gathered");
+            assert!(more.response(local, local.part.clone(), &[17.0, 50.0]).is_none());
+            served_by_larger += usize::from(largest.iter().all(|f| f.eqs != local.form.eqs));
+            let values: Vec<f64> = local.params.values(&local.part).iter().map(|v| v * 1.7).collect();
+            let mut evaluated = [&own, &more].map(|data| {
+                let mut r = data.response(local, local.part.clone(), &lines).unwrap();
+                r.set(&values).unwrap();
+                r.evaluate(&lines, true).unwrap()
+            });
+            let (h_more, s_more) = evaluated[1].clone();
+            let (h_own, s_own) = std::mem::take(&mut evaluated[0]);
+            for k in 0..lines.len() {
+                let scale = h_own[k].iter().map(|v| v.norm()).fold(0.0, f64::max);
+                for (a, b) in h_own[k].iter().zip(&h_more[k]) {
+                    assert!((a - b).norm() <= 1e-10 * scale, "H at line {k}");
+                }
+                let (a, b) = (&s_own.as_ref().unwrap()[k], &s_more.as_ref().unwrap()[k]);
+                assert!((a - b).norm_max() <= 1e-10 * a.norm_max(), "sensitivities at line {k}");
+            }
+        }
+        // candidates whose own set is not gathered, served by one containing it
+        assert!(served_by_larger > 0, "no candidate was served by a larger set");
+        // a set of equations no gathered set contains serves nothing
+        let first = &locals[0];
+        let alone = LocalData::new(&nominal, &channels, &lines, &[&first.form]).unwrap();
+        let other = locals.iter().find(|l| l.form.eqs.iter().any(|e| !first.form.eqs.contains(e))).unwrap();
+        assert!(!alone.covers(&lines, &[&other.form]));
+        assert!(alone.response(other, other.part.clone(), &lines).is_none());
     }
 }

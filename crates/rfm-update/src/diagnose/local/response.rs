@@ -14,17 +14,40 @@ use crate::output_error::{Evaluated, Response};
 use crate::params::ParameterSet;
 
 impl LocalData {
-    /// The model response of one candidate, starting at the values of
-    /// `sys` (its part, [`LocalCandidate::part`], possibly with other values).
-    pub(crate) fn response<'a>(&'a self, local: &'a LocalCandidate, sys: DampedSystem) -> LocalResponse<'a> {
+    /// The model response of one candidate at `lines` (Hz, all among
+    /// those gathered), starting at the values of `sys` (its part,
+    /// [`LocalCandidate::part`], possibly with other values); `None` when
+    /// these data do not serve it (see [`LocalData::covers`]).
+    pub(crate) fn response<'a>(
+        &'a self,
+        local: &'a LocalCandidate,
+        sys: DampedSystem,
+        lines: &[f64],
+    ) -> Option<LocalResponse<'a>> {
         let (form, nominal) = (&local.form, &local.nominal_part);
-        let slot = self.slots.iter().position(|e| *e == form.eqs).expect("the form was given to LocalData::new");
+        let line_idx = self.line_indices(lines)?;
+        let slot = self.slots.find(&form.eqs)?;
         let d = form.eqs.len();
+        // S on D: the slot's S where the slot is D, else its rows and
+        // columns at D (both sorted)
+        let slot_eqs = &self.slots.eqs[slot];
+        let at: Vec<usize> = form.eqs.iter().map(|e| slot_eqs.binary_search(e).expect("the slot holds D")).collect();
+        let ds = slot_eqs.len();
+        let s = line_idx
+            .iter()
+            .map(|&l| {
+                let full = &self.per_line[l].s[slot];
+                if ds == d {
+                    full.clone()
+                } else {
+                    at.iter().flat_map(|&r| at.iter().map(move |&c| full[r * ds + c])).collect()
+                }
+            })
+            .collect();
         let a0 = nominal.assembly();
         let nominal_blocks: Vec<Placed> =
             form.nominal_blocks.iter().map(|&b| Placed::new(&a0.blocks()[b], |e| form.nominal_index(e))).collect();
-        let nominal_z = self
-            .lines
+        let nominal_z = lines
             .iter()
             .map(|&f| {
                 let coefs = nominal.coefficients(2.0 * std::f64::consts::PI * f);
@@ -39,10 +62,10 @@ impl LocalData {
             })
             .collect();
         let k = self.w_eqs.len();
-        let x = self
-            .per_line
+        let x = line_idx
             .iter()
-            .map(|line| {
+            .map(|&l| {
+                let line = &self.per_line[l];
                 form.eqs
                     .iter()
                     .flat_map(|&e| {
@@ -61,18 +84,20 @@ impl LocalData {
         refs.sort_unstable();
         refs.dedup();
         let n_local = d + form.new_eqs;
-        LocalResponse {
+        Some(LocalResponse {
             data: self,
-            slot,
+            lines: lines.to_vec(),
+            line_idx,
             form,
             sys,
             params: &local.params,
             nominal_z,
             x,
+            s,
             placed,
             work: Work::new(n_local, d, refs.len()),
             refs,
-        }
+        })
     }
 }
 
@@ -151,7 +176,9 @@ impl Work {
 /// [`Response`] of one local candidate; see the module docs.
 pub(crate) struct LocalResponse<'a> {
     data: &'a LocalData,
-    slot: usize,
+    /// The lines it is evaluated at, and their indices in `data`.
+    lines: Vec<f64>,
+    line_idx: Vec<usize>,
     form: &'a LocalForm,
     sys: DampedSystem,
     params: &'a ParameterSet,
@@ -160,6 +187,8 @@ pub(crate) struct LocalResponse<'a> {
     nominal_z: Vec<Vec<C64>>,
     /// Per line: `X = H_0[D, W]`, row-major `d x |W|`.
     x: Vec<Vec<C64>>,
+    /// Per line: `S = H_0[D, D]`, row-major `d x d`.
+    s: Vec<Vec<C64>>,
     /// Each block of the candidate's part, placed locally when it changed.
     placed: Vec<Option<Placed>>,
     /// Distinct reference columns in `W`.
@@ -179,7 +208,7 @@ impl Response for LocalResponse<'_> {
     }
 
     fn evaluate(&mut self, lines: &[f64], jacobian: bool) -> Option<Evaluated> {
-        if lines != self.data.lines.as_slice() {
+        if lines != self.lines.as_slice() {
             return None;
         }
         let (d, e) = (self.form.eqs.len(), self.form.new_eqs);
@@ -224,7 +253,7 @@ impl Response for LocalResponse<'_> {
                 w.nz.extend(row.iter().enumerate().filter(|(_, v)| **v != ZERO).map(|(j, &v)| (j, v)));
                 w.nz_ptr.push(w.nz.len());
             }
-            let s = &self.data.per_line[li].s[self.slot];
+            let s = &self.s[li];
             w.m.fill(ZERO);
             for i in 0..d {
                 w.m[i * d + i] = C64::new(1.0, 0.0);
@@ -249,7 +278,7 @@ impl Response for LocalResponse<'_> {
             }
             lu_solve(&w.m, d, &w.m_piv, &mut w.y, nr);
             // H = H_0 - X^T dZ Y on the channels
-            let line = &self.data.per_line[li];
+            let line = &self.data.per_line[self.line_idx[li]];
             let mut h = line.h0.clone();
             for (a, &fr) in self.refs.iter().enumerate() {
                 for i in 0..d {
