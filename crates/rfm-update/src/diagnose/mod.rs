@@ -605,13 +605,16 @@ fn diagnose_in(
     let nominal = DampedSystem::new(model.clone())?;
     // the nominal model at every line read below, in one synthesis (on a
     // 96k-DOF frame, 2 s saved against one per line set)
-    let mut read: Vec<f64> = noise_lines(measured);
-    for n in [opts.lines, opts.screen_lines, opts.prescreen_lines] {
-        read.extend(informative_lines(measured, n));
-    }
-    read.sort_by(f64::total_cmp);
-    read.dedup();
-    let (at_lines, singular) = frf::synthesize_regular(&nominal, measured.channels(), &read)?;
+    let read_of = |measured: &FrfSet| {
+        let mut read: Vec<f64> = noise_lines(measured);
+        for n in [opts.lines, opts.screen_lines, opts.prescreen_lines] {
+            read.extend(informative_lines(measured, n));
+        }
+        read.sort_by(f64::total_cmp);
+        read.dedup();
+        read
+    };
+    let (mut at_lines, singular) = frf::synthesize_regular(&nominal, measured.channels(), &read_of(measured))?;
     // a lightly damped model evaluated on its own resonance is singular
     // there: that line is left out of the diagnosis (and said), not the
     // diagnosis stopped
@@ -627,6 +630,10 @@ fn diagnose_in(
         });
         (&reduced, reduced_weights.as_deref())
     };
+    if !singular.is_empty() {
+        // the lines chosen from what is left differ from those chosen with it
+        at_lines = frf::synthesize_regular(&nominal, measured.channels(), &read_of(measured))?.0;
+    }
     let lines = measured.frequencies_hz();
     let noise = noise_against(measured, weights, &at_lines)
         .ok_or_else(|| UpdateError::Data("too few usable measured values to estimate the noise level".into()))?;
