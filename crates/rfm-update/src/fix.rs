@@ -1005,8 +1005,10 @@ pub fn fix(
             if !late.is_empty() {
                 progress(FixProgress::Checked { findings: &late });
                 fl.data = checks::corrected(&fl.data, &late)?;
-                current = with_corrections(&current, &late, opts)?;
-                base = with_corrections(&base, &late, opts)?;
+                // the case names a channel moved earlier by its own response
+                let written = as_the_case_names(&late, &findings);
+                current = with_corrections(&current, &written, opts)?;
+                base = with_corrections(&base, &written, opts)?;
                 let (editor, case_after, stats, outcome) =
                     fl.update_case(&current, current.editor()?, steps.len(), steps.len() >= opts.max_steps)?;
                 current = case_after;
@@ -1174,6 +1176,27 @@ fn applied_with<'a>(applied: &'a [(Diagnosis, usize)], d: &'a Diagnosis, r: usiz
 /// `[[measurement.corrections]]` (reading its data from the file the loop
 /// writes, when it synthesises them from a truth); the case as it is when
 /// it has no data file to correct.
+/// `late` (found on data already corrected by `earlier`) with each
+/// correction of a channel an earlier one moved named as the case names
+/// it: by the response it was read at, not the DOF it was moved to (its
+/// entry then composes with the earlier one).
+fn as_the_case_names(late: &[Finding], earlier: &[Finding]) -> Vec<Finding> {
+    let moved: Vec<&checks::Correction> =
+        earlier.iter().flat_map(|f| &f.corrections).filter(|c| c.measured_at.is_some()).collect();
+    late.iter()
+        .map(|f| {
+            let mut f = f.clone();
+            for c in &mut f.corrections {
+                if let Some(e) = moved.iter().find(|e| e.measured_at == Some(c.response) && e.reference == c.reference)
+                {
+                    c.response = e.response;
+                }
+            }
+            f
+        })
+        .collect()
+}
+
 fn with_corrections(case: &CaseFile, findings: &[Finding], opts: &FixOptions) -> Result<CaseFile, UpdateError> {
     let mut editor = case.editor()?;
     let has_data = case.measurement.as_ref().is_some_and(|m| m.data.is_some());

@@ -175,12 +175,11 @@ impl CaseEditor {
     /// its sensor `measured_at`, each written only when it changes
     /// something, and `why` as the entry's reason.
     ///
-    /// `response` names the channel as the data read after the corrections
-    /// already written: a channel an earlier entry moved (`measured_at`) is
-    /// named by where it was moved, as a check of the corrected data names
-    /// it. A second correction of a channel is composed into its entry
-    /// (signs and scales multiplied, the later `measured_at` kept, both
-    /// reasons), since the case allows one entry per channel.
+    /// A second correction of a channel (the same `response` and
+    /// `reference`) is composed into its entry (signs and scales
+    /// multiplied, the later `measured_at` kept, both reasons), since the
+    /// case allows one entry per channel; two that undo each other leave
+    /// none.
     pub fn add_correction(
         &mut self,
         response: DofRef,
@@ -200,8 +199,7 @@ impl CaseEditor {
             };
             let (response_s, reference_s) = (response.to_string(), reference.map(|r| r.to_string()));
             let earlier = a.iter().position(|t| {
-                let now = text(t, "measured_at").or_else(|| text(t, "response"));
-                now.as_deref() == Some(response_s.as_str()) && text(t, "reference") == reference_s
+                text(t, "response").as_deref() == Some(response_s.as_str()) && text(t, "reference") == reference_s
             });
             if let Some(i) = earlier {
                 let t = a.get_mut(i).expect("found above");
@@ -449,9 +447,9 @@ mod tests {
         assert!(same.contains("# the user's comment"), "comments stay");
     }
 
-    /// A correction found after another was written names the channel as
-    /// the corrected data do; it is composed into the channel's one entry,
-    /// and two that undo each other leave none.
+    /// A correction of a channel corrected before is composed into the
+    /// channel's one entry, and two that undo each other leave none; the
+    /// two entries of a swap stay two.
     #[test]
     fn a_later_correction_of_a_channel_is_composed_into_its_entry() {
         let dir = std::env::temp_dir().join(format!("rfm-correct-{}", std::process::id()));
@@ -460,12 +458,15 @@ mod tests {
         let mut e = c.editor().unwrap();
         e.add_correction(ux(3), Some(ux(5)), 1.0, 1.0, Some(ux(4)), "at node 4").unwrap();
         e.add_correction(ux(2), None, -1.0, 1.0, None, "inverted").unwrap();
-        // the moved channel, as the corrected data name it, turns out inverted
-        e.add_correction(ux(4), Some(ux(5)), -1.0, 1.25, None, "inverted too").unwrap();
+        // the moved channel turns out inverted too
+        e.add_correction(ux(3), Some(ux(5)), -1.0, 1.25, None, "inverted too").unwrap();
         // and the inverted one was not
         e.add_correction(ux(2), None, -1.0, 1.0, None, "not inverted after all").unwrap();
+        // a swap: each channel at the other's DOF
+        e.add_correction(ux(2), Some(ux(5)), 1.0, 1.0, Some(ux(5)), "swapped").unwrap();
+        e.add_correction(ux(5), Some(ux(5)), 1.0, 1.0, Some(ux(2)), "swapped").unwrap();
         let text = e.text_at(&dir.join("case.toml")).unwrap();
-        assert_eq!(text.matches("[[measurement.corrections]]").count(), 1, "{text}");
+        assert_eq!(text.matches("[[measurement.corrections]]").count(), 3, "{text}");
         let back = CaseFile::parse(&dir.join("case.toml"), &text).unwrap();
         let m = back.measurement.unwrap();
         let k = &m.corrections[0];
