@@ -150,7 +150,10 @@ fn run(t: &LabTrial, seed: u64) -> Trial {
         diagnose: study.diagnose_options(study.measured()).expect("options"),
         ..FixOptions::default()
     };
-    let outcome = fix(study.case(), study.measured(), &opts, |_| {}).expect("the loop runs");
+    let outcome = fix(study.case(), study.measured(), &opts, |_| {}).unwrap_or_else(|e| {
+        let kept = dir.keep();
+        panic!("{}: the loop failed: {e} (the trial's files are in {})", t.label, kept.display())
+    });
     let key = |s: &Score| {
         usize::from(s.findings) + usize::from(s.spurious.is_empty()) + usize::from(s.effects) + usize::from(s.verdict)
     };
