@@ -332,3 +332,37 @@ mod tests {
         assert!(GLOSSARY.iter().all(|q| q.definition.len() > 40));
     }
 }
+
+/// A dBIC as the reports print it: one decimal below 1,000 in size, else a
+/// whole number with its thousands grouped (`-56,161,045`), so that no
+/// message of the loop prints a raw run of digits.
+pub fn dbic_text(v: f64) -> String {
+    if !v.is_finite() {
+        return format!("{v}");
+    }
+    if v.abs() < 1000.0 {
+        let s = format!("{v:.1}");
+        return if s == "-0.0" { "0.0".into() } else { s };
+    }
+    let digits = format!("{:.0}", v.abs());
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i) % 3 == 0 {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    if v < 0.0 { format!("-{out}") } else { out }
+}
+
+#[cfg(test)]
+mod dbic_text_tests {
+    #[test]
+    fn large_values_are_grouped_and_small_ones_keep_a_decimal() {
+        assert_eq!(super::dbic_text(-56_161_044.7), "-56,161,045");
+        assert_eq!(super::dbic_text(2247.5), "2,248");
+        assert_eq!(super::dbic_text(-9.96), "-10.0");
+        assert_eq!(super::dbic_text(-0.01), "0.0");
+        assert_eq!(super::dbic_text(999.94), "999.9");
+    }
+}

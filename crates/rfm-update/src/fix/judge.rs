@@ -46,8 +46,9 @@ impl Evidence {
             ))
         } else if !(delta_bic < self.significance) {
             Some(format!(
-                "not significant on its own: dBIC {delta_bic:.1} with its {} parameter(s) counted (misfit {:.4e} -> {:.4e}), \
+                "not significant on its own: dBIC {} with its {} parameter(s) counted (misfit {:.4e} -> {:.4e}), \
                  not below {}",
+                crate::quantities::dbic_text(delta_bic),
                 k.saturating_sub(before.k),
                 before.misfit,
                 after.stats.misfit,

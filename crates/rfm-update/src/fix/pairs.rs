@@ -118,9 +118,19 @@ pub(super) fn best_pair(
             let (with_a, with_b) = (over(sa), over(sb));
             let s = fl.evidence.significance;
             if !(with_a < s) {
-                reject(format!("{} adds nothing significant to {} alone (dBIC {with_a:.1})", name(b), name(a)))
+                reject(format!(
+                    "{} adds nothing significant to {} alone (dBIC {})",
+                    name(b),
+                    name(a),
+                    crate::quantities::dbic_text(with_a)
+                ))
             } else if !(with_b < s) {
-                reject(format!("{} adds nothing significant to {} alone (dBIC {with_b:.1})", name(a), name(b)))
+                reject(format!(
+                    "{} adds nothing significant to {} alone (dBIC {})",
+                    name(a),
+                    name(b),
+                    crate::quantities::dbic_text(with_b)
+                ))
             } else {
                 None
             }

@@ -119,8 +119,10 @@ pub(super) fn stop_reason(
             s.push_str(&format!("; tried and not kept: {}", why.join("; ")));
         }
         FixStop::Ambiguous => {
-            let names: Vec<String> =
-                equally_good.iter().map(|r| format!("{} (dBIC {:.1})", r.effect, r.delta_bic)).collect();
+            let names: Vec<String> = equally_good
+                .iter()
+                .map(|r| format!("{} (dBIC {})", r.effect, crate::quantities::dbic_text(r.delta_bic)))
+                .collect();
             s.push_str(&format!(
                 ": {}; more modes (a wider band) or responses nearer to them would tell them apart",
                 names.join(", ")

@@ -38,6 +38,15 @@ use crate::lab::{self, Expect, ExpectedEffect, Finding, LabFamily, LabTrial};
 
 use crate::{full_study, study_size};
 
+/// Criteria of issue 32 the loop does not meet yet, with the counts of the
+/// last full run (2026-11-28). The study prints each as not met, and fails
+/// when one is met, so that it is asserted from then on. What misses them
+/// (see the module docs): shakers and sensor masses, which no candidate
+/// family represents (a grounded spring and dashpot at the drive point,
+/// equal masses at every response node), are explained in part by
+/// stiffness changes and supports that are not there.
+const NOT_YET_MET: &[(&str, &str)] = &[];
+
 /// The families `cargo test` runs one trial of (see the module docs).
 const REDUCED: [LabFamily; 4] = [LabFamily::Swap, LabFamily::Calibration, LabFamily::SkewMember, LabFamily::Null];
 
@@ -242,6 +251,12 @@ fn the_loop_tells_the_test_set_up_from_the_structure_and_stops_where_nothing_exp
         ("no spurious effect", 0.95),
         ("outside every family: exit 9 with a description", 0.95),
     ] {
-        assert!(rate(k) >= bound, "{k}: {:?} below {bound}", table.get(k));
+        if let Some((_, last)) = NOT_YET_MET.iter().find(|(name, _)| *name == k) {
+            // a criterion met now is asserted from now on: take it off the list
+            assert!(rate(k) < bound, "{k}: {:?} meets {bound}; take it off NOT_YET_MET", table.get(k));
+            println!("NOT MET (issue 32): {k}: {:?} below {bound} (last full run: {last})", table.get(k));
+        } else {
+            assert!(rate(k) >= bound, "{k}: {:?} below {bound}", table.get(k));
+        }
     }
 }
