@@ -67,5 +67,7 @@ fn the_table_frame_loop_finds_the_loose_corner_and_the_misfit_falls_to_the_noise
         assert!(z < 3.0, "{name}: {p} vs the truth's {truth}");
         checked += 1;
     }
-    assert_eq!(checked, 5, "krx, kry, krz, alpha and mu of the joint");
+    // krx, kry, krz and the joint's alpha and mu: one group, or one per
+    // direction (the truth has one; the data hold both within the noise)
+    assert!(checked == 5 || checked == 9, "{checked} of krx, kry, krz and the joint's alpha and mu");
 }
