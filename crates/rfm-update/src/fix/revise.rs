@@ -300,8 +300,11 @@ pub(super) fn revise(
                 };
                 if !carry.is_empty() {
                     // it was started from `own`'s values, not its screening
-                    // fit's (whose tuning its description may give)
+                    // fit's (whose tuning its description may give), with a
+                    // kernel that damps as the viscous one did: where the
+                    // update started is the misfit `own` left
                     a.effect.description = retitled(&own, &a.effect);
+                    a.effect.misfit = state.misfit;
                 }
                 let v = fl.evidence.judge(state, &a, &tried);
                 if v.rejected.is_none() && best.as_ref().is_none_or(|(b, ..)| v.delta_bic < *b) {
