@@ -205,31 +205,9 @@ pub(crate) fn times(v: f64) -> String {
     }
 }
 
-/// A dBIC: one decimal where the threshold of -10 is near, whole numbers
-/// with thousands grouped beyond 1,000 (a raw `-56161044.7` cannot be
-/// compared at a glance).
+/// A dBIC, as [`rfm_update::quantities::dbic_text`] writes every one.
 pub(crate) fn dbic(v: f64) -> String {
-    if !v.is_finite() {
-        "-".into()
-    } else if v.abs() < 1000.0 {
-        let s = format!("{v:.1}");
-        if s == "-0.0" { "0.0".into() } else { s }
-    } else {
-        grouped(v.round())
-    }
-}
-
-/// A whole number with its thousands grouped by commas: `-56,161,045`.
-pub(crate) fn grouped(v: f64) -> String {
-    let digits = format!("{:.0}", v.abs());
-    let mut out = String::new();
-    for (i, c) in digits.chars().enumerate() {
-        if i > 0 && (digits.len() - i) % 3 == 0 {
-            out.push(',');
-        }
-        out.push(c);
-    }
-    if v < 0.0 && digits != "0" { format!("-{out}") } else { out }
+    rfm_update::quantities::dbic_text(v)
 }
 
 #[cfg(test)]
@@ -273,8 +251,6 @@ mod tests {
         assert_eq!(dbic(-999.94), "-999.9");
         assert_eq!(dbic(6.94), "6.9");
         assert_eq!(dbic(-0.01), "0.0");
-        assert_eq!(grouped(0.0), "0");
-        assert_eq!(grouped(-100.0), "-100");
         let mut t = Table::new(&["effect", "dBIC"]);
         t.row(vec!["a".into(), dbic(-56161044.7)]);
         t.row(vec!["b".into(), dbic(-7.0)]);

@@ -333,17 +333,23 @@ mod tests {
     }
 }
 
-/// A dBIC as the reports print it: one decimal below 1,000 in size, else a
-/// whole number with its thousands grouped (`-56,161,045`), so that no
-/// message of the loop prints a raw run of digits.
+/// A dBIC as every output prints it (terminal, JSON messages, reports):
+/// one decimal below 1,000 in size, where the threshold of -10 is near,
+/// else a whole number with its thousands grouped (`-56,161,045`: a raw
+/// `-56161044.7` cannot be compared at a glance); `-` when not a number.
 pub fn dbic_text(v: f64) -> String {
     if !v.is_finite() {
-        return format!("{v}");
-    }
-    if v.abs() < 1000.0 {
+        "-".into()
+    } else if v.abs() < 1000.0 {
         let s = format!("{v:.1}");
-        return if s == "-0.0" { "0.0".into() } else { s };
+        if s == "-0.0" { "0.0".into() } else { s }
+    } else {
+        grouped(v.round())
     }
+}
+
+/// A whole number with its thousands grouped by commas: `-56,161,045`.
+pub fn grouped(v: f64) -> String {
     let digits = format!("{:.0}", v.abs());
     let mut out = String::new();
     for (i, c) in digits.chars().enumerate() {
@@ -352,7 +358,7 @@ pub fn dbic_text(v: f64) -> String {
         }
         out.push(c);
     }
-    if v < 0.0 { format!("-{out}") } else { out }
+    if v < 0.0 && digits != "0" { format!("-{out}") } else { out }
 }
 
 #[cfg(test)]
@@ -364,5 +370,8 @@ mod dbic_text_tests {
         assert_eq!(super::dbic_text(-9.96), "-10.0");
         assert_eq!(super::dbic_text(-0.01), "0.0");
         assert_eq!(super::dbic_text(999.94), "999.9");
+        assert_eq!(super::dbic_text(f64::NAN), "-");
+        assert_eq!(super::grouped(0.0), "0");
+        assert_eq!(super::grouped(-100.0), "-100");
     }
 }
