@@ -1,6 +1,6 @@
 //! The model a case file describes: materials, sections, groups, nodes,
 //! lines of elements, beams, springs, joints, masses, supports, ties, group
-//! assignments and resonators, built in that order through the checked
+//! assignments, resonators and shakers, built in that order through the checked
 //! `Model::add_*` methods, each error placed at the entry that caused it.
 
 use std::ops::Range;
@@ -9,7 +9,9 @@ use toml::Spanned;
 
 use super::Ctx;
 use super::lookup::{group_ref, material_ref, section_ref};
-use super::raw::{RawCase, RawGroup, RawJoint, RawLine, RawMass, RawMaterial, RawResonator, RawSection, RawSpring};
+use super::raw::{
+    RawCase, RawGroup, RawJoint, RawLine, RawMass, RawMaterial, RawResonator, RawSection, RawShaker, RawSpring,
+};
 use crate::dof::{Dimension, Dof, PerDof};
 use crate::error::CaseError;
 use crate::model::{Group, Model, NodeId, Section};
@@ -210,6 +212,9 @@ pub(super) fn build_model(ctx: &Ctx<'_>, raw: &RawCase, model: &mut Model) -> Re
     // then shifts no id that a line or joint without its own takes
     for r in &raw.resonators {
         add_resonator(ctx, model, r)?;
+    }
+    for s in &raw.shakers {
+        add_shaker(ctx, model, s)?;
     }
     if model.beams.is_empty() && model.springs.is_empty() && model.imported().is_empty() {
         return Err(ctx.whole("the case defines no beams, lines, springs or imported matrices"));
@@ -450,6 +455,57 @@ pub(super) fn add_resonator(ctx: &Ctx<'_>, model: &mut Model, s: &Spanned<RawRes
     model.add_spring(&r.name, r.node, Some(id), k, g).map_err(err)?;
     model.add_mass(&r.name, id, r.m, [0.0; 3], g).map_err(err)?;
     model.add_support(id, &held).map_err(err)
+}
+
+/// A shaker at its drive point (`[[shakers]]`): its armature, a lumped
+/// mass `m` on a new node coincident with `node`, moves with the node in
+/// the one direction given a stiffness (a stiff stinger, a tie) and is
+/// held in the others (the stinger's bending passes little across), and
+/// its suspension, a spring of that stiffness from the new node to ground,
+/// is damped by the entry's group (alpha = c / k for a dashpot `c` beside
+/// it: the suspension's loss, or the back-EMF damping of a voltage drive).
+/// Mass and spring are named as the entry.
+pub(super) fn add_shaker(ctx: &Ctx<'_>, model: &mut Model, s: &Spanned<RawShaker>) -> Result<(), CaseError> {
+    let r = s.get_ref();
+    let dim = model.dimension();
+    let what = format!("shaker `{}`", r.name);
+    let keys: Vec<&str> = dim.translations().iter().map(|&d| dim.spring_key(d)).collect();
+    if let Some((key, v)) = r.stiffnesses().into_iter().skip(3).find_map(|(key, v)| Some((key, v?))) {
+        return Err(
+            ctx.err(v.span(), format!("{what}: `{key}`: a shaker drives in a translation ({})", keys.join(", ")))
+        );
+    }
+    let mut k = PerDof::default();
+    for (d, v) in stiffnesses(ctx, dim, &what, r.stiffnesses())? {
+        k[d] = v;
+    }
+    let acts = k.non_zero(dim.translations());
+    let [drive] = acts[..] else {
+        return Err(ctx.err(
+            s.span(),
+            format!(
+                "{what}: give the stiffness of its suspension in the one direction it drives ({})",
+                keys.join(" or ")
+            ),
+        ));
+    };
+    let at = model
+        .node(NodeId(r.node))
+        .map(|n| n.position())
+        .ok_or_else(|| ctx.err(s.span(), format!("{what}: node {} does not exist", r.node)))?;
+    let id = match r.new_node {
+        Some(id) => id,
+        None => model.max_node_id().checked_add(1).ok_or_else(|| ctx.err(s.span(), "node ids are exhausted"))?,
+    };
+    let g = group_ref(ctx, model, &r.group)?;
+    let held: Vec<Dof> = dim.dofs().iter().copied().filter(|&d| d != drive).collect();
+    let err = |e| ctx.model_err(s.span(), e);
+    model.add_node_at(id, at).map_err(err)?;
+    model.add_tie(r.node, id, &[drive]).map_err(err)?;
+    model.add_support(id, &held).map_err(err)?;
+    model.add_mass(&r.name, id, r.m, [0.0; 3], g).map_err(err)?;
+    model.add_spring(&r.name, id, None, k, g).map_err(err)?;
+    Ok(())
 }
 
 pub(super) fn add_mass(ctx: &Ctx<'_>, model: &mut Model, m: &Spanned<RawMass>) -> Result<usize, CaseError> {

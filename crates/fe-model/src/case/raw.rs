@@ -45,6 +45,8 @@ pub(super) struct RawCase {
     #[serde(default)]
     pub(super) resonators: Vec<Spanned<RawResonator>>,
     #[serde(default)]
+    pub(super) shakers: Vec<Spanned<RawShaker>>,
+    #[serde(default)]
     pub(super) set: BTreeMap<String, Spanned<f64>>,
     pub(super) measurement: Option<Spanned<RawMeasurement>>,
     pub(super) truth: Option<Spanned<RawTruth>>,
@@ -329,6 +331,10 @@ impl RawResonator {
     }
 }
 
+/// `[[shakers]]`: a shaker's armature and suspension at its drive point
+/// (read in `build.rs`); the keys of a resonator, with one direction.
+pub(super) type RawShaker = RawResonator;
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawTruth {
@@ -348,6 +354,8 @@ pub(super) struct RawTruth {
     pub(super) joints: Vec<Spanned<RawJoint>>,
     #[serde(default)]
     pub(super) resonators: Vec<Spanned<RawResonator>>,
+    #[serde(default)]
+    pub(super) shakers: Vec<Spanned<RawShaker>>,
     #[serde(default)]
     pub(super) groups: BTreeMap<String, Spanned<RawGroup>>,
 }

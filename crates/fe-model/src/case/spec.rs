@@ -112,7 +112,7 @@ pub struct HistoryEntry {
 
 /// The kinds of effect a history entry may name (the names of
 /// `rfm_update::diagnose::EffectKind`, whose tests keep the two lists equal).
-pub const EFFECT_KINDS: [&str; 8] = [
+pub const EFFECT_KINDS: [&str; 10] = [
     "flexible_support",
     "flexible_joint",
     "lumped_mass",
@@ -121,6 +121,8 @@ pub const EFFECT_KINDS: [&str; 8] = [
     "viscous_damping",
     "non_viscous_damping",
     "resonator",
+    "shaker",
+    "sensor_masses",
 ];
 
 /// How an updating run may end, as its results name it (the statuses of

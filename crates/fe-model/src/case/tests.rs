@@ -579,3 +579,70 @@ fn a_resonator_is_a_mass_on_a_spring_at_a_new_node_held_in_its_other_dofs() {
         assert_eq!(line_of(&text, &e), line, "{e}");
     }
 }
+
+/// A `[[shakers]]` entry is the node, tie, supports, mass and spring to
+/// ground a user would write by hand: the armature moves with the drive
+/// point in the drive's direction only, its suspension holds it to ground;
+/// a suspension in two directions, or in a rotation, is refused where written.
+#[test]
+fn a_shaker_is_an_armature_tied_to_its_drive_point_on_a_suspension_to_ground() {
+    let entry =
+        "[groups.coil]\nalpha = 1e-4\n[[shakers]]\nname = \"coil\"\nnode = 5\nm = 0.05\nky = 3e3\ngroup = \"coil\"\n";
+    let (head, tail) = BEAM.split_at(BEAM.find("[[lines]]").unwrap());
+    let c = parse(&format!("{head}{entry}{tail}")).unwrap();
+    let by_hand = parse(&format!(
+        "nodes = [[1, 0.0, 0.0], [6, 1.0, 0.0]]\n{}\n[groups.coil]\nalpha = 1e-4\n\
+         [[springs]]\nname = \"coil\"\nnode = 6\nky = 3e3\ngroup = \"coil\"\n\
+         [[masses]]\nname = \"coil\"\nnode = 6\nm = 0.05\ngroup = \"coil\"\n\
+         [[ties]]\nnodes = [5, 6]\ndofs = [\"uy\"]\n\
+         [[supports]]\nnode = 6\ndofs = [\"ux\", \"rz\"]\n",
+        BEAM.replace("from = [0.0, 0.0]", "from = 1\nfirst_node = 2")
+    ))
+    .unwrap();
+    let (a, b) = (&c.model, &by_hand.model);
+    assert_eq!(a.node(NodeId(6)).unwrap().position(), [1.0, 0.0, 0.0]);
+    let (sa, sb) = (&a.springs()[0], &b.springs()[0]);
+    assert_eq!((sa.a, sa.b, sa.k, &a.groups()[sa.group]), (sb.a, sb.b, sb.k, &b.groups()[sb.group]));
+    assert_eq!(sa.b, None, "to ground");
+    let (ma, mb) = (&a.masses()[0], &b.masses()[0]);
+    assert_eq!((ma.node, ma.m, ma.j), (mb.node, mb.m, mb.j));
+    assert_eq!(a.ties().len(), 1);
+    assert_eq!((a.ties()[0].nodes, &a.ties()[0].dofs), (b.ties()[0].nodes, &b.ties()[0].dofs));
+    let held: Vec<&crate::model::Support> = a.supports().iter().filter(|s| s.node == NodeId(6)).collect();
+    assert_eq!(held[0].dofs, vec![Dof::Ux, Dof::Rz]);
+    // the same matrices as the hand-written model
+    let (ka, kb) = (crate::Assembly::new(a).unwrap(), crate::Assembly::new(b).unwrap());
+    // (the equations in another order: the by-hand case names node 6 first)
+    let sorted = |m: nalgebra::DMatrix<f64>| {
+        let mut v: Vec<f64> = m.iter().copied().collect();
+        v.sort_by(f64::total_cmp);
+        v
+    };
+    let (m_a, m_b) = (ka.mass_dense(), kb.mass_dense());
+    assert_eq!(m_a.trace(), m_b.trace());
+    assert_eq!(sorted(m_a), sorted(m_b));
+    assert_eq!(sorted(ka.stiffness_dense()), sorted(kb.stiffness_dense()));
+    // the armature adds its mass to the drive point's uy alone
+    let beam_only = crate::Assembly::new(&parse(BEAM).unwrap().model).unwrap().mass_dense();
+    assert!((ka.mass_dense().trace() - beam_only.trace() - 0.05).abs() < 1e-12);
+    for name in ["mass.coil.m", "spring.coil.ky", "group.coil.alpha"] {
+        a.quantity(name).unwrap();
+    }
+    let measurement = "[measurement]\nfrequencies = [10.0]\nreferences = [\"5:uy\"]\nresponses = [\"5:uy\"]\n";
+    let truth = format!(
+        "{BEAM}{measurement}[truth.groups.coil]\nalpha = 1e-4\n\
+         [[truth.shakers]]\nname = \"coil\"\nnode = 5\nm = 0.05\nky = 3e3\ngroup = \"coil\"\n"
+    );
+    let t = parse(&truth).unwrap().truth.unwrap();
+    assert_eq!(t.model.masses()[0].node, NodeId(6));
+    for (text, line, words) in [
+        (entry.replace("ky = 3e3", "kr = 3e3"), "kr = 3e3", "`kr`: a shaker drives in a translation (kx, ky)"),
+        (entry.replace("ky = 3e3", "kx = 1e3\nky = 3e3"), "[[shakers]]", "in the one direction it drives (kx or ky)"),
+        (entry.replace("node = 5", "node = 9"), "[[shakers]]", "shaker `coil`: node 9 does not exist"),
+    ] {
+        let text = format!("{BEAM}{text}");
+        let e = parse(&text).unwrap_err();
+        assert!(e.message.contains(words), "{line}: {e}");
+        assert_eq!(line_of(&text, &e), line, "{e}");
+    }
+}

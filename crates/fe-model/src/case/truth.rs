@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use toml::Spanned;
 
 use super::Ctx;
-use super::build::{add_joints, add_mass, add_resonator, add_spring, raw_group};
+use super::build::{add_joints, add_mass, add_resonator, add_shaker, add_spring, raw_group};
 use super::raw::RawTruth;
 use super::spec::TruthSpec;
 use crate::error::CaseError;
@@ -50,6 +50,9 @@ pub(super) fn parse_truth(ctx: &Ctx<'_>, t: &Spanned<RawTruth>, base: &Model) ->
     add_joints(ctx, &mut model, &r.joints)?;
     for s in &r.resonators {
         add_resonator(ctx, &mut model, s)?;
+    }
+    for s in &r.shakers {
+        add_shaker(ctx, &mut model, s)?;
     }
     // Values may name items the truth adds, so resolve them on the truth model.
     for (name, v) in &r.set {

@@ -46,6 +46,8 @@ pub(crate) fn short_effect(kind: Option<EffectKind>, nodes: &[u32], elements: &[
         Some(EffectKind::MassChange) => "mass change",
         Some(EffectKind::ViscousDamping | EffectKind::NonViscousDamping) => "damping",
         Some(EffectKind::Resonator) => "resonator",
+        Some(EffectKind::Shaker) => "shaker",
+        Some(EffectKind::SensorMasses) => "sensor masses",
         None => "effect",
     };
     let span = |ids: &[u32], one: &str, many: &str| match (ids.iter().min(), ids.iter().max()) {
@@ -53,8 +55,16 @@ pub(crate) fn short_effect(kind: Option<EffectKind>, nodes: &[u32], elements: &[
         (Some(a), Some(b)) => format!("{many} {a}-{b}"),
         _ => String::new(),
     };
-    let at_nodes =
-        matches!(kind, Some(EffectKind::FlexibleSupport | EffectKind::FlexibleJoint | EffectKind::LumpedMass));
+    let at_nodes = matches!(
+        kind,
+        Some(
+            EffectKind::FlexibleSupport
+                | EffectKind::FlexibleJoint
+                | EffectKind::LumpedMass
+                | EffectKind::Shaker
+                | EffectKind::SensorMasses
+        )
+    );
     let place = if at_nodes && !nodes.is_empty() {
         format!("at {}", span(nodes, "node", "nodes"))
     } else if !elements.is_empty() {

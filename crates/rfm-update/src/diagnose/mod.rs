@@ -642,12 +642,37 @@ fn diagnose_in(
     let full = LineSet::with_model(measured, opts.lines, opts.gains, &at_lines, weights)?;
     let mut copts = opts.candidates.clone();
     copts.band_hz = (lines[0], lines[lines.len() - 1]);
+    set_up_places(&mut copts, measured);
     let mut pool = Pool::new(model, &nominal, s2, copts.band_hz);
     prepare(&mut pool);
     search::search(&mut pool, measured, &at_lines, &full, opts, &copts, progress)?;
     let mut d = rank(pool, noise, &full, opts);
     d.singular_hz = singular;
     Ok(d)
+}
+
+/// The places of the test's own hardware, from the data where the caller
+/// names none: the drive points (the references in a translation, where a
+/// shaker's armature and suspension load the structure) and the response
+/// nodes (where the sensors' masses sit).
+fn set_up_places(copts: &mut CandidateOptions, measured: &FrfSet) {
+    if copts.drive_points.is_empty() {
+        let mut drives: Vec<(u32, fe_model::Dof)> = measured
+            .channels()
+            .iter()
+            .filter(|c| c.reference.dof.is_translation())
+            .map(|c| (c.reference.node.0, c.reference.dof))
+            .collect();
+        drives.sort_unstable();
+        drives.dedup();
+        copts.drive_points = drives;
+    }
+    if copts.sensor_nodes.is_empty() {
+        let mut nodes: Vec<u32> = measured.channels().iter().map(|c| c.response.node.0).collect();
+        nodes.sort_unstable();
+        nodes.dedup();
+        copts.sensor_nodes = nodes;
+    }
 }
 
 /// The ranking of a finished search.

@@ -48,11 +48,12 @@ pub(super) struct Replacement {
 }
 
 /// Kinds that stand in for one another: a joint and a short stiffness
-/// change, a lumped mass and a short mass change, the two damping forms.
+/// change, a lumped mass and a short mass change (and the test's hardware,
+/// a shaker's armature or a sensor's mass), the two damping forms.
 fn family(kind: EffectKind) -> u8 {
     match kind {
         EffectKind::FlexibleJoint | EffectKind::StiffnessChange => 0,
-        EffectKind::LumpedMass | EffectKind::MassChange => 1,
+        EffectKind::LumpedMass | EffectKind::MassChange | EffectKind::Shaker | EffectKind::SensorMasses => 1,
         EffectKind::ViscousDamping | EffectKind::NonViscousDamping => 2,
         EffectKind::FlexibleSupport => 3,
         // a mode of its own: nothing else stands in for it

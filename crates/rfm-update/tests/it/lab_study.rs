@@ -26,7 +26,8 @@
 //! runs the inverted channel, the resonator and the declared damping) and
 //! asserts each right in full. `LAB_PER` sets the trials per family (with
 //! fewer than 4 the rates are printed and not asserted), `LAB_ONLY=i,j`
-//! runs those trials alone, and `LAB_SEED` draws another set.
+//! runs those trials alone, `LAB_SEED` draws another set, and `LAB_VERBOSE`
+//! prints each trial's steps and findings.
 
 use std::collections::BTreeMap;
 
@@ -63,17 +64,18 @@ const NOT_YET_MET: &[(&str, &str)] = &[
 const REDUCED: [LabFamily; 4] = [LabFamily::Swap, LabFamily::Calibration, LabFamily::SkewMember, LabFamily::Null];
 
 /// The kinds of the tool that stand for an expected effect's family (a
-/// damping patch either form; a shaker is a mass, a spring to ground or a
-/// resonator at the drive point).
+/// damping patch either form; a shaker is the tool's shaker, or a mass, a
+/// spring to ground or a resonator at the drive point; a sensor's mass may
+/// be found as the sensors' masses at every response node).
 fn kinds_of(family: &str) -> &'static [EffectKind] {
     match family {
         "flexible_support" => &[EffectKind::FlexibleSupport],
         "flexible_joint" => &[EffectKind::FlexibleJoint],
-        "lumped_mass" => &[EffectKind::LumpedMass, EffectKind::MassChange],
+        "lumped_mass" => &[EffectKind::LumpedMass, EffectKind::MassChange, EffectKind::SensorMasses],
         "stiffness_change" => &[EffectKind::StiffnessChange],
         "viscous_damping" | "non_viscous_damping" => &[EffectKind::ViscousDamping, EffectKind::NonViscousDamping],
         "resonator" => &[EffectKind::Resonator],
-        "shaker" => &[EffectKind::LumpedMass, EffectKind::FlexibleSupport, EffectKind::Resonator],
+        "shaker" => &[EffectKind::Shaker, EffectKind::LumpedMass, EffectKind::FlexibleSupport, EffectKind::Resonator],
         _ => &[],
     }
 }
@@ -212,6 +214,22 @@ fn the_loop_tells_the_test_set_up_from_the_structure_and_stops_where_nothing_exp
             o.effects.iter().map(|e| e.description.as_str()).collect::<Vec<_>>(),
             if s.spurious.is_empty() { String::new() } else { format!(" | spurious {:?}", s.spurious) }
         );
+        if std::env::var("LAB_VERBOSE").is_ok() {
+            for (k, st) in o.steps.iter().enumerate() {
+                println!(
+                    "      step {k}: {} | added {:.2} updated {:.2} corrected {:?} x noise | dBIC {:.3e} | {:?}",
+                    st.effect.description,
+                    st.misfit_added / o.noise,
+                    st.misfit_updated / o.noise,
+                    st.corrected_misfit.map(|m| m / o.noise),
+                    st.delta_bic,
+                    st.status
+                );
+            }
+            for f in &o.findings {
+                println!("      finding after step {}: {:?} {:?}", f.found_after_step, f.kind, f.channels);
+            }
+        }
         trials.push(trial);
     }
     let mut table: BTreeMap<String, (usize, usize)> = BTreeMap::new();

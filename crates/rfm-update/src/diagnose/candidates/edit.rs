@@ -60,6 +60,17 @@ pub(crate) enum Edit {
         k: PerDof,
         dim: Dimension,
     },
+    /// A shaker at its drive point: a new node `new_node` coincident with
+    /// `node`, tied to it in `dof` (the stinger) and held in its other
+    /// DOFs, carrying the armature's mass `m`, on a spring `k` in `dof` to
+    /// ground (the suspension); mass and spring are named `name` and are in
+    /// `group` of their own, whose alpha is the dashpot beside the spring
+    /// over its stiffness. Written as a case's `[[shakers]]` entry.
+    Shaker { node: u32, new_node: u32, dof: Dof, name: String, group: Group, m: f64, k: f64, dim: Dimension },
+    /// The sensors' masses: a lumped mass of [`SENSOR_UNIT`] at each of
+    /// `nodes` (named `<group>_<node>`), all in the undamped `group`, whose
+    /// mass factor is then each sensor's mass in grams.
+    Sensors { nodes: Vec<u32>, group: String },
     /// Nothing added: the parameters exist in the nominal model.
     Set,
     /// Elements `first..=last` moved to a new group.
@@ -98,6 +109,10 @@ fn springs(
         })
         .collect()
 }
+
+/// The mass (kg) of each sensor of [`Edit::Sensors`] before its group's
+/// mass factor: 1 g, so that the factor reads as grams.
+pub(crate) const SENSOR_UNIT: f64 = 1e-3;
 
 /// The natural frequency (Hz) of a mass `m` on a spring `k`.
 fn tuned_hz(k: f64, m: f64) -> f64 {
@@ -167,6 +182,27 @@ impl Edit {
                 let held: Vec<Dof> = dim.dofs().iter().copied().filter(|d| !dofs.contains(d)).collect();
                 m.add_support(*new_node, &held)?;
             }
+            Edit::Shaker { node, new_node, dof, name, group, m: mass, k, dim } => {
+                let at = m
+                    .node(NodeId(*node))
+                    .ok_or_else(|| ModelError::UnknownNode { id: *node, context: format!("shaker `{name}`") })?
+                    .position();
+                let g = m.add_group(group.clone())?;
+                m.add_node_at(*new_node, at)?;
+                m.add_tie(*node, *new_node, &[*dof])?;
+                let held: Vec<Dof> = dim.dofs().iter().copied().filter(|d| d != dof).collect();
+                m.add_support(*new_node, &held)?;
+                m.add_mass(name, *new_node, *mass, [0.0; 3], g)?;
+                let mut spring = PerDof::default();
+                spring[*dof] = *k;
+                m.add_spring(name, *new_node, None, spring, g)?;
+            }
+            Edit::Sensors { nodes, group } => {
+                let g = m.add_group(Group::new(group))?;
+                for node in nodes {
+                    m.add_mass(&format!("{group}_{node}"), *node, SENSOR_UNIT, [0.0; 3], g)?;
+                }
+            }
             Edit::Set => {}
             Edit::Region { first, last, group } => {
                 let g = m.add_group(group.clone())?;
@@ -187,6 +223,8 @@ impl Edit {
             Edit::Joint { sprung, .. } => sprung.contains(&d),
             Edit::Mass { j, .. } => d.is_translation() || *j > 0.0,
             Edit::Resonator { dofs, .. } => dofs.contains(&d),
+            Edit::Shaker { dof, .. } => *dof == d,
+            Edit::Sensors { .. } => d.is_translation(),
             _ => true,
         }
     }
@@ -244,6 +282,13 @@ impl Edit {
                     names.iter().zip(&shown).map(|(d, f)| format!("{d} {f}")).collect::<Vec<_>>().join(", ")
                 };
                 format!("resonator at node {node} ({tuning}; {})", damping(group, false))
+            }
+            Edit::Shaker { node, dof, .. } => {
+                format!("shaker's armature and suspension at the drive point, node {node} ({})", dof.name())
+            }
+            Edit::Sensors { nodes, .. } => {
+                let list: Vec<String> = nodes.iter().map(u32::to_string).collect();
+                format!("equal sensor masses at the {} response nodes ({})", nodes.len(), list.join(", "))
             }
             Edit::Region { first, last, .. } => format!("{} in {}", kind.label(), range_name(*first, *last)),
             Edit::Set => kind.label().to_string(),
@@ -396,6 +441,28 @@ impl Edit {
                     fitted(format!("mass.{name}.m")).unwrap_or(*m),
                     spring_lines(name, &acting, group, dim)
                 )
+            }
+            Edit::Shaker { node, new_node, dof, name, group, m, k, dim } => {
+                let key = dim.spring_key(*dof);
+                format!(
+                    "{}\n[[shakers]]\nname = \"{name}\"\nnode = {node}                      # the drive point\nnew_node = {new_node}                 # the armature's node, coincident with node {node}\nm = {:e}\n{key} = {:e}\ngroup = \"{}\"\n",
+                    group_table(group),
+                    fitted(format!("mass.{name}.m")).unwrap_or(*m),
+                    fitted(format!("spring.{name}.{key}")).unwrap_or(*k),
+                    group.name
+                )
+            }
+            Edit::Sensors { nodes, group } => {
+                let grams = fitted(format!("group.{group}.mass")).unwrap_or(1.0);
+                let mut s = format!(
+                    "[groups.{group}]                # undamped; its mass factor is each sensor's mass in grams\nmass = {grams:e}\n"
+                );
+                for node in nodes {
+                    s.push_str(&format!(
+                        "\n[[masses]]\nname = \"{group}_{node}\"\nnode = {node}\nm = {SENSOR_UNIT:e}                   # 1 g, times the group's factor\ngroup = \"{group}\"\n"
+                    ));
+                }
+                s
             }
             Edit::Region { first, last, group } => {
                 format!(

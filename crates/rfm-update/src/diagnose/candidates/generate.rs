@@ -22,7 +22,10 @@
 //! Resonators are candidates only where the caller names the frequencies
 //! of measured modes the model lacks
 //! ([`CandidateOptions::resonator_hz`]): one tuned to each, at every node
-//! that can move (`resonators.rs`).
+//! that can move (`resonators.rs`). A shaker's armature and suspension is
+//! a candidate at each drive point, and equal sensor masses at the
+//! response nodes (`set_up.rs`), where the caller names them (the diagnosis
+//! names the data's).
 
 use std::collections::{HashMap, HashSet};
 
@@ -33,6 +36,7 @@ mod points;
 use points::{existing_joints, ground_spring, imported_stiffness_nodes, joint, mass, mass_nodes, supports};
 mod resonators;
 pub(crate) use resonators::RESONATOR_MASS_STARTS;
+mod set_up;
 pub(crate) mod twins;
 
 use super::edit::Edit;
@@ -478,6 +482,12 @@ pub fn generate(model: &Model, opts: &CandidateOptions) -> Vec<Candidate> {
             specs.extend(resonators::resonators(&ctx, hz));
         }
     }
+
+    // the test's own hardware: a shaker at each drive point, the sensors' masses
+    for &(node, dof) in &opts.drive_points {
+        specs.extend(set_up::shaker(&ctx, node, dof));
+    }
+    specs.extend(set_up::sensor_masses(&ctx, &opts.sensor_nodes));
 
     // windows: on small models single elements at every offset and longer
     // windows at a stride (every size at every offset follows around the

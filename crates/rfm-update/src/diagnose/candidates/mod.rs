@@ -11,6 +11,8 @@
 //! | non-viscous damping | the same windows | alpha and mu of the window |
 //! | stiffness, mass or damping change of an imported group | each group with imported matrices | its factor, or its alpha (and mu) |
 //! | attached resonator | each node free in a translation, for each frequency of [`CandidateOptions::resonator_hz`] (none by default): in each translation, and in x and y at once on a planar model | a mass on a spring to a new coincident node: the mass, a spring per direction, its own damping group: alpha (viscous) or alpha and mu |
+//! | shaker | each drive point of [`CandidateOptions::drive_points`] (the data's references in a diagnosis), in the drive's direction | the armature's mass, tied to the drive point in that direction, on its suspension to ground: the mass, the spring, its group's alpha (a dashpot beside the spring) |
+//! | sensor masses | the response nodes of [`CandidateOptions::sensor_nodes`] (two or more; the data's in a diagnosis) | one mass, the same at every node (its group's mass factor on masses of 1 g) |
 //!
 //! Each candidate is a change of the nominal model, the effect inserted at a
 //! starting value that changes little (a very stiff spring, a tiny mass, a
@@ -69,11 +71,17 @@ pub enum EffectKind {
     /// tuned-mass damper, a loose appendage, a cable, a sensor mount),
     /// which adds a mode of its own.
     Resonator,
+    /// A shaker's armature and suspension at the drive point: a mass that
+    /// moves with it in the drive's direction, on a spring and dashpot to
+    /// ground (the FRFs of a force not measured at the structure show it).
+    Shaker,
+    /// The sensors' own masses at the response nodes, the same at each.
+    SensorMasses,
 }
 
 impl EffectKind {
     /// Every kind.
-    pub const ALL: [EffectKind; 8] = [
+    pub const ALL: [EffectKind; 10] = [
         EffectKind::FlexibleSupport,
         EffectKind::FlexibleJoint,
         EffectKind::LumpedMass,
@@ -82,6 +90,8 @@ impl EffectKind {
         EffectKind::ViscousDamping,
         EffectKind::NonViscousDamping,
         EffectKind::Resonator,
+        EffectKind::Shaker,
+        EffectKind::SensorMasses,
     ];
 
     /// The name in JSON and in a case's `[[history]]` (`flexible_joint`).
@@ -95,6 +105,8 @@ impl EffectKind {
             EffectKind::ViscousDamping => "viscous_damping",
             EffectKind::NonViscousDamping => "non_viscous_damping",
             EffectKind::Resonator => "resonator",
+            EffectKind::Shaker => "shaker",
+            EffectKind::SensorMasses => "sensor_masses",
         }
     }
 
@@ -114,6 +126,8 @@ impl EffectKind {
             EffectKind::ViscousDamping => "viscous damping",
             EffectKind::NonViscousDamping => "non-viscous damping",
             EffectKind::Resonator => "attached resonator",
+            EffectKind::Shaker => "shaker at the drive point",
+            EffectKind::SensorMasses => "sensor masses",
         }
     }
 }
@@ -197,11 +211,26 @@ pub struct CandidateOptions {
     /// attached resonator tuned to it is a candidate at every node that can
     /// move. Empty (the default): no resonator candidates.
     pub resonator_hz: Vec<f64>,
+    /// The drive points (node and direction) of the data: at each, a
+    /// shaker's armature and suspension is a candidate. Empty (the
+    /// default): none here; the diagnosis takes the data's references.
+    pub drive_points: Vec<(u32, Dof)>,
+    /// The response nodes of the data: equal sensor masses at all of them
+    /// are a candidate when there are two or more. Empty (the default): none
+    /// here; the diagnosis takes the data's response nodes.
+    pub sensor_nodes: Vec<u32>,
 }
 
 impl Default for CandidateOptions {
     fn default() -> Self {
-        CandidateOptions { region_size: 4, per_element_limit: 40, band_hz: (1.0, 1000.0), resonator_hz: Vec::new() }
+        CandidateOptions {
+            region_size: 4,
+            per_element_limit: 40,
+            band_hz: (1.0, 1000.0),
+            resonator_hz: Vec::new(),
+            drive_points: Vec::new(),
+            sensor_nodes: Vec::new(),
+        }
     }
 }
 
@@ -308,7 +337,8 @@ impl Candidate {
             Edit::Support { group, .. }
             | Edit::Joint { group, .. }
             | Edit::Region { group, .. }
-            | Edit::Resonator { group, .. } => Some(if group.mu.is_some() { "non-viscous" } else { "viscous" }),
+            | Edit::Resonator { group, .. }
+            | Edit::Shaker { group, .. } => Some(if group.mu.is_some() { "non-viscous" } else { "viscous" }),
             _ => None,
         }
     }
@@ -481,7 +511,10 @@ impl Candidate {
                     )
                 });
             }
-            if self.roles[i] == Role::Alpha {
+            // a shaker's dashpot may hold more than its suspension over the
+            // whole band (the back-EMF damping of a voltage drive): judged
+            // by its plausible range alone
+            if self.roles[i] == Role::Alpha && !matches!(self.edit, Edit::Shaker { .. }) {
                 // the relaxation parameter of the same group
                 let mu_name = self.parameters[i].strip_suffix(".alpha").map(|g| format!("{g}.mu"));
                 let mu = self.parameters.iter().position(|p| Some(p) == mu_name.as_ref()).map(|m| values[m]);
