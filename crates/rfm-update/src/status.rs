@@ -46,7 +46,9 @@ pub enum Status {
     Converged,
     /// Restarts from spread starts end at the same minimum, but its residual
     /// stays above the noise: the parameters cannot represent the data
-    /// (something is missing from the model).
+    /// (something is missing from the model). A step of `rfm fix` whose
+    /// update reached a stationary point above the noise shows it too
+    /// ([`crate::fix::step_status`]): the loop looks for what is missing next.
     ModelInadequate,
     /// The iteration stopped at a point above the noise, and restarts from
     /// spread starts disagree about the minimum: the fit is not known to be
@@ -90,9 +92,9 @@ impl Status {
     pub fn meaning(&self) -> String {
         match self {
             Status::Converged => "the residual is consistent with the noise".to_string(),
-            Status::ModelInadequate => "restarts from spread starts confirm the minimum, but the residual stays above \
-                                        the noise: something the parameters cannot represent remains (try rfm \
-                                        diagnose on the updated case)"
+            Status::ModelInadequate => "the fit reached a minimum (restarts from spread starts confirm it where they \
+                                        were made), but the residual stays above the noise: something the \
+                                        parameters cannot represent remains (try rfm diagnose on the updated case)"
                 .to_string(),
             Status::LocalMinimum => "the residual stays above the noise and restarts from spread starts disagree \
                                      about the minimum (the best fit is reported)"

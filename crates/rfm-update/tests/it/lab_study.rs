@@ -27,13 +27,14 @@
 //! asserts each right in full. `LAB_PER` sets the trials per family (with
 //! fewer than 4 the rates are printed and not asserted), `LAB_ONLY=i,j`
 //! runs those trials alone, `LAB_SEED` draws another set, and `LAB_VERBOSE`
-//! prints each trial's steps and findings.
+//! prints each trial's steps and findings (`LAB_KEEP` keeps its files).
 
 use std::collections::BTreeMap;
 
 use rfm_update::checks::FindingKind;
 use rfm_update::diagnose::EffectKind;
 use rfm_update::fix::{FixOptions, FixOutcome, FixStop, fix};
+use rfm_update::status::Status;
 
 use crate::lab::{self, Expect, ExpectedEffect, Finding, LabFamily, LabTrial};
 
@@ -173,15 +174,21 @@ fn run(t: &LabTrial, seed: u64) -> Trial {
         diagnose: study.diagnose_options(study.measured()).expect("options"),
         ..FixOptions::default()
     };
-    let outcome = fix(study.case(), study.measured(), &opts, |_| {}).unwrap_or_else(|e| {
-        let kept = dir.keep();
-        panic!("{}: the loop failed: {e} (the trial's files are in {})", t.label, kept.display())
-    });
+    let outcome = match fix(study.case(), study.measured(), &opts, |_| {}) {
+        Ok(o) => o,
+        Err(e) => {
+            let kept = dir.keep();
+            panic!("{}: the loop failed: {e} (the trial's files are in {})", t.label, kept.display())
+        }
+    };
     let key = |s: &Score| {
         usize::from(s.findings) + usize::from(s.spurious.is_empty()) + usize::from(s.effects) + usize::from(s.verdict)
     };
     let score = t.expect.answers().into_iter().map(|a| score(&outcome, a)).max_by_key(key).expect("an answer");
     let exit9 = matches!(outcome.stop, FixStop::ModelInadequate | FixStop::Ambiguous) && !outcome.explained();
+    if std::env::var("LAB_KEEP").is_ok() {
+        println!("      the trial's files: {}", dir.keep().display());
+    }
     Trial { family: t.family, label: t.label.clone(), score, outcome, exit9 }
 }
 
@@ -214,6 +221,11 @@ fn the_loop_tells_the_test_set_up_from_the_structure_and_stops_where_nothing_exp
             o.effects.iter().map(|e| e.description.as_str()).collect::<Vec<_>>(),
             if s.spurious.is_empty() { String::new() } else { format!(" | spurious {:?}", s.spurious) }
         );
+        // the loop keeps only updates that reached a stationary point: no
+        // kept step reads as stalled, whatever it leaves
+        for st in &o.steps {
+            assert!(st.status != Status::Stalled, "{}: step {} shows stalled", trial.label, st.effect.description);
+        }
         if std::env::var("LAB_VERBOSE").is_ok() {
             for (k, st) in o.steps.iter().enumerate() {
                 println!(
