@@ -5,7 +5,9 @@
 //! [`super::diagnose`] runs them in that order.
 
 use std::collections::HashSet;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
+use std::time::Instant;
 
 use damping::DampedSystem;
 use frf::FrfSet;
@@ -147,6 +149,8 @@ pub(crate) struct Pool<'a> {
     plan: Option<Plan>,
     /// The low-rank data last gathered by the plan.
     gathered: Mutex<Option<Arc<LocalData>>>,
+    /// Where the time of the stages went, for the progress messages.
+    pub(crate) clock: Clock,
     /// Makes the fits of the candidates it picks fail at a stage: the
     /// failures a real search meets (a singular low-rank and whole-model
     /// system at a line, a misfit that is not finite) hang on floating-point
@@ -173,6 +177,7 @@ impl<'a> Pool<'a> {
             mu_starts,
             plan: None,
             gathered: Mutex::new(None),
+            clock: Clock::default(),
             #[cfg(test)]
             forced_failure: None,
         }
@@ -181,8 +186,10 @@ impl<'a> Pool<'a> {
     /// Adds candidates; returns their indices.
     pub(crate) fn add(&mut self, new: Vec<Candidate>) -> Vec<usize> {
         let first = self.candidates.len();
+        let t = Instant::now();
         let locals: Vec<Option<LocalCandidate>> =
             new.par_iter().map(|c| LocalCandidate::new(self.nominal, c)).collect();
+        self.clock.forms.add(t);
         self.candidates.extend(new);
         self.locals.extend(locals);
         let n = self.candidates.len();
@@ -257,11 +264,16 @@ impl<'a> Pool<'a> {
             && freqs.iter().all(|f| plan.lines.contains(f))
             && forms.iter().all(|f| plan.slots.find(&f.eqs).is_some())
         {
+            let t = Instant::now();
             let data = Arc::new(LocalData::new(self.nominal, channels, &plan.lines, &self.forms(&plan.which))?);
+            self.clock.gather.add_lines(t, plan.lines.len());
             *gathered = Some(Arc::clone(&data));
             return Ok(data);
         }
-        Ok(Arc::new(LocalData::new(self.nominal, channels, freqs, &forms)?))
+        let t = Instant::now();
+        let data = Arc::new(LocalData::new(self.nominal, channels, freqs, &forms)?);
+        self.clock.gather.add_lines(t, freqs.len());
+        Ok(data)
     }
 
     /// Fits `which` on `lines` by `data` (from [`Self::local_data`] for
@@ -275,7 +287,8 @@ impl<'a> Pool<'a> {
         which: &[usize],
         starts: &[Option<Vec<f64>>],
     ) -> Vec<Result<Fit, String>> {
-        which
+        let t = Instant::now();
+        let fits = which
             .par_iter()
             .zip(starts)
             .map(|(&i, start)| {
@@ -295,7 +308,9 @@ impl<'a> Pool<'a> {
                     .or_else(|e| if local.is_some() { attempt(None, start) } else { Err(e) })
                     .or_else(|e| if start.is_some() { attempt(None, None) } else { Err(e) })
             })
-            .collect()
+            .collect();
+        self.clock.fits.add_lines(t, which.len());
+        fits
     }
 
     /// Screens `which` (at `stage`, pre-screening or screening): a short fit
@@ -611,11 +626,20 @@ pub(crate) fn search(
 ) -> Result<(), UpdateError> {
     let weights = opts.weights.as_deref();
     let coarse = LineSet::with_model(measured, opts.screen_lines, opts.gains, nominal, weights)?;
-    let all = pool.add(candidates::generate(pool.model, copts));
+    let t = Instant::now();
+    let generated = candidates::generate(pool.model, copts);
+    let generation = t.elapsed().as_secs_f64();
+    let all = pool.add(generated);
+    trace(&format!("generated {} candidates ({generation:.2} s): {}", all.len(), pool.clock.since_last()));
     let to_screen = if all.len() > opts.prescreen_above {
         let pre = LineSet::with_model(measured, opts.prescreen_lines, opts.gains, nominal, weights)?;
         pool.screen(FitStage::PreScreening, &pre, opts.prescreen_iterations, &all, false)?;
-        trace(&format!("pre-screened {} candidates on {} lines", all.len(), pre.data.n_freq()));
+        trace(&format!(
+            "pre-screened {} candidates on {} lines: {}",
+            all.len(),
+            pre.data.n_freq(),
+            pool.clock.since_last()
+        ));
         let mut best = pool.by_screening(&all);
         best.truncate(opts.prescreen_keep);
         best
@@ -632,11 +656,16 @@ pub(crate) fn search(
     planned.extend(pool.leaders(&pool.by_screening(&all), opts.keep));
     pool.plan(&[&coarse, full], &planned);
     pool.screen(FitStage::Screening, &coarse, opts.screen_iterations, &to_screen, factor_starts)?;
-    trace(&format!("screened {} candidates on {} lines", to_screen.len(), coarse.data.n_freq()));
+    trace(&format!(
+        "screened {} candidates on {} lines: {}",
+        to_screen.len(),
+        coarse.data.n_freq(),
+        pool.clock.since_last()
+    ));
     let order = pool.by_screening(&all);
     let keep = pool.leaders(&order, opts.keep);
     pool.full_fit(full, &coarse, (opts.iterations, opts.screen_iterations), &keep, None)?;
-    trace(&format!("fitted the best {} on {} lines", keep.len(), full.data.n_freq()));
+    trace(&format!("fitted the best {} on {} lines: {}", keep.len(), full.data.n_freq(), pool.clock.since_last()));
 
     // around the leaders: fuller variants, and on large models finer windows
     let refined = pool.refine(copts, REFINED_LEADERS);
@@ -649,7 +678,12 @@ pub(crate) fn search(
         pool.screen(FitStage::Screening, &coarse, opts.screen_iterations, &refined, factor_starts)?;
         let best: Vec<usize> = pool.by_screening(&refined).into_iter().take(REFINED_FITS).collect();
         pool.full_fit(full, &coarse, (opts.iterations, opts.screen_iterations), &best, None)?;
-        trace(&format!("refined around the leaders: {} candidates, {} fitted", refined.len(), best.len()));
+        trace(&format!(
+            "refined around the leaders: {} candidates, {} fitted: {}",
+            refined.len(),
+            best.len(),
+            pool.clock.since_last()
+        ));
     }
     // a support or joint among the leaders with one damping group per
     // direction: fitted fully from its leader's fit, beside the refined
@@ -658,17 +692,21 @@ pub(crate) fn search(
     let variants = pool.per_direction(REFINED_LEADERS);
     if !variants.is_empty() {
         pool.full_fit(full, &coarse, (opts.iterations, opts.screen_iterations), &variants, None)?;
-        trace(&format!("fitted {} variants with a damping group per direction", variants.len()));
+        trace(&format!(
+            "fitted {} variants with a damping group per direction: {}",
+            variants.len(),
+            pool.clock.since_last()
+        ));
     }
     // the twins of the leading stiffness changes, started where those ended
     let Twins { twins, originals, starts } = pool.twins(copts, TWINNED_LEADERS);
     if !twins.is_empty() {
         pool.full_fit(full, &coarse, (opts.iterations, opts.screen_iterations), &twins, Some(starts))?;
         pool.keep_better_twins(&twins, &originals);
-        trace(&format!("fitted {} twins of the leaders", twins.len()));
+        trace(&format!("fitted {} twins of the leaders: {}", twins.len(), pool.clock.since_last()));
     }
     pool.hold_undetermined(full, &coarse, (opts.iterations, opts.screen_iterations))?;
-    trace("held what the data do not determine");
+    trace(&format!("held what the data do not determine: {}", pool.clock.since_last()));
     Ok(())
 }
 
@@ -689,6 +727,65 @@ fn factor_starts(c: &Candidate) -> Vec<Vec<f64>> {
         _ => return c.other_starts(),
     };
     scales.iter().map(|f| start.iter().map(|v| v * f).collect()).collect()
+}
+
+/// Wall time spent in one kind of work, and how much of it was done.
+#[derive(Default)]
+pub(crate) struct Timer {
+    nanos: AtomicU64,
+    calls: AtomicU64,
+    items: AtomicU64,
+}
+
+impl Timer {
+    /// Adds the time since `start` as one call.
+    fn add(&self, start: Instant) {
+        self.add_lines(start, 0);
+    }
+
+    /// Adds the time since `start` as one call over `items` (lines gathered, fits made).
+    fn add_lines(&self, start: Instant, items: usize) {
+        let ns = u64::try_from(start.elapsed().as_nanos()).unwrap_or(u64::MAX);
+        self.nanos.fetch_add(ns, Ordering::Relaxed);
+        self.calls.fetch_add(1, Ordering::Relaxed);
+        self.items.fetch_add(items as u64, Ordering::Relaxed);
+    }
+
+    /// Seconds, calls and items since the last take, and starts again.
+    fn take(&self) -> (f64, u64, u64) {
+        let ns = self.nanos.swap(0, Ordering::Relaxed);
+        (ns as f64 * 1e-9, self.calls.swap(0, Ordering::Relaxed), self.items.swap(0, Ordering::Relaxed))
+    }
+}
+
+/// Where the diagnosis's time goes, stage by stage (wall time; the fits of
+/// a stage run in parallel, so their time is the stage's, not summed over
+/// threads): the candidates' local forms, the gatherings of the nominal
+/// model's low-rank data (a factorisation, solves and a selected inverse per
+/// line) and the fits. Read by the progress messages, which say where each
+/// stage's time went; nothing is decided by it.
+#[derive(Default)]
+pub(crate) struct Clock {
+    forms: Timer,
+    gather: Timer,
+    fits: Timer,
+}
+
+impl Clock {
+    /// What the work since the last call took, in words, and starts again.
+    pub(crate) fn since_last(&self) -> String {
+        let (forms, _, _) = self.forms.take();
+        let (gather, gatherings, lines) = self.gather.take();
+        let (fits, _, fitted) = self.fits.take();
+        let mut out = format!("fits {fits:.2} s ({fitted} fits)");
+        if gatherings > 0 {
+            out += &format!(", low-rank data {gather:.2} s ({gatherings} gathering(s), {lines} lines)");
+        }
+        if forms > 0.0 {
+            out += &format!(", local forms {forms:.2} s");
+        }
+        out
+    }
 }
 
 /// The low-rank data planned for the next stages (see [`Pool::plan`]).
