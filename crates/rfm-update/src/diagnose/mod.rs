@@ -818,11 +818,11 @@ mod determinism_tests {
 
     use super::*;
 
-    /// The frame of `diagnose_point` at a small size: a 40 % stiffness
-    /// loss in the middle of the first floor beam, 12 measured
-    /// translations, 1 % noise; returns the nominal model and the data.
-    pub(super) fn small_frame() -> (fe_model::Model, FrfSet) {
-        let (bays, storeys, per) = (2, 2, 3);
+    /// The frame of `diagnose_point` at a small size (`bays`, `storeys`,
+    /// `per` elements per member): a 40 % stiffness loss in the middle of
+    /// the first floor beam, 12 measured translations, 1 % noise; returns
+    /// the nominal model and the data.
+    pub(super) fn small_frame(bays: usize, storeys: usize, per: usize) -> (fe_model::Model, FrfSet) {
         let nominal = samples::frame_grid(bays, storeys, per);
         let sys = DampedSystem::new(nominal.clone()).unwrap();
         let element = (((bays + 1) + bays / 2) * per + per / 2 + 1) as u32;
@@ -847,7 +847,7 @@ mod determinism_tests {
     /// hung on their order would differ between runs).
     #[test]
     fn listening_to_the_stages_changes_nothing() {
-        let (nominal, data) = small_frame();
+        let (nominal, data) = small_frame(2, 2, 3);
         let opts = DiagnoseOptions::default();
         let quiet = diagnose(&nominal, &data, &opts).unwrap();
         let mut heard = Vec::new();
@@ -864,6 +864,41 @@ mod determinism_tests {
                 assert_eq!(values(a), values(b), "{}", a.description);
             }
         }
+    }
+
+    /// The refinement's candidates, gathered with the screening's data on
+    /// a pre-screened model with coarse windows, are fitted as they are when the refinement
+    /// gathers its own: the same candidates, the same ranking (to
+    /// round-off: the factorisation's ordering differs with its cliques),
+    /// and no second gathering.
+    #[test]
+    fn anticipated_refinement_data_fit_as_their_own() {
+        // members of 12 elements, so that the refinement's windows reach
+        // beyond the coarse ones screened
+        let (nominal, data) = small_frame(2, 2, 12);
+        // coarse windows first and the refinement's every window around the
+        // leaders, as on a large model
+        let mut opts = DiagnoseOptions { prescreen_above: 0, prescreen_keep: 20, ..DiagnoseOptions::default() };
+        opts.candidates.per_element_limit = 8;
+        let run = |anticipate: bool| {
+            let mut heard = Vec::new();
+            let d = diagnose_in(&nominal, &data, &opts, &mut |s: &str| heard.push(s.to_string()), |pool| {
+                pool.anticipate = anticipate;
+            })
+            .unwrap();
+            let refined = heard.into_iter().find(|s| s.starts_with("refined around")).expect("a refinement");
+            (d, refined)
+        };
+        let ((own, own_msg), (early, early_msg)) = (run(false), run(true));
+        assert!(own_msg.contains("gathering"), "{own_msg}");
+        assert!(!early_msg.contains("gathering"), "the refinement gathered again: {early_msg}");
+        assert_eq!(own.candidates.len(), early.candidates.len());
+        assert_eq!(own.ranking.len(), early.ranking.len());
+        for (a, b) in own.ranking.iter().zip(&early.ranking).take(20) {
+            assert_eq!(a.description, b.description);
+            assert!((a.delta_bic - b.delta_bic).abs() <= 1e-8 * a.delta_bic.abs(), "{}", a.description);
+        }
+        assert_eq!(own.ranking[0].kind, EffectKind::StiffnessChange, "{}", own.ranking[0].description);
     }
 }
 
