@@ -43,20 +43,9 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Mutex, PoisonError};
 use std::time::Instant;
 
-use point::{arg, peak_kib};
+use point::{arg, cpu_seconds, peak_kib};
 use rayon::prelude::*;
 use rfm_update::sensitivity::{self, ChannelPlan, Hybrid};
-
-/// CPU time used so far by all threads of this process (s), from
-/// /proc/self/task/*/schedstat (nanoseconds on the CPU).
-fn cpu_seconds() -> Option<f64> {
-    let mut total = 0u64;
-    for task in std::fs::read_dir("/proc/self/task").ok()? {
-        let stat = std::fs::read_to_string(task.ok()?.path().join("schedstat")).ok()?;
-        total += stat.split_whitespace().next()?.parse::<u64>().ok()?;
-    }
-    Some(total as f64 * 1e-9)
-}
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();

@@ -9,7 +9,8 @@
 //! 1 % noise at `--measured` translational DOFs (default 20) over `--lines`
 //! lines (default 200), runs [`rfm_update::diagnose::diagnose`] with its
 //! default options on the nominal frame, and prints one JSON line: sizes,
-//! the number of candidates, the wall time, the peak memory, and whether the
+//! the number of candidates, the wall and CPU time (all threads), the peak
+//! memory, and whether the
 //! leader is the hidden stiffness loss at the right element (or a neighbour).
 //! `--verbose` prints the stages as they end, the first six of the
 //! ranking, the noise estimate and the nominal misfit to stderr.
@@ -21,7 +22,7 @@ use std::time::Instant;
 use damping::DampedSystem;
 use fe_model::{Dof, samples};
 use frf::{Channel, NoiseModel, synthesize};
-use point::{arg, peak_kib};
+use point::{arg, cpu_seconds, peak_kib};
 use rfm_update::diagnose::{DiagnoseOptions, EffectKind, diagnose_with};
 
 fn main() {
@@ -52,15 +53,18 @@ fn main() {
     let mut data = synthesize(&truth_sys, &channels, &lines).expect("synthesis");
     NoiseModel::relative(0.01, 7).apply(&mut data);
 
-    let t = Instant::now();
+    let (t, cpu0) = (Instant::now(), cpu_seconds());
+    let cpu = || cpu_seconds().zip(cpu0).map(|(b, a)| b - a);
     let verbose = args.iter().any(|a| a == "--verbose");
     let d = diagnose_with(&nominal, &data, &DiagnoseOptions::default(), |stage| {
         if verbose {
-            eprintln!("{:>8.2} s  {stage}", t.elapsed().as_secs_f64());
+            let cpu = cpu().map_or("?".to_string(), |c| format!("{c:.2}"));
+            eprintln!("{:>8.2} s (CPU {cpu:>7} s)  {stage}", t.elapsed().as_secs_f64());
         }
     })
     .expect("diagnosis runs");
     let seconds = t.elapsed().as_secs_f64();
+    let cpu_seconds = cpu();
     for r in d.ranking.iter().take(if verbose { 6 } else { 0 }) {
         eprintln!("{:<50} explained {:.4} dBIC {:.1}", r.description, r.explained, r.delta_bic);
     }
@@ -74,11 +78,12 @@ fn main() {
     let found = top.kind == EffectKind::StiffnessChange && top.elements.iter().any(near);
     println!(
         "{{\"label\":\"diagnosis, frame {frame}\",\"dofs\":{},\"candidates\":{},\"measured\":{},\"freqs\":{},\
-         \"seconds\":{seconds:e},\"found\":{found},\"leader\":\"{}\",\"peak_kib\":{}}}",
+         \"seconds\":{seconds:e},\"cpu_seconds\":{},\"found\":{found},\"leader\":\"{}\",\"peak_kib\":{}}}",
         sys.n(),
         d.candidates.len(),
         channels.len(),
         lines.len(),
+        cpu_seconds.map_or("null".to_string(), |c| format!("{c:e}")),
         top.description,
         peak_kib().map_or("null".to_string(), |k| k.to_string()),
     );

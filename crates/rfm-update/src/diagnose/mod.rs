@@ -836,6 +836,98 @@ mod tests {
 }
 
 #[cfg(test)]
+mod determinism_tests {
+    use damping::DampedSystem;
+    use fe_model::{Dof, samples};
+    use frf::{Channel, NoiseModel, synthesize};
+
+    use super::*;
+
+    /// The frame of `diagnose_point` at a small size (`bays`, `storeys`,
+    /// `per` elements per member): a 40 % stiffness loss in the middle of
+    /// the first floor beam, 12 measured translations, 1 % noise; returns
+    /// the nominal model and the data.
+    pub(super) fn small_frame(bays: usize, storeys: usize, per: usize) -> (fe_model::Model, FrfSet) {
+        let nominal = samples::frame_grid(bays, storeys, per);
+        let sys = DampedSystem::new(nominal.clone()).unwrap();
+        let element = (((bays + 1) + bays / 2) * per + per / 2 + 1) as u32;
+        let mut truth = nominal.clone();
+        let q = truth.quantity(&format!("element.{element}.stiffness")).unwrap();
+        truth.set(q, 0.6).unwrap();
+        let dofs = sys.assembly().dofs();
+        let uy: Vec<_> = (0..sys.n()).map(|eq| dofs.dof_of(eq)).filter(|d| d.dof == Dof::Uy).collect();
+        let measured: Vec<_> = (0..12).map(|i| uy[(2 * i + 1) * uy.len() / 24]).collect();
+        let channels: Vec<Channel> = measured.iter().map(|&r| Channel::new(r, measured[6])).collect();
+        let top = 1.2 * crate::study::natural_frequencies(&sys, 1e6).0[5];
+        let lines: Vec<f64> = (1..=200).map(|k| top * k as f64 / 200.0).collect();
+        let mut data = synthesize(&DampedSystem::new(truth).unwrap(), &channels, &lines).unwrap();
+        NoiseModel::relative(0.01, 7).apply(&mut data);
+        (nominal, data)
+    }
+
+    /// Listening to the stages changes nothing: the same candidates and the
+    /// same ranking, value for value, with a callback that reads every
+    /// message (as `diagnose_point --verbose` prints them) and without one,
+    /// and from one run to the next (the fits run in parallel; a result that
+    /// hung on their order would differ between runs).
+    #[test]
+    fn listening_to_the_stages_changes_nothing() {
+        let (nominal, data) = small_frame(2, 2, 3);
+        let opts = DiagnoseOptions::default();
+        let quiet = diagnose(&nominal, &data, &opts).unwrap();
+        let mut heard = Vec::new();
+        let verbose = diagnose_with(&nominal, &data, &opts, |s| heard.push(s.to_string())).unwrap();
+        let again = diagnose(&nominal, &data, &opts).unwrap();
+        assert!(heard.len() >= 4 && heard.iter().any(|s| s.contains("fits")), "{heard:?}");
+        for other in [&verbose, &again] {
+            assert_eq!(quiet.candidates.len(), other.candidates.len());
+            assert_eq!(quiet.ranking.len(), other.ranking.len());
+            for (a, b) in quiet.ranking.iter().zip(&other.ranking) {
+                assert_eq!(a.description, b.description);
+                assert_eq!(a.delta_bic.to_bits(), b.delta_bic.to_bits(), "{}", a.description);
+                let values = |r: &Ranked| r.parameters.iter().map(|p| p.value.to_bits()).collect::<Vec<_>>();
+                assert_eq!(values(a), values(b), "{}", a.description);
+            }
+        }
+    }
+
+    /// The refinement's candidates, gathered with the screening's data on
+    /// a pre-screened model with coarse windows, are fitted as they are when the refinement
+    /// gathers its own: the same candidates, the same ranking (to
+    /// round-off: the factorisation's ordering differs with its cliques),
+    /// and no second gathering.
+    #[test]
+    fn anticipated_refinement_data_fit_as_their_own() {
+        // members of 12 elements, so that the refinement's windows reach
+        // beyond the coarse ones screened
+        let (nominal, data) = small_frame(2, 2, 12);
+        // coarse windows first and the refinement's every window around the
+        // leaders, as on a large model
+        let mut opts = DiagnoseOptions { prescreen_above: 0, prescreen_keep: 20, ..DiagnoseOptions::default() };
+        opts.candidates.per_element_limit = 8;
+        let run = |anticipate: bool| {
+            let mut heard = Vec::new();
+            let d = diagnose_in(&nominal, &data, &opts, &mut |s: &str| heard.push(s.to_string()), |pool| {
+                pool.anticipate = anticipate;
+            })
+            .unwrap();
+            let refined = heard.into_iter().find(|s| s.starts_with("refined around")).expect("a refinement");
+            (d, refined)
+        };
+        let ((own, own_msg), (early, early_msg)) = (run(false), run(true));
+        assert!(own_msg.contains("gathering"), "{own_msg}");
+        assert!(!early_msg.contains("gathering"), "the refinement gathered again: {early_msg}");
+        assert_eq!(own.candidates.len(), early.candidates.len());
+        assert_eq!(own.ranking.len(), early.ranking.len());
+        for (a, b) in own.ranking.iter().zip(&early.ranking).take(20) {
+            assert_eq!(a.description, b.description);
+            assert!((a.delta_bic - b.delta_bic).abs() <= 1e-8 * a.delta_bic.abs(), "{}", a.description);
+        }
+        assert_eq!(own.ranking[0].kind, EffectKind::StiffnessChange, "{}", own.ranking[0].description);
+    }
+}
+
+#[cfg(test)]
 mod lack_of_fit_tests {
     use super::MisfitStats;
 

@@ -5,7 +5,9 @@
 //! [`super::diagnose`] runs them in that order.
 
 use std::collections::HashSet;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
+use std::time::Instant;
 
 use damping::DampedSystem;
 use frf::FrfSet;
@@ -13,7 +15,7 @@ use rayon::prelude::*;
 
 use super::candidates::{self, Candidate, CandidateOptions, EffectKind, Role};
 use super::lines::LineSet;
-use super::local::{LocalCandidate, LocalData, Slots};
+use super::local::{LocalCandidate, LocalData, LocalForm, Slots};
 use super::{DiagnoseOptions, FitStage};
 use crate::error::UpdateError;
 use crate::output_error::{self, Misfit, OeData, OeOptions};
@@ -147,6 +149,11 @@ pub(crate) struct Pool<'a> {
     plan: Option<Plan>,
     /// The low-rank data last gathered by the plan.
     gathered: Mutex<Option<Arc<LocalData>>>,
+    /// Where the time of the stages went, for the progress messages.
+    pub(crate) clock: Clock,
+    /// Gather the refinement's sets of equations with the screening's
+    /// data (see [`search`]); off only where a test compares the two paths.
+    pub(crate) anticipate: bool,
     /// Makes the fits of the candidates it picks fail at a stage: the
     /// failures a real search meets (a singular low-rank and whole-model
     /// system at a line, a misfit that is not finite) hang on floating-point
@@ -173,6 +180,8 @@ impl<'a> Pool<'a> {
             mu_starts,
             plan: None,
             gathered: Mutex::new(None),
+            clock: Clock::default(),
+            anticipate: true,
             #[cfg(test)]
             forced_failure: None,
         }
@@ -181,8 +190,10 @@ impl<'a> Pool<'a> {
     /// Adds candidates; returns their indices.
     pub(crate) fn add(&mut self, new: Vec<Candidate>) -> Vec<usize> {
         let first = self.candidates.len();
+        let t = Instant::now();
         let locals: Vec<Option<LocalCandidate>> =
             new.par_iter().map(|c| LocalCandidate::new(self.nominal, c)).collect();
+        self.clock.forms.add(t);
         self.candidates.extend(new);
         self.locals.extend(locals);
         let n = self.candidates.len();
@@ -227,17 +238,33 @@ impl<'a> Pool<'a> {
     /// parameters, the full fits and what follows them): one gathering per
     /// plan serves them all.
     pub(crate) fn plan(&mut self, sets: &[&LineSet], which: &[usize]) {
-        let mut lines: Vec<f64> = sets.iter().flat_map(|s| s.data.frequencies_hz().iter().copied()).collect();
-        lines.sort_by(f64::total_cmp);
-        lines.dedup();
+        self.plan_anticipating(sets, which, Vec::new());
+    }
+
+    /// As [`Pool::plan`], with the sets of equations of candidates not in
+    /// the pool yet (`anticipated`: those a later stage may add) gathered
+    /// as well, so that the data serve that stage too (see
+    /// [`Pool::serves`]).
+    fn plan_anticipating(&mut self, sets: &[&LineSet], which: &[usize], anticipated: Vec<LocalForm>) {
+        let lines = lines_of(sets);
         let which = which.to_vec();
-        let slots = Slots::of(&self.forms(&which));
-        self.plan = Some(Plan { lines, which, slots });
+        let mut forms = self.forms(&which);
+        forms.extend(&anticipated);
+        let slots = Slots::of(&forms);
+        self.plan = Some(Plan { lines, which, anticipated, slots });
         // the data of an earlier plan are not needed again
         *self.gathered.get_mut().unwrap_or_else(PoisonError::into_inner) = None;
     }
 
-    fn forms(&self, which: &[usize]) -> Vec<&super::local::LocalForm> {
+    /// Whether the low-rank data gathered last serve the candidates of
+    /// `which` on the lines of `sets`, so that a new plan for them would
+    /// gather the same factorisations again for nothing.
+    fn serves(&self, sets: &[&LineSet], which: &[usize]) -> bool {
+        let gathered = self.gathered.lock().unwrap_or_else(PoisonError::into_inner);
+        gathered.as_ref().is_some_and(|data| data.covers(&lines_of(sets), &self.forms(which)))
+    }
+
+    fn forms(&self, which: &[usize]) -> Vec<&LocalForm> {
         which.iter().filter_map(|&i| self.locals[i].as_ref().map(|l| &l.form)).collect()
     }
 
@@ -257,11 +284,18 @@ impl<'a> Pool<'a> {
             && freqs.iter().all(|f| plan.lines.contains(f))
             && forms.iter().all(|f| plan.slots.find(&f.eqs).is_some())
         {
-            let data = Arc::new(LocalData::new(self.nominal, channels, &plan.lines, &self.forms(&plan.which))?);
+            let t = Instant::now();
+            let mut planned = self.forms(&plan.which);
+            planned.extend(&plan.anticipated);
+            let data = Arc::new(LocalData::new(self.nominal, channels, &plan.lines, &planned)?);
+            self.clock.gather.add_lines(t, plan.lines.len());
             *gathered = Some(Arc::clone(&data));
             return Ok(data);
         }
-        Ok(Arc::new(LocalData::new(self.nominal, channels, freqs, &forms)?))
+        let t = Instant::now();
+        let data = Arc::new(LocalData::new(self.nominal, channels, freqs, &forms)?);
+        self.clock.gather.add_lines(t, freqs.len());
+        Ok(data)
     }
 
     /// Fits `which` on `lines` by `data` (from [`Self::local_data`] for
@@ -275,7 +309,8 @@ impl<'a> Pool<'a> {
         which: &[usize],
         starts: &[Option<Vec<f64>>],
     ) -> Vec<Result<Fit, String>> {
-        which
+        let t = Instant::now();
+        let fits = which
             .par_iter()
             .zip(starts)
             .map(|(&i, start)| {
@@ -295,7 +330,9 @@ impl<'a> Pool<'a> {
                     .or_else(|e| if local.is_some() { attempt(None, start) } else { Err(e) })
                     .or_else(|e| if start.is_some() { attempt(None, None) } else { Err(e) })
             })
-            .collect()
+            .collect();
+        self.clock.fits.add_lines(t, which.len());
+        fits
     }
 
     /// Screens `which` (at `stage`, pre-screening or screening): a short fit
@@ -611,11 +648,20 @@ pub(crate) fn search(
 ) -> Result<(), UpdateError> {
     let weights = opts.weights.as_deref();
     let coarse = LineSet::with_model(measured, opts.screen_lines, opts.gains, nominal, weights)?;
-    let all = pool.add(candidates::generate(pool.model, copts));
+    let t = Instant::now();
+    let generated = candidates::generate(pool.model, copts);
+    let generation = t.elapsed().as_secs_f64();
+    let all = pool.add(generated);
+    trace(&format!("generated {} candidates ({generation:.2} s): {}", all.len(), pool.clock.since_last()));
     let to_screen = if all.len() > opts.prescreen_above {
         let pre = LineSet::with_model(measured, opts.prescreen_lines, opts.gains, nominal, weights)?;
         pool.screen(FitStage::PreScreening, &pre, opts.prescreen_iterations, &all, false)?;
-        trace(&format!("pre-screened {} candidates on {} lines", all.len(), pre.data.n_freq()));
+        trace(&format!(
+            "pre-screened {} candidates on {} lines: {}",
+            all.len(),
+            pre.data.n_freq(),
+            pool.clock.since_last()
+        ));
         let mut best = pool.by_screening(&all);
         best.truncate(opts.prescreen_keep);
         best
@@ -629,14 +675,39 @@ pub(crate) fn search(
     // candidates screened and the best of each kind so far (the leaders
     // come from them unless their screening fails)
     let mut planned = to_screen.clone();
-    planned.extend(pool.leaders(&pool.by_screening(&all), opts.keep));
-    pool.plan(&[&coarse, full], &planned);
+    let leaders = pool.leaders(&pool.by_screening(&all), opts.keep);
+    planned.extend(&leaders);
+    // After pre-screening, the refinement below will add candidates around
+    // the best three full fits, and those come from these leaders: their
+    // sets of equations are gathered now too (a few hundred small cliques,
+    // local to a few places), so that the refinement finds its data here
+    // rather than in a second pass over every full line, a factorisation,
+    // solves and a selected inverse each (13 s of 88 of CPU on the 100k-DOF
+    // frame). Where the full fits lead elsewhere, the refinement gathers
+    // its own as before.
+    let anticipated = if pool.anticipate && all.len() > opts.prescreen_above {
+        let around: Vec<&Candidate> = leaders.iter().map(|&i| &pool.candidates[i]).collect();
+        let tried = pool.descriptions();
+        let nominal = pool.nominal;
+        candidates::refine(pool.model, copts, &around, &tried)
+            .par_iter()
+            .filter_map(|c| LocalCandidate::new(nominal, c).map(|l| l.form))
+            .collect()
+    } else {
+        Vec::new()
+    };
+    pool.plan_anticipating(&[&coarse, full], &planned, anticipated);
     pool.screen(FitStage::Screening, &coarse, opts.screen_iterations, &to_screen, factor_starts)?;
-    trace(&format!("screened {} candidates on {} lines", to_screen.len(), coarse.data.n_freq()));
+    trace(&format!(
+        "screened {} candidates on {} lines: {}",
+        to_screen.len(),
+        coarse.data.n_freq(),
+        pool.clock.since_last()
+    ));
     let order = pool.by_screening(&all);
     let keep = pool.leaders(&order, opts.keep);
     pool.full_fit(full, &coarse, (opts.iterations, opts.screen_iterations), &keep, None)?;
-    trace(&format!("fitted the best {} on {} lines", keep.len(), full.data.n_freq()));
+    trace(&format!("fitted the best {} on {} lines: {}", keep.len(), full.data.n_freq(), pool.clock.since_last()));
 
     // around the leaders: fuller variants, and on large models finer windows
     let refined = pool.refine(copts, REFINED_LEADERS);
@@ -645,11 +716,18 @@ pub(crate) fn search(
         // twins of every candidate fitted fully (on the same equations)
         let mut planned = refined.clone();
         planned.extend(pool.by_full_fit());
-        pool.plan(&[&coarse, full], &planned);
+        if !pool.serves(&[&coarse, full], &planned) {
+            pool.plan(&[&coarse, full], &planned);
+        }
         pool.screen(FitStage::Screening, &coarse, opts.screen_iterations, &refined, factor_starts)?;
         let best: Vec<usize> = pool.by_screening(&refined).into_iter().take(REFINED_FITS).collect();
         pool.full_fit(full, &coarse, (opts.iterations, opts.screen_iterations), &best, None)?;
-        trace(&format!("refined around the leaders: {} candidates, {} fitted", refined.len(), best.len()));
+        trace(&format!(
+            "refined around the leaders: {} candidates, {} fitted: {}",
+            refined.len(),
+            best.len(),
+            pool.clock.since_last()
+        ));
     }
     // a support or joint among the leaders with one damping group per
     // direction: fitted fully from its leader's fit, beside the refined
@@ -658,17 +736,21 @@ pub(crate) fn search(
     let variants = pool.per_direction(REFINED_LEADERS);
     if !variants.is_empty() {
         pool.full_fit(full, &coarse, (opts.iterations, opts.screen_iterations), &variants, None)?;
-        trace(&format!("fitted {} variants with a damping group per direction", variants.len()));
+        trace(&format!(
+            "fitted {} variants with a damping group per direction: {}",
+            variants.len(),
+            pool.clock.since_last()
+        ));
     }
     // the twins of the leading stiffness changes, started where those ended
     let Twins { twins, originals, starts } = pool.twins(copts, TWINNED_LEADERS);
     if !twins.is_empty() {
         pool.full_fit(full, &coarse, (opts.iterations, opts.screen_iterations), &twins, Some(starts))?;
         pool.keep_better_twins(&twins, &originals);
-        trace(&format!("fitted {} twins of the leaders", twins.len()));
+        trace(&format!("fitted {} twins of the leaders: {}", twins.len(), pool.clock.since_last()));
     }
     pool.hold_undetermined(full, &coarse, (opts.iterations, opts.screen_iterations))?;
-    trace("held what the data do not determine");
+    trace(&format!("held what the data do not determine: {}", pool.clock.since_last()));
     Ok(())
 }
 
@@ -691,12 +773,81 @@ fn factor_starts(c: &Candidate) -> Vec<Vec<f64>> {
     scales.iter().map(|f| start.iter().map(|v| v * f).collect()).collect()
 }
 
+/// Wall time spent in one kind of work, and how much of it was done.
+#[derive(Default)]
+pub(crate) struct Timer {
+    nanos: AtomicU64,
+    calls: AtomicU64,
+    items: AtomicU64,
+}
+
+impl Timer {
+    /// Adds the time since `start` as one call.
+    fn add(&self, start: Instant) {
+        self.add_lines(start, 0);
+    }
+
+    /// Adds the time since `start` as one call over `items` (lines gathered, fits made).
+    fn add_lines(&self, start: Instant, items: usize) {
+        let ns = u64::try_from(start.elapsed().as_nanos()).unwrap_or(u64::MAX);
+        self.nanos.fetch_add(ns, Ordering::Relaxed);
+        self.calls.fetch_add(1, Ordering::Relaxed);
+        self.items.fetch_add(items as u64, Ordering::Relaxed);
+    }
+
+    /// Seconds, calls and items since the last take, and starts again.
+    fn take(&self) -> (f64, u64, u64) {
+        let ns = self.nanos.swap(0, Ordering::Relaxed);
+        (ns as f64 * 1e-9, self.calls.swap(0, Ordering::Relaxed), self.items.swap(0, Ordering::Relaxed))
+    }
+}
+
+/// Where the diagnosis's time goes, stage by stage (wall time; the fits of
+/// a stage run in parallel, so their time is the stage's, not summed over
+/// threads): the candidates' local forms, the gatherings of the nominal
+/// model's low-rank data (a factorisation, solves and a selected inverse per
+/// line) and the fits. Read by the progress messages, which say where each
+/// stage's time went; nothing is decided by it.
+#[derive(Default)]
+pub(crate) struct Clock {
+    forms: Timer,
+    gather: Timer,
+    fits: Timer,
+}
+
+impl Clock {
+    /// What the work since the last call took, in words, and starts again.
+    pub(crate) fn since_last(&self) -> String {
+        let (forms, _, _) = self.forms.take();
+        let (gather, gatherings, lines) = self.gather.take();
+        let (fits, _, fitted) = self.fits.take();
+        let mut out = format!("fits {fits:.2} s ({fitted} fits)");
+        if gatherings > 0 {
+            out += &format!(", low-rank data {gather:.2} s ({gatherings} gathering(s), {lines} lines)");
+        }
+        if forms > 0.0 {
+            out += &format!(", local forms {forms:.2} s");
+        }
+        out
+    }
+}
+
 /// The low-rank data planned for the next stages (see [`Pool::plan`]).
 struct Plan {
     /// The lines of every line set the stages fit on.
     lines: Vec<f64>,
     which: Vec<usize>,
+    /// The local forms of candidates a later stage may add.
+    anticipated: Vec<LocalForm>,
     slots: Slots,
+}
+
+/// The distinct lines of `sets`, sorted.
+fn lines_of(sets: &[&LineSet]) -> Vec<f64> {
+    let mut lines: Vec<f64> = sets.iter().flat_map(|s| s.data.frequencies_hz().iter().copied()).collect();
+    lines.sort_by(f64::total_cmp);
+    lines.dedup();
+    lines
 }
 
 /// Twins of candidates added by [`Pool::twins`].

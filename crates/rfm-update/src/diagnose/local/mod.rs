@@ -285,6 +285,21 @@ mod tests {
         }
         // candidates whose own set is not gathered, served by one containing it
         assert!(served_by_larger > 0, "no candidate was served by a larger set");
+        // gathered for every candidate, only the sets no other contains are
+        // kept, and each candidate is served by one that holds its equations
+        let all_forms: Vec<&LocalForm> = locals.iter().map(|l| &l.form).collect();
+        let slots = Slots::of(&all_forms);
+        let mut maximal: Vec<&Vec<usize>> = largest.iter().map(|f| &f.eqs).collect();
+        maximal.sort();
+        maximal.dedup();
+        let mut kept: Vec<&Vec<usize>> = slots.eqs.iter().collect();
+        kept.sort();
+        assert_eq!(kept, maximal, "the slots are the sets no other contains");
+        assert!(kept.len() < all_forms.len(), "no candidate's set lies inside another's");
+        for f in &all_forms {
+            let slot = slots.find(&f.eqs).expect("every candidate is served");
+            assert!(f.eqs.iter().all(|e| slots.eqs[slot].binary_search(e).is_ok()));
+        }
         // a set of equations no gathered set contains serves nothing
         let first = &locals[0];
         let alone = LocalData::new(&nominal, &channels, &lines, &[&first.form]).unwrap();
