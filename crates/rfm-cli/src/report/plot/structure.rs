@@ -309,8 +309,13 @@ fn draw_model(area: &Area<'_>, model: &Model, view: &View, colour: RGBColor, wid
         return Ok(());
     }
     for s in model.supports() {
-        // a resonator's mass is held in the DOFs its spring leaves free
-        if resonators.iter().any(|r| r.node == s.node) {
+        // a resonator's mass is held in the DOFs its spring leaves free, a
+        // shaker's armature (`[[shakers]]`: a mass on a node of its own,
+        // tied to the drive point) in those its stinger does not drive:
+        // neither is a support of the structure
+        let bare_mass =
+            !model.beams().iter().any(|b| b.nodes.contains(&s.node)) && model.masses().iter().any(|m| m.node == s.node);
+        if resonators.iter().any(|r| r.node == s.node) || bare_mass {
             continue;
         }
         let Some(p) = at(s.node) else { continue };
@@ -811,6 +816,32 @@ mod tests {
         let candidate = structure("frame", &plain, &no_sensors, &[highlight(HighlightKind::Resonator)]).unwrap();
         let fill = format!("fill=\"#{:02X}{:02X}{:02X}\"", HIGHLIGHTS[0].0, HIGHLIGHTS[0].1, HIGHLIGHTS[0].2);
         assert!(candidate.lines().any(|l| l.starts_with("<rect") && l.contains(&fill)), "no mass for the candidate");
+    }
+
+    /// A shaker (`[[shakers]]`: the armature's mass on a node of its own,
+    /// tied to the drive point, held in its other DOFs, on a spring to
+    /// ground) is drawn as a mass and a spring to ground at the drive
+    /// point, not as a support of the structure there.
+    #[test]
+    fn a_shaker_is_drawn_as_a_mass_on_a_spring_to_ground_not_a_support() {
+        let plain = l_frame();
+        let mut m = l_frame();
+        let g = m.group_or_default("frame");
+        m.add_node(4, 0.5, 0.6).unwrap();
+        m.add_tie(3, 4, &[Dof::Uy]).unwrap();
+        m.add_support(4, &[Dof::Ux, Dof::Rz]).unwrap();
+        m.add_mass("coil", 4, 0.05, [0.0; 3], g).unwrap();
+        m.add_spring("coil", 4, None, [0.0, 3e3, 0.0], g).unwrap();
+        assert!(resonators(&m).is_empty(), "no resonator: its spring goes to ground");
+        let no_sensors = Sensors { responses: &[], references: &[] };
+        let without = structure("frame", &plain, &no_sensors, &[]).unwrap();
+        let with = structure("frame", &m, &no_sensors, &[]).unwrap();
+        let count = |svg: &str, what: &str| svg.lines().filter(|l| l.starts_with(what)).count();
+        assert_eq!(count(&with, "<rect") - count(&without, "<rect"), 1, "one square: the armature");
+        assert_eq!(count(&with, "<polygon"), count(&without, "<polygon"), "a support drawn at the drive point");
+        assert!(
+            count(&with, "<polyline") + count(&with, "<path") > count(&without, "<polyline") + count(&without, "<path")
+        );
     }
 
     #[test]
