@@ -626,6 +626,51 @@ impl Loop<'_> {
     }
 }
 
+/// Writes the history of a step the loop made by rebuilding its case from
+/// the nominal one (a revision, a swap: each effect applied again from its
+/// diagnosis, which writes it at its screening fit): the history of the
+/// case before the step (`before`), the step's own entry (`what` added at
+/// the misfit it started from, or taken out) and its update as step `n`,
+/// in place of what the rebuilt case holds (the lab frame's revised
+/// resonator read "+ resonator (10.0 Hz; non-viscous)" at its screening
+/// fit's misfit and "updated after step 3" for step 2).
+fn rebuilt_history(
+    before: &CaseFile,
+    a: &mut Added,
+    what: &str,
+    removed: bool,
+    n: usize,
+    noise: f64,
+) -> Result<(), UpdateError> {
+    let mut h = before.history.clone();
+    h.push(if removed {
+        HistoryEntry {
+            step: format!("- {what} (taken out)"),
+            misfit: a.stats.misfit,
+            noise: Some(noise),
+            ..Default::default()
+        }
+    } else {
+        HistoryEntry {
+            step: format!("+ {what}"),
+            misfit: a.effect.misfit,
+            noise: Some(noise),
+            effect: Some(a.effect.kind.name().into()),
+            nodes: a.effect.nodes.clone(),
+            elements: a.effect.elements.clone(),
+        }
+    });
+    h.push(HistoryEntry {
+        step: format!("updated after step {n}"),
+        misfit: a.stats.misfit,
+        noise: Some(noise),
+        ..Default::default()
+    });
+    a.editor.set_history(&h)?;
+    a.case.history = h;
+    Ok(())
+}
+
 /// The ranks of up to `width` recommendable effects (significant and
 /// plausible, fully fitted or screened) that differ from each other in kind
 /// or place, best first, with the test's own hardware (a shaker, the
@@ -1043,9 +1088,19 @@ pub fn fix(
                 let current = with_corrections(&current, &written, opts)?;
                 let base = with_corrections(&base, &written, opts)?;
                 let trial = Loop { data, opts: fl.opts, evidence: fl.evidence };
-                let updated =
+                let (mut editor, mut case, stats, outcome) =
                     trial.update_case(&current, current.editor()?, steps.len(), steps.len() >= opts.max_steps)?;
-                Ok((trial.data, base, updated))
+                // the step's history, and this update as what it is
+                let mut h = current.history.clone();
+                h.push(HistoryEntry {
+                    step: format!("updated after step {} with the data corrected", steps.len()),
+                    misfit: stats.misfit,
+                    noise: Some(noise),
+                    ..HistoryEntry::default()
+                });
+                editor.set_history(&h)?;
+                case.history = h;
+                Ok((trial.data, base, (editor, case, stats, outcome)))
             };
             // a correction whose update fails is not made (the step stands)
             if let Some((data, new_base, (editor, case_after, stats, outcome))) =
@@ -1074,9 +1129,9 @@ pub fn fix(
     let mut effects: Vec<Ranked> = steps.iter().map(|s| s.effect.clone()).collect();
     // revisions and replacements, each kept by the same rule
     if !applied.is_empty() && state.misfit > REVISE_ABOVE * noise && stop != FixStop::Ambiguous {
-        let (kept, revised) = revise::revise(&fl, &base, &applied, &current, state);
+        let (kept, revised) = revise::revise(&fl, &base, &applied, &current, state, steps.len() + 1);
         if !kept.is_empty() {
-            for r in kept {
+            for mut r in kept {
                 let effect = if r.removed {
                     r.replaced.clone()
                 } else {
@@ -1089,6 +1144,7 @@ pub fn fix(
                     misfit: r.added.stats.misfit,
                     status: &step_status(&r.added.outcome),
                 });
+                rebuilt_history(&current, &mut r.added, &effect, r.removed, steps.len() + 1, noise)?;
                 current = r.added.case.clone();
                 state = State { misfit: r.added.stats.misfit, k: r.added.outcome.parameters.len() };
                 if r.removed {
@@ -1111,14 +1167,14 @@ pub fn fix(
     if applied.len() >= 2
         && state.misfit > CONSISTENT * noise
         && stop != FixStop::Ambiguous
-        && let Some((outs, added)) = swap::swap(&fl, &base, &applied, state)
+        && let Some((outs, added)) = swap::swap(&fl, &base, &applied, state, steps.len() + 1)
     {
         let removed: Vec<String> = outs.iter().map(|&i| effects[i].description.clone()).collect();
         for &i in outs.iter().rev() {
             effects.remove(i);
         }
         let replaced = removed.join(" and ");
-        for (k, (a, delta_bic)) in added.into_iter().enumerate() {
+        for (k, (mut a, delta_bic)) in added.into_iter().enumerate() {
             let effect = if k == 0 {
                 format!("{} instead of {replaced}", a.effect.description)
             } else {
@@ -1131,6 +1187,7 @@ pub fn fix(
                 misfit: a.stats.misfit,
                 status: &step_status(&a.outcome),
             });
+            rebuilt_history(&current, &mut a, &effect, false, steps.len() + 1, noise)?;
             effects.push(a.effect.clone());
             current = a.case.clone();
             state = State { misfit: a.stats.misfit, k: a.outcome.parameters.len() };

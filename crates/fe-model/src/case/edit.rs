@@ -253,6 +253,17 @@ impl CaseEditor {
         }
     }
 
+    /// Replaces the `[[history]]` of the misfit by `entries` (a history
+    /// rebuilt from a case before it, where the case was rebuilt from its
+    /// nominal one: `rfm fix`'s revisions).
+    pub fn set_history(&mut self, entries: &[HistoryEntry]) -> Result<(), CaseError> {
+        self.doc.remove("history");
+        for e in entries {
+            self.push_history(e)?;
+        }
+        Ok(())
+    }
+
     /// Appends an entry to the `[[history]]` of the misfit.
     pub fn push_history(&mut self, entry: &HistoryEntry) -> Result<(), CaseError> {
         let mut t = Table::new();
@@ -585,6 +596,13 @@ mod tests {
         // where the effect sits comes back; a step without one has none
         assert_eq!(back.history[1], joint);
         assert_eq!((back.history[0].effect.as_ref(), back.history[0].nodes.len()), (None, 0));
+        // a history set anew replaces the old one, entry for entry
+        let mut again = back.editor().unwrap();
+        let rebuilt = [back.history[0].clone(), HistoryEntry { step: "updated after step 1".into(), ..joint.clone() }];
+        again.set_history(&rebuilt).unwrap();
+        let out = again.text_at(Path::new("/tmp/y.toml")).unwrap();
+        assert_eq!(out.matches("[[history]]").count(), 2, "{out}");
+        assert_eq!(CaseFile::parse(Path::new("/tmp/y.toml"), &out).unwrap().history, rebuilt);
     }
 
     #[test]

@@ -138,6 +138,28 @@ fn check(name: &str) {
         }
     }
 
+    // each step's case tells its own story: the history of the case before
+    // it, then the step (at the misfit it started from) and its update as
+    // that step, ending at the step's misfit (a revision rebuilt from the
+    // nominal case once read as step 3 from its screening fit)
+    for (k, s) in steps.iter().enumerate() {
+        let n = k + 1;
+        let written = dir.path().join("out").join(format!("step-{n}.toml"));
+        let text = std::fs::read_to_string(&written).expect("the step's case");
+        let history = text.parse::<toml::Table>().expect("TOML")["history"].as_array().expect("a history").clone();
+        let labels: Vec<&str> = history.iter().map(|h| h["step"].as_str().expect("a label")).collect();
+        let updates: Vec<&str> = labels
+            .iter()
+            .copied()
+            .filter(|l| l.strip_prefix("updated after step ").is_some_and(|r| r.parse::<usize>().is_ok()))
+            .collect();
+        let want: Vec<String> = (1..=n).map(|i| format!("updated after step {i}")).collect();
+        assert_eq!(updates, want, "{name}: step {n}'s history {labels:?}");
+        let end = history.last().expect("an entry")["misfit"].as_float().expect("a misfit");
+        let misfit = s["corrected_misfit"].as_f64().unwrap_or_else(|| s["misfit_updated"].as_f64().expect("misfit"));
+        assert!((end / misfit - 1.0).abs() < 1e-9, "{name}: step {n}'s history ends at {end}, the step at {misfit}");
+    }
+
     // declared parameters: updated at step 0 to their true values
     if let Some(declared) = answer.get("declared").and_then(|d| d.as_table()) {
         let updated = o["declared"]["parameters"].as_array().expect("a step 0");

@@ -230,12 +230,15 @@ pub(super) fn revise(
     applied: &[(Diagnosis, usize)],
     current: &CaseFile,
     before: State,
+    next_step: usize,
 ) -> (Vec<Replacement>, Vec<(Diagnosis, usize)>) {
     let mut applied: Vec<(Diagnosis, usize)> = applied.to_vec();
     let mut warm = current.model.clone();
     let mut state = before;
     let mut kept: Vec<Replacement> = Vec::new();
-    let step = fl.opts.max_steps.max(applied.len() + 1);
+    // the number the loop gives the first revision kept (its update's
+    // comment in the case; the loop writes the history anew)
+    let step = next_step;
     // a second pass when the first changed something: an effect revised
     // early was revised against others not yet mended (trial 27: the mass
     // before the damping window)

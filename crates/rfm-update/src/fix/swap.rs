@@ -62,8 +62,11 @@ pub(super) fn swap(
     nominal: &CaseFile,
     applied: &[(Diagnosis, usize)],
     before: State,
+    next_step: usize,
 ) -> Option<(Vec<usize>, Vec<Judged>)> {
-    let step = fl.opts.max_steps.max(applied.len() + 1);
+    // the number the loop gives the first replacement (its update's comment
+    // in the case; the loop writes the history anew)
+    let step = next_step;
     let mut best: Option<(f64, Vec<usize>, Vec<Judged>)> = None;
     for outs in left_out_sets(applied.len()) {
         let Ok((kept, kept_state, kept_effects)) = kept_case(fl, nominal, applied, &outs, step) else { continue };
