@@ -589,7 +589,7 @@ mod tests {
         e.push_history(&joint).unwrap();
         let out = e.text_at(Path::new("/tmp/x.toml")).unwrap();
         let back = CaseFile::parse(Path::new("/tmp/x.toml"), &out).unwrap();
-        assert_eq!(back.update.unwrap().parameters[0].name, "group.beam.alpha");
+        assert_eq!(back.update.as_ref().unwrap().parameters[0].name, "group.beam.alpha");
         assert_eq!(back.history.len(), 2);
         assert_eq!((back.history[0].step.as_str(), back.history[0].misfit), ("nominal", 1.25));
         assert_eq!((back.history[1].misfit, back.history[1].noise), (0.0125, None));
