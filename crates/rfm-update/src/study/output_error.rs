@@ -1,7 +1,7 @@
 //! The output-error estimator on a study: its options from the case and a
 //! run that restarts from spread starts when the fit ends above the noise.
 
-use super::{Method, Restart, Study, UpdateOutcome, describe_masked};
+use super::{FrequencyTable, Method, Restart, Study, UpdateOutcome, describe_masked};
 use crate::error::UpdateError;
 use crate::output_error::{self, Misfit, OeData, OeOptions};
 use crate::status::{IterationRecord, Status};
@@ -45,6 +45,27 @@ impl Study {
     pub fn run_output_error(
         &self,
         opts: &OeOptions,
+        on_iteration: impl FnMut(&IterationRecord),
+    ) -> Result<UpdateOutcome, UpdateError> {
+        self.output_error_run(opts, true, on_iteration)
+    }
+
+    /// The fit of [`Study::run_output_error`] and what judging it needs
+    /// (the status, the values and their uncertainty, the updated system),
+    /// without the table of natural frequencies that reports show: its
+    /// dense eigensolutions of the initial and the updated model cost as
+    /// much as the fit itself on a beam of 300 DOFs, and `rfm fix` judges
+    /// tens of updates that no report shows. `natural_frequencies_hz` is
+    /// empty, of kind `not computed`; everything else is as
+    /// [`Study::run_output_error`] returns it.
+    pub fn fit_output_error(&self, opts: &OeOptions) -> Result<UpdateOutcome, UpdateError> {
+        self.output_error_run(opts, false, |_| {})
+    }
+
+    fn output_error_run(
+        &self,
+        opts: &OeOptions,
+        natural_frequencies: bool,
         on_iteration: impl FnMut(&IterationRecord),
     ) -> Result<UpdateOutcome, UpdateError> {
         if self.parameters.is_empty() {
@@ -123,7 +144,8 @@ impl Study {
         let status = verdict::classify(&result.status, noise_ratio, agree);
         let band = (lines[0], lines[lines.len() - 1]);
         let report = uncertainty::analyse(&params, &result, band, noise);
-        let natural_frequencies_hz = self.frequency_table(&sys);
+        let natural_frequencies_hz =
+            if natural_frequencies { self.frequency_table(&sys) } else { FrequencyTable::not_computed() };
         let first_residual = history.first().map_or(f64::NAN, |r| r.residual);
         let residual = result.history.last().map_or(f64::NAN, |r| r.residual);
         Ok(UpdateOutcome {

@@ -43,3 +43,30 @@ fn a_case_without_an_update_has_no_updating_lines_to_set() {
     }
     assert!(study.update_frequencies_hz().is_empty());
 }
+
+/// The fit `rfm fix` judges its steps by is the run `rfm update` makes, to
+/// the bit, without the natural frequencies (two dense eigensolutions) that
+/// only a report reads.
+#[test]
+fn a_fit_without_natural_frequencies_is_the_run_without_them() {
+    let study = Study::load(&case("two-material-beam-noisy")).unwrap();
+    let opts = study.output_error_options().unwrap();
+    let run = study.run_output_error(&opts, |_| {}).unwrap();
+    let fit = study.fit_output_error(&opts).unwrap();
+    assert_eq!(run.natural_frequencies_hz.kind, "damped");
+    assert!(!run.natural_frequencies_hz.updated.is_empty() && !run.natural_frequencies_hz.initial.is_empty());
+    let nf = &fit.natural_frequencies_hz;
+    assert_eq!(nf.kind, "not computed");
+    assert!(nf.initial.is_empty() && nf.updated.is_empty() && nf.truth.is_none() && nf.paper.is_none());
+    assert_eq!((&fit.status, &fit.iteration_end, fit.residual), (&run.status, &run.iteration_end, run.residual));
+    let values = |o: &rfm_update::UpdateOutcome| o.parameters.iter().map(|p| p.updated).collect::<Vec<f64>>();
+    assert_eq!(values(&fit), values(&run));
+    let sd = |o: &rfm_update::UpdateOutcome| {
+        o.uncertainty.as_ref().unwrap().parameters.iter().map(|p| p.relative_std).collect::<Vec<f64>>()
+    };
+    assert_eq!(sd(&fit), sd(&run));
+    assert_eq!(
+        (fit.history.len(), fit.restarts.len(), fit.noise_ratio),
+        (run.history.len(), run.restarts.len(), run.noise_ratio)
+    );
+}
