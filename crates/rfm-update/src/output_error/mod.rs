@@ -544,6 +544,83 @@ mod tests {
         assert!((cov[(2, 2)] / want - 1.0).abs() < 1e-10, "{} against {want}", cov[(2, 2)]);
     }
 
+    /// A [`Response`] that delegates to another, says whether its Jacobian
+    /// is cheap as told, and counts the evaluations.
+    struct Counted<'r, R> {
+        inner: &'r mut R,
+        cheap: bool,
+        evaluations: usize,
+    }
+
+    impl<R: Response> Response for Counted<'_, R> {
+        fn set(&mut self, values: &[f64]) -> Result<(), UpdateError> {
+            self.inner.set(values)
+        }
+
+        fn evaluate(&mut self, lines: &[f64], jacobian: bool) -> Option<response::Evaluated> {
+            self.evaluations += 1;
+            self.inner.evaluate(lines, jacobian)
+        }
+
+        fn cheap_jacobian(&self) -> bool {
+            self.cheap
+        }
+    }
+
+    /// A whole model's trial steps evaluated with their sensitivities
+    /// ([`FullModel`] says its Jacobian is cheap) take the fit through the
+    /// same iterates, bit for bit, as trial steps evaluated by their
+    /// receptances alone with the sensitivities made once a step is
+    /// accepted, and the fit evaluates the model fewer times: an accepted
+    /// step needs no second evaluation. With a gain per reference, whose
+    /// start is fitted to the receptances of the first evaluation.
+    #[test]
+    fn trial_steps_with_their_sensitivities_make_the_same_iterates_in_fewer_evaluations() {
+        use fe_model::{Dof, DofRef, samples};
+        use frf::{Channel, NoiseModel};
+        let truth = DampedSystem::new(samples::cantilever(12)).unwrap();
+        let tip = DofRef::new(13, Dof::Uy);
+        let channels: Vec<Channel> = [5, 9, 13].iter().map(|&n| Channel::new(DofRef::new(n, Dof::Uy), tip)).collect();
+        let lines: Vec<f64> = (1..=120).map(|i| 4.0 * f64::from(i)).collect();
+        let mut data = frf::synthesize(&truth, &channels, &lines).unwrap();
+        NoiseModel::relative(0.01, 5).apply(&mut data);
+        let names = ["group.beam.alpha", "group.beam.beta", "element.4.stiffness", "element.10.mass"];
+        let start = [0.4, 2.5, 0.7, 1.3];
+        let fit = |cheap: bool, gains: Gains| {
+            let mut sys = truth.clone();
+            let params = ParameterSet::new(names.iter().map(|n| sys.model().parameter(n).unwrap()).collect());
+            let p0: Vec<f64> = params.values(&sys).iter().zip(start).map(|(v, f)| v * f).collect();
+            params.set_values(&mut sys, &p0).unwrap();
+            let mut full = FullModel {
+                solver: ZSolver::new(sys.assembly().pattern()).unwrap(),
+                plan: ChannelPlan::new(&sys, data.channels()).unwrap(),
+                sys: &mut sys,
+                params: &params,
+            };
+            let mut counted = Counted { inner: &mut full, cheap, evaluations: 0 };
+            let opts = OeOptions { gains, ..OeOptions::default() };
+            let r = run_with(&mut counted, p0, &OeData { measured: &data, weights: None }, &opts, |_| {}).unwrap();
+            (r, counted.evaluations)
+        };
+        for gains in [Gains::None, Gains::PerReference] {
+            let ((cheap, n_cheap), (dear, n_dear)) = (fit(true, gains), fit(false, gains));
+            assert!(cheap.history.len() > 5, "a fit of several steps: {}", cheap.history.len());
+            assert_eq!(cheap.history.len(), dear.history.len());
+            for (a, b) in cheap.history.iter().zip(&dear.history) {
+                assert_eq!(
+                    (a.residual, &a.values, a.lambda),
+                    (b.residual, &b.values, b.lambda),
+                    "step {}",
+                    a.iteration
+                );
+            }
+            assert_eq!((cheap.values, cheap.cost, cheap.status), (dear.values, dear.cost, dear.status));
+            assert_eq!(cheap.gains.len(), dear.gains.len());
+            // every accepted step saved an evaluation
+            assert_eq!(n_dear - n_cheap, cheap.history.len() - 1, "{n_cheap} against {n_dear} evaluations");
+        }
+    }
+
     /// A gain multiplies exactly the channels of its reference, by its
     /// magnitude and phase.
     #[test]
