@@ -299,7 +299,7 @@ pub(crate) fn run_with(
         return Err(UpdateError::Method(format!("{} weights for {} data values", w.len(), measured.values().len())));
     }
     let (group_of, keys) = crate::gain::gain_groups(measured.channels(), opts.gains);
-    let ev = Evaluator { data, opts, group_of, keys, p0 };
+    let ev = Evaluator::new(data, opts, group_of, keys, p0);
     let (n, ng) = (ev.n_params(), ev.n_gain());
     let n_data = ev.n_data();
     let m_free = n + ng;
