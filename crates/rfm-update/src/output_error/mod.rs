@@ -101,8 +101,8 @@ impl Misfit {
 /// Steps over which the chi-square gain is tested against the noise.
 const NOISE_WINDOW: usize = 10;
 /// Chi-square gain over [`NOISE_WINDOW`] steps below which the fit stops
-/// ([`OeResult::flat_valley`]).
-const NOISE_WINDOW_GAIN: f64 = 0.5;
+/// ([`OeResult::flat_valley`]): less than the noise can show.
+pub(crate) const NOISE_WINDOW_GAIN: f64 = 0.5;
 
 /// Options of the output-error estimator.
 #[derive(Clone, Debug)]
