@@ -144,12 +144,78 @@ fn imported_against_beam(beam: &Point, shell: &Point) -> Vec<String> {
     missed
 }
 
+/// Wall time (s) within which `rfm fix` runs 3 steps on test-resolution
+/// data (issue 35): an 8,000-line, 4-channel file of a 100-element beam
+/// and a 3D frame measured at 44 channels from two references.
+const FIX_SECONDS: f64 = 30.0;
+
+/// The loop of `rfm fix` end to end (`fix_point`): 3 steps on each
+/// workload, with its wall and CPU time and the load average the machine
+/// ran it at. Returns the bounds missed: over [`FIX_SECONDS`], or a wrong
+/// answer (a hidden effect not found, or a final misfit above 1.5 times
+/// the noise), which fails however fast it came.
+fn fix_times() -> Result<Vec<String>, String> {
+    let exe = release_example("fix_point")?;
+    println!("\nthe loop of rfm fix, 3 steps, on test-resolution data (bound {FIX_SECONDS} s of wall time):");
+    println!(
+        "{:<26} {:>5} {:>8} {:>6} {:>8} {:>8} {:>16} {:>8}  effects at the end",
+        "workload", "DOFs", "channels", "lines", "wall s", "CPU s", "load before", "x noise"
+    );
+    let mut missed = Vec::new();
+    for model in ["beam", "tower"] {
+        let p = bench_point(&exe, &format!("fix {model}"), &["--model", model, "--steps", "3"])?;
+        let label = p.json["label"].as_str().unwrap_or("?").to_string();
+        let effects: Vec<&str> =
+            p.json["effects"].as_array().map(|a| a.iter().filter_map(|e| e.as_str()).collect()).unwrap_or_default();
+        let right = p.json["right"].as_bool() == Some(true);
+        println!(
+            "{label:<26} {:>5} {:>8} {:>6} {:>8.1} {:>8.1} {:>16} {:>8.2}  {} {}",
+            p.num("dofs"),
+            p.num("channels"),
+            p.num("freqs"),
+            p.num("seconds"),
+            p.num("cpu_seconds"),
+            p.json["load_before"].as_str().unwrap_or("?"),
+            p.num("misfit_over_noise"),
+            effects.join("; "),
+            if right { "(right)" } else { "(WRONG)" }
+        );
+        if !right {
+            missed.push(format!(
+                "fix {model}: the loop ended with [{}] at {:.2} times the noise, where it should find [{}] within 1.5",
+                effects.join("; "),
+                p.num("misfit_over_noise"),
+                p.json["hidden"].as_array().map_or(String::new(), |a| a
+                    .iter()
+                    .filter_map(|e| e.as_str())
+                    .collect::<Vec<_>>()
+                    .join("; "))
+            ));
+        }
+        if !(p.num("seconds") <= FIX_SECONDS) {
+            missed.push(format!(
+                "fix {model}: 3 steps took {:.1} s ({:.1} s of CPU at a load average of {}), over its bound of \
+                 {FIX_SECONDS} s",
+                p.num("seconds"),
+                p.num("cpu_seconds"),
+                p.json["load_before"].as_str().unwrap_or("?")
+            ));
+        }
+    }
+    Ok(missed)
+}
+
 /// Builds an example of rfm-update in release mode; returns its path.
 fn release_example(name: &str) -> Result<std::path::PathBuf, String> {
     crate::release_build(&["-p", "rfm-update", "--example", name], name)
 }
 
 pub(crate) fn bench(args: &[String]) -> Result<(), String> {
+    if args.iter().any(|a| a == "--fix") {
+        println!("machine: {}", machine());
+        let missed = fix_times()?;
+        return if missed.is_empty() { Ok(()) } else { Err(format!("missed bounds:\n  {}", missed.join("\n  "))) };
+    }
     let full = args.iter().any(|a| a == "--full");
     let exe = release_example("bench_point")?;
     let reps = |quick: u32, more: u32| if full { more } else { quick }.to_string();
@@ -283,6 +349,7 @@ pub(crate) fn bench(args: &[String]) -> Result<(), String> {
     // the bounds are on wall time for two cores; on a loaded machine the
     // CPU time (all threads) says what the diagnosis itself cost
     println!("(CPU s: summed over threads; load average after the diagnoses: {})", load_average());
+    wrong.extend(fix_times()?);
     update_times()?;
     wrong.extend(shell_bounds);
     // a diagnosis that misses the hidden effect is a failure, however fast

@@ -26,7 +26,10 @@
 //!   Then the whole diagnosis end to end on frames of 225 to 96,186 DOFs
 //!   (`diagnose_point` example): candidates, time, and whether it named the
 //!   hidden effect; it exits non-zero when a diagnosis names the wrong one
-//!   or misses its time bound (3k DOFs 3 s, 10k 10 s, 100k 60 s).
+//!   or misses its time bound (3k DOFs 3 s, 10k 10 s, 100k 60 s). Then
+//!   the loop of `rfm fix` (3 steps, `fix_point` example) on an 8,000-line,
+//!   4-channel beam and a 44-channel frame in space, each within 30 s and
+//!   with the right answer. `--fix` runs the loop's benchmark alone.
 //! - `heldout`: the statistical studies (held-out loop, hidden effects, lab
 //!   study) at the size their criteria ask for; `cargo test` runs them
 //!   reduced (see `heldout.rs`). CI runs both.
@@ -68,7 +71,7 @@ fn main() -> ExitCode {
         Some("heldout") => heldout::heldout(&args[1..]),
         Some("figures") => figures::figures(),
         Some("montecarlo") => montecarlo::montecarlo(&args[1..]),
-        _ => Err("usage: cargo xtask reproduce [CASE... | tutorial] | cargo xtask bench [--full] | \
+        _ => Err("usage: cargo xtask reproduce [CASE... | tutorial] | cargo xtask bench [--full | --fix] | \
                   cargo xtask heldout | cargo xtask figures | cargo xtask montecarlo [N] | \
                   cargo xtask mutants [--list | cargo-mutants options]"
             .to_string()),

@@ -585,7 +585,9 @@ impl Loop<'_> {
         if !last {
             oe_opts.restarts = 0;
         }
-        let outcome = study.run_output_error(&oe_opts, |_| {})?;
+        // the loop reads the fit and its judgement, not the natural
+        // frequencies a report would show
+        let outcome = study.fit_output_error(&oe_opts)?;
         let stats = self.stats(&outcome.system)?;
         let values = crate::params::quantity_values(study.parameters(), outcome.system.model());
         editor.set_values(&values, &format!("updated by rfm fix, step {step}"))?;

@@ -5,6 +5,13 @@
 //! are scaled to unit norm before the SVD, singular values below
 //! `rcond * s_max` are dropped (those parameter combinations keep their
 //! values), and the solution is scaled back.
+//!
+//! A fit's Jacobian is tall and thin (thousands of residuals, a few
+//! parameters): [`solve_tall`] takes the SVD of the triangular factor of
+//! its Householder QR instead (Chan's R-SVD), which has the same singular
+//! values and right singular vectors (up to their signs) and costs a third
+//! of the SVD of the whole matrix, most of which went into its left
+//! singular vectors; the fits iterate with it.
 
 use faer::Mat;
 
@@ -102,9 +109,85 @@ pub fn solve(a: &Mat<f64>, b: &[f64], rcond: f64) -> LstsqSolution {
     let (u, s, v) = (svd.U(), svd.S(), svd.V());
     let k = s.dim();
     let singular_values: Vec<f64> = (0..k).map(|i| s[i]).collect();
+    let utb: Vec<f64> = (0..k).map(|i| (0..m).map(|r| u[(r, i)] * b[r]).sum()).collect();
+    finish(singular_values, utb, v.to_owned(), column_norms, rcond)
+}
+
+/// Solves `min |A x - b|` as [`solve`] does, by the SVD of the triangular
+/// factor `R` of a Householder QR of the column-scaled `A` (`A_s = Q R`,
+/// `R = U_R S V^T`, `U^T b = U_R^T Q^T b`): the same solution, singular
+/// values, rank, damped solutions and covariance to round-off, with right
+/// singular vectors that may differ from [`solve`]'s in sign. For tall
+/// matrices (more rows than columns; otherwise it is [`solve`]).
+pub fn solve_tall(a: &Mat<f64>, b: &[f64], rcond: f64) -> LstsqSolution {
+    let (m, n) = (a.nrows(), a.ncols());
+    assert_eq!(b.len(), m);
+    if m <= n {
+        return solve(a, b, rcond);
+    }
+    let column_norms: Vec<f64> = (0..n)
+        .map(|j| {
+            let s = (0..m).map(|i| a[(i, j)] * a[(i, j)]).sum::<f64>().sqrt();
+            if s > 0.0 && s.is_finite() { s } else { 1.0 }
+        })
+        .collect();
+    // the scaled columns, one after the other, reduced in place to R and
+    // the Householder vectors below it; b along with them to Q^T b
+    let mut cols: Vec<f64> =
+        (0..n).flat_map(|j| (0..m).map(move |i| (i, j))).map(|(i, j)| a[(i, j)] / column_norms[j]).collect();
+    let mut qtb = b.to_vec();
+    for j in 0..n {
+        let (done, rest) = cols.split_at_mut((j + 1) * m);
+        let x = &mut done[j * m + j..(j + 1) * m];
+        let norm = dot(x, x).sqrt();
+        if norm == 0.0 {
+            continue;
+        }
+        // H = I - tau v v^T with v = (1, x[1..] / (alpha - beta)) takes x to (beta, 0, ...)
+        let alpha = x[0];
+        let beta = if alpha >= 0.0 { -norm } else { norm };
+        let scale = 1.0 / (alpha - beta);
+        x[1..].iter_mut().for_each(|v| *v *= scale);
+        let tau = (beta - alpha) / beta;
+        x[0] = 1.0;
+        let v: &[f64] = x;
+        for k in 0..n - j - 1 {
+            let y = &mut rest[k * m + j..(k + 1) * m];
+            let s = tau * dot(v, y);
+            y.iter_mut().zip(v).for_each(|(y, v)| *y -= s * v);
+        }
+        let y = &mut qtb[j..];
+        let s = tau * dot(v, y);
+        y.iter_mut().zip(v).for_each(|(y, v)| *y -= s * v);
+        done[j * m + j] = beta;
+    }
+    let r = Mat::from_fn(n, n, |i, j| if i <= j { cols[j * m + i] } else { 0.0 });
+    let svd = r.thin_svd().expect("SVD of a finite matrix converges");
+    let (u, s, v) = (svd.U(), svd.S(), svd.V());
+    let singular_values: Vec<f64> = (0..n).map(|i| s[i]).collect();
+    let utb: Vec<f64> = (0..n).map(|i| (0..n).map(|r| u[(r, i)] * qtb[r]).sum()).collect();
+    finish(singular_values, utb, v.to_owned(), column_norms, rcond)
+}
+
+/// `x . y`, in four interleaved sums (which the compiler vectorises).
+fn dot(x: &[f64], y: &[f64]) -> f64 {
+    let mut acc = [0.0; 4];
+    let (xc, yc) = (x.chunks_exact(4), y.chunks_exact(4));
+    let tail: f64 = xc.remainder().iter().zip(yc.remainder()).map(|(a, b)| a * b).sum();
+    for (a, b) in xc.zip(yc) {
+        for l in 0..4 {
+            acc[l] += a[l] * b[l];
+        }
+    }
+    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
+}
+
+/// The solution from the scaled problem's singular values, `U^T b` and
+/// right singular vectors (columns of `v`).
+fn finish(singular_values: Vec<f64>, utb: Vec<f64>, v: Mat<f64>, column_norms: Vec<f64>, rcond: f64) -> LstsqSolution {
+    let (k, n) = (singular_values.len(), column_norms.len());
     let smax = singular_values.iter().copied().fold(0.0, f64::max);
     let keep: Vec<usize> = (0..k).filter(|&i| singular_values[i] > rcond * smax && singular_values[i] > 0.0).collect();
-    let utb: Vec<f64> = (0..k).map(|i| (0..m).map(|r| u[(r, i)] * b[r]).sum()).collect();
     let mut xs = vec![0.0; n];
     for &i in &keep {
         let coef = utb[i] / singular_values[i];
@@ -122,16 +205,7 @@ pub fn solve(a: &Mat<f64>, b: &[f64], rcond: f64) -> LstsqSolution {
         }
     }
     let x = xs.iter().zip(&column_norms).map(|(x, s)| x / s).collect();
-    LstsqSolution {
-        x,
-        singular_values,
-        rank: keep.len(),
-        column_norms,
-        scaled_inverse_normal: inv,
-        v: v.to_owned(),
-        utb,
-        keep,
-    }
+    LstsqSolution { x, singular_values, rank: keep.len(), column_norms, scaled_inverse_normal: inv, v, utb, keep }
 }
 
 /// A parameter whose component along the unresolved direction exceeds this
@@ -248,5 +322,81 @@ mod tests {
         for (f, t) in fit.iter().zip(&b) {
             assert!((f - t).abs() < 1e-12);
         }
+    }
+
+    /// `solve_tall` against `solve` on one problem: the same rank, kept
+    /// directions, singular values, solution, damped solutions, predicted
+    /// reduction, covariance and undetermined unknowns, to round-off: both
+    /// are backward stable, so they agree to the working precision times
+    /// the condition of the kept directions (its square for the covariance).
+    fn same_as_the_svd_of_the_whole(a: &Mat<f64>, b: &[f64], rcond: f64) {
+        let (full, tall) = (solve(a, b, rcond), solve_tall(a, b, rcond));
+        let smallest = full.keep.iter().map(|&i| full.singular_values[i]).fold(f64::INFINITY, f64::min);
+        let cond = full.largest_singular_value() / smallest;
+        let close = |x: f64, y: f64, what: &str| {
+            assert!((x - y).abs() <= 1e-10 * x.abs().max(y.abs()).max(1e-300), "{what}: {x} against {y}")
+        };
+        assert_eq!((full.rank, &full.keep, full.undetermined()), (tall.rank, &tall.keep, tall.undetermined()));
+        for (x, y) in full.singular_values.iter().zip(&tall.singular_values) {
+            // dropped directions' singular values are round-off of both
+            if *x > 1e-8 * full.largest_singular_value() {
+                close(*x, *y, "singular value");
+            }
+        }
+        // vectors to round-off of their largest component
+        let same = |x: &[f64], y: &[f64], what: &str| {
+            let scale = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            for (a, b) in x.iter().zip(y) {
+                assert!((a - b).abs() <= 1e-13 * cond.max(100.0) * scale, "{what}: {x:?} against {y:?}");
+            }
+        };
+        for lambda in [0.0, 1e-6, 0.3, 10.0] {
+            same(&full.damped(lambda), &tall.damped(lambda), "damped solution");
+        }
+        same(&full.x, &tall.x, "solution");
+        close(full.predicted_reduction(), tall.predicted_reduction(), "predicted reduction");
+        let n = a.ncols();
+        let scale = (0..n).map(|i| full.scaled_inverse_normal[(i, i)].abs()).fold(0.0, f64::max);
+        for r in 0..n {
+            for c in 0..n {
+                let (x, y) = (full.scaled_inverse_normal[(r, c)], tall.scaled_inverse_normal[(r, c)]);
+                assert!((x - y).abs() <= 1e-13 * cond.max(100.0).powi(2) * scale, "({r}, {c}): {x} against {y}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_svd_of_the_r_factor_solves_as_the_svd_of_the_whole() {
+        // tall, columns scaled over twelve orders of magnitude, full rank
+        let a = Mat::from_fn(500, 6, |i, j| {
+            let t = i as f64 * 0.013;
+            (t * (j + 1) as f64).sin() * 10f64.powi(2 * j as i32 - 6) + if i % 7 == j { 0.1 } else { 0.0 }
+        });
+        let b: Vec<f64> = (0..500).map(|i| (i as f64 * 0.7).cos()).collect();
+        same_as_the_svd_of_the_whole(&a, &b, 1e-12);
+        // a zero column and two proportional ones: rank 2 of 4
+        let a = Mat::from_fn(40, 4, |i, j| match j {
+            0 => (i + 1) as f64,
+            1 => 0.0,
+            2 => -3.0 * (i + 1) as f64,
+            _ => ((i * i) as f64).cos(),
+        });
+        let b: Vec<f64> = (0..40).map(|i| (i as f64).sin()).collect();
+        same_as_the_svd_of_the_whole(&a, &b, 1e-10);
+        assert_eq!(solve_tall(&a, &b, 1e-10).rank, 2);
+        // nearly dependent columns, kept at a tight cut-off
+        let a = Mat::from_fn(80, 3, |i, j| {
+            let t = i as f64 / 80.0;
+            match j {
+                0 => t,
+                1 => t + 1e-7 * t * t,
+                _ => 1.0 - t,
+            }
+        });
+        let b: Vec<f64> = (0..80).map(|i| (i as f64 / 9.0).exp().ln_1p()).collect();
+        same_as_the_svd_of_the_whole(&a, &b, 1e-12);
+        // as wide as it is tall: the plain SVD
+        let a = Mat::from_fn(3, 3, |i, j| ((i * 3 + j) as f64).sin() + if i == j { 2.0 } else { 0.0 });
+        same_as_the_svd_of_the_whole(&a, &[1.0, -2.0, 0.5], 1e-12);
     }
 }

@@ -26,6 +26,10 @@ pub(super) struct Evaluator<'a> {
     /// What each gain belongs to.
     pub(super) keys: Vec<GainKey>,
     pub(super) p0: Vec<f64>,
+    /// The weight of each value, channel-major as the data (0 where the
+    /// measured value is zero or not finite), read once: the diagnosis
+    /// evaluates tens of thousands of fits.
+    weights: Vec<f64>,
 }
 
 pub(super) struct Point {
@@ -35,7 +39,27 @@ pub(super) struct Point {
     pub(super) jacobian: Option<Mat<f64>>,
 }
 
-impl Evaluator<'_> {
+impl<'a> Evaluator<'a> {
+    pub(super) fn new(
+        data: &'a OeData<'a>,
+        opts: &'a OeOptions,
+        group_of: Vec<usize>,
+        keys: Vec<GainKey>,
+        p0: Vec<f64>,
+    ) -> Self {
+        let m = data.measured;
+        let nf = m.n_freq();
+        let weights = (0..m.channels().len())
+            .flat_map(|c| (0..nf).map(move |k| (c, k)))
+            .map(|(c, k)| {
+                let w = data.weights.map_or(1.0, |w| w[c * nf + k]);
+                let v = m.get(c, k);
+                if v.norm() > 0.0 && v.norm().is_finite() { w } else { 0.0 }
+            })
+            .collect();
+        Evaluator { data, opts, group_of, keys, p0, weights }
+    }
+
     pub(super) fn n_params(&self) -> usize {
         self.p0.len()
     }
@@ -45,16 +69,11 @@ impl Evaluator<'_> {
     }
 
     pub(super) fn weight(&self, c: usize, k: usize) -> f64 {
-        let nf = self.data.measured.n_freq();
-        let w = self.data.weights.map_or(1.0, |w| w[c * nf + k]);
-        let m = self.data.measured.get(c, k);
-        if m.norm() > 0.0 && m.norm().is_finite() { w } else { 0.0 }
+        self.weights[c * self.data.measured.n_freq() + k]
     }
 
     pub(super) fn n_data(&self) -> usize {
-        let nf = self.data.measured.n_freq();
-        let nc = self.data.measured.channels().len();
-        2 * (0..nc).flat_map(|c| (0..nf).map(move |k| (c, k))).filter(|&(c, k)| self.weight(c, k) > 0.0).count()
+        2 * self.weights.iter().filter(|&&w| w > 0.0).count()
     }
 
     /// Sets the model to `theta` (structural part of `x`).
@@ -90,6 +109,8 @@ impl Evaluator<'_> {
         let mut residual = vec![0.0; 2 * rows + n_reg];
         let mut jac = jacobian.then(|| Mat::<f64>::zeros(2 * rows + n_reg, ncol));
         let mut cost_data = 0.0;
+        // each gain once, not once per value
+        let gains: Vec<C64> = (0..self.keys.len().max(1)).map(|v| self.gain(x, v)).collect();
         for k in 0..nf {
             for c in 0..nc {
                 let w = self.weight(c, k);
@@ -97,8 +118,7 @@ impl Evaluator<'_> {
                     continue;
                 }
                 let r = k * nc + c;
-                let v = self.group_of[c];
-                let g = self.gain(x, v);
+                let g = gains[self.group_of[c]];
                 let h = model[k][c];
                 let meas = m.get(c, k);
                 let rho = match self.opts.misfit {
@@ -111,25 +131,51 @@ impl Evaluator<'_> {
                 residual[r] = rho.re;
                 residual[rows + r] = rho.im;
                 cost_data += rho.norm_sqr();
-                if let (Some(j), Some(s)) = (jac.as_mut(), sens.as_ref()) {
-                    for i in 0..n {
+            }
+        }
+        if let (Some(j), Some(s)) = (jac.as_mut(), sens.as_ref()) {
+            // column by column, each written in order: the values of a line
+            // and channel scattered over the columns in turn were most of
+            // the evaluation on many channels (the same numbers either way)
+            for i in 0..n {
+                for k in 0..nf {
+                    for c in 0..nc {
+                        let w = self.weight(c, k);
+                        if w == 0.0 {
+                            continue;
+                        }
+                        let r = k * nc + c;
                         let d = match self.opts.misfit {
-                            Misfit::Relative => -w * g * s[k][(c, i)] / meas.norm(),
-                            Misfit::Log => -w * s[k][(c, i)] / h,
+                            Misfit::Relative => -w * gains[self.group_of[c]] * s[k][(c, i)] / m.get(c, k).norm(),
+                            Misfit::Log => -w * s[k][(c, i)] / model[k][c],
                         };
                         j[(r, i)] = d.re;
                         j[(rows + r, i)] = d.im;
                     }
-                    if self.opts.gains != Gains::None {
-                        let da = match self.opts.misfit {
-                            Misfit::Relative => w * g * h / meas.norm(),
-                            Misfit::Log => C64::new(w, 0.0),
-                        };
-                        let db = da * C64::new(0.0, 1.0);
-                        j[(r, n + 2 * v)] = da.re;
-                        j[(rows + r, n + 2 * v)] = da.im;
-                        j[(r, n + 2 * v + 1)] = db.re;
-                        j[(rows + r, n + 2 * v + 1)] = db.im;
+                }
+            }
+            if self.opts.gains != Gains::None {
+                // a gain's two columns: its log-magnitude and its phase, on its channels only
+                for v in 0..self.keys.len() {
+                    let members: Vec<usize> = (0..nc).filter(|&c| self.group_of[c] == v).collect();
+                    for part in 0..2 {
+                        let i = n + 2 * v + part;
+                        for k in 0..nf {
+                            for &c in &members {
+                                let w = self.weight(c, k);
+                                if w == 0.0 {
+                                    continue;
+                                }
+                                let r = k * nc + c;
+                                let da = match self.opts.misfit {
+                                    Misfit::Relative => w * gains[v] * model[k][c] / m.get(c, k).norm(),
+                                    Misfit::Log => C64::new(w, 0.0),
+                                };
+                                let d = if part == 0 { da } else { da * C64::new(0.0, 1.0) };
+                                j[(r, i)] = d.re;
+                                j[(rows + r, i)] = d.im;
+                            }
+                        }
                     }
                 }
             }

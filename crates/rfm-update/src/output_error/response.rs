@@ -49,6 +49,17 @@ impl Response for FullModel<'_> {
         self.params.set_values(self.sys, values)
     }
 
+    /// The sensitivity assembly factorises each line once for both, and
+    /// its receptances are bit for bit those of the synthesis (the same
+    /// factorisation and substitutions), so evaluating a trial step with
+    /// its sensitivities changes no iterate: it adds the sensitivities'
+    /// solves to a step the fit rejects, and spares a step it accepts a
+    /// second factorisation of every line (a quarter of the update's time
+    /// in `rfm fix` on a 300-DOF beam).
+    fn cheap_jacobian(&self) -> bool {
+        true
+    }
+
     fn evaluate(&mut self, lines: &[f64], jacobian: bool) -> Option<Evaluated> {
         if jacobian {
             let blocks = sensitivity::assemble(

@@ -21,10 +21,25 @@ pub struct FrequencyTable {
     pub truth: Option<Vec<f64>>,
     /// Published values, when quoted.
     pub paper: Option<Vec<f64>>,
-    /// `damped` (complex modes), `undamped` (normal modes), or `none` when
+    /// `damped` (complex modes), `undamped` (normal modes), `none` when
     /// the model is too large for the dense modal analyses
-    /// ([`MAX_UNDAMPED_DOFS`]; the lists are then empty).
+    /// ([`MAX_UNDAMPED_DOFS`]; the lists are then empty), or `not computed`
+    /// when the run was not asked for them ([`Study::fit_output_error`];
+    /// empty too).
     pub kind: String,
+}
+
+impl FrequencyTable {
+    /// The table of a run that was not asked for natural frequencies.
+    pub fn not_computed() -> Self {
+        FrequencyTable {
+            initial: Vec::new(),
+            updated: Vec::new(),
+            truth: None,
+            paper: None,
+            kind: "not computed".into(),
+        }
+    }
 }
 
 /// Equations above which no natural frequencies are computed for reports:
