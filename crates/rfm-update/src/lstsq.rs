@@ -9,7 +9,7 @@
 //! A fit's Jacobian is tall and thin (thousands of residuals, a few
 //! parameters): [`solve_tall`] takes the SVD of the triangular factor of
 //! its Householder QR instead (Chan's R-SVD), which has the same singular
-//! values and right singular vectors (up to their signs) and costs a third
+//! values and right singular vectors (up to their signs) and costs a quarter
 //! of the SVD of the whole matrix, most of which went into its left
 //! singular vectors; the fits iterate with it.
 

@@ -380,7 +380,7 @@ pub(crate) fn run_with(
     for iteration in 1..=opts.max_iterations {
         let jac = point.jacobian.as_ref().expect("points kept have a Jacobian");
         let minus_r: Vec<f64> = point.residual.iter().map(|v| -v).collect();
-        // the step only: by the SVD of the QR's R factor, a third of the cost
+        // the step only: by the SVD of the QR's R factor, a quarter of the cost
         let sol = lstsq::solve_tall(jac, &minus_r, opts.rcond);
         // first-order optimality: the Gauss-Newton step would gain almost nothing
         let predicted = sol.predicted_reduction();
