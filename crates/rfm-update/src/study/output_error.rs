@@ -77,12 +77,12 @@ impl Study {
     ///   (within [`verdict::SAME_MINIMUM`] above its cost, and not below it
     ///   by more than a chi-square of 0.5, which the noise cannot show),
     ///   that minimum is confirmed (`model_inadequate`, the first fit kept)
-    ///   and the others are not made. Otherwise (a restart lower, or ending
-    ///   elsewhere or short of a stationary point) all are made and the two
-    ///   best run to the end, as [`Study::run_output_error`] does. On the
-    ///   beam of `cargo xtask bench` every restarted look-ahead of the last
-    ///   step had its minimum confirmed so, and the restarts took a sixth
-    ///   of the loop's time.
+    ///   and the others are not made. Otherwise (a restart lower by more
+    ///   than that, or fewer than two back at the minimum) all are made and
+    ///   the two best run to the end, as [`Study::run_output_error`] does.
+    ///   On the beam of `cargo xtask bench`, two restarts confirmed the
+    ///   minimum of four of the five restarted look-aheads of the last step,
+    ///   where the restarts had taken a sixth of the loop's time.
     ///
     /// Otherwise as [`Study::run_output_error`].
     pub fn fit_output_error(&self, opts: &OeOptions) -> Result<UpdateOutcome, UpdateError> {
@@ -139,20 +139,25 @@ impl Study {
             // by more than the noise can show (the chi-square gain at which
             // a fit itself stops in a flat valley)
             let (first_cost, first_sigma2) = (result.cost, result.sigma2);
+            let lower =
+                |t: &output_error::OeResult| first_cost - t.cost > output_error::NOISE_WINDOW_GAIN * first_sigma2;
             let confirms = |t: &output_error::OeResult| {
-                t.status == Status::Converged
-                    && first_cost - t.cost <= output_error::NOISE_WINDOW_GAIN * first_sigma2
-                    && t.cost - first_cost <= verdict::SAME_MINIMUM * first_cost
+                t.status == Status::Converged && !lower(t) && t.cost - first_cost <= verdict::SAME_MINIMUM * first_cost
+            };
+            // confirmed by two, and none found lower (then all are made and refined)
+            let confirmed = |tried: &[output_error::OeResult]| {
+                scope.stop_when_confirmed
+                    && !tried.iter().any(lower)
+                    && tried.iter().filter(|t| confirms(t)).count() >= CONFIRMING_RESTARTS
             };
             let mut tried: Vec<output_error::OeResult> = Vec::new();
             for i in 1..=opts.restarts {
                 tried.extend(fit(&verdict::spread_start(&p_init, &bounds, i, RESTART_SPREAD), &short));
-                if scope.stop_when_confirmed && tried.iter().filter(|t| confirms(t)).count() >= CONFIRMING_RESTARTS {
+                if confirmed(&tried) {
                     break;
                 }
             }
-            let confirmed =
-                scope.stop_when_confirmed && tried.iter().filter(|t| confirms(t)).count() >= CONFIRMING_RESTARTS;
+            let confirmed = confirmed(&tried);
             tried.sort_by(|a, b| a.cost.total_cmp(&b.cost));
             // a confirmed minimum has nothing to refine: the restarts came back to it
             let refined = if confirmed { 0 } else { RESTARTS_REFINED.min(tried.len()) };
