@@ -21,11 +21,10 @@
 //!
 //! CI runs the study at the size the criteria ask for: 12 trials per family
 //! (72), 8 pairs and 20 null trials (about 12 minutes in the test profile on
-//! two cores). On the code of today: right kind and place first 77/80,
-//! within 1.5 times the noise 78/80, true values within 3 sd 59/67, both
-//! effects of a pair 8/8, null trials clean 20/20. `cargo xtask heldout`
-//! runs it with 16 pairs (the first 8 are CI's) in the release profile:
-//! 85/88, 84/88, 65/74, 16/16 and 20/20. `HELD_OUT_SINGLE` (per family),
+//! two cores). On 2026-11-28: right kind and place first 78/80, within 1.5
+//! times the noise 79/80, true values within 3 sd 58/67, both effects of a
+//! pair 8/8, null trials clean 20/20 (`cargo xtask heldout` runs the same
+//! size, `RFM_STUDY=full`). `HELD_OUT_SINGLE` (per family),
 //! `HELD_OUT_PAIRS` and `HELD_OUT_NULL` set the numbers of trials (a smaller
 //! study checks the rates but not the counts); `HELD_OUT_ONLY=i,j,...` runs
 //! those trials alone and `HELD_OUT_DUMP=DIR` writes
