@@ -410,6 +410,52 @@ fn add_joint(ctx: &Ctx<'_>, model: &mut Model, entries: &[&Spanned<RawJoint>]) -
     Ok(())
 }
 
+/// The spring keys of the translations (`kx`, `ky`, and `kz` in space).
+fn translation_keys(dim: Dimension) -> Vec<&'static str> {
+    dim.translations().iter().map(|&d| dim.spring_key(d)).collect()
+}
+
+/// The stiffnesses of a resonator's or shaker's spring (`r`), which act in
+/// translations only: a rotational one is refused where written, saying
+/// `why`.
+fn translational_springs(
+    ctx: &Ctx<'_>,
+    dim: Dimension,
+    r: &RawResonator,
+    what: &str,
+    why: &str,
+) -> Result<PerDof, CaseError> {
+    if let Some((key, v)) = r.stiffnesses().into_iter().skip(3).find_map(|(key, v)| Some((key, v?))) {
+        let keys = translation_keys(dim).join(", ");
+        return Err(ctx.err(v.span(), format!("{what}: `{key}`: {why} ({keys})")));
+    }
+    let mut k = PerDof::default();
+    for (d, v) in stiffnesses(ctx, dim, what, r.stiffnesses())? {
+        k[d] = v;
+    }
+    Ok(k)
+}
+
+/// Where the new node of a resonator or shaker entry `s` goes (its node's
+/// position) and its id (`new_node`, or the largest id + 1).
+fn new_node_at(
+    ctx: &Ctx<'_>,
+    model: &Model,
+    s: &Spanned<RawResonator>,
+    what: &str,
+) -> Result<([f64; 3], u32), CaseError> {
+    let r = s.get_ref();
+    let at = model
+        .node(NodeId(r.node))
+        .map(|n| n.position())
+        .ok_or_else(|| ctx.err(s.span(), format!("{what}: node {} does not exist", r.node)))?;
+    let id = match r.new_node {
+        Some(id) => id,
+        None => model.max_node_id().checked_add(1).ok_or_else(|| ctx.err(s.span(), "node ids are exhausted"))?,
+    };
+    Ok((at, id))
+}
+
 /// A resonator (`[[resonators]]`): a new node coincident with `node`, a
 /// spring named as the entry between the two in the translations given a
 /// stiffness, a lumped mass `m` of the same name on the new node, both in
@@ -420,19 +466,10 @@ pub(super) fn add_resonator(ctx: &Ctx<'_>, model: &mut Model, s: &Spanned<RawRes
     let r = s.get_ref();
     let dim = model.dimension();
     let what = format!("resonator `{}`", r.name);
-    let keys: Vec<&str> = dim.translations().iter().map(|&d| dim.spring_key(d)).collect();
+    let keys = translation_keys(dim);
     // a mass without rotary inertia on a rotational spring would move in
     // no direction: a resonator acts in translations
-    if let Some((key, v)) = r.stiffnesses().into_iter().skip(3).find_map(|(key, v)| Some((key, v?))) {
-        return Err(ctx.err(
-            v.span(),
-            format!("{what}: `{key}`: a resonator's spring acts in translations ({})", keys.join(", ")),
-        ));
-    }
-    let mut k = PerDof::default();
-    for (d, v) in stiffnesses(ctx, dim, &what, r.stiffnesses())? {
-        k[d] = v;
-    }
+    let k = translational_springs(ctx, dim, r, &what, "a resonator's spring acts in translations")?;
     let acts = k.non_zero(dim.translations());
     if acts.is_empty() {
         return Err(ctx.err(
@@ -440,14 +477,7 @@ pub(super) fn add_resonator(ctx: &Ctx<'_>, model: &mut Model, s: &Spanned<RawRes
             format!("{what}: give the stiffness of its spring in the directions it acts in ({})", keys.join(", ")),
         ));
     }
-    let at = model
-        .node(NodeId(r.node))
-        .map(|n| n.position())
-        .ok_or_else(|| ctx.err(s.span(), format!("{what}: node {} does not exist", r.node)))?;
-    let id = match r.new_node {
-        Some(id) => id,
-        None => model.max_node_id().checked_add(1).ok_or_else(|| ctx.err(s.span(), "node ids are exhausted"))?,
-    };
+    let (at, id) = new_node_at(ctx, model, s, &what)?;
     let g = group_ref(ctx, model, &r.group)?;
     let held: Vec<Dof> = dim.dofs().iter().copied().filter(|d| !acts.contains(d)).collect();
     let err = |e| ctx.model_err(s.span(), e);
@@ -469,16 +499,8 @@ pub(super) fn add_shaker(ctx: &Ctx<'_>, model: &mut Model, s: &Spanned<RawShaker
     let r = s.get_ref();
     let dim = model.dimension();
     let what = format!("shaker `{}`", r.name);
-    let keys: Vec<&str> = dim.translations().iter().map(|&d| dim.spring_key(d)).collect();
-    if let Some((key, v)) = r.stiffnesses().into_iter().skip(3).find_map(|(key, v)| Some((key, v?))) {
-        return Err(
-            ctx.err(v.span(), format!("{what}: `{key}`: a shaker drives in a translation ({})", keys.join(", ")))
-        );
-    }
-    let mut k = PerDof::default();
-    for (d, v) in stiffnesses(ctx, dim, &what, r.stiffnesses())? {
-        k[d] = v;
-    }
+    let keys = translation_keys(dim);
+    let k = translational_springs(ctx, dim, r, &what, "a shaker drives in a translation")?;
     let acts = k.non_zero(dim.translations());
     let [drive] = acts[..] else {
         return Err(ctx.err(
@@ -489,14 +511,7 @@ pub(super) fn add_shaker(ctx: &Ctx<'_>, model: &mut Model, s: &Spanned<RawShaker
             ),
         ));
     };
-    let at = model
-        .node(NodeId(r.node))
-        .map(|n| n.position())
-        .ok_or_else(|| ctx.err(s.span(), format!("{what}: node {} does not exist", r.node)))?;
-    let id = match r.new_node {
-        Some(id) => id,
-        None => model.max_node_id().checked_add(1).ok_or_else(|| ctx.err(s.span(), "node ids are exhausted"))?,
-    };
+    let (at, id) = new_node_at(ctx, model, s, &what)?;
     let g = group_ref(ctx, model, &r.group)?;
     let held: Vec<Dof> = dim.dofs().iter().copied().filter(|&d| d != drive).collect();
     let err = |e| ctx.model_err(s.span(), e);
