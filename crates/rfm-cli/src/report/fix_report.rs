@@ -396,7 +396,15 @@ pub(crate) fn write(
     let as_read = rfm_update::checks::corrected(&study.measured_as_read(), &outcome.findings)?;
     let measured = &as_read;
     let corrected = rfm_update::checks::corrected(study.measured(), &outcome.findings)?;
-    let unweighted = quantities::noise(study.system(), &corrected, None)?;
+    // read as the loop reads it: against the nominal and the fixed model,
+    // the lower (the data's own roughness reads high over dense modes; a
+    // model near the structure leaves only the noise in its residual)
+    let mut unweighted = quantities::noise(study.system(), &corrected, None)?;
+    if let Some(f) = fixed
+        && let Some(n) = quantities::noise(f, &corrected, None)?
+    {
+        unweighted = Some(unweighted.map_or(n, |u| u.min(n)));
+    }
     let data = Data::new(measured, study.per_volt(), unweighted);
     let weights = study.line_weights(measured)?;
     let gains = match study.gains() {
