@@ -101,6 +101,28 @@ impl Default for FixOptions {
     }
 }
 
+/// A stage updated again from a better start: the next step's effect,
+/// added and updated, left no more than the parameters before it at the
+/// values its fit reached (it was not needed at its own fit: the first
+/// update had stopped in a local minimum, and the effect only led the
+/// optimiser out). The stage's misfit, parameters and case are those of
+/// the update from that start.
+#[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct Refit {
+    /// The misfit the stage's first update ended at.
+    pub first_misfit: f64,
+    /// The effect whose fit found the lower minimum.
+    pub found_by: String,
+    /// The misfit with that effect, updated.
+    pub misfit_with_it: f64,
+    /// The evidence for that effect at its own fit: the change of the
+    /// information criterion from the parameters before it at the values
+    /// its fit reached to the model with it (not below the significance:
+    /// it was not needed).
+    pub delta_bic_there: f64,
+}
+
 /// Step 0: the case's own `[update]` parameters updated before any effect is added.
 #[derive(Clone, Debug)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
@@ -117,6 +139,9 @@ pub struct DeclaredStep {
     pub parameters: Vec<ParameterReport>,
     /// Their uncertainty.
     pub uncertainty: Option<UncertaintyReport>,
+    /// Updated again from a better start ([`Refit`]); `misfit_updated`,
+    /// `status`, `parameters` and `case` are then that update's.
+    pub refit: Option<Refit>,
     /// The case after it.
     #[cfg_attr(feature = "serde", serde(skip))]
     pub case: CaseEditor,
@@ -161,6 +186,10 @@ pub struct FixStep {
     /// `found_after_step`); `case`, `parameters` and `status` are then that
     /// update's.
     pub corrected_misfit: Option<f64>,
+    /// Updated again from a better start ([`Refit`]): the misfit, status,
+    /// parameters and case above are then that update's (after any data
+    /// correction, `corrected_misfit` is its misfit).
+    pub refit: Option<Refit>,
     /// The case after this step (write it with [`CaseEditor::text_at`]).
     #[cfg_attr(feature = "serde", serde(skip))]
     pub case: CaseEditor,
@@ -194,6 +223,7 @@ impl FixStep {
             replaced,
             removed: false,
             corrected_misfit: None,
+            refit: None,
             case: a.editor,
         }
     }
@@ -396,6 +426,19 @@ pub enum FixProgress<'a> {
         /// How the update ended.
         status: &'a Status,
     },
+    /// The stage before (step 0, or the last step) was updated again from
+    /// the start an effect's fit found, the effect not being needed there
+    /// ([`Refit`]); a `Declared` or `StepDone` with the stage follows.
+    Refitted {
+        /// Effects added before the effect tried.
+        step: usize,
+        /// What was found.
+        refit: &'a Refit,
+        /// The misfit after the update from the better start.
+        misfit: f64,
+        /// How that update ended.
+        status: &'a Status,
+    },
     /// A step is finished and will stay in the outcome: its effect added (or
     /// taken out), every parameter updated, and the data checked again after
     /// it. It carries the whole step, its case among it, so that a caller
@@ -492,6 +535,10 @@ struct Added {
     outcome: crate::study::UpdateOutcome,
 }
 
+/// An update's result: the case's editor holding the updated values, the
+/// case it holds, its misfit statistics and the update's outcome.
+type Updated = (CaseEditor, CaseFile, MisfitStats, crate::study::UpdateOutcome);
+
 /// The loop's state shared by its parts: the data, options and evidence.
 struct Loop<'a> {
     /// The data the models are fitted to (corrected).
@@ -538,6 +585,57 @@ impl Loop<'_> {
         Ok(Added { effect: d.ranking[rank - 1].clone(), rank, editor, case, stats, outcome })
     }
 
+    /// Whether the effect `a` added to `current` (at misfit `state`) was
+    /// needed at its own fit: the parameters of `current` set to the values
+    /// `a`'s update reached, without the effect, must leave more than `a`
+    /// by the significance. When they do not (the update before it had
+    /// stopped in a local minimum, and the effect only led the optimiser
+    /// out: a modulus 20 % high declared on a frame's band of 30 modes
+    /// stalled at 217 times the noise, and a damping patch whose update
+    /// moved the modulus reached the noise), `current` is updated again
+    /// from those values and returned with the [`Refit`] record (`None`:
+    /// the effect was needed, or the start is no better than `state`).
+    fn not_needed(
+        &self,
+        current: &CaseFile,
+        state: State,
+        a: &Added,
+        step: usize,
+        last: bool,
+    ) -> Result<Option<(Refit, Updated)>, UpdateError> {
+        if state.k == 0 {
+            return Ok(None);
+        }
+        let study = Study::with_measured(current.clone(), self.data.clone())?;
+        let reached = a.outcome.system.model();
+        let mut values = Vec::new();
+        for (name, _) in crate::params::quantity_values(study.parameters(), &current.model) {
+            let Ok(q) = reached.quantity(&name) else { return Ok(None) };
+            values.push((name, reached.get(q)));
+        }
+        let mut editor = current.editor()?;
+        editor.set_values(&values, &format!("from where the fit with {} ended", a.effect.description))?;
+        let start = CaseFile::parse(&current.path, &editor.text_at(&current.path)?)?;
+        let without = self.stats(&damping::DampedSystem::new(start.model.clone())?)?;
+        let k_with = a.outcome.parameters.len();
+        let there = diagnose::delta_bic(without.misfit, state.k, &a.stats, k_with, self.evidence.noise);
+        let better = diagnose::delta_bic(state.misfit, state.k, &without, state.k, self.evidence.noise);
+        if there < -self.evidence.significance || better >= -self.evidence.significance {
+            return Ok(None);
+        }
+        let again = self.update_case(current, editor, step, last)?;
+        if again.2.misfit > without.misfit {
+            return Ok(None);
+        }
+        let refit = Refit {
+            first_misfit: state.misfit,
+            found_by: a.effect.description.clone(),
+            misfit_with_it: a.stats.misfit,
+            delta_bic_there: there,
+        };
+        Ok(Some((refit, again)))
+    }
+
     /// Updates every parameter of the `[update]` of the case `editor` holds
     /// by output error on the diagnosis's lines; returns the editor with the
     /// updated values and the misfit in the case's history (as step
@@ -553,7 +651,7 @@ impl Loop<'_> {
         editor: CaseEditor,
         step: usize,
         last: bool,
-    ) -> Result<(CaseEditor, CaseFile, MisfitStats, crate::study::UpdateOutcome), UpdateError> {
+    ) -> Result<Updated, UpdateError> {
         let first = self.update_once(current, editor.clone(), step, last)?;
         if judge::stationary(&first.3) {
             return Ok(first);
@@ -583,7 +681,7 @@ impl Loop<'_> {
         mut editor: CaseEditor,
         step: usize,
         last: bool,
-    ) -> Result<(CaseEditor, CaseFile, MisfitStats, crate::study::UpdateOutcome), UpdateError> {
+    ) -> Result<Updated, UpdateError> {
         let opts = self.opts;
         let lines = opts.diagnose.lines;
         let added = CaseFile::parse(&current.path, &editor.text_at(&current.path)?)?;
@@ -819,6 +917,7 @@ pub fn prepare(
                 status: outcome.status.clone(),
                 parameters: outcome.parameters.clone(),
                 uncertainty: outcome.uncertainty.clone(),
+                refit: None,
                 case: editor,
             };
             progress(FixProgress::Declared { step: &step });
@@ -902,7 +1001,7 @@ pub fn fix(
     let (nominal, corrected) = (p.nominal_misfit, p.corrected_misfit);
     let mut findings = p.findings;
     let mut extra_hz = p.extra_modes_hz;
-    let declared = p.declared;
+    let mut declared = p.declared;
     let mut current = p.case;
     let mut state = p.state;
 
@@ -1030,6 +1129,59 @@ pub fn fix(
         };
         moves.sort_by(|a, b| score(a).total_cmp(&score(b)));
         let best = moves.remove(0);
+        // an effect not needed at its own fit: the stage before had stopped
+        // in a local minimum, and is updated again from where this fit
+        // ended (the effect is not added; the diagnosis is made again)
+        if let [(a, _)] = best.steps.as_slice()
+            && let Some((refit, (mut editor, mut case, stats, outcome))) =
+                fl.not_needed(&current, state, a, steps.len(), last).ok().flatten()
+        {
+            let status = step_status(&outcome);
+            progress(FixProgress::Refitted { step: steps.len(), refit: &refit, misfit: stats.misfit, status: &status });
+            let mut h = case.history.clone();
+            if let Some(e) = h.last_mut() {
+                e.step = format!("{} again, from where the fit with {} ended", e.step, refit.found_by);
+            }
+            editor.set_history(&h)?;
+            case.history = h;
+            let k = outcome.parameters.len();
+            let n = steps.len();
+            if n > 0 {
+                let (before, k_before) = match n {
+                    1 => declared.as_ref().map_or((corrected, 0), |d| (d.misfit_updated, d.parameters.len())),
+                    _ => {
+                        let p = &steps[n - 2];
+                        (p.corrected_misfit.unwrap_or(p.misfit_updated), p.parameter_count)
+                    }
+                };
+                let s = steps.last_mut().expect("a step");
+                s.delta_bic = diagnose::delta_bic(before, k_before, &stats, k, noise);
+                if s.corrected_misfit.is_some() {
+                    s.corrected_misfit = Some(stats.misfit);
+                } else {
+                    s.misfit_updated = stats.misfit;
+                }
+                s.status = status;
+                s.parameters = outcome.parameters;
+                s.uncertainty = outcome.uncertainty;
+                s.case = editor;
+                s.refit = Some(refit);
+                progress(FixProgress::StepDone { index: n - 1, done: s });
+            } else if let Some(d) = declared.as_mut() {
+                d.misfit_updated = stats.misfit;
+                d.delta_bic = diagnose::delta_bic(d.misfit_before, 0, &stats, k, noise);
+                d.status = status;
+                d.parameters = outcome.parameters;
+                d.uncertainty = outcome.uncertainty;
+                d.case = editor;
+                d.refit = Some(refit);
+                progress(FixProgress::Declared { step: d });
+                base = case.clone();
+            }
+            current = case;
+            state = State { misfit: stats.misfit, k };
+            continue;
+        }
         // alternatives at other places that the evidence cannot tell from the best
         let first = best.last();
         let mut alternatives: Vec<LookAhead> = Vec::new();

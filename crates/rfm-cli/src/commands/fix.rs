@@ -363,6 +363,16 @@ fn progress_lines_after(p: &FixProgress<'_>, done: usize) -> Vec<String> {
                 table::misfit(*misfit)
             )]
         }
+        FixProgress::Refitted { step, refit, misfit, status } => vec![format!(
+            "  {} was not needed at its own fit (dBIC {} there): {} updated again from where that fit ended ({}); \
+             misfit {} -> {}",
+            refit.found_by,
+            table::dbic(refit.delta_bic_there),
+            if *step == 0 { "the case's own parameters".to_string() } else { format!("step {}", done + step) },
+            status.name(),
+            table::misfit(refit.first_misfit),
+            table::misfit(*misfit)
+        )],
         // the step was announced by `Updated`; this one is for keeping it
         FixProgress::StepDone { .. } => Vec::new(),
     }

@@ -80,6 +80,21 @@ pub(crate) fn stage_dbics(o: &FixOutcome) -> Vec<String> {
     bics
 }
 
+/// What a stage updated again from a better start says ([`Refit`]).
+pub(crate) fn refit_text(r: &rfm_update::fix::Refit, times: impl Fn(f64) -> String) -> String {
+    format!(
+        "its first update ended at {} ({} x noise), in a local minimum: the next effect tried, {}, reached {} but \
+         was not needed there (dBIC {} without it at the values its fit reached, not below {}); it was not added, \
+         and every parameter was updated again from those values (the misfit above)",
+        table::misfit(r.first_misfit),
+        times(r.first_misfit),
+        r.found_by,
+        table::misfit(r.misfit_with_it),
+        table::dbic(r.delta_bic_there),
+        quantities::SIGNIFICANT_DBIC
+    )
+}
+
 /// A stage label of a resumed run with its step number counted from the
 /// first run's start: `updated after step 1` after 2 earlier steps reads
 /// `updated after step 3`; its step 0 updates the parameters of the
@@ -330,6 +345,9 @@ pub(crate) fn write(
                 "after the data found wrong since were corrected".into(),
                 format!("{} ({} x noise), every parameter updated again", table::misfit(m), times(m)),
             ));
+        }
+        if let Some(r) = &s.refit {
+            facts.push(("updated again".into(), refit_text(r, times)));
         }
         facts.push(("case file".into(), step_file(k + 1)));
         if !e.gains.is_empty() {

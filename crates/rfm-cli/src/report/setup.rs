@@ -146,6 +146,9 @@ pub(crate) fn blocks(
                 ),
             ),
         ]));
+        if let Some(r) = &d.refit {
+            blocks.push(Block::Facts(vec![("updated again".into(), super::fix_report::refit_text(r, times))]));
+        }
         let mut t = Table::new(&["parameter", "unit", "given", "updated", "+-1 sd"])
             .caption("Step 0: the parameters the case declares under [update], updated first.");
         for (i, p) in d.parameters.iter().enumerate() {
