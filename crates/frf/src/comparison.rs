@@ -71,13 +71,25 @@ pub fn compare_modes(
     measured: &FrfSet,
     min_mac: f64,
 ) -> Result<ModalComparison, ComparisonError> {
+    compare_modes_with(system, measured, min_mac, LscfOptions::new(0.0, 0.0).orders)
+}
+
+/// As [`compare_modes`], the LSCF run over the model `orders` given (the
+/// other options the defaults): a heavily damped mode beside lightly damped
+/// ones needs higher orders to stabilise than the defaults reach.
+pub fn compare_modes_with(
+    system: &DampedSystem,
+    measured: &FrfSet,
+    min_mac: f64,
+    orders: std::ops::RangeInclusive<usize>,
+) -> Result<ModalComparison, ComparisonError> {
     let rec = measured.to_receptance();
     let f = rec.frequencies_hz();
     let band = match (f.first(), f.last()) {
         (Some(&a), Some(&b)) => (a, b),
         _ => return Err(ComparisonError::NoLines),
     };
-    let estimate = lscf(&rec, &LscfOptions::new(band.0, band.1))?;
+    let estimate = lscf(&rec, &LscfOptions { orders, ..LscfOptions::new(band.0, band.1) })?;
     let meas = measured_modes(&estimate);
     // model modes above the band too, so that a measured mode near its top
     // is paired with a partner the model has moved out of it (and says so)

@@ -91,7 +91,7 @@ pub mod set;
 pub mod solver;
 pub mod synth;
 
-pub use comparison::{ComparisonError, ModalComparison, compare_modes};
+pub use comparison::{ComparisonError, ModalComparison, compare_modes, compare_modes_with};
 pub use correlation::{BandSpec, Correlation, correlate};
 pub use error::{FileError, FrfError, MismatchError};
 pub use lscf::{EstimatedMode, LscfError, LscfOptions, ModalEstimate, PoleStatus, lscf};

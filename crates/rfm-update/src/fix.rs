@@ -63,6 +63,7 @@ use crate::status::Status;
 use crate::study::{ParameterReport, Study};
 use crate::uncertainty::UncertaintyReport;
 
+mod explains;
 mod judge;
 mod pairs;
 mod remains;
@@ -545,6 +546,10 @@ struct Loop<'a> {
     data: FrfSet,
     opts: &'a FixOptions,
     evidence: Evidence,
+    /// Frequencies (Hz) of the measured modes the model lacked before any
+    /// step or after one: the modes resonators are offered for, and judged
+    /// by (`fix/explains.rs`).
+    modes_hz: Vec<f64>,
 }
 
 impl Loop<'_> {
@@ -567,6 +572,26 @@ impl Loop<'_> {
 }
 
 impl Loop<'_> {
+    /// The verdict of the loop's rule on `after` (see [`Evidence::judge`]),
+    /// and, for a step that passes it with resonators, whether each
+    /// explains the mode it was offered for (`fix/explains.rs`): one that
+    /// leaves that mode's lines far above the noise is the wrong form.
+    fn judge(&self, before: State, after: &Added, effects: &[(&Diagnosis, usize)]) -> judge::Verdict {
+        let mut v = self.evidence.judge(before, after, effects);
+        if v.rejected.is_none() {
+            let noise = self.evidence.noise;
+            match explains::unexplained(after, effects, &self.data, &self.opts.diagnose, noise, &self.modes_hz) {
+                Ok(Some(u)) => {
+                    v.rejected = Some(u.reason());
+                    v.unexplained = Some(u);
+                }
+                Ok(None) => {}
+                Err(e) => v.rejected = Some(format!("its resonator's mode could not be compared with the data: {e}")),
+            }
+        }
+        v
+    }
+
     /// Adds ranked effect `rank` of `d` to `current` and updates every
     /// parameter of the case's `[update]` by output error on the diagnosis's
     /// lines; the updated values and the misfit go into the case's history
@@ -900,7 +925,7 @@ pub fn prepare(
             current = with_corrections(case, &findings, opts)?;
         }
     }
-    let fl = Loop { data, opts, evidence };
+    let fl = Loop { data, opts, evidence, modes_hz: Vec::new() };
     let corrected = if fl.data == *measured { nominal } else { fl.stats(&nominal_sys)? };
     let mut state = State { misfit: corrected.misfit, k: 0 };
     // the case's own parameters next
@@ -997,7 +1022,12 @@ pub fn fix(
     let p = prepare(case, measured, opts, &mut progress)?;
     let d_opts = &opts.diagnose;
     let mut noise = p.noise;
-    let mut fl = Loop { data: p.data, opts, evidence: Evidence { noise, significance: d_opts.significance } };
+    let mut fl = Loop {
+        data: p.data,
+        opts,
+        evidence: Evidence { noise, significance: d_opts.significance },
+        modes_hz: p.extra_modes_hz.clone(),
+    };
     let (nominal, corrected) = (p.nominal_misfit, p.corrected_misfit);
     let mut findings = p.findings;
     let mut extra_hz = p.extra_modes_hz;
@@ -1015,6 +1045,8 @@ pub fn fix(
     let mut undecided: Vec<LookAhead> = Vec::new();
     let mut last_diagnosis: Option<Result<Diagnosis, String>>;
     let mut rejected_all: Vec<LookAhead> = Vec::new();
+    // the modes that a resonator tuned to them left unexplained
+    let mut unexplained: Vec<explains::Unexplained> = Vec::new();
     let stop = loop {
         let d = match fl.diagnosed(&current, &extra_hz, steps.len(), &mut progress) {
             Ok(d) => d,
@@ -1046,7 +1078,12 @@ pub fn fix(
             let name = d.ranking[r - 1].description.clone();
             match fl.add_and_update(&current, &d, r, step, last) {
                 Ok(a) => {
-                    let mut verdict = fl.evidence.judge(state, &a, &applied_with(&applied, &d, r));
+                    let mut verdict = fl.judge(state, &a, &applied_with(&applied, &d, r));
+                    if let Some(u) = verdict.unexplained.take()
+                        && !unexplained.iter().any(|x: &explains::Unexplained| x.hz == u.hz)
+                    {
+                        unexplained.push(u);
+                    }
                     if verdict.rejected.is_none() {
                         verdict.rejected = small_share(state.misfit, a.stats.misfit, noise);
                     }
@@ -1244,6 +1281,11 @@ pub fn fix(
         if opts.check_data {
             let sys = damping::DampedSystem::new(current.model.clone())?;
             extra_hz = checks::extra_modes(&sys, &fl.data)?.iter().filter_map(|f| f.frequency_hz).collect();
+            for &f in &extra_hz {
+                if !fl.modes_hz.iter().any(|&g| (g / f - 1.0).abs() < 0.01) {
+                    fl.modes_hz.push(f);
+                }
+            }
             // far from the data, a correction must earn its place (see
             // LATE_CHECKS_BELOW)
             let near = state.misfit <= LATE_CHECKS_BELOW * noise;
@@ -1261,7 +1303,7 @@ pub fn fix(
                 let data = checks::corrected(&fl.data, &late)?;
                 let current = with_corrections(&current, &written, opts)?;
                 let base = with_corrections(&base, &written, opts)?;
-                let trial = Loop { data, opts: fl.opts, evidence: fl.evidence };
+                let trial = Loop { data, opts: fl.opts, evidence: fl.evidence, modes_hz: fl.modes_hz.clone() };
                 let (mut editor, mut case, stats, outcome) =
                     trial.update_case(&current, current.editor()?, steps.len(), steps.len() >= opts.max_steps)?;
                 // the step's history, and this update as what it is
@@ -1400,7 +1442,7 @@ pub fn fix(
     }
     let final_sys = damping::DampedSystem::new(current.model.clone())?;
     let remains = if state.misfit > CONSISTENT * noise {
-        remains::describe(&final_sys, &fl.data, d_opts, noise, &findings)
+        remains::describe(&final_sys, &fl.data, d_opts, noise, &findings, &unexplained)
     } else {
         Vec::new()
     };

@@ -30,6 +30,9 @@ pub(super) struct Verdict {
     pub(super) delta_bic: f64,
     /// Why it is not kept; `None` when it passes.
     pub(super) rejected: Option<String>,
+    /// The mode a resonator of the step left unexplained, when that is why
+    /// it is not kept (see `fix/explains.rs`).
+    pub(super) unexplained: Option<super::explains::Unexplained>,
 }
 
 impl Evidence {
@@ -57,7 +60,7 @@ impl Evidence {
         } else {
             implausible_after(effects, &after.outcome).map(|why| format!("implausible after its update: {why}"))
         };
-        Verdict { delta_bic, rejected }
+        Verdict { delta_bic, rejected, unexplained: None }
     }
 
     /// The evidence for `b` over `a` (two models after the same step),

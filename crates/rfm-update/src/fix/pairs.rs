@@ -80,7 +80,7 @@ pub(super) fn best_pair(
     };
     let (sa, sb) = (alone(a), alone(b));
     let name = |r: usize| d.ranking[r - 1].description.clone();
-    let judge_first = |s: &Added, r: usize| fl.evidence.judge(before, s, &applied_with(applied, d, r));
+    let judge_first = |s: &Added, r: usize| fl.judge(before, s, &applied_with(applied, d, r));
     // the first step: whichever of the two alone has the better evidence
     let firsts: Vec<(usize, Added, super::judge::Verdict)> = [(a, sa.clone()), (b, sb.clone())]
         .into_iter()
@@ -93,7 +93,7 @@ pub(super) fn best_pair(
     let first = firsts.iter().min_by(|x, y| x.2.delta_bic.total_cmp(&y.2.delta_bic)).cloned();
     let mut effects = applied_with(applied, d, a);
     effects.push((d, b));
-    let total = fl.evidence.judge(before, &pair, &effects);
+    let total = fl.judge(before, &pair, &effects);
     let mut record = LookAhead {
         effect: name(a),
         misfit_ahead: pair.stats.misfit,

@@ -4,6 +4,7 @@
 use damping::DampedSystem;
 use frf::{BandSpec, FrfSet};
 
+use super::explains::Unexplained;
 use super::{CONSISTENT, FixStop, LookAhead};
 use crate::checks::{self, Finding, FindingKind};
 use crate::comparison::{self, GainSource};
@@ -20,7 +21,8 @@ const DAMPING_OFF: f64 = 0.3;
 /// Frequencies within this (relative) agree.
 const SAME_FREQUENCY: f64 = 0.01;
 
-/// What the final model (`sys`) leaves unexplained in the data: measured
+/// What the final model (`sys`) leaves unexplained in the data: the modes
+/// a resonator tuned to them left unexplained (`unexplained`), measured
 /// modes it lacks, a channel or a band that holds most of the misfit, a
 /// mode whose damping differs while its frequency agrees (a damping form
 /// the candidates lack). One sentence each; a comparison that cannot be
@@ -31,11 +33,16 @@ pub(super) fn describe(
     opts: &DiagnoseOptions,
     noise: f64,
     findings: &[Finding],
+    unexplained: &[Unexplained],
 ) -> Vec<String> {
-    let mut out = Vec::new();
+    let mut out: Vec<String> = unexplained.iter().map(Unexplained::remains).collect();
     if let Ok(extra) = checks::extra_modes(sys, data) {
         for f in extra {
-            out.push(f.summary);
+            // a mode said above already, with what was tried on it
+            let said = f.frequency_hz.is_some_and(|hz| unexplained.iter().any(|u| (u.hz / hz - 1.0).abs() < 0.05));
+            if !said {
+                out.push(f.summary);
+            }
         }
     }
     for f in findings.iter().filter(|f| f.kind != FindingKind::ExtraMode && f.corrections.is_empty()) {

@@ -273,7 +273,7 @@ pub(super) fn revise(
             && stats.misfit.is_finite()
         {
             let a = Added { effect: own.clone(), rank: applied[index].1, editor, case, stats, outcome };
-            let v = fl.evidence.judge(state, &a, &without);
+            let v = fl.judge(state, &a, &without);
             if v.rejected.is_none() {
                 best = Some((v.delta_bic, None, a));
             }
@@ -310,7 +310,7 @@ pub(super) fn revise(
                     a.effect.description = retitled(&own, &a.effect);
                     a.effect.misfit = state.misfit;
                 }
-                let v = fl.evidence.judge(state, &a, &tried);
+                let v = fl.judge(state, &a, &tried);
                 if v.rejected.is_none() && best.as_ref().is_none_or(|(b, ..)| v.delta_bic < *b) {
                     best = Some((v.delta_bic, Some(other), a));
                 }

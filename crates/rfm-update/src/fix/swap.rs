@@ -78,7 +78,7 @@ pub(super) fn swap(
             let end = &added.last().expect("not empty").0;
             let mut effects: Vec<(&Diagnosis, usize)> = kept_effects.clone();
             effects.push((&first, r));
-            let v = fl.evidence.judge(before, end, &effects);
+            let v = fl.judge(before, end, &effects);
             if v.rejected.is_none() && best.as_ref().is_none_or(|(b, ..)| v.delta_bic < *b) {
                 best = Some((v.delta_bic, outs.clone(), added));
             }
@@ -124,7 +124,7 @@ fn replace(
     let a = fl.add_and_update(kept, first, rank, step, count == 1)?;
     let mut effects: Vec<(&Diagnosis, usize)> = kept_effects.to_vec();
     effects.push((first, rank));
-    let v = fl.evidence.judge(kept_state, &a, &effects);
+    let v = fl.judge(kept_state, &a, &effects);
     if let Some(why) = v.rejected {
         return Err(UpdateError::Method(why));
     }
@@ -140,7 +140,7 @@ fn replace(
         let d = diagnoses.last().expect("pushed");
         let mut with: Vec<(&Diagnosis, usize)> = effects.clone();
         with.push((d, rank));
-        let v = fl.evidence.judge(state, &a, &with);
+        let v = fl.judge(state, &a, &with);
         if v.rejected.is_some() {
             break;
         }

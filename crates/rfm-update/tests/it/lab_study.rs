@@ -42,25 +42,29 @@ use crate::{full_study, study_size};
 
 /// Criteria of issue 32 the loop does not meet yet, with the counts of the
 /// last full run (2026-11-28, 72 trials; data errors reported as such
-/// 38/40 meet their bound and are asserted). The study prints each as not
-/// met, and fails when one is met, so that it is asserted from then on.
-/// Right in full by family: polarity 8/8, swap 8/8, misdirected 6/8, wrong
-/// node 7/8, calibration 7/8, resonator 1/4, shaker 4/4, sensor masses 4/4,
-/// damping form 4/4, null 4/4, phase drift 4/4, skew member 4/4, fin 0/4.
-/// What misses them: three of the four resonators show no mode of their
-/// own that the modal estimate pairs with none (heavily damped, or tuned
-/// beside a mode of the structure), so no resonator is offered and
-/// joints, supports and damping patches explain them in part; a fin's
-/// bending modes, driven by its root's rotation, draw translational
-/// resonators and damping patches before the loop stops; a sensor at the
-/// next node beside a lumped mass draws a stiffness change before the
-/// check finds the sensor; beside a miscalibrated channel corrected after
-/// the first step (the loop at 1.02 times the noise), a shaker at the
-/// drive point takes up what the correction's scale left (to 0.99).
+/// 38/40 and the trials outside every family stopped with exit 9 and a
+/// description 12/12 meet their bounds and are asserted). The study prints
+/// each as not met, and fails when one is met, so that it is asserted from
+/// then on. Right in full by family: polarity 8/8, swap 8/8, misdirected
+/// 6/8, wrong node 7/8, calibration 7/8, resonator 2/4, shaker 4/4, sensor
+/// masses 4/4, damping form 4/4, null 4/4, phase drift 4/4, skew member
+/// 4/4, fin 2/4. What misses them: two resonators heavily damped (a
+/// coupled mode of 12 to 16 % damping at a node that moves little) show no
+/// mode of their own to the modal estimate at any order, so no resonator
+/// is offered and a support and a damping patch explain one of them in
+/// part; beside two fins a damping patch lowers the misfit by more than
+/// half of its excess (the resonators tried on the fins' modes are not
+/// kept: `fix/explains.rs`); a sensor at the next node beside a lumped mass
+/// draws a stiffness change before the check finds the sensor; beside a
+/// miscalibrated channel corrected after the first step (the loop at 1.02
+/// times the noise), a shaker at the drive point takes up what the
+/// correction's scale left (to 0.99).
 const NOT_YET_MET: &[(&str, &str)] = &[
-    ("resonator found", "1/4: three resonators with no mode of their own in the modal estimate"),
-    ("no spurious effect", "64/72: four fins, two resonators, a wrong node and a calibration beside a model error"),
-    ("outside every family: exit 9 with a description", "11/12: a fin ended after its three steps"),
+    ("resonator found", "2/4: two heavily damped resonators with no mode of their own in the modal estimate"),
+    (
+        "no spurious effect",
+        "67/72: two damping patches beside fins, a resonator's, a wrong node and a calibration beside a model error",
+    ),
 ];
 
 /// The families `cargo test` runs one trial of (see the module docs).
@@ -305,4 +309,44 @@ fn the_loop_tells_the_test_set_up_from_the_structure_and_stops_where_nothing_exp
             assert!(rate(k) >= bound, "{k}: {:?} below {bound}", table.get(k));
         }
     }
+}
+
+/// The rule that tells a resonator which explains the mode it was offered
+/// for from one that bends toward a mode of another form
+/// (`fix/explains.rs`), on both, as the full study draws them: trial 20, a
+/// 77 g resonator with 3.4 % damping between the cantilever's first two
+/// modes, is found, alone, and the data explained; trial 49, a fin across
+/// the cantilever whose bending its root's rotation drives, draws
+/// resonators tuned to its mode that leave that mode's lines far above the
+/// noise: none is kept, the loop stops as inadequate, and what remains
+/// names the mode.
+#[test]
+fn a_resonator_that_explains_its_mode_is_kept_and_one_bent_toward_a_fin_is_not() {
+    let draws = lab::trials(4, 2711);
+    let (res, fin) = (&draws[20], &draws[49]);
+    assert_eq!((res.family, fin.family), (LabFamily::Resonator, LabFamily::Fin), "the full study's draws");
+    let r = run(res, 8020);
+    let o = &r.outcome;
+    println!(
+        "{}: {:?} {:?} at {:.2} x noise",
+        r.label,
+        o.effects.iter().map(|e| &e.description).collect::<Vec<_>>(),
+        o.stop,
+        o.final_misfit() / o.noise
+    );
+    assert!(r.score.effects && r.score.spurious.is_empty() && o.explained(), "{}: {:?}", r.label, r.score);
+    let f = run(fin, 8049);
+    let o = &f.outcome;
+    println!(
+        "{}: {:?} {:?}; {}; remains {:?}",
+        f.label,
+        o.effects.iter().map(|e| &e.description).collect::<Vec<_>>(),
+        o.stop,
+        o.stop_reason,
+        o.remains
+    );
+    assert!(!o.effects.iter().any(|e| e.kind == EffectKind::Resonator), "{}: {:?}", f.label, o.effects);
+    assert!(f.exit9 && f.score.spurious.is_empty(), "{}: {:?} {:?}", f.label, o.stop, f.score);
+    assert!(o.stop_reason.contains("the wrong form for the data's mode at"), "{}", o.stop_reason);
+    assert!(o.remains.iter().any(|s| s.contains("which no candidate explains")), "{:?}", o.remains);
 }
