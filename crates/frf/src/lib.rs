@@ -100,7 +100,7 @@ pub use modal::{
 };
 pub use noise::NoiseModel;
 pub use set::{Channel, FrfKind, FrfSet};
-pub use solver::{FactorKind, Layout, SelectedInverse, Workspace, ZSolver};
+pub use solver::{FactorKind, Layout, Reach, SelectedInverse, Workspace, ZSolver};
 pub use synth::{equation_of, receptance_columns, synthesize, synthesize_regular, synthesize_with};
 
 /// Complex double.

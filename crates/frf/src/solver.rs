@@ -382,6 +382,35 @@ impl ZSolver {
         eqs: &[usize],
         x: &mut Vec<C64>,
         freq_hz: f64,
+        visit: impl FnMut(usize, &[C64]),
+    ) -> Result<(), FrfError> {
+        self.solve_units_in(ws, eqs, x, freq_hz, None, visit)
+    }
+
+    /// As [`Self::solve_units_ordered`], where only the rows of `within`
+    /// (from [`Self::reach`] of the equations whose rows are read, which
+    /// must include `eqs`) are wanted: the rows outside it are left
+    /// undefined, and the substitutions skip what they do not need. The
+    /// rows of `within` are bit for bit those of the whole solve. Where the
+    /// factorisation held is not a simplicial `L D L^T` every row is solved.
+    pub fn solve_units_within(
+        &self,
+        ws: &mut Workspace,
+        eqs: &[usize],
+        within: &Reach,
+        x: &mut Vec<C64>,
+        freq_hz: f64,
+    ) -> Result<(), FrfError> {
+        self.solve_units_in(ws, eqs, x, freq_hz, within.rows.as_deref(), |_, _| {})
+    }
+
+    fn solve_units_in(
+        &self,
+        ws: &mut Workspace,
+        eqs: &[usize],
+        x: &mut Vec<C64>,
+        freq_hz: f64,
+        within: Option<&[bool]>,
         mut visit: impl FnMut(usize, &[C64]),
     ) -> Result<(), FrfError> {
         let (n, k) = (self.n(), eqs.len());
@@ -390,7 +419,7 @@ impl ZSolver {
             let mut rows = std::mem::take(&mut ws.buf_rows);
             rows.clear();
             rows.extend(eqs.iter().map(|&e| self.position(e)));
-            let finite = self.ldlt.solve_units(&mut ws.ldlt, &rows, x, visit);
+            let finite = self.ldlt.solve_units(&mut ws.ldlt, &rows, x, within, visit);
             ws.buf_rows = rows;
             return if finite { Ok(()) } else { Err(FrfError::Singular { freq_hz }) };
         }
@@ -441,6 +470,26 @@ impl ZSolver {
     }
 }
 
+/// The part of a factorisation that the solution at some equations, and the
+/// entries of `Z^-1` between them, depend on ([`ZSolver::reach`]): the
+/// equations and their ancestors in the elimination tree. A solve or a
+/// selected inversion restricted to it ([`ZSolver::solve_units_within`],
+/// [`ZSolver::selected_inverse_within`]) skips the rest of the factor.
+#[derive(Clone, Debug)]
+pub struct Reach {
+    /// Per internal row, whether it is in the reach; `None`: every row (the
+    /// supernodal layout).
+    rows: Option<Vec<bool>>,
+}
+
+impl Reach {
+    /// How many of the factor's rows it holds; `None` where it holds every
+    /// row (the supernodal layout).
+    pub fn rows(&self) -> Option<usize> {
+        self.rows.as_ref().map(|r| r.iter().filter(|&&b| b).count())
+    }
+}
+
 /// Entries of `Z^-1` on the pattern of the factor (`L + L^T` plus the
 /// diagonal), made by [`ZSolver::selected_inverse`] and read with
 /// [`ZSolver::inverse_entry`] and [`ZSolver::inverse_block`].
@@ -467,6 +516,17 @@ impl SelectedInverse {
 
 /// Selected inversion: entries of `Z^-1` without a solve per equation.
 impl ZSolver {
+    /// The part of the factorisation that the solution at the equations
+    /// `eqs`, and the entries of `Z^-1` between them, depend on (see
+    /// [`Reach`]).
+    ///
+    /// # Panics
+    ///
+    /// When an equation is out of range.
+    pub fn reach(&self, eqs: impl IntoIterator<Item = usize>) -> Reach {
+        Reach { rows: self.ldlt.reach(eqs.into_iter().map(|e| self.position(e))) }
+    }
+
     /// `Z^-1` on the pattern of the factor, from the `L D L^T` factors in
     /// `ws`, by the Takahashi equations (see the module docs): about the
     /// cost of the numeric factorisation, whatever the number of entries
@@ -478,6 +538,31 @@ impl ZSolver {
     /// [`FrfError::Singular`] when an entry is not finite. On error `out`
     /// holds nothing that can be read.
     pub fn selected_inverse(&self, ws: &Workspace, out: &mut SelectedInverse) -> Result<(), FrfError> {
+        self.selected_inverse_in(ws, out, None)
+    }
+
+    /// As [`Self::selected_inverse`], where only the entries between the
+    /// equations of `within` (from [`Self::reach`]) are read afterwards:
+    /// only the columns of the factor they depend on are inverted (about
+    /// the cost of the factorisation when they lie in a few places of a
+    /// large model), bit for bit as the whole inversion makes them. Other
+    /// entries are left undefined. The supernodal layout inverts every
+    /// column.
+    pub fn selected_inverse_within(
+        &self,
+        ws: &Workspace,
+        within: &Reach,
+        out: &mut SelectedInverse,
+    ) -> Result<(), FrfError> {
+        self.selected_inverse_in(ws, out, within.rows.as_deref())
+    }
+
+    fn selected_inverse_in(
+        &self,
+        ws: &Workspace,
+        out: &mut SelectedInverse,
+        within: Option<&[bool]>,
+    ) -> Result<(), FrfError> {
         out.ready = false;
         if ws.kind != Some(FactorKind::Ldlt) {
             return Err(FrfError::NoLdltFactors { held: ws.kind });
@@ -488,7 +573,7 @@ impl ZSolver {
         if out.values.len() != len {
             out.values = vec![ZERO; len];
         }
-        if !self.ldlt.selected_inverse(&ws.ldlt, &mut out.values, &mut out.scratch) {
+        if !self.ldlt.selected_inverse(&ws.ldlt, &mut out.values, &mut out.scratch, within) {
             return Err(FrfError::Singular { freq_hz: ws.freq_hz });
         }
         out.ready = true;

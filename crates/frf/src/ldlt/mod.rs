@@ -240,17 +240,33 @@ impl Analysis {
     /// `visit(r, &x[r * k..])` is called for each internal row `r`, from the
     /// last to the first, as soon as rows `r..n` are final (while they are
     /// still in cache).
+    ///
+    /// With `within` (from [`Self::reach`]) the simplicial layout solves
+    /// only for its rows, and visits only them; the others are left
+    /// undefined. The supernodal layout solves for every row.
     pub(crate) fn solve_units<V: FnMut(usize, &[C64])>(
         &self,
         num: &mut Factors,
         rows: &[usize],
         x: &mut [C64],
+        within: Option<&[bool]>,
         visit: V,
     ) -> bool {
         match (self, num) {
-            (Analysis::Simplicial(a), Factors::Simplicial(f)) => a.solve_units(f, rows, x, visit),
+            (Analysis::Simplicial(a), Factors::Simplicial(f)) => a.solve_units(f, rows, x, within, visit),
             (Analysis::Supernodal(a), Factors::Supernodal(f)) => a.solve_units(f, rows, x, visit),
             _ => unreachable!("factors of another layout"),
+        }
+    }
+
+    /// The internal rows `rows` and every row the solution there, or the
+    /// selected inverse between them, depends on (their ancestors in the
+    /// elimination tree), as a mask over the internal rows; `None` in the
+    /// supernodal layout, whose solves and inversions cover every row.
+    pub(crate) fn reach(&self, rows: impl IntoIterator<Item = usize>) -> Option<Vec<bool>> {
+        match self {
+            Analysis::Simplicial(a) => Some(a.reach(rows)),
+            Analysis::Supernodal(_) => None,
         }
     }
 
@@ -278,14 +294,24 @@ impl Analysis {
     /// [`Self::inverse_len`], read through [`Self::inverse_position`]).
     /// Allocates nothing once `scratch` has been used with this analysis.
     /// Returns whether every entry is finite.
-    pub(crate) fn selected_inverse(&self, num: &Factors, out: &mut [C64], scratch: &mut InverseScratch) -> bool {
+    ///
+    /// With `within` (from [`Self::reach`]) the simplicial layout inverts
+    /// only its columns (the entries between its rows); the supernodal
+    /// layout inverts every column.
+    pub(crate) fn selected_inverse(
+        &self,
+        num: &Factors,
+        out: &mut [C64],
+        scratch: &mut InverseScratch,
+        within: Option<&[bool]>,
+    ) -> bool {
         match (self, num) {
             (Analysis::Simplicial(a), Factors::Simplicial(f)) => {
                 if scratch.slot.len() != a.n() {
                     scratch.slot = vec![NOT_IN_COLUMN; a.n()];
                 }
                 let (diag, lower) = out.split_at_mut(a.n());
-                a.selected_inverse(f, diag, lower, &mut scratch.slot)
+                a.selected_inverse(f, diag, lower, &mut scratch.slot, within)
             }
             (Analysis::Supernodal(a), Factors::Supernodal(f)) => {
                 a.selected_inverse(f, out, &mut scratch.work, &mut scratch.rel)

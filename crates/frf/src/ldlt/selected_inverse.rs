@@ -16,6 +16,27 @@ fn is_finite(z: C64) -> bool {
 }
 
 impl SymbolicLdlt {
+    /// The internal rows `rows` and their ancestors in the elimination tree
+    /// (the parent of a column is the first row of `L` below its diagonal),
+    /// as a mask over the internal rows. The set is closed: the rows of
+    /// `L`'s column `j` are ancestors of `j`, so the solution of `L^T x = y`
+    /// on these rows, and the selected inverse on these columns, read
+    /// nothing outside it.
+    pub(crate) fn reach(&self, rows: impl IntoIterator<Item = usize>) -> Vec<bool> {
+        let mut mask = vec![false; self.n];
+        for r in rows {
+            mask[r] = true;
+        }
+        // ascending: a column's parent comes after it, and is marked in turn
+        for j in 0..self.n {
+            let (c0, c1) = (self.l_col_ptr[j], self.l_col_ptr[j + 1]);
+            if mask[j] && c0 < c1 {
+                mask[self.l_row_idx[c0] as usize] = true;
+            }
+        }
+        mask
+    }
+
     /// Position in the column storage of `L` of the entry `(row, col)`,
     /// internal order, `row > col`; `None` when it is not in the pattern.
     pub(crate) fn lower_position(&self, row: usize, col: usize) -> Option<usize> {
@@ -45,18 +66,27 @@ impl SymbolicLdlt {
     /// `L`'s column `t`. The product walks `B^-1[S, S]` by its stored lower
     /// triangle: the entry `(r, t)`, `r > t`, contributes to row `t` through
     /// `L[r, j]` and to row `r` through `L[t, j]`.
+    ///
+    /// With `within` (a closed set of columns, [`Self::reach`]) only its
+    /// columns are computed: a column reads only the columns of its rows,
+    /// which are its ancestors in the elimination tree. The others are left
+    /// as they were.
     pub(crate) fn selected_inverse(
         &self,
         num: &NumericLdlt,
         diag: &mut [C64],
         lower: &mut [C64],
         slot: &mut [u32],
+        within: Option<&[bool]>,
     ) -> bool {
         let n = self.n;
         assert!(diag.len() == n && lower.len() == self.nnz_l() && slot.len() == n, "selected inverse of another size");
         let (l_val, d_inv) = (&num.l_val[..], &num.d_inv[..n]);
         let mut finite = true;
         for j in (0..n).rev() {
+            if within.is_some_and(|w| !w[j]) {
+                continue;
+            }
             let (c0, c1) = (self.l_col_ptr[j], self.l_col_ptr[j + 1]);
             let rows = &self.l_row_idx[c0..c1];
             let l_j = &l_val[c0..c1];

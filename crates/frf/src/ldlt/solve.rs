@@ -44,6 +44,7 @@ impl SymbolicLdlt {
             x,
             k,
             units: None,
+            within: None,
             visit: |_: usize, _: &[C64]| {},
         })
     }
@@ -60,6 +61,7 @@ impl SymbolicLdlt {
         num: &mut NumericLdlt,
         rows: &[usize],
         x: &mut [C64],
+        within: Option<&[bool]>,
         visit: V,
     ) -> bool {
         let k = rows.len();
@@ -72,7 +74,8 @@ impl SymbolicLdlt {
         units.extend(rows.iter().enumerate().map(|(j, &r)| (r, j)));
         units.sort_unstable();
         let (l_val, d_inv) = (&num.l_val, &num.d_inv);
-        let finite = Arch::new().dispatch(Substitution { sym: self, l_val, d_inv, x, k, units: Some(&units), visit });
+        let finite =
+            Arch::new().dispatch(Substitution { sym: self, l_val, d_inv, x, k, units: Some(&units), within, visit });
         num.units = units;
         finite
     }
@@ -89,6 +92,12 @@ struct Substitution<'a, V> {
     /// Unit right-hand sides `(internal row, column)`, sorted, made on the
     /// fly; `None` when `x` holds the right-hand sides.
     units: Option<&'a [(usize, usize)]>,
+    /// The rows wanted (a closed set, [`SymbolicLdlt::reach`]): the
+    /// backward sweep skips the others, which are then left undefined and
+    /// not visited. With unit right-hand sides the forward sweep skips the
+    /// rows outside the units' own reach, where the solution of `L y = b`
+    /// is zero.
+    within: Option<&'a [bool]>,
     /// Called with each row as it becomes final in the backward sweep.
     visit: V,
 }
@@ -98,8 +107,12 @@ impl<V: FnMut(usize, &[C64])> WithSimd for Substitution<'_, V> {
 
     #[inline(always)]
     fn with_simd<S: Simd>(self, simd: S) -> bool {
-        let Substitution { sym, l_val, d_inv, x, k, units, mut visit } = self;
+        let Substitution { sym, l_val, d_inv, x, k, units, within, mut visit } = self;
         let n = sym.n;
+        // the rows where L y = b has non-zeros, when only some rows are
+        // wanted: the unit rows' ancestors (a row elsewhere has none of
+        // them among the columns of its row of L)
+        let live = within.zip(units).map(|(_, units)| sym.reach(units.iter().map(|&(r, _)| r)));
         // forward, L y = b, by rows: row r gathers the final rows above it
         // (close to it for a banded matrix, so in cache), and is written once
         let mut next_unit = 0;
@@ -110,6 +123,9 @@ impl<V: FnMut(usize, &[C64])> WithSimd for Substitution<'_, V> {
                 xr.fill(ZERO);
                 if next_unit == 0 && units.first().is_some_and(|&(first, _)| r < first) {
                     continue; // above the first unit row everything is zero
+                }
+                if live.as_ref().is_some_and(|live| !live[r]) {
+                    continue;
                 }
                 while let Some(&(_, j)) = units.get(next_unit).filter(|&&(row, _)| row == r) {
                     xr[j] = C64::new(1.0, 0.0);
@@ -127,6 +143,9 @@ impl<V: FnMut(usize, &[C64])> WithSimd for Substitution<'_, V> {
         // so row j gathers the rows below it, which are final
         let mut finite = true;
         for j in (0..n).rev() {
+            if within.is_some_and(|w| !w[j]) {
+                continue;
+            }
             let (head, tail) = x.split_at_mut((j + 1) * k);
             let xj = &mut head[j * k..];
             scale(simd, xj, d_inv[j]);

@@ -5,7 +5,7 @@ use damping::DampedSystem;
 use faer::Mat;
 use faer::linalg::solvers::Solve;
 use fe_model::{Assembly, BlockSource, Pattern, samples};
-use frf::{C64, FactorKind, FrfError, SelectedInverse, ZSolver};
+use frf::{C64, FactorKind, FrfError, Layout, SelectedInverse, ZSolver};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -167,6 +167,62 @@ fn selected_inverse_of_a_frame_equals_unit_solves() {
                         assert!(solver.inverse_entry(&inv, i, j).is_some(), "{name}: pair ({i}, {j})");
                     }
                 }
+            }
+        }
+    }
+}
+
+/// Solves and selected inversions restricted to the reach of a few places
+/// of a frame (the measured equations and a few runs of elements, as the
+/// diagnosis gathers them around its leaders) give the rows and entries
+/// read there bit for bit as the whole ones, while skipping most of the
+/// simplicial factor; in the supernodal layout, which has no such
+/// restriction, they are the whole ones.
+#[test]
+fn solves_and_inversions_within_a_reach_equal_the_whole_ones() {
+    let sys = DampedSystem::new(samples::frame_grid(6, 6, 4)).unwrap();
+    let n = sys.n();
+    let runs = element_run_cliques(sys.assembly(), 3);
+    // three places along the members, and four measured equations elsewhere
+    let cliques: Vec<Vec<usize>> = [5, 6, runs.len() / 2].iter().map(|&i| runs[i].clone()).collect();
+    let measured = [n / 7, n / 3, n / 2 + 1, n - 4];
+    let read: Vec<usize> = measured.iter().copied().chain(cliques.iter().flatten().copied()).collect();
+    for layout in [Layout::Simplicial, Layout::Supernodal] {
+        let solver = ZSolver::with_layout(sys.assembly().pattern(), &cliques, layout).unwrap();
+        let solved = solver.reach(read.iter().copied());
+        let inverted = solver.reach(cliques.iter().flatten().copied());
+        match layout {
+            Layout::Simplicial => {
+                let (s, i) = (solved.rows().unwrap(), inverted.rows().unwrap());
+                assert!(i < s && s < n / 2, "{layout:?}: the reaches hold {i} and {s} of {n} rows");
+            }
+            Layout::Supernodal => assert_eq!((solved.rows(), inverted.rows()), (None, None)),
+        }
+        let mut ws = solver.workspace();
+        let (mut whole, mut part) = (SelectedInverse::new(), SelectedInverse::new());
+        let (mut x_whole, mut x_part) = (Vec::new(), Vec::new());
+        for f in [3.0, 170.0, 900.0] {
+            let z = sys.z_values(2.0 * std::f64::consts::PI * f);
+            solver.factorize(&mut ws, &z, f).unwrap();
+            solver.solve_units_ordered(&mut ws, &measured, &mut x_whole, f).unwrap();
+            solver.solve_units_within(&mut ws, &measured, &solved, &mut x_part, f).unwrap();
+            let k = measured.len();
+            for &eq in &read {
+                let row = solver.position(eq) * k;
+                for j in 0..k {
+                    let (a, b) = (x_whole[row + j], x_part[row + j]);
+                    assert!(a.re.to_bits() == b.re.to_bits() && a.im.to_bits() == b.im.to_bits(), "row of {eq}");
+                }
+            }
+            solver.selected_inverse(&ws, &mut whole).unwrap();
+            solver.selected_inverse_within(&ws, &inverted, &mut part).unwrap();
+            for clique in &cliques {
+                let m = clique.len();
+                let (mut a, mut b) = (vec![C64::new(0.0, 0.0); m * m], vec![C64::new(0.0, 0.0); m * m]);
+                assert!(solver.inverse_block(&whole, clique, &mut a) && solver.inverse_block(&part, clique, &mut b));
+                assert!(
+                    a.iter().zip(&b).all(|(a, b)| a.re.to_bits() == b.re.to_bits() && a.im.to_bits() == b.im.to_bits())
+                );
             }
         }
     }

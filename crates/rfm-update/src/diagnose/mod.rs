@@ -92,6 +92,7 @@ mod search;
 use damping::DampedSystem;
 use fe_model::case::Gains;
 use frf::FrfSet;
+use rayon::prelude::*;
 
 pub use candidates::{Candidate, CandidateOptions, EffectKind, Role};
 
@@ -725,9 +726,14 @@ fn rank(pool: Pool<'_>, noise: f64, full: &LineSet, opts: &DiagnoseOptions) -> D
     ranking.sort_by(|a, b| a.delta_bic.total_cmp(&b.delta_bic));
     let rest: Vec<usize> =
         (0..pool.candidates.len()).filter(|&i| pool.full[i].is_none() && !pool.superseded[i]).collect();
-    ranking.extend(
-        pool.by_screening(&rest).into_iter().map(|i| ranked(i, pool.screened[i].as_ref().expect("screened"), false)),
-    );
+    // (in parallel: a large model ranks tens of thousands of screening
+    // fits, a second on one thread at the end of the diagnosis)
+    let screened: Vec<Ranked> = pool
+        .by_screening(&rest)
+        .par_iter()
+        .map(|&i| ranked(i, pool.screened[i].as_ref().expect("screened"), false))
+        .collect();
+    ranking.extend(screened);
     let recommended = ranking.iter().position(|r| r.fully_fitted && r.significant && r.plausible).map(|r| r + 1);
     // a ranked candidate is listed under the description it is ranked with
     let ranked: std::collections::HashMap<usize, &str> =

@@ -172,6 +172,14 @@ impl LocalData {
         // the selected inverse holds every S = H_0[D, D] (about the cost of
         // the factorisation, where a solve per equation would cost N solves).
         let solver = ZSolver::with_cliques(nominal.assembly().pattern(), &slots.eqs)?;
+        // Only the rows read below are solved for (those of W and of every
+        // D), and only the entries between the equations of each D inverted:
+        // where the Ds lie in a few places of a large model (the screening's
+        // and the full fits' candidates, around the leaders), most of the
+        // factor is skipped. The numbers read are the same bit for bit.
+        let slot_eqs = || slots.eqs.iter().flatten().copied();
+        let solved = solver.reach(w_eqs.iter().copied().chain(slot_eqs()));
+        let inverted = solver.reach(slot_eqs());
         let per_line: Vec<Line> = lines
             .par_iter()
             .map_init(
@@ -182,7 +190,7 @@ impl LocalData {
                     nominal.z_values_into(omega, z);
                     solver.factorize(ws, z, f)?;
                     let k = w_eqs.len();
-                    solver.solve_units_ordered(ws, &w_eqs, x, f)?;
+                    solver.solve_units_within(ws, &w_eqs, &solved, x, f)?;
                     let h0 = picks.iter().map(|&(r, c)| x[solver.position(w_eqs[r]) * k + c]).collect();
                     let mut w_rows = vec![ZERO; rows * k];
                     for (eq, &row) in row_of.iter().enumerate().filter(|(_, r)| **r != usize::MAX) {
@@ -190,7 +198,7 @@ impl LocalData {
                         w_rows[row * k..row * k + k].copy_from_slice(&x[p * k..p * k + k]);
                     }
                     let mut s: Vec<Vec<C64>> = slots.eqs.iter().map(|e| vec![ZERO; e.len() * e.len()]).collect();
-                    let selected = match solver.selected_inverse(ws, inv) {
+                    let selected = match solver.selected_inverse_within(ws, &inverted, inv) {
                         Ok(()) => slots.eqs.iter().zip(&mut s).all(|(eqs, s)| solver.inverse_block(inv, eqs, s)),
                         // the LU fallback has no selected inverse
                         Err(frf::FrfError::NoLdltFactors { .. }) => false,

@@ -239,6 +239,56 @@ mod tests {
         }
     }
 
+    /// An evaluation asked for its sensitivities after one without them, at
+    /// the same values, gives what one evaluation of both gives, bit for
+    /// bit (the sensitivities read the factorisations kept); after other
+    /// values are set, everything is evaluated again at those.
+    #[test]
+    fn sensitivities_after_an_evaluation_equal_those_of_one_evaluation() {
+        let model = samples::frame_with_joint();
+        let nominal = DampedSystem::new(model.clone()).unwrap();
+        let uy: Vec<DofRef> =
+            (0..nominal.n()).map(|eq| nominal.assembly().dofs().dof_of(eq)).filter(|d| d.dof == Dof::Uy).collect();
+        let channels: Vec<Channel> = uy.iter().map(|&r| Channel::new(r, uy[0])).collect();
+        let lines = [3.0, 17.0, 41.0];
+        let opts = CandidateOptions { band_hz: (1.0, 100.0), ..CandidateOptions::default() };
+        let locals: Vec<LocalCandidate> =
+            candidates::generate(&model, &opts).iter().filter_map(|c| LocalCandidate::new(&nominal, c)).collect();
+        // with equations of their own (condensed) and without
+        assert!(locals.iter().any(|l| l.form.new_eqs > 0) && locals.iter().any(|l| l.form.new_eqs == 0));
+        let forms: Vec<&LocalForm> = locals.iter().map(|l| &l.form).collect();
+        let data = LocalData::new(&nominal, &channels, &lines, &forms).unwrap();
+        let bits = |e: &crate::output_error::Evaluated| {
+            let h = e.0.iter().flatten().flat_map(|v| [v.re.to_bits(), v.im.to_bits()]);
+            let s = e.1.iter().flatten().flat_map(|m| {
+                (0..m.nrows()).flat_map(move |i| {
+                    (0..m.ncols()).flat_map(move |j| [m[(i, j)].re.to_bits(), m[(i, j)].im.to_bits()])
+                })
+            });
+            h.chain(s).collect::<Vec<u64>>()
+        };
+        for local in &locals {
+            let start = local.params.values(&local.part);
+            let away: Vec<f64> = start.iter().map(|v| v * 1.7).collect();
+            let once = |values: &[f64]| {
+                let mut r = data.response(local, local.part.clone(), &lines).unwrap();
+                r.set(values).unwrap();
+                r.evaluate(&lines, true).unwrap()
+            };
+            let mut r = data.response(local, local.part.clone(), &lines).unwrap();
+            r.set(&start).unwrap();
+            let plain = r.evaluate(&lines, false).unwrap();
+            assert!(plain.1.is_none());
+            r.set(&start).unwrap();
+            let both = r.evaluate(&lines, true).unwrap();
+            assert_eq!(bits(&both), bits(&once(&start)));
+            r.set(&away).unwrap();
+            let moved = r.evaluate(&lines, true).unwrap();
+            assert_eq!(bits(&moved), bits(&once(&away)));
+            assert_ne!(bits(&moved), bits(&both), "the values moved nothing");
+        }
+    }
+
     /// Data gathered on more lines and for larger sets of equations serve
     /// a candidate exactly as data gathered for it alone: its `S` is the
     /// larger set's on its own equations, its lines picked among the others.

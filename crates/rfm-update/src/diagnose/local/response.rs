@@ -95,8 +95,12 @@ impl LocalData {
             x,
             s,
             placed,
-            work: Work::new(n_local, d, refs.len()),
+            work: Work::new(n_local, d),
             refs,
+            states: (0..lines.len()).map(|_| LineState::default()).collect(),
+            model: Vec::new(),
+            values: None,
+            fresh: false,
         })
     }
 }
@@ -131,8 +135,7 @@ impl Placed {
 struct Work {
     /// The local change `[[A, B], [B^T, C]]`, `(d + e)^2`.
     z: Vec<C64>,
-    /// `G = C^-1 B^T`, `e x d`, and the LU of `C`.
-    g: Vec<C64>,
+    /// The LU of `C` (`G = C^-1 B^T` is kept per line: [`LineState`]).
     c: Vec<C64>,
     c_piv: Vec<usize>,
     /// The condensed change `dZ`, `d x d`.
@@ -140,11 +143,6 @@ struct Work {
     /// The non-zeros `(column, value)` of `dZ` by row, and row pointers.
     nz: Vec<(usize, C64)>,
     nz_ptr: Vec<usize>,
-    /// `I + S dZ` and its LU.
-    m: Vec<C64>,
-    m_piv: Vec<usize>,
-    /// `Y = (I + S dZ)^-1 X` at the reference columns, `d x refs`.
-    y: Vec<C64>,
     /// One parameter's derivative, `(d + e)^2`, and condensed, `d x d`.
     dzi: Vec<C64>,
     dzi_c: Vec<C64>,
@@ -153,19 +151,15 @@ struct Work {
 }
 
 impl Work {
-    fn new(n_local: usize, d: usize, refs: usize) -> Self {
+    fn new(n_local: usize, d: usize) -> Self {
         let e = n_local - d;
         Work {
             z: vec![ZERO; n_local * n_local],
-            g: vec![ZERO; e * d],
             c: vec![ZERO; e * e],
             c_piv: vec![0; e],
             dz: vec![ZERO; d * d],
             nz: Vec::with_capacity(d * d),
             nz_ptr: Vec::with_capacity(d + 1),
-            m: vec![ZERO; d * d],
-            m_piv: vec![0; d],
-            y: vec![ZERO; d * refs],
             dzi: vec![ZERO; n_local * n_local],
             dzi_c: vec![ZERO; d * d],
             col: vec![ZERO; d],
@@ -194,33 +188,75 @@ pub(crate) struct LocalResponse<'a> {
     /// Distinct reference columns in `W`.
     refs: Vec<usize>,
     work: Work,
+    /// Per line, what the sensitivities read of the last evaluation (see
+    /// [`LineState`]), and its receptances.
+    states: Vec<LineState>,
+    model: Vec<Vec<C64>>,
+    /// The values last set ([`Response::set`]; `None`: those it started with).
+    values: Option<Vec<f64>>,
+    /// Whether `states` and `model` hold the evaluation at those values.
+    fresh: bool,
+}
+
+/// What the sensitivities at one line read of an evaluation: the LU of `I +
+/// S dZ`, `Y` at the reference columns and the condensation `G`, so that
+/// the sensitivities at the point of the last evaluation cost no second
+/// factorisation of the local system.
+#[derive(Default)]
+struct LineState {
+    m: Vec<C64>,
+    m_piv: Vec<usize>,
+    y: Vec<C64>,
+    g: Vec<C64>,
 }
 
 impl Response for LocalResponse<'_> {
     fn set(&mut self, values: &[f64]) -> Result<(), UpdateError> {
+        if self.values.as_deref() != Some(values) {
+            self.fresh = false;
+            self.values = Some(values.to_vec());
+        }
         self.params.set_values(&mut self.sys, values)
     }
 
-    /// A sensitivity costs one transposed solve of a `d x d` system per
-    /// parameter, beside the factorisation the receptances need anyway.
+    /// Not cheap beside the receptances (on a damping window the
+    /// sensitivities cost about what the receptances do), but an
+    /// evaluation keeps the factorisations its sensitivities read: a trial
+    /// step is evaluated without them, and an accepted one adds only the
+    /// sensitivities, with the same numbers as one evaluation of both.
+    /// The brief fits of the pre-screening reject about half their trial
+    /// steps on damping windows.
     fn cheap_jacobian(&self) -> bool {
-        true
+        false
     }
 
     fn evaluate(&mut self, lines: &[f64], jacobian: bool) -> Option<Evaluated> {
         if lines != self.lines.as_slice() {
             return None;
         }
+        if !self.fresh {
+            self.model = self.receptances()?;
+            self.fresh = true;
+        }
+        let sens = jacobian.then(|| self.sensitivities());
+        Some((self.model.clone(), sens))
+    }
+}
+
+impl LocalResponse<'_> {
+    /// The receptances at the current values, keeping per line what the
+    /// sensitivities read ([`LineState`]); `None` when the local system is
+    /// singular at a line or a receptance is not finite.
+    fn receptances(&mut self) -> Option<Vec<Vec<C64>>> {
         let (d, e) = (self.form.eqs.len(), self.form.new_eqs);
         let (n, k) = (d + e, self.data.w_eqs.len());
         let a = self.sys.assembly();
-        let n_par = self.params.len();
         let w = &mut self.work;
-        let mut model = Vec::with_capacity(lines.len());
-        let mut sens = jacobian.then(|| Vec::with_capacity(lines.len()));
-        for (li, &f) in lines.iter().enumerate() {
+        let mut model = Vec::with_capacity(self.lines.len());
+        for (li, &f) in self.lines.iter().enumerate() {
             let omega = 2.0 * std::f64::consts::PI * f;
             let coefs = self.sys.coefficients(omega);
+            let state = &mut self.states[li];
             // the change on D and the candidate's own equations, [[A, B], [B^T, C]]
             w.z.fill(ZERO);
             for (i, row) in self.nominal_z[li].chunks_exact(d).enumerate() {
@@ -233,17 +269,19 @@ impl Response for LocalResponse<'_> {
                 }
             }
             // condensed onto D: dZ = A - B C^-1 B^T, with G = C^-1 B^T
+            state.g.clear();
+            state.g.resize(e * d, ZERO);
             if e > 0 {
                 for m in 0..e {
                     w.c[m * e..m * e + e].copy_from_slice(&w.z[(d + m) * n + d..(d + m) * n + n]);
-                    w.g[m * d..m * d + d].copy_from_slice(&w.z[(d + m) * n..(d + m) * n + d]);
+                    state.g[m * d..m * d + d].copy_from_slice(&w.z[(d + m) * n..(d + m) * n + d]);
                 }
                 if !lu_in_place(&mut w.c, e, &mut w.c_piv) {
                     return None;
                 }
-                lu_solve(&w.c, e, &w.c_piv, &mut w.g, d);
+                lu_solve(&w.c, e, &w.c_piv, &mut state.g, d);
             }
-            condense(&w.z, &w.g, d, e, &mut w.dz);
+            condense(&w.z, &state.g, d, e, &mut w.dz);
             // I + S dZ over the non-zeros of dZ: a row of dZ couples a DOF
             // only to the DOFs of its elements, so this costs d nnz(dZ), not d^3
             w.nz.clear();
@@ -254,35 +292,39 @@ impl Response for LocalResponse<'_> {
                 w.nz_ptr.push(w.nz.len());
             }
             let s = &self.s[li];
-            w.m.fill(ZERO);
+            state.m.clear();
+            state.m.resize(d * d, ZERO);
+            state.m_piv.resize(d, 0);
             for i in 0..d {
-                w.m[i * d + i] = C64::new(1.0, 0.0);
-                let (s_row, m_row) = (&s[i * d..i * d + d], &mut w.m[i * d..i * d + d]);
+                state.m[i * d + i] = C64::new(1.0, 0.0);
+                let (s_row, m_row) = (&s[i * d..i * d + d], &mut state.m[i * d..i * d + d]);
                 for (kk, &sik) in s_row.iter().enumerate() {
                     for &(j, v) in &w.nz[w.nz_ptr[kk]..w.nz_ptr[kk + 1]] {
                         m_row[j] += sik * v;
                     }
                 }
             }
-            if !lu_in_place(&mut w.m, d, &mut w.m_piv) {
+            if !lu_in_place(&mut state.m, d, &mut state.m_piv) {
                 return None;
             }
             // Y = (I + S dZ)^-1 X, needed only at the reference columns:
             // the sensitivities use the transposed system instead (below)
             let x = &self.x[li];
             let nr = self.refs.len();
+            state.y.clear();
+            state.y.resize(d * nr, ZERO);
             for i in 0..d {
                 for (a, &fr) in self.refs.iter().enumerate() {
-                    w.y[i * nr + a] = x[i * k + fr];
+                    state.y[i * nr + a] = x[i * k + fr];
                 }
             }
-            lu_solve(&w.m, d, &w.m_piv, &mut w.y, nr);
+            lu_solve(&state.m, d, &state.m_piv, &mut state.y, nr);
             // H = H_0 - X^T dZ Y on the channels
             let line = &self.data.per_line[self.line_idx[li]];
             let mut h = line.h0.clone();
             for (a, &fr) in self.refs.iter().enumerate() {
                 for i in 0..d {
-                    w.col[i] = (0..d).map(|j| w.dz[i * d + j] * w.y[j * nr + a]).sum();
+                    w.col[i] = (0..d).map(|j| w.dz[i * d + j] * state.y[j * nr + a]).sum();
                 }
                 for (c, &(r, fi)) in self.data.picks.iter().enumerate() {
                     if fi == fr {
@@ -293,37 +335,52 @@ impl Response for LocalResponse<'_> {
             if h.iter().any(|v| !(v.re.is_finite() && v.im.is_finite())) {
                 return None;
             }
-            // (dH/dp_i) p_i [r, f] = -Y[:, r]^T dZ_i Y[:, f] with
-            // Y[:, r]^T = X[:, r]^T (I + S dZ)^-T: one transposed solve per
-            // parameter and reference, not one solve per response
-            if let Some(sens) = sens.as_mut() {
-                let mut block = Mat::<C64>::zeros(h.len(), n_par);
-                for (pi, p) in self.params.params().iter().enumerate() {
-                    w.dzi.fill(ZERO);
-                    for &q in &p.quantities {
-                        for (b, t, c) in self.sys.derivative(q, omega).terms {
-                            let term = &a.blocks()[b].terms()[t];
-                            let p = self.placed[b].as_ref().expect("a parameter's blocks are changed blocks");
-                            p.add(term.unit(), c * term.value(), &mut w.dzi, n);
-                        }
+            model.push(h);
+        }
+        Some(model)
+    }
+
+    /// The sensitivities at the values of the last evaluation, from what it
+    /// kept per line: `(dH/dp_i) p_i [r, f] = -Y[:, r]^T dZ_i Y[:, f]` with
+    /// `Y[:, r]^T = X[:, r]^T (I + S dZ)^-T`, one transposed solve per
+    /// parameter and reference, not one solve per response.
+    fn sensitivities(&mut self) -> Vec<Mat<C64>> {
+        let (d, e) = (self.form.eqs.len(), self.form.new_eqs);
+        let (n, k) = (d + e, self.data.w_eqs.len());
+        let a = self.sys.assembly();
+        let n_par = self.params.len();
+        let nr = self.refs.len();
+        let w = &mut self.work;
+        let mut sens = Vec::with_capacity(self.lines.len());
+        for (li, &f) in self.lines.iter().enumerate() {
+            let omega = 2.0 * std::f64::consts::PI * f;
+            let state = &self.states[li];
+            let x = &self.x[li];
+            let mut block = Mat::<C64>::zeros(self.data.picks.len(), n_par);
+            for (pi, p) in self.params.params().iter().enumerate() {
+                w.dzi.fill(ZERO);
+                for &q in &p.quantities {
+                    for (b, t, c) in self.sys.derivative(q, omega).terms {
+                        let term = &a.blocks()[b].terms()[t];
+                        let p = self.placed[b].as_ref().expect("a parameter's blocks are changed blocks");
+                        p.add(term.unit(), c * term.value(), &mut w.dzi, n);
                     }
-                    condense(&w.dzi, &w.g, d, e, &mut w.dzi_c);
-                    for (a, &fr) in self.refs.iter().enumerate() {
-                        for i in 0..d {
-                            w.col[i] = (0..d).map(|j| w.dzi_c[i * d + j] * w.y[j * nr + a]).sum();
-                        }
-                        lu_solve_transposed(&w.m, d, &w.m_piv, &mut w.col);
-                        for (c, &(r, fi)) in self.data.picks.iter().enumerate() {
-                            if fi == fr {
-                                block[(c, pi)] = (0..d).map(|i| x[i * k + r] * w.col[i]).sum();
-                            }
+                }
+                condense(&w.dzi, &state.g, d, e, &mut w.dzi_c);
+                for (a, &fr) in self.refs.iter().enumerate() {
+                    for i in 0..d {
+                        w.col[i] = (0..d).map(|j| w.dzi_c[i * d + j] * state.y[j * nr + a]).sum();
+                    }
+                    lu_solve_transposed(&state.m, d, &state.m_piv, &mut w.col);
+                    for (c, &(r, fi)) in self.data.picks.iter().enumerate() {
+                        if fi == fr {
+                            block[(c, pi)] = (0..d).map(|i| x[i * k + r] * w.col[i]).sum();
                         }
                     }
                 }
-                sens.push(block);
             }
-            model.push(h);
+            sens.push(block);
         }
-        Some((model, sens))
+        sens
     }
 }
