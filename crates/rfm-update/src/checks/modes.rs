@@ -26,7 +26,7 @@ const MAX_DAMPING: f64 = 0.2;
 const ORDERS: std::ops::RangeInclusive<usize> = 4..=60;
 
 /// The measured modes the model lacks: modes of an LSCF estimate of the
-/// data (receptances, orders [`ORDERS`]) that pair with no model mode by MAC (0.5 or more),
+/// data (receptances, model orders 4 to 60) that pair with no model mode by MAC (0.5 or more),
 /// and that have no unpaired model mode within 15 % of their frequency
 /// (which would be their partner with a shape a model error spoils). An
 /// attached resonator makes one: the data show a mode more than the
