@@ -210,6 +210,12 @@ pub fn step_status(outcome: &crate::study::UpdateOutcome) -> Status {
 }
 
 impl FixStep {
+    /// The misfit the step ends at: after the late correction of the data
+    /// when there was one, else after its update.
+    pub fn final_misfit(&self) -> f64 {
+        self.corrected_misfit.unwrap_or(self.misfit_updated)
+    }
+
     fn of(a: Added, delta_bic: f64, alternatives: Vec<LookAhead>, replaced: Option<String>) -> FixStep {
         FixStep {
             misfit_added: a.effect.misfit,
@@ -369,7 +375,7 @@ impl FixOutcome {
     /// The final misfit.
     pub fn final_misfit(&self) -> f64 {
         match (self.steps.last(), &self.declared) {
-            (Some(s), _) => s.corrected_misfit.unwrap_or(s.misfit_updated),
+            (Some(s), _) => s.final_misfit(),
             (None, Some(d)) => d.misfit_updated,
             (None, None) => self.corrected_misfit,
         }
@@ -631,10 +637,10 @@ impl Loop<'_> {
         if state.k == 0 {
             return Ok(None);
         }
-        let study = Study::with_measured(current.clone(), self.data.clone())?;
+        let Some(update) = current.update.as_ref() else { return Ok(None) };
         let reached = a.outcome.system.model();
         let mut values = Vec::new();
-        for (name, _) in crate::params::quantity_values(study.parameters(), &current.model) {
+        for (name, _) in crate::params::quantity_values(&update.parameters, &current.model) {
             let Ok(q) = reached.quantity(&name) else { return Ok(None) };
             values.push((name, reached.get(q)));
         }
@@ -1188,7 +1194,7 @@ pub fn fix(
                     1 => declared.as_ref().map_or((corrected, 0), |d| (d.misfit_updated, d.parameters.len())),
                     _ => {
                         let p = &steps[n - 2];
-                        (p.corrected_misfit.unwrap_or(p.misfit_updated), p.parameter_count)
+                        (p.final_misfit(), p.parameter_count)
                     }
                 };
                 let s = steps.last_mut().expect("a step");
