@@ -7,8 +7,12 @@
 //! per family, 8 pairs, 20 null trials), the hidden-effect diagnosis (13
 //! trials per kind, 20 null trials) and the lab study (4 trials per family
 //! of `tests/it/lab.rs`: 72), with their counts asserted. It builds in the
-//! test profile, as `cargo test` does (opt-level 3 in this workspace), so
-//! that CI, which runs it after the tests, compiles nothing again. The
+//! test profile, as `cargo test` does (opt-level 3 in this workspace), and
+//! for the whole workspace (`--workspace --test it`, the filters select
+//! rfm-update's studies), so that cargo resolves the dependencies' features
+//! as `cargo test --workspace` did and CI, which runs it after the tests,
+//! compiles nothing again (`-p rfm-update` alone would compile faer,
+//! nalgebra and the workspace once more). The
 //! studies' own variables (`HELD_OUT_PAIRS=16`, `LAB_PER`, ...) still set
 //! their sizes. It fails when a study misses a criterion.
 
@@ -22,7 +26,7 @@ pub(crate) fn heldout(args: &[String]) -> Result<(), String> {
     }
     let status = crate::cargo()
         .current_dir(crate::root())
-        .args(["test", "-p", "rfm-update", "--test", "it", "--"])
+        .args(["test", "--workspace", "--test", "it", "--"])
         .args(STUDIES)
         .args(["--nocapture", "--test-threads", "2"])
         .env("RFM_STUDY", "full")
