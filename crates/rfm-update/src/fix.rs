@@ -492,12 +492,29 @@ const REVISE_ABOVE: f64 = 1.1;
 /// trials with a model error).
 const LATE_CHECKS_BELOW: f64 = 5.0;
 
+/// How many times a step is made again on data the checks corrected after
+/// it. Each step is judged on the data the model is fitted to: a
+/// correction found only once a model error is fitted (a sensor at the
+/// next node, a sensitivity, hidden beside a lumped mass at 44 times the
+/// noise) changes which effect the data prefer, and the step chosen before
+/// it was chosen on data that were wrong (the lab study's trial 64: a mass
+/// change of two elements chosen over the lumped mass with its rotary
+/// inertia, then a stiffness change and a mass added to make up for its
+/// form). The step is undone and the model before it diagnosed again on
+/// the corrected data; beyond this many times, the step is kept and
+/// updated on the corrected data instead (each time a channel is
+/// corrected, so this only bounds the loop's work).
+const REDONE: usize = 2;
+
 /// How many distinct leaders are added and updated at each step.
 const WIDTH: usize = 5;
 
 /// The part of what the model before a step leaves above the noise (its
 /// misfit's variance less the noise's) that a new effect, or a pair, must
-/// explain to be added. A missing effect explains its own part of the data
+/// explain to be added; the noise read here is the step's floor
+/// ([`Loop::floor`]: the lower of the loop's reading and the roughness of
+/// the residual of the model before the step), so that a model near the
+/// data is not taken for one within the noise. A missing effect explains its own part of the data
 /// (alone, all of it; one of two, about its half, and the pair together
 /// all); an effect that only bends a model toward an error of another form
 /// (a member at another angle, a delay in the acquisition, a fin) lowers
@@ -578,6 +595,31 @@ impl Loop<'_> {
 }
 
 impl Loop<'_> {
+    /// The noise level the share of a step ([`SHARE`]) is read against: the
+    /// lower of the loop's reading and the roughness of the residual of
+    /// the model before the step on every line
+    /// ([`diagnose::residual_roughness`]). The share of an excess depends on
+    /// the noise most where the model before is near it: the data's own
+    /// roughness reads 6 to 9 % high on the lab study's cantilevers, and a
+    /// model at 1.02 times that reading (1.08 times the noise injected)
+    /// left an excess of 3 % of the noise's variance instead of 17 %, which
+    /// any effect that took up part of it then explained "all of" (a
+    /// shaker beside a lumped mass that the data hold with the structure's
+    /// damping: 67 % of the excess at the loop's reading, 35 % at the
+    /// residual's). The loop's reading stays the one the evidence and the
+    /// stop are judged against: there a higher noise is the cautious one,
+    /// as a lower one is here.
+    fn floor(&self, current: &CaseFile) -> f64 {
+        let noise = self.evidence.noise;
+        let read = damping::DampedSystem::new(current.model.clone()).ok().and_then(|sys| {
+            diagnose::residual_roughness(&sys, &self.data, self.opts.diagnose.weights.as_deref()).ok().flatten()
+        });
+        match read {
+            Some(r) if r > 0.0 && r < noise => r,
+            _ => noise,
+        }
+    }
+
     /// The verdict of the loop's rule on `after` (see [`Evidence::judge`]),
     /// and, for a step that passes it with resonators, whether each
     /// explains the mode it was offered for (`fix/explains.rs`): one that
@@ -1053,6 +1095,8 @@ pub fn fix(
     let mut rejected_all: Vec<LookAhead> = Vec::new();
     // the modes that a resonator tuned to them left unexplained
     let mut unexplained: Vec<explains::Unexplained> = Vec::new();
+    // steps made again on data corrected after them
+    let mut redone = 0;
     let stop = loop {
         let d = match fl.diagnosed(&current, &extra_hz, steps.len(), &mut progress) {
             Ok(d) => d,
@@ -1077,6 +1121,7 @@ pub fn fix(
         }
         let step = steps.len() + 1;
         let last = step >= opts.max_steps;
+        let floor = fl.floor(&current);
         let mut moves: Vec<Move> = Vec::new();
         let mut singles: Vec<(usize, Added)> = Vec::new();
         let mut tried: Vec<LookAhead> = Vec::new();
@@ -1091,7 +1136,7 @@ pub fn fix(
                         unexplained.push(u);
                     }
                     if verdict.rejected.is_none() {
-                        verdict.rejected = small_share(state.misfit, a.stats.misfit, noise);
+                        verdict.rejected = small_share(state.misfit, a.stats.misfit, floor);
                     }
                     let record = LookAhead {
                         effect: name,
@@ -1143,7 +1188,7 @@ pub fn fix(
                 pairs::best_pair(&fl, &current, &d, &pair_leaders, &singles, state, (step, last), &applied)
             {
                 if m.record.rejected.is_none() {
-                    m.record.rejected = small_share(state.misfit, m.last().stats.misfit, noise);
+                    m.record.rejected = small_share(state.misfit, m.last().stats.misfit, floor);
                 }
                 progress(FixProgress::LookedAhead { step: steps.len(), ahead: &m.record });
                 if m.record.rejected.is_none() {
@@ -1266,6 +1311,10 @@ pub fn fix(
         }
         alternatives.extend(tried);
         let first_new = steps.len();
+        // the model before the step, to make it again should the data be
+        // corrected after it
+        let (before_step, state_before) = (current.clone(), state);
+        let undecided_before = undecided.len();
         for (k, (added, delta_bic)) in best.steps.into_iter().enumerate() {
             progress(FixProgress::Updated {
                 step: steps.len(),
@@ -1332,6 +1381,21 @@ pub fn fix(
                 progress(FixProgress::Checked { findings: &late });
                 fl.data = data;
                 base = new_base;
+                // the step was chosen on data now corrected: it is made
+                // again on the corrected data, from the model before it
+                // (see REDONE)
+                if redone < REDONE {
+                    redone += 1;
+                    findings.extend(late);
+                    current = with_corrections(&before_step, &written, opts)?;
+                    let sys = damping::DampedSystem::new(current.model.clone())?;
+                    state = State { misfit: fl.stats(&sys)?.misfit, k: state_before.k };
+                    steps.truncate(first_new);
+                    applied.truncate(first_new);
+                    undecided.truncate(undecided_before);
+                    extra_hz = checks::extra_modes(&sys, &fl.data)?.iter().filter_map(|f| f.frequency_hz).collect();
+                    continue;
+                }
                 current = case_after;
                 state = State { misfit: stats.misfit, k: outcome.parameters.len() };
                 let s = steps.last_mut().expect("a step was kept");
