@@ -22,7 +22,10 @@
 //!    measured modes the model lacks). A correction found is applied to the
 //!    data and written into the case (`[[measurement.corrections]]`): the
 //!    model is fitted to the corrected data, and nothing is blamed on it
-//!    that the set-up made.
+//!    that the set-up made. The channels are checked again after each
+//!    step (a model error can hide a sensor's error from the first check);
+//!    a correction found then makes the step again on the corrected data,
+//!    since it was chosen on data that were wrong (`REDONE`).
 //! 1. **The case's declared parameters.** When the case lists parameters
 //!    under `[update]`, they are updated first (step 0 of the report): an
 //!    effect is blamed on missing physics only after the user's own
@@ -185,7 +188,9 @@ pub struct FixStep {
     /// The misfit after the data found wrong once this step was kept were
     /// corrected and every parameter updated again (see [`FixOutcome::findings`],
     /// `found_after_step`); `case`, `parameters` and `status` are then that
-    /// update's.
+    /// update's. Only when the loop has made steps again `REDONE` times
+    /// already: otherwise a correction found after a step makes that step
+    /// again on the corrected data.
     pub corrected_misfit: Option<f64>,
     /// Updated again from a better start ([`Refit`]): the misfit, status,
     /// parameters and case above are then that update's (after any data
@@ -511,10 +516,10 @@ const WIDTH: usize = 5;
 
 /// The part of what the model before a step leaves above the noise (its
 /// misfit's variance less the noise's) that a new effect, or a pair, must
-/// explain to be added; the noise read here is the step's floor
-/// ([`Loop::floor`]: the lower of the loop's reading and the roughness of
-/// the residual of the model before the step), so that a model near the
-/// data is not taken for one within the noise. A missing effect explains its own part of the data
+/// explain to be added; the noise read here is the step's floor (the
+/// lower of the loop's reading and the roughness of the residual of the
+/// model before the step), so that a model near the data is not taken for
+/// one within the noise. A missing effect explains its own part of the data
 /// (alone, all of it; one of two, about its half, and the pair together
 /// all); an effect that only bends a model toward an error of another form
 /// (a member at another angle, a delay in the acquisition, a fin) lowers
