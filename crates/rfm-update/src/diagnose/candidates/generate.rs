@@ -19,10 +19,10 @@
 //! ground at each of its free nodes, a mass at each node, and the changes of
 //! each group (`imported.rs`).
 //!
-//! Resonators are candidates only where the caller names the frequencies
-//! of measured modes the model lacks
-//! ([`CandidateOptions::resonator_hz`]): one tuned to each, at every node
-//! that can move (`resonators.rs`). A shaker's armature and suspension is
+//! Resonators are candidates only at the frequencies the options name
+//! ([`CandidateOptions::resonator_hz`]: measured modes the model lacks, and
+//! the bands of broad residual the diagnosis reads): one tuned to each, at
+//! every node that can move (`resonators.rs`). A shaker's armature and suspension is
 //! a candidate at each drive point, and equal sensor masses at the
 //! response nodes (`set_up.rs`), where the caller names them (the diagnosis
 //! names the data's).
