@@ -53,7 +53,8 @@
 //! coarse windows; around the three leaders every window and in-line joint
 //! is then tried too (on small models they are candidates from the start),
 //! with the fuller variants of the leaders (a joint's translational
-//! springs, a mass's rotary inertia); the best are screened and fitted
+//! springs, a mass's rotary inertia, a lumped mass with its rotary inertia
+//! at a resonator's node); the best are screened and fitted
 //! fully, so that one weakened element is named as such and not as its
 //! region or a mass at its node. Then a support or joint among the leaders
 //! with springs in two or more DOFs gets a damping group per direction,
@@ -648,7 +649,7 @@ fn diagnose_in(
     let mut copts = opts.candidates.clone();
     copts.band_hz = (lines[0], lines[lines.len() - 1]);
     set_up_places(&mut copts, measured);
-    for hz in suspected_hz(model, &nominal, measured, weights, opts.gains, noise, copts.per_element_limit)? {
+    for (hz, _) in broad_bands(&nominal, measured, weights, opts.gains, noise, copts.per_element_limit)? {
         if !copts.resonator_hz.iter().any(|&g| (hz / g - 1.0).abs() < SAME_TUNING) {
             copts.resonator_hz.push(hz);
         }
@@ -666,27 +667,29 @@ fn diagnose_in(
 /// further than that (see `suspects`).
 const SAME_TUNING: f64 = 0.1;
 
-/// The middles of the bands where the nominal model's residual points at
-/// a resonator without a mode of its own (see `suspects`), on a model of
-/// beams small enough to get every candidate from the start (up to
-/// `per_element_limit` elements, [`CandidateOptions::per_element_limit`]): the resonators tuned
-/// to them go to every node that can move, and the nominal model is
-/// synthesised at every measured line to find them, neither of which a
-/// large model can afford. None on a large or an imported model.
-fn suspected_hz(
-    model: &fe_model::Model,
-    nominal: &DampedSystem,
+/// The middles (Hz) of the bands where the residual of `sys` is broad
+/// between the modes, each with its level (see `suspects`): where a
+/// heavily damped resonator that shows no mode of its own points at
+/// itself, and where such a resonator, once added, leaves none. Read only
+/// on a model of beams small enough to get every candidate from the start
+/// (up to `per_element_limit` elements,
+/// [`CandidateOptions::per_element_limit`]): the resonators tuned to them
+/// go to every node that can move, and the model is synthesised at every
+/// measured line to find them, neither of which a large model can afford.
+/// None on a large or an imported model.
+pub(crate) fn broad_bands(
+    sys: &DampedSystem,
     measured: &FrfSet,
     weights: Option<&[f64]>,
     gains: Gains,
     noise: f64,
     per_element_limit: usize,
-) -> Result<Vec<f64>, UpdateError> {
-    let beams = model.beams().len();
+) -> Result<Vec<(f64, f64)>, UpdateError> {
+    let beams = sys.model().beams().len();
     if beams == 0 || beams > per_element_limit {
         return Ok(Vec::new());
     }
-    let (at_all, _) = frf::synthesize_regular(nominal, measured.channels(), measured.frequencies_hz())?;
+    let (at_all, _) = frf::synthesize_regular(sys, measured.channels(), measured.frequencies_hz())?;
     suspects::broad_residual_hz(measured, &at_all, weights, gains, noise)
 }
 

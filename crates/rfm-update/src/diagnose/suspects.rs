@@ -57,13 +57,14 @@ const MIN_LINES: usize = 5;
 /// of the model and of the data. The residual at a line is the RMS over
 /// channels of the weighted `ln(H / M)`, with the gains of `gains` fitted
 /// on every line first (`weights` channel-major, as the diagnosis's).
+/// Each with its level (the median; the noise's units).
 pub(crate) fn broad_residual_hz(
     measured: &FrfSet,
     model: &FrfSet,
     weights: Option<&[f64]>,
     gains: Gains,
     noise: f64,
-) -> Result<Vec<f64>, UpdateError> {
+) -> Result<Vec<(f64, f64)>, UpdateError> {
     // a line where the model is singular (left out of its synthesis) is
     // left out here too
     let all = measured.frequencies_hz();
@@ -123,13 +124,13 @@ pub(crate) fn broad_residual_hz(
         }
     }
     broad.sort_by(|a, b| b.0.total_cmp(&a.0));
-    let mut out: Vec<f64> = Vec::new();
-    for (_, hz) in broad {
+    let mut out: Vec<(f64, f64)> = Vec::new();
+    for (level, hz) in broad {
         if out.len() == MAX_BANDS {
             break;
         }
-        if out.iter().all(|&g: &f64| (hz / g).ln().abs() >= SEPARATION.ln()) {
-            out.push(hz);
+        if out.iter().all(|&(g, _)| (hz / g).ln().abs() >= SEPARATION.ln()) {
+            out.push((hz, level));
         }
     }
     Ok(out)
@@ -184,9 +185,13 @@ mod tests {
         let n = DampedSystem::new(nominal).unwrap();
         assert_eq!(
             broad_residual_hz(&data, &model_at(&t, &data), None, Gains::None, noise).unwrap(),
-            Vec::<f64>::new()
+            Vec::<(f64, f64)>::new()
         );
-        let bands = broad_residual_hz(&data, &model_at(&n, &data), None, Gains::None, noise).unwrap();
+        let bands: Vec<f64> = broad_residual_hz(&data, &model_at(&n, &data), None, Gains::None, noise)
+            .unwrap()
+            .iter()
+            .map(|b| b.0)
+            .collect();
         // the nominal model's modes on either side of the tuning
         let modes: Vec<f64> =
             damping::complex_modes::complex_modes(&n).unwrap().oscillatory.iter().map(|m| m.frequency_hz).collect();
@@ -201,7 +206,11 @@ mod tests {
                 *v *= frf::C64::from_polar(3.0, 0.7);
             }
         }
-        let with_gain = broad_residual_hz(&scaled, &model_at(&n, &data), None, Gains::PerReference, noise).unwrap();
+        let with_gain: Vec<f64> = broad_residual_hz(&scaled, &model_at(&n, &data), None, Gains::PerReference, noise)
+            .unwrap()
+            .iter()
+            .map(|b| b.0)
+            .collect();
         assert_eq!(with_gain, bands);
     }
 }

@@ -207,7 +207,8 @@ fn a_damped_resonator_between_modes_is_found_as_a_mode_the_model_lacks() {
 /// residual between the modes is the evidence instead, and `rfm fix`'s
 /// loop adds the resonator at its node or beside it, nothing else, and
 /// explains the data. On the nominal model's own data no band stands out
-/// and no resonator is even a candidate.
+/// and no resonator is even a candidate, nor on a model too large to get
+/// every candidate from the start.
 #[test]
 fn a_heavily_damped_resonator_without_a_mode_of_its_own_is_found_from_its_broad_residual() {
     let (m, f_r, loss) = (0.1, 160.0, 0.3);
@@ -236,5 +237,12 @@ fn a_heavily_damped_resonator_without_a_mode_of_its_own_is_found_from_its_broad_
     assert!(o.explained(), "{:?} at {:.2} x the noise", o.stop, o.final_misfit() / o.noise);
     // the nominal model's own data: no resonator among the candidates
     let d = diagnose(&nominal.model, &measure(&nominal.model), &DiagnoseOptions::default()).unwrap();
+    assert!(!d.candidates.iter().any(|c| c.kind == EffectKind::Resonator), "{} candidates", d.tried);
+    // a model above the limit of elements that get every candidate from the
+    // start (here 10, for its 20) reads no band: a large model gets no
+    // resonator at every node, which the 100k-DOF diagnosis could not afford
+    let mut large = DiagnoseOptions::default();
+    large.candidates.per_element_limit = 10;
+    let d = diagnose(&nominal.model, &measured, &large).unwrap();
     assert!(!d.candidates.iter().any(|c| c.kind == EffectKind::Resonator), "{} candidates", d.tried);
 }
