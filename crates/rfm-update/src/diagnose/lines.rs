@@ -20,24 +20,7 @@ pub fn informative_lines(measured: &FrfSet, n: usize) -> Vec<f64> {
         return lines.to_vec();
     }
     let nl = lines.len();
-    let level: Vec<f64> = (0..nl)
-        .map(|k| {
-            (0..measured.channels().len()).map(|c| measured.get(c, k).norm().max(f64::MIN_POSITIVE).ln()).sum::<f64>()
-                / measured.channels().len().max(1) as f64
-        })
-        .collect();
-    // prominence: the height above the lowest level within a few peak widths
-    const REACH: usize = 8;
-    let mut peaks: Vec<(f64, usize)> = (1..nl - 1)
-        .filter(|&k| level[k] > level[k - 1] && level[k] >= level[k + 1])
-        .map(|k| {
-            let lo = k.saturating_sub(REACH);
-            let hi = (k + REACH + 1).min(nl);
-            let floor = level[lo..hi].iter().copied().fold(f64::INFINITY, f64::min);
-            (level[k] - floor, k)
-        })
-        .filter(|&(p, _)| p > 1.0)
-        .collect();
+    let mut peaks = peaks(measured);
     peaks.sort_by(|a, b| b.0.total_cmp(&a.0));
     let mut idx: Vec<usize> = Vec::new();
     'peaks: for &(_, k) in &peaks {
@@ -64,6 +47,29 @@ pub fn informative_lines(measured: &FrfSet, n: usize) -> Vec<f64> {
         m += (n - all.len()).max(1);
     }
     lines.to_vec()
+}
+
+/// The resonance peaks of a set: local maxima of the mean over channels
+/// of `ln |M|` that stand more than 1 (a factor of e) above the lowest
+/// level within eight lines either side, as (that prominence, line index).
+pub(crate) fn peaks(set: &FrfSet) -> Vec<(f64, usize)> {
+    let nl = set.n_freq();
+    let nc = set.channels().len();
+    let level: Vec<f64> = (0..nl)
+        .map(|k| (0..nc).map(|c| set.get(c, k).norm().max(f64::MIN_POSITIVE).ln()).sum::<f64>() / nc.max(1) as f64)
+        .collect();
+    // prominence: the height above the lowest level within a few peak widths
+    const REACH: usize = 8;
+    (1..nl.saturating_sub(1))
+        .filter(|&k| level[k] > level[k - 1] && level[k] >= level[k + 1])
+        .map(|k| {
+            let lo = k.saturating_sub(REACH);
+            let hi = (k + REACH + 1).min(nl);
+            let floor = level[lo..hi].iter().copied().fold(f64::INFINITY, f64::min);
+            (level[k] - floor, k)
+        })
+        .filter(|&(p, _)| p > 1.0)
+        .collect()
 }
 
 /// The correlation between adjacent lines of channel-major residuals

@@ -2,7 +2,10 @@
 //!
 //! Every candidate effect ([`candidates`]; attached resonators only where
 //! [`CandidateOptions::resonator_hz`] names the frequencies of measured
-//! modes the model lacks) is fitted to the measured FRFs by
+//! modes the model lacks, and, on a small model of beams, where the nominal
+//! model's residual is broad between the modes, as a heavily damped
+//! resonator that shows no mode of its own leaves it: module `suspects`)
+//! is fitted to the measured FRFs by
 //! the output-error estimator on the complex-log misfit `ln(H / M)`, which
 //! stays well behaved when a resonance is shifted by more than its width
 //! (one linearised step from the nominal model does not: it ranks a 40 %
@@ -50,7 +53,8 @@
 //! coarse windows; around the three leaders every window and in-line joint
 //! is then tried too (on small models they are candidates from the start),
 //! with the fuller variants of the leaders (a joint's translational
-//! springs, a mass's rotary inertia); the best are screened and fitted
+//! springs, a mass's rotary inertia, a lumped mass with its rotary inertia
+//! at a resonator's node); the best are screened and fitted
 //! fully, so that one weakened element is named as such and not as its
 //! region or a mass at its node. Then a support or joint among the leaders
 //! with springs in two or more DOFs gets a damping group per direction,
@@ -88,6 +92,7 @@ pub mod candidates;
 mod lines;
 mod local;
 mod search;
+mod suspects;
 
 use damping::DampedSystem;
 use fe_model::case::Gains;
@@ -693,12 +698,48 @@ fn diagnose_in(
     let mut copts = opts.candidates.clone();
     copts.band_hz = (lines[0], lines[lines.len() - 1]);
     set_up_places(&mut copts, measured);
+    for (hz, _) in broad_bands(&nominal, measured, weights, opts.gains, noise, copts.per_element_limit)? {
+        if !copts.resonator_hz.iter().any(|&g| (hz / g - 1.0).abs() < SAME_TUNING) {
+            copts.resonator_hz.push(hz);
+        }
+    }
     let mut pool = Pool::new(model, &nominal, s2, copts.band_hz);
     prepare(&mut pool);
     search::search(&mut pool, measured, &at_lines, &full, opts, &copts, progress)?;
     let mut d = rank(pool, noise, &full, opts);
     d.singular_hz = singular;
     Ok(d)
+}
+
+/// A band whose middle lies within this relative distance of a frequency
+/// resonators are tuned to already adds none: the fit moves the tuning
+/// further than that (see `suspects`).
+const SAME_TUNING: f64 = 0.1;
+
+/// The middles (Hz) of the bands where the residual of `sys` is broad
+/// between the modes, each with its level (see `suspects`): where a
+/// heavily damped resonator that shows no mode of its own points at
+/// itself, and where such a resonator, once added, leaves none. Read only
+/// on a model of beams small enough to get every candidate from the start
+/// (up to `per_element_limit` elements,
+/// [`CandidateOptions::per_element_limit`]): the resonators tuned to them
+/// go to every node that can move, and the model is synthesised at every
+/// measured line to find them, neither of which a large model can afford.
+/// None on a large or an imported model.
+pub(crate) fn broad_bands(
+    sys: &DampedSystem,
+    measured: &FrfSet,
+    weights: Option<&[f64]>,
+    gains: Gains,
+    noise: f64,
+    per_element_limit: usize,
+) -> Result<Vec<(f64, f64)>, UpdateError> {
+    let beams = sys.model().beams().len();
+    if beams == 0 || beams > per_element_limit {
+        return Ok(Vec::new());
+    }
+    let (at_all, _) = frf::synthesize_regular(sys, measured.channels(), measured.frequencies_hz())?;
+    suspects::broad_residual_hz(measured, &at_all, weights, gains, noise)
 }
 
 /// The places of the test's own hardware, from the data where the caller

@@ -1,8 +1,17 @@
 //! Whether a resonator explains the measured mode it was offered for.
 //!
-//! Resonators are offered only where the data hold a mode the model lacks
-//! ([`crate::checks::extra_modes`]). A resonator is a mass on translational
-//! springs at a node: it adds a mode of its own, and wherever the data's
+//! Resonators are offered where the data hold a mode the model lacks
+//! ([`crate::checks::extra_modes`]), and where the residual is broad between
+//! the modes (a heavily damped resonator without a mode of its own: the
+//! diagnosis's `suspects`). Where the data hold an extra mode, a resonator
+//! is judged by the one nearest its tuning; where they hold none, by the
+//! bands of broad residual its update leaves: a resonator the data hold
+//! leaves none (lab study, trials 22 and 23: the whole misfit at 0.90 and
+//! 0.89 times the noise after its update), while one fitted to another
+//! form of error (a member at another angle, trials 46 and 47, a fin whose
+//! mode the check does not find, trial 50) leaves the band it was offered
+//! for, or another. A resonator is a mass on
+//! translational springs at a node: it adds a mode of its own, and wherever the data's
 //! extra mode has that form (a part driven by its node's translation) its
 //! update fits that mode to the noise. A mode of another form (a fin fixed
 //! across a member, driven by its root's rotation; a part that is not at
@@ -37,12 +46,17 @@ const AROUND: f64 = 0.05;
 /// about twice from either side.
 pub(super) const UNEXPLAINED: f64 = 4.0;
 
-/// A mode that a resonator tuned to it left unexplained.
+/// A mode that a resonator tuned to it left unexplained, or, where the
+/// data hold no extra mode, a band of broad residual a resonator left.
 #[derive(Clone, Debug)]
 pub(super) struct Unexplained {
-    /// The mode's frequency (Hz), as the check of the data found it.
+    /// The mode's frequency (Hz), as the check of the data found it; or
+    /// the middle of the band.
     pub(super) hz: f64,
-    /// The misfit at its lines after the resonator's update, over the noise.
+    /// `hz` is a mode of the data (else a band's middle).
+    pub(super) of_mode: bool,
+    /// The misfit at its lines after the resonator's update (a band's
+    /// median), over the noise.
     pub(super) ratio: f64,
     /// The resonator.
     pub(super) effect: String,
@@ -51,6 +65,13 @@ pub(super) struct Unexplained {
 impl Unexplained {
     /// Why the step is not kept.
     pub(super) fn reason(&self) -> String {
+        if !self.of_mode {
+            return format!(
+                "no resonator of the data: after its update the misfit is still broad around {:.1} Hz ({:.1} times \
+                 the noise over 10 % either side), where a resonator that the data hold leaves no such band",
+                self.hz, self.ratio
+            );
+        }
         format!(
             "the wrong form for the data's mode at {:.1} Hz: after its update the lines within {:.0} % of that mode \
              are left at {:.1} times the noise (a resonator that explains its mode leaves them within {UNEXPLAINED})",
@@ -62,6 +83,13 @@ impl Unexplained {
 
     /// What remains, in the user's terms.
     pub(super) fn remains(&self) -> String {
+        if !self.of_mode {
+            return format!(
+                "a misfit spread over the band around {:.1} Hz ({:.1} times the noise), which no candidate explains: \
+                 the best resonator ({}) leaves it",
+                self.hz, self.ratio, self.effect
+            );
+        }
         format!(
             "the data's mode at {:.1} Hz, which no candidate explains: a resonator tuned to it ({}) leaves its lines \
              at {:.1} times the noise (a part driven otherwise than by one node's translation: a fin or plate driven \
@@ -74,8 +102,9 @@ impl Unexplained {
 /// The first resonator among `effects` (diagnosis and rank of each, as
 /// added to the model `after`) that leaves the extra mode it is tuned
 /// nearest to (of `modes_hz`, the modes the data hold and the model before
-/// the loop lacked) unexplained; `None` when each explains its mode, or
-/// there is no mode to judge it by.
+/// the loop lacked) unexplained, or, where the data hold no extra mode,
+/// that leaves a band of broad residual (the worst); `None` when each
+/// explains its mode or leaves no band.
 pub(super) fn unexplained(
     after: &Added,
     effects: &[(&Diagnosis, usize)],
@@ -108,11 +137,29 @@ pub(super) fn unexplained(
             .collect();
         let distance = |f: f64| tunings.iter().map(|t| (f / t).ln().abs()).fold(f64::INFINITY, f64::min);
         let Some(hz) = modes_hz.iter().copied().min_by(|a, b| distance(*a).total_cmp(&distance(*b))) else {
+            // no extra mode: a resonator the data hold leaves no broad band
+            let sys = &after.outcome.system;
+            let bands = diagnose::broad_bands(
+                sys,
+                data,
+                opts.weights.as_deref(),
+                opts.gains,
+                noise,
+                opts.candidates.per_element_limit,
+            )?;
+            if let Some(&(hz, level)) = bands.first() {
+                return Ok(Some(Unexplained {
+                    hz,
+                    of_mode: false,
+                    ratio: level / noise,
+                    effect: r.description.clone(),
+                }));
+            }
             continue;
         };
         let Some(local) = misfit_around(&after.outcome.system, data, opts, hz)? else { continue };
         if local > UNEXPLAINED * noise {
-            return Ok(Some(Unexplained { hz, ratio: local / noise, effect: r.description.clone() }));
+            return Ok(Some(Unexplained { hz, of_mode: true, ratio: local / noise, effect: r.description.clone() }));
         }
     }
     Ok(None)

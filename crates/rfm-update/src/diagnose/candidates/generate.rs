@@ -8,7 +8,8 @@
 //! ([`refine`]), as a region that explains a weakened element in part leads
 //! to that element. On every model the refinement adds the fuller variants
 //! of the leaders: translational springs for a joint, a rotary inertia for
-//! a mass.
+//! a mass, and for a resonator a lumped mass with its rotary inertia at
+//! its node (tuned above the band, a resonator acts there as a mass).
 //!
 //! A 3D model gets the same families in its own DOFs: supports release every
 //! fixed DOF (that the structure there gives stiffness), a joint springs the three rotations (and in its fuller variant
@@ -19,10 +20,10 @@
 //! ground at each of its free nodes, a mass at each node, and the changes of
 //! each group (`imported.rs`).
 //!
-//! Resonators are candidates only where the caller names the frequencies
-//! of measured modes the model lacks
-//! ([`CandidateOptions::resonator_hz`]): one tuned to each, at every node
-//! that can move (`resonators.rs`). A shaker's armature and suspension is
+//! Resonators are candidates only at the frequencies the options name
+//! ([`CandidateOptions::resonator_hz`]: measured modes the model lacks, and
+//! the bands of broad residual the diagnosis reads): one tuned to each, at
+//! every node that can move (`resonators.rs`). A shaker's armature and suspension is
 //! a candidate at each drive point, and equal sensor masses at the
 //! response nodes (`set_up.rs`), where the caller names them (the diagnosis
 //! names the data's).
@@ -538,7 +539,8 @@ fn in_line_joints(ctx: &Ctx<'_>, nodes: impl IntoIterator<Item = u32>) -> Vec<Sp
 ///   models the in-line joints there; around a joint, every stiffness
 ///   window within reach as well;
 /// - the fuller variants of a joint (translational springs) and a mass
-///   (rotary inertia).
+///   (rotary inertia), and for a resonator a lumped mass with its rotary
+///   inertia at its node.
 pub(crate) fn refine(
     model: &Model,
     opts: &CandidateOptions,
@@ -558,6 +560,12 @@ pub(crate) fn refine(
                 specs.push(joint(&ctx, *node, &beams, *in_line, true, group.mu.is_some()));
             }
             Edit::Mass { node, j, .. } if *j == 0.0 => specs.push(mass(&ctx, *node, true)),
+            // a resonator tuned above the band acts there as a mass at its
+            // node, and where resonators lead they may stand for a lumped
+            // mass with its rotary inertia, which none has (lab study,
+            // trial 53: resonators at a 172 g mass's node took the first
+            // places, and its fuller variant was never tried)
+            Edit::Resonator { node, .. } => specs.push(mass(&ctx, *node, true)),
             _ => {}
         }
         let kinds: &[EffectKind] = match c.kind {

@@ -10,7 +10,7 @@
 //! | viscous damping | the same windows | alpha of the window |
 //! | non-viscous damping | the same windows | alpha and mu of the window |
 //! | stiffness, mass or damping change of an imported group | each group with imported matrices | its factor, or its alpha (and mu) |
-//! | attached resonator | each node free in a translation, for each frequency of [`CandidateOptions::resonator_hz`] (none by default): in each translation, and in x and y at once on a planar model | a mass on a spring to a new coincident node: the mass, a spring per direction, its own damping group: alpha (viscous) or alpha and mu |
+//! | attached resonator | each node free in a translation, for each frequency of [`CandidateOptions::resonator_hz`] (none by default; the diagnosis adds the middles of bands of broad residual on a small model): in each translation, and in x and y at once on a planar model | a mass on a spring to a new coincident node: the mass, a spring per direction, its own damping group: alpha (viscous) or alpha and mu |
 //! | shaker | each drive point of [`CandidateOptions::drive_points`] (the data's references in a diagnosis), in the drive's direction | the armature's mass, tied to the drive point in that direction, on its suspension to ground: the mass, the spring, its group's alpha (a dashpot beside the spring) |
 //! | sensor masses | the response nodes of [`CandidateOptions::sensor_nodes`] (two or more; the data's in a diagnosis) | one mass, the same at every node (its group's mass factor on masses of 1 g) |
 //!
@@ -209,7 +209,10 @@ pub struct CandidateOptions {
     pub band_hz: (f64, f64),
     /// Frequencies (Hz) of measured modes the model lacks: at each, an
     /// attached resonator tuned to it is a candidate at every node that can
-    /// move. Empty (the default): no resonator candidates.
+    /// move. Empty (the default): no resonator candidates here; the
+    /// diagnosis adds, on a small model of beams, the middles of the bands
+    /// where the nominal model's residual is broad between the modes (a
+    /// heavily damped resonator without a mode of its own).
     pub resonator_hz: Vec<f64>,
     /// The drive points (node and direction) of the data: at each, a
     /// shaker's armature and suspension is a candidate. Empty (the

@@ -1,5 +1,7 @@
 //! Attached resonators: a mass on a spring and damper at a node, tuned to a
-//! measured mode the model lacks.
+//! measured mode the model lacks, or to the middle of a band where the
+//! nominal model's residual is broad between the modes (a heavily damped
+//! resonator shows no mode of its own; see the diagnosis's `suspects`).
 //!
 //! A resonator adds a mode of its own near its tuning frequency, and where
 //! that lies near a mode of the structure the two split; no other candidate
