@@ -1145,7 +1145,9 @@ pub fn fix(
         }
         let step = steps.len() + 1;
         let last = step >= opts.max_steps;
-        let floor = fl.floor(&current);
+        // the residual's reading costs a synthesis at every line; the share
+        // is read only for a model above the loop's noise (`small_share`)
+        let floor = if state.misfit > noise { fl.floor(&current) } else { noise };
         let mut moves: Vec<Move> = Vec::new();
         let mut singles: Vec<(usize, Added)> = Vec::new();
         let mut tried: Vec<LookAhead> = Vec::new();
