@@ -101,7 +101,7 @@ pub use modal::{
 pub use noise::NoiseModel;
 pub use set::{Channel, FrfKind, FrfSet};
 pub use solver::{FactorKind, Layout, Reach, SelectedInverse, Workspace, ZSolver};
-pub use synth::{equation_of, receptance_columns, synthesize, synthesize_regular, synthesize_with};
+pub use synth::{equation_of, lines_per_job, receptance_columns, synthesize, synthesize_regular, synthesize_with};
 
 /// Complex double.
 pub use num_complex::Complex64 as C64;

@@ -649,7 +649,11 @@ fn is_finite(v: C64) -> bool {
 /// Checks that every value is finite; returns the largest `|Z_ij|`.
 fn check_values(solver: &ZSolver, values: &[C64], freq_hz: f64) -> Result<f64, FrfError> {
     assert_eq!(values.len(), solver.pattern.row_idx().len(), "values must lie on the solver's pattern");
-    match values.iter().position(|&v| !is_finite(v)) {
+    // one pass for both the check and the largest squared modulus (a pass
+    // over a 100,000-DOF frame's values is a fiftieth of its factorisation)
+    let (m2, finite) = values.iter().fold((0.0f64, true), |(m, ok), v| (m.max(v.norm_sqr()), ok && is_finite(*v)));
+    match if finite { None } else { values.iter().position(|&v| !is_finite(v)) } {
+        None if m2.is_normal() => Ok(m2.sqrt()),
         None => Ok(largest_norm(values)),
         Some(_) if !(freq_hz.is_finite() && freq_hz > 0.0) => Err(FrfError::BadFrequency { freq_hz }),
         Some(i) => {
