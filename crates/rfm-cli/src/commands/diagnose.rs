@@ -303,6 +303,19 @@ fn data_beside(case: &Path) -> PathBuf {
 /// rest are in `--json`.
 const UNFITTED_SHOWN: usize = 5;
 
+/// The fuller variants not fitted because their plain twin was not among
+/// the pre-screening's best, when there are any.
+fn deferred_text(d: &Diagnosis) -> String {
+    if d.deferred == 0 {
+        return String::new();
+    }
+    format!(
+        ", {} fuller variants (non-viscous damping, rotary inertia) not fitted: their plain twins were not among \
+         the pre-screening's best",
+        d.deferred
+    )
+}
+
 /// How many candidates' fits failed, how many of them are left out of the
 /// ranking, and the first few with the stage and the reason (nothing when
 /// every fit succeeded).
@@ -433,10 +446,11 @@ fn print_diagnosis(d: &Diagnosis, top: usize, after_step0: bool) -> Result<()> {
     outln!(
         "\n(explained: the share of the nominal model's squared misfit the effect removes; dBIC: the change of the \
          Bayesian information criterion, comparable only within one diagnosis; significant: dBIC below {}, very \
-         strong evidence; {} candidates tried, {} of them replaced by a variant)",
+         strong evidence; {} candidates tried, {} of them replaced by a variant{})",
         quantities::SIGNIFICANT_DBIC,
         d.tried,
-        d.superseded
+        d.superseded,
+        deferred_text(d)
     );
     for line in unfitted_lines(d) {
         outln!("{line}");
@@ -504,6 +518,7 @@ mod tests {
             recommended: None,
             tried: 40,
             superseded: 2,
+            deferred: 0,
             gains: Gains::None,
             weighted: false,
             unfitted,

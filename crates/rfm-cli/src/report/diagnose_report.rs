@@ -84,7 +84,22 @@ pub(crate) fn write(
                 if d.weighted { ", each value weighted by its coherence" } else { "" }
             ),
         ),
-        ("candidates".into(), format!("{} tried, {} replaced by a variant", d.tried, d.superseded)),
+        (
+            "candidates".into(),
+            format!(
+                "{} tried, {} replaced by a variant{}",
+                d.tried,
+                d.superseded,
+                if d.deferred > 0 {
+                    format!(
+                        ", {} fuller variants not fitted (their plain twins were not among the pre-screening's best)",
+                        d.deferred
+                    )
+                } else {
+                    String::new()
+                }
+            ),
+        ),
     ];
     if let Some(l) = d.ranking.first().filter(|l| !l.gains.is_empty()) {
         facts.push(("gain fitted with the first".into(), gains_text(&gain_reports(&l.gains))));

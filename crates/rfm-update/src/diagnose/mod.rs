@@ -46,7 +46,9 @@
 //! large model has thousands of candidates (a mass at every node, damping
 //! in every region): above [`DiagnoseOptions::prescreen_above`] of them, all
 //! are first fitted with fewer iterations on fewer lines (pre-screening) and
-//! only the best few hundred are screened. Screening-only entries of the
+//! only the best few hundred are screened; a fuller variant (non-viscous
+//! damping, a mass's rotary inertia) is pre-screened through its plain
+//! twin, and screened where that twin is among the best. Screening-only entries of the
 //! ranking are scored on their own lines; screened ones come before
 //! pre-screened ones.
 //! On large models stiffness, mass and damping changes are first tried in
@@ -481,6 +483,11 @@ pub struct Diagnosis {
     /// How many of them gave way to a variant: one that holds what the data
     /// do not determine, or a twin that did not beat its original.
     pub superseded: usize,
+    /// How many fuller variants (non-viscous damping, a mass's rotary
+    /// inertia) were left unfitted on a large model because their plain
+    /// twin, through which they were pre-screened, was not among the best
+    /// (see [`DiagnoseOptions::prescreen_above`]).
+    pub deferred: usize,
     /// The unknown gains every fit (and the nominal misfit) fitted.
     #[cfg_attr(feature = "serde", serde(serialize_with = "crate::serialize_display"))]
     pub gains: Gains,
@@ -767,7 +774,8 @@ fn set_up_places(copts: &mut CandidateOptions, measured: &FrfSet) {
 }
 
 /// The ranking of a finished search.
-fn rank(pool: Pool<'_>, noise: f64, full: &LineSet, opts: &DiagnoseOptions) -> Diagnosis {
+fn rank(mut pool: Pool<'_>, noise: f64, full: &LineSet, opts: &DiagnoseOptions) -> Diagnosis {
+    pool.release();
     // each candidate judged against what it leaves (see `delta_bic`), with
     // the correlation of the nominal model's residual standing for its own
     let evidence = |f: &search::Fit, k: usize| {
@@ -847,6 +855,7 @@ fn rank(pool: Pool<'_>, noise: f64, full: &LineSet, opts: &DiagnoseOptions) -> D
         recommended,
         tried: pool.candidates.len(),
         superseded: pool.superseded.iter().filter(|&&s| s).count(),
+        deferred: pool.deferred.len(),
         gains: full.gains,
         weighted: full.weights.is_some(),
         unfitted,
@@ -927,7 +936,7 @@ mod tests {
         assert!(d.leader().is_some_and(|l| l.kind == EffectKind::FlexibleSupport), "{:?}", d.ranking.first());
         // every candidate tried is ranked, superseded or unfitted
         let unranked = d.unfitted.iter().filter(|u| !u.ranked).count();
-        assert_eq!(d.tried, d.ranking.len() + d.superseded + unranked);
+        assert_eq!(d.tried, d.ranking.len() + d.superseded + unranked + d.deferred);
     }
 }
 

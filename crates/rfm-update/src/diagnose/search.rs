@@ -131,6 +131,9 @@ pub(crate) struct Pool<'a> {
     model: &'a fe_model::Model,
     nominal: &'a DampedSystem,
     pub(crate) candidates: Vec<Candidate>,
+    /// Fuller variants left unfitted: their plain twin, through which they
+    /// were pre-screened, was not among the best.
+    pub(crate) deferred: Vec<usize>,
     locals: Vec<Option<LocalCandidate>>,
     /// The latest screening fit of each candidate.
     pub(crate) screened: Vec<Option<Fit>>,
@@ -171,6 +174,7 @@ impl<'a> Pool<'a> {
             model,
             nominal,
             candidates: Vec::new(),
+            deferred: Vec::new(),
             locals: Vec::new(),
             screened: Vec::new(),
             full: Vec::new(),
@@ -185,6 +189,15 @@ impl<'a> Pool<'a> {
             #[cfg(test)]
             forced_failure: None,
         }
+    }
+
+    /// Frees the search's working data (the candidates' local forms and
+    /// the low-rank data gathered last) aside, once the fits are done.
+    pub(crate) fn release(&mut self) {
+        free_aside((
+            std::mem::take(&mut self.locals),
+            self.gathered.get_mut().unwrap_or_else(PoisonError::into_inner).take(),
+        ));
     }
 
     /// Adds candidates; returns their indices.
@@ -225,7 +238,9 @@ impl<'a> Pool<'a> {
         starts: &[Option<Vec<f64>>],
     ) -> Result<Vec<Result<Fit, String>>, UpdateError> {
         let data = self.local_data(lines, which)?;
-        Ok(self.fit_on(stage, lines, &data, iterations, which, starts))
+        let fits = self.fit_on(stage, lines, &data, iterations, which, starts);
+        free_aside(data);
+        Ok(fits)
     }
 
     /// Plans the low-rank data of the next stages: the candidates of
@@ -253,7 +268,7 @@ impl<'a> Pool<'a> {
         let slots = Slots::of(&forms);
         self.plan = Some(Plan { lines, which, anticipated, slots });
         // the data of an earlier plan are not needed again
-        *self.gathered.get_mut().unwrap_or_else(PoisonError::into_inner) = None;
+        free_aside(self.gathered.get_mut().unwrap_or_else(PoisonError::into_inner).take());
     }
 
     /// Whether the low-rank data gathered last serve the candidates of
@@ -655,15 +670,29 @@ pub(crate) fn search(
     trace(&format!("generated {} candidates ({generation:.2} s): {}", all.len(), pool.clock.since_last()));
     let to_screen = if all.len() > opts.prescreen_above {
         let pre = LineSet::with_model(measured, opts.prescreen_lines, opts.gains, nominal, weights)?;
-        pool.screen(FitStage::PreScreening, &pre, opts.prescreen_iterations, &all, false)?;
+        // a fuller variant (non-viscous damping, a mass's rotary inertia)
+        // waits for its plain twin: pre-screened only through it, and
+        // screened beside it when the twin is among the best
+        let plain = plain_twins(&pool.candidates, &all);
+        let first: Vec<usize> = all.iter().zip(&plain).filter(|(_, p)| p.is_none()).map(|(&i, _)| i).collect();
+        pool.screen(FitStage::PreScreening, &pre, opts.prescreen_iterations, &first, false)?;
         trace(&format!(
-            "pre-screened {} candidates on {} lines: {}",
-            all.len(),
+            "pre-screened {} candidates on {} lines ({} fuller variants wait for their plain twins): {}",
+            first.len(),
             pre.data.n_freq(),
+            all.len() - first.len(),
             pool.clock.since_last()
         ));
-        let mut best = pool.by_screening(&all);
+        let mut best = pool.by_screening(&first);
         best.truncate(opts.prescreen_keep);
+        let chosen: HashSet<usize> = best.iter().copied().collect();
+        for (&i, p) in all.iter().zip(&plain) {
+            match p {
+                Some(p) if chosen.contains(p) => best.push(i),
+                Some(_) => pool.deferred.push(i),
+                None => {}
+            }
+        }
         best
     } else {
         all.clone()
@@ -752,6 +781,44 @@ pub(crate) fn search(
     pool.hold_undetermined(full, &coarse, (opts.iterations, opts.screen_iterations))?;
     trace(&format!("held what the data do not determine: {}", pool.clock.since_last()));
     Ok(())
+}
+
+/// Frees `what` on a thread of its own. The low-rank data of a large
+/// model's stage are gigabytes (the 100k-DOF frame's pre-screening held
+/// 3 GiB), and handing their pages back to the system took over a second
+/// of the diagnosis's time on its own thread; nothing waits for it.
+pub(crate) fn free_aside<T: Send + 'static>(what: T) {
+    // where no thread can be had, the refused closure frees it here
+    let _ = std::thread::Builder::new().name("rfm-free".into()).spawn(move || drop(what));
+}
+
+/// Per candidate of `which`, its plain twin among them where it is a
+/// fuller variant of one: a window, support or joint with non-viscous
+/// damping (a relaxation parameter more) of the same one with viscous
+/// damping, or a lumped mass with its rotary inertia of the mass alone at
+/// its node. On a large model the pre-screening fits the plain one only
+/// (the 100k-DOF frame's 8,568 non-viscous windows took a third of its
+/// fits, at 8 evaluations each against 5.4 for their viscous twins) and
+/// screens the fuller one where the plain one is among the best: the place
+/// is what the pre-screening chooses, and a relaxation parameter fitted
+/// from its start in three iterations on twenty lines says little about
+/// the form.
+fn plain_twins(candidates: &[Candidate], which: &[usize]) -> Vec<Option<usize>> {
+    let fuller = |r: &Role| matches!(r, Role::Mu | Role::Inertia);
+    let key = |c: &Candidate| {
+        let kind = if c.kind == EffectKind::NonViscousDamping { EffectKind::ViscousDamping } else { c.kind };
+        let roles: Vec<Role> = c.roles.iter().copied().filter(|r| !fuller(r)).collect();
+        (kind, c.nodes.clone(), c.elements.clone(), roles)
+    };
+    let plain: std::collections::HashMap<_, usize> =
+        which.iter().filter(|&&i| !candidates[i].roles.iter().any(fuller)).map(|&i| (key(&candidates[i]), i)).collect();
+    which
+        .iter()
+        .map(|&i| {
+            let c = &candidates[i];
+            if c.roles.iter().any(fuller) { plain.get(&key(c)).copied() } else { None }
+        })
+        .collect()
 }
 
 /// Other starting values of a candidate of one stiffness factor (a loss of
@@ -867,3 +934,68 @@ const TWINNED_LEADERS: usize = 3;
 const REFINED_LEADERS: usize = 3;
 /// Refined candidates fitted fully after screening.
 const REFINED_FITS: usize = 10;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// On a frame large enough for coarse windows, every non-viscous window
+    /// (and support or joint) and every mass with its rotary inertia waits
+    /// for a plain twin of the same place: the same elements and nodes,
+    /// viscous or without the inertia, and otherwise the same parameters;
+    /// plain candidates wait for nothing.
+    /// The first lumped mass.
+    fn masses_at(all: &[Candidate]) -> usize {
+        all.iter().position(|c| c.kind == EffectKind::LumpedMass).expect("a lumped mass")
+    }
+
+    #[test]
+    fn fuller_variants_find_their_plain_twins() {
+        let model = fe_model::samples::frame_grid(2, 2, 4);
+        let all = candidates::generate(&model, &CandidateOptions::default());
+        let which: Vec<usize> = (0..all.len()).collect();
+        let plain = plain_twins(&all, &which);
+        let (mut windows, mut masses) = (0, 0);
+        for (c, p) in all.iter().zip(&plain) {
+            let fuller = c.roles.iter().any(|r| matches!(r, Role::Mu | Role::Inertia));
+            // an existing group's relaxation (a joint as modelled) may have no plain twin
+            let Some(p) = p else {
+                assert!(!fuller || c.kind != EffectKind::LumpedMass, "{} has no plain twin", c.description);
+                assert!(!fuller || c.kind != EffectKind::NonViscousDamping, "{} has no plain twin", c.description);
+                continue;
+            };
+            assert!(fuller, "{} is plain yet waits for {}", c.description, all[*p].description);
+            let t = &all[*p];
+            assert_eq!((&t.nodes, &t.elements), (&c.nodes, &c.elements), "{} and {}", c.description, t.description);
+            assert_eq!(t.parameters.len() + 1, c.parameters.len(), "{} and {}", c.description, t.description);
+            match c.kind {
+                EffectKind::NonViscousDamping => {
+                    assert_eq!(t.kind, EffectKind::ViscousDamping);
+                    windows += 1;
+                }
+                EffectKind::LumpedMass => {
+                    assert!(t.kind == EffectKind::LumpedMass && !t.roles.contains(&Role::Inertia));
+                    masses += 1;
+                }
+                _ => assert_eq!(t.kind, c.kind, "{} and {}", c.description, t.description),
+            }
+        }
+        let count = |k: EffectKind| all.iter().filter(|c| c.kind == k).count();
+        assert_eq!(windows, count(EffectKind::NonViscousDamping));
+        let others = plain.iter().flatten().count() - windows - masses;
+        assert!(windows > 10 && others > 10, "{windows} windows, {others} supports and joints");
+        // the masses with their rotary inertia come with the refinement
+        let refined =
+            candidates::refine(&model, &CandidateOptions::default(), &[&all[masses_at(&all)]], &HashSet::new());
+        let mut pool: Vec<Candidate> = all.clone();
+        pool.extend(refined);
+        let which: Vec<usize> = (0..pool.len()).collect();
+        let plain = plain_twins(&pool, &which);
+        let with_inertia = (0..pool.len()).filter(|&i| pool[i].roles.contains(&Role::Inertia)).collect::<Vec<_>>();
+        assert!(!with_inertia.is_empty(), "the refinement of a mass offers its rotary inertia");
+        for i in with_inertia {
+            let t = &pool[plain[i].unwrap_or_else(|| panic!("{} has no plain twin", pool[i].description))];
+            assert!(t.kind == EffectKind::LumpedMass && t.nodes == pool[i].nodes && !t.roles.contains(&Role::Inertia));
+        }
+    }
+}

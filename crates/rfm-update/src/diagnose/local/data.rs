@@ -40,6 +40,9 @@ pub(crate) struct LocalData {
 /// set itself, or a set that contains it.
 pub(crate) struct Slots {
     pub(super) eqs: Vec<Vec<usize>>,
+    /// Where each slot's `S` starts in a line's [`Line::s`] (one more
+    /// than the slots: the last is the length).
+    pub(super) offsets: Vec<usize>,
     exact: HashMap<Vec<usize>, usize>,
     /// The slots holding each equation.
     by_eq: HashMap<usize, Vec<usize>>,
@@ -55,7 +58,7 @@ impl Slots {
     /// factorisation is the same either way, as a contained clique adds no
     /// pair to the pattern.
     pub(crate) fn of(forms: &[&LocalForm]) -> Self {
-        let mut slots = Slots { eqs: Vec::new(), exact: HashMap::new(), by_eq: HashMap::new() };
+        let mut slots = Slots { eqs: Vec::new(), offsets: vec![0], exact: HashMap::new(), by_eq: HashMap::new() };
         let mut order: Vec<&Vec<usize>> = forms.iter().map(|f| &f.eqs).collect();
         // stable: equal sizes keep their first order
         order.sort_by_key(|eqs| std::cmp::Reverse(eqs.len()));
@@ -67,9 +70,15 @@ impl Slots {
                     slots.by_eq.entry(e).or_default().push(slot);
                 }
                 slots.eqs.push(eqs.clone());
+                slots.offsets.push(slots.offsets[slot] + eqs.len() * eqs.len());
             }
         }
         slots
+    }
+
+    /// The range of a line's [`Line::s`] that holds the slot's `S`.
+    pub(super) fn range(&self, slot: usize) -> std::ops::Range<usize> {
+        self.offsets[slot]..self.offsets[slot + 1]
     }
 
     /// A slot holding every equation of `eqs` (sorted): the set itself when
@@ -94,8 +103,11 @@ pub(super) struct Line {
     /// `H_0[:, W]` on the rows that some `D` needs (see
     /// [`LocalData::row_of`]), `rows x |W|` row-interleaved.
     pub(super) w_rows: Vec<C64>,
-    /// Per slot: `S = H_0[D, D]`, row-major.
-    pub(super) s: Vec<Vec<C64>>,
+    /// Per slot: `S = H_0[D, D]`, row-major, one after the other
+    /// ([`Slots::range`]): one allocation per line, where one per slot
+    /// made freeing the pre-screening's data of a 100k-DOF frame (4,387
+    /// slots on 20 lines) and the screening's take over a second.
+    pub(super) s: Vec<C64>,
 }
 
 /// Every `S = H_0[D, D]` by unit solves, `CHUNK` equations at a time: the
@@ -103,11 +115,12 @@ pub(super) struct Line {
 pub(super) fn unit_solves(
     solver: &ZSolver,
     ws: &mut frf::Workspace,
-    slots: &[Vec<usize>],
+    slots: &Slots,
     x: &mut Vec<C64>,
     f: f64,
-    s: &mut [Vec<C64>],
+    s: &mut [C64],
 ) -> Result<(), frf::FrfError> {
+    let (offsets, slots) = (&slots.offsets, &slots.eqs);
     // for each equation of some D: the (slot, local column) it fills
     let mut users: HashMap<usize, Vec<(usize, usize)>> = HashMap::new();
     for (slot, eqs) in slots.iter().enumerate() {
@@ -124,7 +137,7 @@ pub(super) fn unit_solves(
             for &(slot, col) in &users[eq] {
                 let d = slots[slot].len();
                 for (row, &e) in slots[slot].iter().enumerate() {
-                    s[slot][row * d + col] = x[solver.position(e) * k + j];
+                    s[offsets[slot] + row * d + col] = x[solver.position(e) * k + j];
                 }
             }
         }
@@ -182,6 +195,7 @@ impl LocalData {
         let inverted = solver.reach(slot_eqs());
         let per_line: Vec<Line> = lines
             .par_iter()
+            .with_min_len(frf::lines_per_job(lines.len()))
             .map_init(
                 || (solver.workspace(), Vec::new(), Vec::new(), SelectedInverse::new()),
                 |(ws, z, x, inv), &f| {
@@ -197,15 +211,19 @@ impl LocalData {
                         let p = solver.position(eq);
                         w_rows[row * k..row * k + k].copy_from_slice(&x[p * k..p * k + k]);
                     }
-                    let mut s: Vec<Vec<C64>> = slots.eqs.iter().map(|e| vec![ZERO; e.len() * e.len()]).collect();
+                    let mut s = vec![ZERO; slots.offsets[slots.eqs.len()]];
                     let selected = match solver.selected_inverse_within(ws, &inverted, inv) {
-                        Ok(()) => slots.eqs.iter().zip(&mut s).all(|(eqs, s)| solver.inverse_block(inv, eqs, s)),
+                        Ok(()) => slots
+                            .eqs
+                            .iter()
+                            .enumerate()
+                            .all(|(k, eqs)| solver.inverse_block(inv, eqs, &mut s[slots.range(k)])),
                         // the LU fallback has no selected inverse
                         Err(frf::FrfError::NoLdltFactors { .. }) => false,
                         Err(e) => return Err(e),
                     };
                     if !selected {
-                        unit_solves(&solver, ws, &slots.eqs, x, f, &mut s)?;
+                        unit_solves(&solver, ws, &slots, x, f, &mut s)?;
                     }
                     Ok(Line { h0, w_rows, s })
                 },

@@ -36,9 +36,9 @@ impl LocalData {
         let s = line_idx
             .iter()
             .map(|&l| {
-                let full = &self.per_line[l].s[slot];
+                let full = &self.per_line[l].s[self.slots.range(slot)];
                 if ds == d {
-                    full.clone()
+                    full.to_vec()
                 } else {
                     at.iter().flat_map(|&r| at.iter().map(move |&c| full[r * ds + c])).collect()
                 }
@@ -323,8 +323,9 @@ impl LocalResponse<'_> {
             let line = &self.data.per_line[self.line_idx[li]];
             let mut h = line.h0.clone();
             for (a, &fr) in self.refs.iter().enumerate() {
+                // over the non-zeros of dZ's rows (the zeros add nothing)
                 for i in 0..d {
-                    w.col[i] = (0..d).map(|j| w.dz[i * d + j] * state.y[j * nr + a]).sum();
+                    w.col[i] = w.nz[w.nz_ptr[i]..w.nz_ptr[i + 1]].iter().map(|&(j, v)| v * state.y[j * nr + a]).sum();
                 }
                 for (c, &(r, fi)) in self.data.picks.iter().enumerate() {
                     if fi == fr {
