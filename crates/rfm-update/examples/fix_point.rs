@@ -284,6 +284,7 @@ fn main() {
                 eprintln!("{s:>8.2} s  kept {effect}: misfit {misfit:.4} ({status:?})")
             }
             FixProgress::StepDone { index, .. } => eprintln!("{s:>8.2} s  step {} done", index + 1),
+            FixProgress::Redone { step, .. } => eprintln!("{s:>8.2} s  steps from {} undone", step + 1),
             FixProgress::Refitted { refit, misfit, .. } => eprintln!(
                 "{s:>8.2} s  {} not needed at its own fit: the stage before updated again, misfit {:.4} -> {misfit:.4}",
                 refit.found_by, refit.first_misfit

@@ -451,6 +451,17 @@ pub enum FixProgress<'a> {
         /// How that update ended.
         status: &'a Status,
     },
+    /// The steps from `step` on were undone: a check of the data after them
+    /// found a set-up error and corrected it, and they had been chosen on
+    /// the data as they were; the loop makes them again on the corrected
+    /// data, from the model before them (a `Diagnosed` with the same `step`
+    /// follows).
+    Redone {
+        /// Effects added before the first step undone.
+        step: usize,
+        /// The effects of the steps undone.
+        effects: Vec<String>,
+    },
     /// A step is finished and will stay in the outcome: its effect added (or
     /// taken out), every parameter updated, and the data checked again after
     /// it. It carries the whole step, its case among it, so that a caller
@@ -1412,6 +1423,10 @@ pub fn fix(
                 // (see REDONE)
                 if redone < REDONE {
                     redone += 1;
+                    progress(FixProgress::Redone {
+                        step: first_new,
+                        effects: steps[first_new..].iter().map(|s| s.effect.description.clone()).collect(),
+                    });
                     findings.extend(late);
                     current = with_corrections(&before_step, &written, opts)?;
                     let sys = damping::DampedSystem::new(current.model.clone())?;

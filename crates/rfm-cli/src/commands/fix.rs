@@ -373,6 +373,15 @@ fn progress_lines_after(p: &FixProgress<'_>, done: usize) -> Vec<String> {
             table::misfit(refit.first_misfit),
             table::misfit(*misfit)
         )],
+        FixProgress::Redone { step, effects } => vec![format!(
+            "{} undone ({}): chosen on data corrected after it, made again on the corrected data",
+            if effects.len() == 1 {
+                format!("step {}", done + step + 1)
+            } else {
+                format!("steps {} to {}", done + step + 1, done + step + effects.len())
+            },
+            effects.join(", ")
+        )],
         // the step was announced by `Updated`; this one is for keeping it
         FixProgress::StepDone { .. } => Vec::new(),
     }
@@ -537,5 +546,20 @@ mod tests {
         let back: Progress = serde_json::from_str(&serde_json::to_string(&p).unwrap()).unwrap();
         assert_eq!(back.effects_done(), 1);
         assert_eq!((back.case, back.case_text, back.steps), (p.case, p.case_text, p.steps));
+    }
+
+    /// A step made again on corrected data is announced by its number and
+    /// effect, numbered from the first run's start when the run resumed.
+    #[test]
+    fn an_undone_step_is_named() {
+        let one = FixProgress::Redone { step: 1, effects: vec!["lumped mass at node 4".into()] };
+        assert_eq!(
+            progress_lines_after(&one, 0),
+            [
+                "step 2 undone (lumped mass at node 4): chosen on data corrected after it, made again on the corrected data"
+            ]
+        );
+        let two = FixProgress::Redone { step: 0, effects: vec!["a".into(), "b".into()] };
+        assert!(progress_lines_after(&two, 2)[0].starts_with("steps 3 to 4 undone (a, b): "));
     }
 }

@@ -161,6 +161,8 @@ struct Trial {
     score: Score,
     outcome: FixOutcome,
     exit9: bool,
+    /// The steps undone ([`rfm_update::fix::FixProgress::Redone`]).
+    redone: Vec<(usize, Vec<String>)>,
 }
 
 fn run(t: &LabTrial, seed: u64) -> Trial {
@@ -172,7 +174,13 @@ fn run(t: &LabTrial, seed: u64) -> Trial {
         diagnose: study.diagnose_options(study.measured()).expect("options"),
         ..FixOptions::default()
     };
-    let outcome = match fix(study.case(), study.measured(), &opts, |_| {}) {
+    let mut redone = Vec::new();
+    let progress = |p: rfm_update::fix::FixProgress<'_>| {
+        if let rfm_update::fix::FixProgress::Redone { step, effects } = p {
+            redone.push((step, effects));
+        }
+    };
+    let outcome = match fix(study.case(), study.measured(), &opts, progress) {
         Ok(o) => o,
         Err(e) => {
             let kept = dir.keep();
@@ -187,7 +195,7 @@ fn run(t: &LabTrial, seed: u64) -> Trial {
     if std::env::var("LAB_KEEP").is_ok() {
         println!("      the trial's files: {}", dir.keep().display());
     }
-    Trial { family: t.family, label: t.label.clone(), score, outcome, exit9 }
+    Trial { family: t.family, label: t.label.clone(), score, outcome, exit9, redone }
 }
 
 #[test]
@@ -370,5 +378,7 @@ fn a_step_is_made_on_the_corrected_data_and_takes_nothing_that_explains_a_third_
         // the data error was found after the first step, which was made again
         assert!(o.findings.iter().any(|f| !f.corrections.is_empty() && f.found_after_step == 1), "{}", r.label);
         assert!(o.steps[0].corrected_misfit.is_none(), "{}: the step was kept, not made again", r.label);
+        // and the loop said so, naming the step it undid
+        assert!(matches!(r.redone.first(), Some((0, undone)) if !undone.is_empty()), "{}: {:?}", r.label, r.redone);
     }
 }
