@@ -2,6 +2,8 @@
 //! identity (see the module docs of `local`), as a [`Response`] the
 //! output-error fit iterates on.
 
+use std::borrow::Cow;
+
 use damping::DampedSystem;
 use faer::Mat;
 use fe_model::Block;
@@ -38,9 +40,9 @@ impl LocalData {
             .map(|&l| {
                 let full = &self.per_line[l].s[self.slots.range(slot)];
                 if ds == d {
-                    full.to_vec()
+                    Cow::Borrowed(full)
                 } else {
-                    at.iter().flat_map(|&r| at.iter().map(move |&c| full[r * ds + c])).collect()
+                    Cow::Owned(at.iter().flat_map(|&r| at.iter().map(move |&c| full[r * ds + c])).collect())
                 }
             })
             .collect();
@@ -181,8 +183,12 @@ pub(crate) struct LocalResponse<'a> {
     nominal_z: Vec<Vec<C64>>,
     /// Per line: `X = H_0[D, W]`, row-major `d x |W|`.
     x: Vec<Vec<C64>>,
-    /// Per line: `S = H_0[D, D]`, row-major `d x d`.
-    s: Vec<Vec<C64>>,
+    /// Per line: `S = H_0[D, D]`, row-major `d x d`: borrowed from the
+    /// gathered data where the slot is `D` itself (a copy of 46 KB per
+    /// line and fit for a window of 8 elements in space, a tenth of the
+    /// pre-screening's time on the 100k-DOF frame), else its rows and
+    /// columns at `D`.
+    s: Vec<Cow<'a, [C64]>>,
     /// Each block of the candidate's part, placed locally when it changed.
     placed: Vec<Option<Placed>>,
     /// Distinct reference columns in `W`.
