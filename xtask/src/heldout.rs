@@ -10,8 +10,7 @@
 //! whose size `RFM_STUDY` sets run here: the other tests of those modules
 //! are the same either way, and CI, which runs this after `cargo test`,
 //! ran them there (they took about four minutes of this task before). It
-//! builds in the
-//! test profile, as `cargo test` does (opt-level 3 in this workspace), and
+//! builds in the test profile, as `cargo test` does (opt-level 3 in this workspace), and
 //! for the whole workspace (`--workspace --test it`, the filters select
 //! rfm-update's studies), so that cargo resolves the dependencies' features
 //! as `cargo test --workspace` did and CI, which runs it after the tests,
@@ -61,17 +60,17 @@ mod tests {
             let text = std::fs::read_to_string(dir.join(format!("{module}.rs"))).expect("the study's module");
             // each test function, and whether its body reads the size
             let mut tests = Vec::new();
-            for (k, part) in text.split("#[test]").enumerate().skip(1) {
+            for part in text.split("#[test]").skip(1) {
                 let name = part.split("fn ").nth(1).and_then(|r| r.split('(').next()).expect("a test function");
                 let body = part.split("\n}\n").next().unwrap_or(part);
                 let sized = body.contains("study_size(") || body.contains("full_study()");
-                tests.push((format!("{module}::{name}"), sized, k));
+                tests.push((format!("{module}::{name}"), sized));
             }
-            for (name, sized, _) in &tests {
+            for (name, sized) in &tests {
                 assert_eq!(STUDIES.contains(&name.as_str()), *sized, "{name}: sized by RFM_STUDY {sized}");
             }
             for study in STUDIES.iter().filter(|s| s.starts_with(&format!("{module}::"))) {
-                assert!(tests.iter().any(|(n, ..)| n == study), "{study} is no test of {module}.rs");
+                assert!(tests.iter().any(|(n, _)| n == study), "{study} is no test of {module}.rs");
             }
         }
     }

@@ -652,24 +652,29 @@ fn check_values(solver: &ZSolver, values: &[C64], freq_hz: f64) -> Result<f64, F
     // one pass for both the check and the largest squared modulus (a pass
     // over a 100,000-DOF frame's values is a fiftieth of its factorisation)
     let (m2, finite) = values.iter().fold((0.0f64, true), |(m, ok), v| (m.max(v.norm_sqr()), ok && is_finite(*v)));
-    match if finite { None } else { values.iter().position(|&v| !is_finite(v)) } {
-        None if m2.is_normal() => Ok(m2.sqrt()),
-        None => Ok(largest_norm(values)),
-        Some(_) if !(freq_hz.is_finite() && freq_hz > 0.0) => Err(FrfError::BadFrequency { freq_hz }),
-        Some(i) => {
-            // the column of entry i (the pattern is symmetric: its row too)
-            let col_ptr = solver.pattern.col_ptr();
-            let equation = col_ptr.partition_point(|&p| p <= i).saturating_sub(1);
-            Err(FrfError::NonFiniteZ { freq_hz, equation })
-        }
+    if finite {
+        return Ok(norm_from_square(m2, values));
     }
+    if !(freq_hz.is_finite() && freq_hz > 0.0) {
+        return Err(FrfError::BadFrequency { freq_hz });
+    }
+    let i = values.iter().position(|&v| !is_finite(v)).expect("a value is not finite");
+    // the column of entry i (the pattern is symmetric: its row too)
+    let col_ptr = solver.pattern.col_ptr();
+    let equation = col_ptr.partition_point(|&p| p <= i).saturating_sub(1);
+    Err(FrfError::NonFiniteZ { freq_hz, equation })
 }
 
 /// `max |x_i|`. The squared moduli are compared first (`hypot` on every
 /// entry of `Z` cost about a twentieth of a 100,000-DOF line); only when the
 /// largest square overflows or underflows is the maximum taken by `hypot`.
 fn largest_norm(x: &[C64]) -> f64 {
-    let m2 = x.iter().fold(0.0, |m: f64, v| m.max(v.norm_sqr()));
+    norm_from_square(x.iter().fold(0.0, |m: f64, v| m.max(v.norm_sqr())), x)
+}
+
+/// `max |x_i|` from the largest squared modulus `m2` of `x`, or by `hypot`
+/// where that square overflowed or underflowed.
+fn norm_from_square(m2: f64, x: &[C64]) -> f64 {
     if m2.is_normal() { m2.sqrt() } else { x.iter().fold(0.0, |m, v| m.max(v.norm())) }
 }
 

@@ -111,7 +111,7 @@ fn synthesize_lines(
     // thirds of the factorisation's.
     let k = ref_eqs.len();
     let within = solver.reach(ref_eqs.iter().copied().chain(picks.iter().map(|&(r, _)| r)));
-    let read: Vec<(usize, usize)> = picks.iter().map(|&(r, j)| (solver.position(r) * k + j, j)).collect();
+    let read: Vec<usize> = picks.iter().map(|&(r, j)| solver.position(r) * k + j).collect();
     let lines: Vec<Result<Option<Vec<C64>>, FrfError>> = freqs_hz
         .par_iter()
         .with_min_len(lines_per_job(freqs_hz.len()))
@@ -125,7 +125,7 @@ fn synthesize_lines(
                     solver.solve_units_within(ws, &ref_eqs, &within, x, f)
                 };
                 match line() {
-                    Ok(()) => Ok(Some(read.iter().map(|&(at, _)| x[at]).collect())),
+                    Ok(()) => Ok(Some(read.iter().map(|&at| x[at]).collect())),
                     Err(FrfError::Singular { .. }) if lenient => Ok(None),
                     Err(e) => Err(e),
                 }

@@ -304,8 +304,9 @@ fn data_beside(case: &Path) -> PathBuf {
 const UNFITTED_SHOWN: usize = 5;
 
 /// The fuller variants not fitted because their plain twin was not among
-/// the pre-screening's best, when there are any.
-fn deferred_text(d: &Diagnosis) -> String {
+/// the pre-screening's best, when there are any (the terminal's and the
+/// report's line of candidates).
+pub(crate) fn deferred_text(d: &Diagnosis) -> String {
     if d.deferred == 0 {
         return String::new();
     }

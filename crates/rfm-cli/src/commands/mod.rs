@@ -1,7 +1,7 @@
 //! One module per subcommand. Only this crate prints.
 
 mod compare;
-mod diagnose;
+pub(crate) mod diagnose;
 pub(crate) mod fix;
 mod inspect;
 mod simulate;

@@ -90,14 +90,7 @@ pub(crate) fn write(
                 "{} tried, {} replaced by a variant{}",
                 d.tried,
                 d.superseded,
-                if d.deferred > 0 {
-                    format!(
-                        ", {} fuller variants not fitted (their plain twins were not among the pre-screening's best)",
-                        d.deferred
-                    )
-                } else {
-                    String::new()
-                }
+                crate::commands::diagnose::deferred_text(d)
             ),
         ),
     ];

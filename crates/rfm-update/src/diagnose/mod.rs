@@ -684,12 +684,8 @@ fn diagnose_in(
     let (measured, weights) = if singular.is_empty() {
         (measured, weights)
     } else {
-        let nf = measured.n_freq();
-        let keep: Vec<usize> = (0..nf).filter(|&k| !singular.contains(&lines[k])).collect();
-        reduced = measured.select_lines(&keep)?;
-        reduced_weights = weights.map(|w| {
-            (0..measured.channels().len()).flat_map(|c| keep.iter().map(move |&k| w[c * nf + k])).collect::<Vec<f64>>()
-        });
+        let keep: Vec<usize> = (0..lines.len()).filter(|&k| !singular.contains(&lines[k])).collect();
+        (reduced, reduced_weights) = select_lines(measured, weights, &keep)?;
         (&reduced, reduced_weights.as_deref())
     };
     if !singular.is_empty() {
@@ -716,6 +712,19 @@ fn diagnose_in(
     let mut d = rank(pool, noise, &full, opts);
     d.singular_hz = singular;
     Ok(d)
+}
+
+/// `measured` and its channel-major `weights` at the lines `keep` (indices,
+/// ascending).
+pub(crate) fn select_lines(
+    measured: &FrfSet,
+    weights: Option<&[f64]>,
+    keep: &[usize],
+) -> Result<(FrfSet, Option<Vec<f64>>), UpdateError> {
+    let nf = measured.n_freq();
+    let weights = weights
+        .map(|w| (0..measured.channels().len()).flat_map(|c| keep.iter().map(move |&k| w[c * nf + k])).collect());
+    Ok((measured.select_lines(keep)?, weights))
 }
 
 /// A band whose middle lies within this relative distance of a frequency

@@ -940,16 +940,16 @@ const REFINED_FITS: usize = 10;
 mod tests {
     use super::*;
 
-    /// On a frame large enough for coarse windows, every non-viscous window
-    /// (and support or joint) and every mass with its rotary inertia waits
-    /// for a plain twin of the same place: the same elements and nodes,
-    /// viscous or without the inertia, and otherwise the same parameters;
-    /// plain candidates wait for nothing.
     /// The first lumped mass.
     fn masses_at(all: &[Candidate]) -> usize {
         all.iter().position(|c| c.kind == EffectKind::LumpedMass).expect("a lumped mass")
     }
 
+    /// On a frame large enough for coarse windows, every non-viscous window
+    /// (and support or joint) and every mass with its rotary inertia waits
+    /// for a plain twin of the same place: the same elements and nodes,
+    /// viscous or without the inertia, and otherwise the same parameters;
+    /// plain candidates wait for nothing.
     #[test]
     fn fuller_variants_find_their_plain_twins() {
         let model = fe_model::samples::frame_grid(2, 2, 4);

@@ -73,13 +73,7 @@ pub(crate) fn broad_residual_hz(
     let (measured, weights) = if present.len() == all.len() {
         (measured, weights)
     } else {
-        let nf = all.len();
-        reduced = measured.select_lines(&present)?;
-        reduced_weights = weights.map(|w| {
-            (0..measured.channels().len())
-                .flat_map(|c| present.iter().map(move |&k| w[c * nf + k]))
-                .collect::<Vec<f64>>()
-        });
+        (reduced, reduced_weights) = super::select_lines(measured, weights, &present)?;
         (&reduced, reduced_weights.as_deref())
     };
     let f = measured.frequencies_hz();
