@@ -532,6 +532,23 @@ mod tests {
         Unfitted { description: description.into(), reason: format!("singular at {description}"), stage, ranked }
     }
 
+    /// Fuller variants left unfitted by the pre-screening are counted in
+    /// the line of candidates (the terminal's and the report's) and in the
+    /// JSON; none, nothing is said.
+    #[test]
+    fn deferred_variants_are_counted() {
+        let mut d = diagnosis(Vec::new());
+        assert_eq!(deferred_text(&d), "");
+        d.deferred = 9723;
+        assert_eq!(
+            deferred_text(&d),
+            ", 9723 fuller variants (non-viscous damping, rotary inertia) not fitted: their plain twins were not \
+             among the pre-screening's best"
+        );
+        let json = serde_json::to_value(WithNotes { notes: &[], result: &d }).unwrap();
+        assert_eq!(json["deferred"], 9723);
+    }
+
     /// The text tells how many fits failed, how many of those are not
     /// ranked, and the first few with stage and reason; the JSON lists all.
     #[test]
