@@ -44,6 +44,10 @@ pub struct Model {
     pub(crate) materials: Vec<Material>,
     pub(crate) sections: Vec<Section>,
     pub(crate) beams: Vec<Beam>,
+    /// Index in `beams` of each element id: a model of 100k elements
+    /// checked each new id against all before it (quadratic: seconds when
+    /// loading a large imported frame).
+    pub(crate) beam_ids: HashMap<ElementId, usize>,
     pub(crate) springs: Vec<Spring>,
     pub(crate) masses: Vec<LumpedMass>,
     pub(crate) supports: Vec<Support>,
@@ -155,7 +159,7 @@ impl Model {
     }
     /// Index of a beam by id.
     pub fn beam_index(&self, id: ElementId) -> Option<usize> {
-        self.beams.iter().position(|b| b.id == id)
+        self.beam_ids.get(&id).copied()
     }
     /// Index of a spring by name.
     pub fn spring_index(&self, name: &str) -> Option<usize> {
@@ -327,7 +331,7 @@ impl Model {
     ) -> Result<usize, ModelError> {
         let id = ElementId(id);
         let ctx = format!("element {id}");
-        if self.beams.iter().any(|b| b.id == id) {
+        if self.beam_ids.contains_key(&id) {
             return Err(ModelError::Duplicate { what: ctx });
         }
         let nodes = [NodeId(nodes[0]), NodeId(nodes[1])];
@@ -384,6 +388,7 @@ impl Model {
             self.beams.pop();
             return Err(e);
         }
+        self.beam_ids.insert(id, self.beams.len() - 1);
         Ok(self.beams.len() - 1)
     }
 
@@ -652,6 +657,7 @@ mod tests {
             node_index,
             materials: m.materials.clone(),
             sections: m.sections.clone(),
+            beam_ids: m.beams.iter().filter(|b| b.nodes.iter().all(kept)).enumerate().map(|(i, b)| (b.id, i)).collect(),
             beams: m.beams.iter().filter(|b| b.nodes.iter().all(kept)).cloned().collect(),
             springs: m.springs.iter().filter(|s| kept(&s.a) && s.b.as_ref().is_none_or(kept)).cloned().collect(),
             masses: m.masses.iter().filter(|m| kept(&m.node)).cloned().collect(),
@@ -787,5 +793,35 @@ mod tests {
         assert_eq!(m.groups()[joint], samples::frame_with_joint().groups()[joint]);
         m.replace_group(joint, Group::new("joint").rayleigh(2e-3, 0.0)).unwrap();
         assert_eq!((m.groups()[joint].alpha, m.groups()[joint].mu), (2e-3, None));
+    }
+
+    /// Element ids are looked up by index, not by a scan: a repeated id is
+    /// refused, an element refused for another reason leaves no id behind,
+    /// and a part knows its own elements' ids.
+    #[test]
+    fn element_ids_are_unique_and_found() {
+        let mut m = samples::cantilever(4);
+        let n = m.beams().len();
+        for (i, b) in m.beams().iter().enumerate() {
+            assert_eq!(m.beam_index(b.id), Some(i));
+        }
+        let first = m.beams()[0].clone();
+        assert_eq!(
+            m.add_beam(first.id.0, [first.nodes[0].0, first.nodes[1].0], first.material, first.section, first.group)
+                .unwrap_err(),
+            ModelError::Duplicate { what: format!("element {}", first.id) }
+        );
+        // a zero-length element with a new id is refused and leaves no id
+        let a = first.nodes[0].0;
+        assert!(m.add_beam(9_999, [a, a], first.material, first.section, first.group).is_err());
+        assert_eq!((m.beam_index(ElementId(9_999)), m.beams().len()), (None, n));
+        let added = m.add_beam(9_999, [first.nodes[0].0, first.nodes[1].0], 0, 0, first.group).unwrap();
+        assert_eq!(m.beam_index(ElementId(9_999)), Some(added));
+        // a part around the last element: its ids index its own list
+        let last = m.beams()[n - 1].clone();
+        let part = m.part(&last.nodes);
+        assert_eq!(part.beams().len(), 1);
+        assert_eq!(part.beam_index(last.id), Some(0));
+        assert_eq!(part.beam_index(first.id), None);
     }
 }

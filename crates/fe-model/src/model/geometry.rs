@@ -53,6 +53,8 @@ impl Model {
         };
         let nodes: Vec<Node> = keep.iter().map(|&i| self.nodes[i].clone()).collect();
         let node_index = nodes.iter().enumerate().map(|(i, n)| (n.id, i)).collect();
+        let beams = cut(&self.beams, at(&index.beams), |b| b.nodes.iter().all(kept));
+        let beam_ids = beams.iter().enumerate().map(|(i, b)| (b.id, i)).collect();
         Model {
             title: self.title.clone(),
             dimension: self.dimension,
@@ -60,7 +62,8 @@ impl Model {
             node_index,
             materials: self.materials.clone(),
             sections: self.sections.clone(),
-            beams: cut(&self.beams, at(&index.beams), |b| b.nodes.iter().all(kept)),
+            beams,
+            beam_ids,
             springs: cut(&self.springs, at(&index.springs), |s| kept(&s.a) && s.b.as_ref().is_none_or(kept)),
             masses: cut(&self.masses, at(&index.masses), |_| true),
             supports: cut(&self.supports, at(&index.supports), |_| true),
