@@ -182,14 +182,6 @@ impl CaseFile {
             .collect::<Result<Vec<_>, CaseError>>()?;
         let check =
             raw.check.as_ref().map(|c| check::parse_check(&ctx, c, truth.as_ref(), update.as_ref())).transpose()?;
-        if let (Some(m), None) = (&measurement, &truth)
-            && m.data.is_none()
-        {
-            return Err(ctx.err(
-                raw.measurement.as_ref().unwrap().span(),
-                "the measurement has no `data` file and the case has no [truth] to synthesise it from",
-            ));
-        }
         Ok(CaseFile {
             path: path.to_path_buf(),
             source: source.to_string(),
@@ -203,6 +195,21 @@ impl CaseFile {
             check,
             imported_files: raw.imported.as_ref().map(|i| imported::files(&ctx, i)).unwrap_or_default(),
         })
+    }
+
+    /// Whether the case gives something to compare with: a `data` file, or
+    /// a `[truth]` to synthesise the data from. A measurement with neither
+    /// is only the lines and channels to synthesise (`rfm simulate` of a
+    /// model written apart); the error, located at `[measurement]`, is for
+    /// the commands that compare.
+    pub fn measured_source(&self) -> Result<(), CaseError> {
+        match &self.measurement {
+            Some(m) if m.data.is_none() && self.truth.is_none() => {
+                let message = "the measurement has no `data` file and the case has no [truth] to synthesise it from";
+                Err(m.place.as_ref().map_or_else(|| self.error(None, message), |p| p.with_message(message)))
+            }
+            _ => Ok(()),
+        }
     }
 
     /// A located error about this file (for checks done by higher layers).

@@ -87,6 +87,11 @@ pub struct MeasurementSpec {
     pub responses: Vec<DofRef>,
     /// Measured data file (resolved relative to the case file), if any.
     pub data: Option<PathBuf>,
+    /// Where the `[measurement]` table starts, for messages about it (a
+    /// measurement without `data` in a case without `[truth]`: the lines
+    /// and channels `rfm simulate` writes, which no command comparing with
+    /// a test can read; see [`crate::CaseFile::measured_source`]).
+    pub place: Option<CaseError>,
     /// Test (node, direction) to model DOF mapping for measured files.
     pub map: Vec<ChannelMap>,
     /// What to leave out of the measured data instead of refusing it
@@ -319,6 +324,7 @@ pub(super) fn parse_measurement(
         references,
         responses,
         data,
+        place: Some(ctx.err(m.span(), "")),
         map,
         mask,
         band,

@@ -646,3 +646,25 @@ fn a_shaker_is_an_armature_tied_to_its_drive_point_on_a_suspension_to_ground() {
         assert_eq!(line_of(&text, &e), line, "{e}");
     }
 }
+
+/// A measurement without data in a case without `[truth]` is the lines and
+/// channels to synthesise a model written apart (`rfm simulate`): it loads,
+/// and the commands that compare ask [`CaseFile::measured_source`], which
+/// points at the `[measurement]` table.
+#[test]
+fn a_measurement_without_data_or_truth_loads_and_is_refused_where_data_are_needed() {
+    let text =
+        format!("{BEAM}\n[measurement]\nfrequencies = [10.0, 20.0]\nreferences = [\"5:uy\"]\nresponses = [\"5:uy\"]\n");
+    let c = parse(&text).unwrap();
+    let m = c.measurement.as_ref().unwrap();
+    assert_eq!((m.frequencies_hz.len(), m.data.is_none(), c.truth.is_none()), (2, true, true));
+    let e = c.measured_source().unwrap_err();
+    assert!(e.message.contains("has no `data` file and the case has no [truth]"), "{e}");
+    assert_eq!(text.lines().nth(e.location.unwrap().line - 1).unwrap().trim(), "[measurement]");
+    // with a truth, or a data file, there is something to compare with
+    let with_truth = parse(&format!("{text}[truth]\n")).unwrap();
+    assert!(with_truth.measured_source().is_ok());
+    let with_data = parse(&text.replace("frequencies = [10.0, 20.0]", "data = \"any.uff\"")).unwrap();
+    assert!(with_data.measured_source().is_ok());
+    assert!(parse(BEAM).unwrap().measured_source().is_ok());
+}

@@ -212,6 +212,36 @@ for s in sets:
 pyuff.UFF(again).write_sets(sets, mode='overwrite')
 "#;
 
+/// A truth written apart (a case of its own, with only the lines and
+/// channels under `[measurement]`) is simulated as it stands; a command
+/// that compares with a test refuses that case at its `[measurement]`
+/// table, and compares once given the simulated file.
+#[test]
+fn a_case_without_data_is_simulated_and_compared_only_with_a_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let tutorial = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases/tutorial/l-frame.toml");
+    let tutorial = std::fs::read_to_string(tutorial).unwrap();
+    let body: String = tutorial
+        .lines()
+        .take_while(|l| !l.starts_with("# What `cargo xtask reproduce"))
+        .filter(|l| !l.starts_with("data ="))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let case = dir.path().join("apart.toml");
+    std::fs::write(&case, &body).unwrap();
+    let (case, csv) = (case.to_str().unwrap(), dir.path().join("apart.csv"));
+    let out = rfm(&["simulate", case, "--noise", "0.01", "--out", csv.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert_eq!(frf::io::csv::read_csv(&csv).unwrap().channels().len(), 8);
+    let out = rfm(&["compare", case, "--json"]);
+    assert_eq!(out.status.code(), Some(3), "{}", text(&out.stderr));
+    let line = body.lines().position(|l| l.trim() == "[measurement]").unwrap() + 1;
+    let err = text(&out.stderr);
+    assert!(err.contains(&format!("apart.toml:{line}:")) && err.contains("no `data` file"), "{err}");
+    let out = rfm(&["compare", case, "--measured", csv.to_str().unwrap(), "--json"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+}
+
 /// `simulate --out x.uff` writes UFF dataset 58 (ASCII, or 58b with
 /// `--binary`) in each kind, which reads back as the CSV of the same run;
 /// when pyuff is installed, pyuff reads rfm's files and writes them again,

@@ -176,7 +176,12 @@ impl Study {
                 NoiseModel { relative: spec_t.noise, floor: spec_t.floor, seed: spec_t.seed }.apply(&mut set);
                 set
             }
-            _ => unreachable!("the case loader requires data or a truth"),
+            _ => {
+                return Err(case.measured_source().err().map_or_else(
+                    || UpdateError::Data("the case gives no measured data and no [truth]".into()),
+                    UpdateError::Case,
+                ));
+            }
         };
         let parameters = case.update.as_ref().map(|u| u.parameters.clone()).unwrap_or_default();
         let (gains, gains_reason) = gain::decide(Some(spec), case.update.as_ref(), &per_volt)?;
