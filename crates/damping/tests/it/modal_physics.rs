@@ -100,3 +100,59 @@ fn very_stiff_joint_springs_reproduce_the_rigid_corner() {
     let soft = normal_modes(&Assembly::new(&corner(Some(1e3))).unwrap()).unwrap();
     assert!(soft.frequencies_hz[0] < 0.9 * rigid.frequencies_hz[0]);
 }
+
+/// `Model::refined` against the same beam meshed finer from the start: a
+/// 10-element cantilever split in three has the frequencies of a
+/// 30-element one to round-off, its mass unchanged, and its error against
+/// Euler-Bernoulli down by the `h^4` of cubic Hermite elements (3^4 = 81,
+/// to 5 % on modes 1 and 2, where the leading term rules).
+#[test]
+fn a_refined_mesh_is_the_finer_mesh() {
+    let coarse = samples::cantilever(10);
+    let refined = coarse.refined(3).unwrap();
+    let direct = samples::cantilever(30);
+    assert_eq!((refined.beams().len(), refined.nodes().len()), (30, direct.nodes().len()));
+    assert!((refined.total_mass() - coarse.total_mass()).abs() <= 1e-12 * coarse.total_mass());
+    let f = |m: &Model| normal_modes(&Assembly::new(m).unwrap()).unwrap().frequencies_hz;
+    let (fc, fr, fd) = (f(&coarse), f(&refined), f(&direct));
+    for (a, b) in fr.iter().zip(&fd) {
+        assert!((a - b).abs() <= 1e-9 * b, "refined {a} Hz, meshed finer {b} Hz");
+    }
+    let (e, rho, b, h, l): (f64, f64, f64, f64, f64) = (2.0e11, 7800.0, 0.05, 0.01, 1.0);
+    let (area, inertia) = (b * h, b * h * h * h / 12.0);
+    for (k, bl) in BETA_L.iter().take(2).enumerate() {
+        let exact = bl * bl / (2.0 * std::f64::consts::PI * l * l) * (e * inertia / (rho * area)).sqrt();
+        let ratio = (fc[k] - exact) / (fr[k] - exact);
+        assert!((ratio / 81.0 - 1.0).abs() < 0.05, "mode {}: error falls {ratio:.1} times", k + 1);
+    }
+    // ids: the first piece keeps the beam's, the rest are new and distinct
+    for b in coarse.beams() {
+        assert!(refined.beam_index(b.id).is_some());
+    }
+    assert_eq!(coarse.refined(1).unwrap().beams().len(), 10);
+}
+
+/// In space, each piece of a refined beam keeps its section's orientation
+/// (the same local axes as its beam), and the refined portal's modes lie
+/// below the coarse one's (Rayleigh-Ritz: a finer conforming mesh can only
+/// lower them) by less than the lowest mode's own spacing.
+#[test]
+fn a_refined_space_frame_keeps_its_sections_turned() {
+    let coarse = samples::space_portal();
+    let refined = coarse.refined(2).unwrap();
+    assert_eq!(refined.beams().len(), 2 * coarse.beams().len());
+    for (i, b) in coarse.beams().iter().enumerate() {
+        let axes = coarse.beam_axes(i);
+        let first = refined.beam_index(b.id).unwrap();
+        for (r, row) in refined.beam_axes(first).iter().enumerate() {
+            for (c, v) in row.iter().enumerate() {
+                assert!((v - axes[r][c]).abs() < 1e-12, "element {}: axis {r} moved", b.id);
+            }
+        }
+    }
+    let f = |m: &Model| normal_modes(&Assembly::new(m).unwrap()).unwrap().frequencies_hz;
+    let (fc, fr) = (f(&coarse), f(&refined));
+    for k in 0..6 {
+        assert!(fr[k] <= fc[k] * (1.0 + 1e-12) && fr[k] > 0.9 * fc[k], "mode {}: {} -> {} Hz", k + 1, fc[k], fr[k]);
+    }
+}
