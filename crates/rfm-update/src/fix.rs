@@ -288,6 +288,11 @@ pub enum FixStop {
     /// The diagnosis of the model after the last step failed (see
     /// [`FixOutcome::diagnosis_error`]); the steps before it stand.
     DiagnosisFailed,
+    /// The model's mesh is too coarse for the band: the same model with
+    /// every element cut in two explains the data to their noise
+    /// ([`FixOutcome::mesh`]), so no effect is added for what the mesh
+    /// decides.
+    MeshTooCoarse,
 }
 
 impl FixStop {
@@ -304,6 +309,10 @@ impl FixStop {
             }
             FixStop::StepsDone => "the number of steps asked for is done",
             FixStop::DiagnosisFailed => "the diagnosis of the model after the last step failed",
+            FixStop::MeshTooCoarse => {
+                "the model's mesh is too coarse for the band: the same model with every element cut in two explains \
+                 the data to their noise, so no effect is added for it; refine the mesh"
+            }
         }
     }
 }
@@ -348,6 +357,10 @@ pub struct FixOutcome {
     pub significant_remains: bool,
     /// Why the diagnosis of the final model failed, when it did.
     pub diagnosis_error: Option<String>,
+    /// The model (corrected, its own parameters updated) against itself
+    /// with a finer mesh, before any effect is added; `None` for a model
+    /// without beams or too large to refine ([`diagnose::mesh_check`]).
+    pub mesh: Option<diagnose::MeshCheck>,
 }
 
 impl FixOutcome {
@@ -971,6 +984,9 @@ pub struct Prepared {
     pub declared: Option<DeclaredStep>,
     /// Frequencies (Hz) of measured modes the model lacks.
     pub extra_modes_hz: Vec<f64>,
+    /// The model after these steps against itself with a finer mesh
+    /// ([`diagnose::mesh_check`]).
+    pub mesh: Option<diagnose::MeshCheck>,
     /// The model's misfit and parameter count after these steps.
     state: State,
 }
@@ -1039,6 +1055,8 @@ pub fn prepare(
             }
         }
     }
+    // a mesh too coarse for the band is a model error that no effect is
+    let mesh = diagnose::mesh_check(&current.model, &fl.data, d_opts.lines, d_opts.gains, d_opts.weights.as_deref())?;
     Ok(Prepared {
         noise,
         nominal_misfit: nominal.misfit,
@@ -1048,6 +1066,7 @@ pub fn prepare(
         data: fl.data,
         case: current,
         declared,
+        mesh,
         state,
     })
 }
@@ -1062,6 +1081,8 @@ pub struct CheckedDiagnosis<'a> {
     pub findings: &'a [Finding],
     /// Step 0, when the case declares parameters.
     pub declared: Option<&'a DeclaredStep>,
+    /// The model after them against itself with a finer mesh.
+    pub mesh: Option<&'a diagnose::MeshCheck>,
     /// The diagnosis of the model after them, on the corrected data.
     #[cfg_attr(feature = "serde", serde(flatten))]
     pub diagnosis: &'a Diagnosis,
@@ -1117,6 +1138,28 @@ pub fn fix(
     let mut declared = p.declared;
     let mut current = p.case;
     let mut state = p.state;
+    // when the same model meshed finer explains the data, nothing is added
+    let mesh = p.mesh;
+    if let Some(m) = mesh.as_ref().filter(|m| m.explains(noise, CONSISTENT)) {
+        let stop = FixStop::MeshTooCoarse;
+        return Ok(FixOutcome {
+            noise,
+            nominal_misfit: nominal,
+            findings,
+            corrected_misfit: corrected,
+            declared,
+            effects: Vec::new(),
+            steps: Vec::new(),
+            stop,
+            stop_reason: remains::stop_reason(stop, &[], &[], None, state.misfit, noise),
+            remains: vec![m.describe(noise)],
+            equally_good: Vec::new(),
+            significant_remains: true,
+            remaining: Vec::new(),
+            diagnosis_error: None,
+            mesh,
+        });
+    }
 
     // the case every effect is added to: corrected, its own parameters updated
     let mut base = current.clone();
@@ -1574,6 +1617,7 @@ pub fn fix(
         significant_remains: last.as_ref().is_none_or(|d| !d.consistent()),
         remaining: last.map_or(Vec::new(), |d| d.ranking.into_iter().filter(|r| r.fully_fitted).take(5).collect()),
         diagnosis_error,
+        mesh,
     })
 }
 

@@ -109,6 +109,9 @@ pub fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
     } else {
         print_checks(&prepared)?;
         print_diagnosis(&d, args.top, prepared.declared.is_some())?;
+        if let Some(line) = mesh_note(&prepared) {
+            outln!("\n{line}");
+        }
     }
     if let Some(mut output) = report_output.take() {
         let source = args.measured.map_or_else(
@@ -165,10 +168,30 @@ pub fn run_diagnosis(
     Ok(diagnose_prepared(study.case(), data, &opts, progress, stage)?)
 }
 
+/// The mesh's share of what the model leaves, when the mesh moves the
+/// FRFs by more than the noise: a note that what the ranking proposes may
+/// stand for the mesh, or, when the model meshed finer explains the data
+/// alone, that no effect should be added before the mesh is refined.
+pub(crate) fn mesh_note(prepared: &Prepared) -> Option<String> {
+    let m = prepared.mesh.as_ref().filter(|m| m.visible(prepared.noise))?;
+    let consequence = if m.explains(prepared.noise, rfm_update::fix::CONSISTENT) {
+        "the same model meshed finer explains the data to their noise: refine the mesh before adding any effect \
+         (what the ranking proposes stands for the mesh)"
+    } else {
+        "effects found may stand in part for the mesh (refine it)"
+    };
+    Some(format!("note: {}; {consequence}", m.describe(prepared.noise)))
+}
+
 /// What `rfm diagnose --json` prints: the notes on reading the data, the
 /// findings about them, step 0 and the diagnosis.
 pub fn diagnosis_json(notes: &[String], prepared: &Prepared, d: &Diagnosis) -> Result<String> {
-    let report = CheckedDiagnosis { findings: &prepared.findings, declared: prepared.declared.as_ref(), diagnosis: d };
+    let report = CheckedDiagnosis {
+        findings: &prepared.findings,
+        declared: prepared.declared.as_ref(),
+        mesh: prepared.mesh.as_ref(),
+        diagnosis: d,
+    };
     Ok(serde_json::to_string_pretty(&WithNotes { notes, result: &report })?)
 }
 

@@ -394,7 +394,7 @@ fn progress_lines_after(p: &FixProgress<'_>, done: usize) -> Vec<String> {
 pub fn fix_exit(outcome: &FixOutcome) -> Exit {
     match outcome.stop {
         _ if outcome.explained() => Exit::Success,
-        FixStop::ModelInadequate | FixStop::Ambiguous => Exit::ModelInadequate,
+        FixStop::ModelInadequate | FixStop::Ambiguous | FixStop::MeshTooCoarse => Exit::ModelInadequate,
         _ => Exit::NotConverged,
     }
 }
@@ -473,6 +473,9 @@ fn print_outcome(o: &FixOutcome, done: usize) -> Result<()> {
         "(dBIC of the step: the evidence for the model after it over the model before, both updated; below {} it is significant)",
         quantities::SIGNIFICANT_DBIC
     );
+    if let Some(m) = o.mesh.as_ref().filter(|m| m.visible(o.noise) && o.stop != FixStop::MeshTooCoarse) {
+        outln!("\nnote: {}: effects found may stand in part for the mesh (refine it)", m.describe(o.noise));
+    }
     outln!("\nstopped: {}", o.stop_reason);
     let last = o.final_misfit();
     let times = table::times(quantities::times_noise(last, o.noise));

@@ -76,3 +76,49 @@ fn an_rfm_run_worse_than_its_start_says_so_and_exits_non_zero() {
     let updated = std::fs::read_to_string(out.join("updated.toml")).unwrap();
     assert!(updated.contains("WARNING: this update made the misfit WORSE"), "{updated}");
 }
+
+/// The tutorial's L-frame (12 + 10 elements) against data of the same
+/// frame meshed four times finer at 2-3000 Hz (the truth written node by
+/// node, `rfm-update/tests/it/cases/l-frame-x4.toml`): `rfm fix` adds
+/// nothing and stops with exit code 9, saying the mesh is too coarse (it
+/// once added a flexible clamp and exited 0); `rfm diagnose` ranks as
+/// before and notes the mesh, in text and JSON.
+#[test]
+fn a_mesh_too_coarse_for_the_band_stops_the_loop_with_nothing_added() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let truth = root.join("crates/rfm-update/tests/it/cases/l-frame-x4.toml");
+    let data = dir.path().join("finer.csv");
+    let args = ["simulate", truth.to_str().unwrap(), "--noise", "0.01", "--seed", "3", "--out", data.to_str().unwrap()];
+    let run = rfm(&args);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let tutorial = std::fs::read_to_string(root.join("cases/tutorial/l-frame.toml")).unwrap();
+    let nominal: String = tutorial
+        .lines()
+        .take_while(|l| !l.starts_with("# What `cargo xtask reproduce"))
+        .map(|l| match l {
+            _ if l.starts_with("data =") => "data = \"finer.csv\"\n".to_string(),
+            _ if l.starts_with("frequencies =") => "frequencies = { from = 2.0, to = 3000.0, step = 2.0 }\n".into(),
+            _ => format!("{l}\n"),
+        })
+        .collect();
+    let case = dir.path().join("coarse.toml");
+    std::fs::write(&case, nominal).unwrap();
+    let case = case.to_str().unwrap();
+
+    let out = dir.path().join("fixed");
+    let run = rfm(&["fix", case, "--out", out.to_str().unwrap()]);
+    let stdout = text(&run.stdout);
+    assert_eq!(run.status.code(), Some(9), "{stdout}\n{}", text(&run.stderr));
+    assert!(stdout.contains("the model's mesh is too coarse for the band"), "{stdout}");
+    assert!(stdout.contains("the mesh: with every element cut in 2"), "{stdout}");
+    assert!(!stdout.contains("step 1: added"), "{stdout}");
+
+    let run = rfm(&["diagnose", case, "--json"]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let doc: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+    let (misfit, refined) = (doc["mesh"]["misfit"].as_f64().unwrap(), doc["mesh"]["refined_misfit"].as_f64().unwrap());
+    assert!(refined < misfit / 1.5 && doc["mesh"]["parts"] == 2, "{}", doc["mesh"]);
+    let run = rfm(&["diagnose", case]);
+    assert!(text(&run.stdout).contains("refine the mesh before adding any effect"), "{}", text(&run.stdout));
+}

@@ -138,7 +138,7 @@ pub(super) fn stop_reason(
         FixStop::DiagnosisFailed => {
             s.push_str(&format!(": {}", diagnosis_error.unwrap_or("no reason given")));
         }
-        FixStop::NothingSignificant | FixStop::StepsDone => {}
+        FixStop::NothingSignificant | FixStop::StepsDone | FixStop::MeshTooCoarse => {}
     }
     if stop != FixStop::Ambiguous && equally_good.len() > 1 {
         let others: Vec<&str> = equally_good[1..].iter().map(|r| r.effect.as_str()).collect();

@@ -10,6 +10,7 @@ mod hidden_effects;
 mod hidden_effects_3d;
 mod lab;
 mod lab_study;
+mod mesh;
 mod noise_estimate;
 mod numerics;
 mod output_error;
