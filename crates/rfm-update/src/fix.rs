@@ -290,8 +290,8 @@ pub enum FixStop {
     DiagnosisFailed,
     /// The model's mesh is too coarse for the band: the same model with
     /// every element cut in two explains the data to their noise
-    /// ([`FixOutcome::mesh`]), so no effect is added for what the mesh
-    /// decides.
+    /// ([`FixOutcome::mesh`]), before the first step or after one, so no
+    /// effect is added for what the mesh decides.
     MeshTooCoarse,
 }
 
@@ -310,8 +310,8 @@ impl FixStop {
             FixStop::StepsDone => "the number of steps asked for is done",
             FixStop::DiagnosisFailed => "the diagnosis of the model after the last step failed",
             FixStop::MeshTooCoarse => {
-                "the model's mesh is too coarse for the band: the same model with every element cut in two explains \
-                 the data to their noise, so no effect is added for it; refine the mesh"
+                "what the model leaves is its mesh's: the same model with every element cut in two explains the data \
+                 to their noise, so no effect is added for it; refine the mesh"
             }
         }
     }
@@ -357,9 +357,10 @@ pub struct FixOutcome {
     pub significant_remains: bool,
     /// Why the diagnosis of the final model failed, when it did.
     pub diagnosis_error: Option<String>,
-    /// The model (corrected, its own parameters updated) against itself
-    /// with a finer mesh, before any effect is added; `None` for a model
-    /// without beams or too large to refine ([`diagnose::mesh_check`]).
+    /// The model against itself with a finer mesh: the last check made,
+    /// before the first step (the model corrected, its own parameters
+    /// updated) and before every step after it; `None` for a model without
+    /// beams or too large to refine ([`diagnose::mesh_check`]).
     pub mesh: Option<diagnose::MeshCheck>,
 }
 
@@ -400,9 +401,11 @@ impl FixOutcome {
     }
 
     /// The model explains the data to their noise: the final misfit within
-    /// [`CONSISTENT`] times the noise and nothing significant left.
+    /// [`CONSISTENT`] times the noise, and nothing significant left or
+    /// what is left the mesh's ([`FixStop::MeshTooCoarse`]).
     pub fn explained(&self) -> bool {
-        self.stop == FixStop::NothingSignificant && self.final_misfit() <= CONSISTENT * self.noise
+        matches!(self.stop, FixStop::NothingSignificant | FixStop::MeshTooCoarse)
+            && self.final_misfit() <= CONSISTENT * self.noise
     }
 
     /// The case the loop ends with: the last step's, or step 0's.
@@ -1139,7 +1142,7 @@ pub fn fix(
     let mut current = p.case;
     let mut state = p.state;
     // when the same model meshed finer explains the data, nothing is added
-    let mesh = p.mesh;
+    let mut mesh = p.mesh;
     if let Some(m) = mesh.as_ref().filter(|m| m.explains(noise, CONSISTENT)) {
         let stop = FixStop::MeshTooCoarse;
         return Ok(FixOutcome {
@@ -1176,6 +1179,15 @@ pub fn fix(
     // steps made again on data corrected after them
     let mut redone = 0;
     let stop = loop {
+        // the same rule after every step: what is left, a finer mesh may explain
+        if !steps.is_empty() {
+            mesh =
+                diagnose::mesh_check(&current.model, &fl.data, d_opts.lines, d_opts.gains, d_opts.weights.as_deref())?;
+            if mesh.as_ref().is_some_and(|m| m.explains(noise, CONSISTENT)) {
+                last_diagnosis = None;
+                break FixStop::MeshTooCoarse;
+            }
+        }
         let d = match fl.diagnosed(&current, &extra_hz, steps.len(), &mut progress) {
             Ok(d) => d,
             Err(e) if !steps.is_empty() || declared.is_some() => {
@@ -1498,7 +1510,8 @@ pub fn fix(
     };
     let mut effects: Vec<Ranked> = steps.iter().map(|s| s.effect.clone()).collect();
     // revisions and replacements, each kept by the same rule
-    if !applied.is_empty() && state.misfit > REVISE_ABOVE * noise && stop != FixStop::Ambiguous {
+    let revisable = !matches!(stop, FixStop::Ambiguous | FixStop::MeshTooCoarse);
+    if !applied.is_empty() && state.misfit > REVISE_ABOVE * noise && revisable {
         let (kept, revised) = revise::revise(&fl, &base, &applied, &current, state, steps.len() + 1);
         if !kept.is_empty() {
             for mut r in kept {
@@ -1536,7 +1549,7 @@ pub fn fix(
     }
     if applied.len() >= 2
         && state.misfit > CONSISTENT * noise
-        && stop != FixStop::Ambiguous
+        && revisable
         && let Some((outs, added)) = swap::swap(&fl, &base, &applied, state, steps.len() + 1)
     {
         let removed: Vec<String> = outs.iter().map(|&i| effects[i].description.clone()).collect();
@@ -1595,10 +1608,12 @@ pub fn fix(
         equally_good = undecided;
     }
     let final_sys = damping::DampedSystem::new(current.model.clone())?;
-    let remains = if state.misfit > CONSISTENT * noise {
-        remains::describe(&final_sys, &fl.data, d_opts, noise, &findings, &unexplained)
-    } else {
-        Vec::new()
+    let remains = match &mesh {
+        Some(m) if stop == FixStop::MeshTooCoarse => vec![m.describe(noise)],
+        _ if state.misfit > CONSISTENT * noise => {
+            remains::describe(&final_sys, &fl.data, d_opts, noise, &findings, &unexplained)
+        }
+        _ => Vec::new(),
     };
     let stop_reason =
         remains::stop_reason(stop, &rejected_all, &equally_good, diagnosis_error.as_deref(), state.misfit, noise);

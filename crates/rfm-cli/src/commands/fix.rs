@@ -473,8 +473,16 @@ fn print_outcome(o: &FixOutcome, done: usize) -> Result<()> {
         "(dBIC of the step: the evidence for the model after it over the model before, both updated; below {} it is significant)",
         quantities::SIGNIFICANT_DBIC
     );
-    if let Some(m) = o.mesh.as_ref().filter(|m| m.visible(o.noise) && o.stop != FixStop::MeshTooCoarse) {
-        outln!("\nnote: {}: effects found may stand in part for the mesh (refine it)", m.describe(o.noise));
+    // (when the mesh stopped the loop above the noise, it is in what remains)
+    if let Some(m) = o.mesh.as_ref().filter(|m| m.visible(o.noise))
+        && (o.stop != FixStop::MeshTooCoarse || o.explained())
+    {
+        let consequence = if o.stop == FixStop::MeshTooCoarse {
+            "what is left is the mesh's (refine it)"
+        } else {
+            "effects found may stand in part for the mesh (refine it)"
+        };
+        outln!("\nnote: {}: {consequence}", m.describe(o.noise));
     }
     outln!("\nstopped: {}", o.stop_reason);
     let last = o.final_misfit();

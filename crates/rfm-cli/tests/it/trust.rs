@@ -110,7 +110,7 @@ fn a_mesh_too_coarse_for_the_band_stops_the_loop_with_nothing_added() {
     let run = rfm(&["fix", case, "--out", out.to_str().unwrap()]);
     let stdout = text(&run.stdout);
     assert_eq!(run.status.code(), Some(9), "{stdout}\n{}", text(&run.stderr));
-    assert!(stdout.contains("the model's mesh is too coarse for the band"), "{stdout}");
+    assert!(stdout.contains("what the model leaves is its mesh's"), "{stdout}");
     assert!(stdout.contains("the mesh: with every element cut in 2"), "{stdout}");
     assert!(!stdout.contains("step 1: added"), "{stdout}");
 

@@ -655,11 +655,12 @@ impl MeshCheck {
         self.change > noise && self.refined_misfit < self.misfit
     }
 
-    /// The mesh alone accounts for the misfit: the model is above
-    /// `consistent` times the `noise`, the refined model within it, and
-    /// the refinement visible.
+    /// The mesh accounts for what the model leaves: the refinement is
+    /// [`Self::visible`] and brings the misfit within `consistent` times
+    /// the `noise` with no parameter added, so an effect fitted to what is
+    /// left stands for the mesh.
     pub fn explains(&self, noise: f64, consistent: f64) -> bool {
-        self.visible(noise) && self.misfit > consistent * noise && self.refined_misfit <= consistent * noise
+        self.visible(noise) && self.refined_misfit <= consistent * noise
     }
 
     /// In words, for reports and terminals.
