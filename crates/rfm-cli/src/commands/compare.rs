@@ -26,6 +26,7 @@ use crate::report::html::{Block, Report, Section};
 use crate::report::modes::{MIN_MAC, ModesJson, mode_table_rows, rows};
 use crate::report::{self, Data, ModelFrfs, ReportOptions, plot, sig, signed};
 use crate::table::{self, Table};
+use rfm_update::diagnose::MeshCheck;
 
 /// What `--json` prints and `compare.json` holds: the library's results
 /// (the correlation, the fitted gains) with what only the command knows.
@@ -48,6 +49,9 @@ struct CompareJson<'a> {
     /// The model's misfit over the diagnosis's lines and the data's noise
     /// (the same numbers `rfm diagnose` and `rfm fix` give this model).
     misfit: MisfitReport,
+    /// The model against itself with every element cut in two, at the
+    /// same lines (`null` for a model without beams or above 10,000 DOFs).
+    mesh: Option<MeshCheck>,
     correlation: &'a Correlation,
     /// The unknown gains the model's FRFs were multiplied by (`none`,
     /// `per-reference`, `per-channel`) and why.
@@ -215,6 +219,14 @@ pub fn compare(args: &CompareArgs<'_>) -> Result<Exit> {
         outln!("{}", serde_json::to_string_pretty(&doc)?);
     } else {
         print_tables(&run.case, &run.data(), &run.source, &run.model.correlation, &run.misfit)?;
+        if let (Some(m), Some(noise)) = (&run.mesh, run.misfit.noise)
+            && m.visible(noise)
+        {
+            outln!(
+                "\nnote: {}; a missing effect fitted to what the mesh decides stands for the mesh (refine it)",
+                m.describe(noise)
+            );
+        }
         print_gains(&doc.gains)?;
         match &run.comparison {
             Ok(_) => {
@@ -264,6 +276,8 @@ pub struct CompareRun {
     gains: Vec<GainReport>,
     /// The model's misfit over the diagnosis's lines, with the noise.
     misfit: MisfitReport,
+    /// The model against itself meshed finer.
+    mesh: Option<MeshCheck>,
     /// The references whose data are per volt.
     per_volt: Vec<fe_model::DofRef>,
     /// The data's noise level without line weights (for the noise floors).
@@ -316,6 +330,13 @@ impl CompareRun {
         // the same gains and weights), so that every command gives this model
         // one misfit
         let misfit = MisfitReport::of(&system, &measured.to_receptance(), gains.0, weights.as_deref())?;
+        let mesh = rfm_update::diagnose::mesh_check(
+            &case.model,
+            &measured.to_receptance(),
+            rfm_update::quantities::MISFIT_LINES,
+            gains.0,
+            weights.as_deref(),
+        )?;
         let comparison =
             comparison::compare_modes(&system, &measured, &compared.model.gains, MIN_MAC).map_err(|e| e.to_string());
         let model = ModelFrfs {
@@ -341,6 +362,7 @@ impl CompareRun {
             gain_setting: format!("{} ({})", gains.0, gains.1),
             gains: fitted.reports(),
             misfit,
+            mesh,
             per_volt,
             unweighted_noise,
             masked,
@@ -372,6 +394,7 @@ impl CompareRun {
             quantity: data.quantity(),
             unit: data.unit(),
             misfit: self.misfit,
+            mesh: self.mesh.clone(),
             correlation: &self.model.correlation,
             gain_setting: self.gain_setting.clone(),
             gains: self.gains.clone(),

@@ -82,7 +82,7 @@ fn an_rfm_run_worse_than_its_start_says_so_and_exits_non_zero() {
 /// node, `rfm-update/tests/it/cases/l-frame-x4.toml`): `rfm fix` adds
 /// nothing and stops with exit code 9, saying the mesh is too coarse (it
 /// once added a flexible clamp and exited 0); `rfm diagnose` ranks as
-/// before and notes the mesh, in text and JSON.
+/// before and notes the mesh, in text and JSON, as `rfm compare` does.
 #[test]
 fn a_mesh_too_coarse_for_the_band_stops_the_loop_with_nothing_added() {
     let dir = tempfile::tempdir().unwrap();
@@ -121,4 +121,10 @@ fn a_mesh_too_coarse_for_the_band_stops_the_loop_with_nothing_added() {
     assert!(refined < misfit / 1.5 && doc["mesh"]["parts"] == 2, "{}", doc["mesh"]);
     let run = rfm(&["diagnose", case]);
     assert!(text(&run.stdout).contains("refine the mesh before adding any effect"), "{}", text(&run.stdout));
+    // compare, the first command run, says it too, with the same numbers
+    let run = rfm(&["compare", case, "--json"]);
+    let doc: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+    assert_eq!(doc["mesh"]["refined_misfit"].as_f64(), Some(refined), "{}", doc["mesh"]);
+    assert_eq!(doc["misfit"]["misfit"].as_f64(), Some(misfit), "{}", doc["misfit"]);
+    assert!(text(&rfm(&["compare", case]).stdout).contains("note: the mesh: with every element cut in 2"));
 }
