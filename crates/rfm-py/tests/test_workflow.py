@@ -29,6 +29,10 @@ def test_compare_is_the_cli_json_and_writes_its_files(rfm_bin, tutorial, tmp_pat
     m, x = result.measured, result.model
     assert m.h.shape == x.h.shape == (599, 8, 1) and m.kind == "receptance"
     assert result.misfit == cli["correlation"]["total"]["log_misfit"]
+    # the tutorial's mesh is fine for its band: cutting every element in two
+    # moves its FRFs by far less than the noise
+    assert result.mesh == cli["mesh"] and result.mesh["parts"] == 2
+    assert result.mesh["change"] < 0.2 * cli["misfit"]["noise"]
 
 
 def test_measured_data_given_as_frfdata_are_read_as_a_file(rfm_bin, tutorial, tmp_path) -> None:

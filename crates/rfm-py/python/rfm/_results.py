@@ -62,6 +62,15 @@ class Comparison(_Result):
         """The complex-log misfit over every channel and line."""
         return float(self._doc["correlation"]["total"]["log_misfit"])
 
+    @property
+    def mesh(self) -> dict[str, Any] | None:
+        """The model against itself with every element cut in two, at the
+        lines the misfit is read on (``change``, ``misfit``,
+        ``refined_misfit``, ``parts``), or None for a model without beams
+        or above 10,000 DOFs: a ``refined_misfit`` well below ``misfit``
+        says the mesh, not missing physics, decides part of the misfit."""
+        return self._doc.get("mesh")
+
     @cached_property
     def mac(self) -> tuple[list[list[float]], list[float], list[float]] | None:
         """The MAC matrix of the measured modes (rows) against the model's
@@ -150,6 +159,15 @@ class Diagnosis(_Result):
     def nominal_misfit(self) -> float:
         """The misfit of the case's model as it is."""
         return float(self._doc["nominal_misfit"])
+
+    @property
+    def mesh(self) -> dict[str, Any] | None:
+        """The model against itself with every element cut in two, at the
+        lines the misfit is read on (``change``, ``misfit``,
+        ``refined_misfit``, ``parts``), or None for a model without beams
+        or above 10,000 DOFs: a ``refined_misfit`` well below ``misfit``
+        says the mesh, not missing physics, decides part of the misfit."""
+        return self._doc.get("mesh")
 
     def _rank(self, rank: int | None) -> int:
         if rank is not None:
@@ -307,6 +325,15 @@ class FixResult(_Result):
     def nominal_misfit(self) -> float:
         """The misfit of the case's model before the loop."""
         return float(self._doc["nominal_misfit"])
+
+    @property
+    def mesh(self) -> dict[str, Any] | None:
+        """The model against itself with every element cut in two, at the
+        lines the misfit is read on (``change``, ``misfit``,
+        ``refined_misfit``, ``parts``), or None for a model without beams
+        or above 10,000 DOFs: a ``refined_misfit`` well below ``misfit``
+        says the mesh, not missing physics, decides part of the misfit."""
+        return self._doc.get("mesh")
 
     @property
     def final_misfit(self) -> float:
