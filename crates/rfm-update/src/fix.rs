@@ -1155,7 +1155,7 @@ pub fn fix(
             steps: Vec::new(),
             stop,
             stop_reason: remains::stop_reason(stop, &[], &[], None, state.misfit, noise),
-            remains: vec![m.describe(noise)],
+            remains: if state.misfit > CONSISTENT * noise { vec![m.describe(noise)] } else { Vec::new() },
             equally_good: Vec::new(),
             significant_remains: true,
             remaining: Vec::new(),
@@ -1609,11 +1609,9 @@ pub fn fix(
     }
     let final_sys = damping::DampedSystem::new(current.model.clone())?;
     let remains = match &mesh {
+        _ if state.misfit <= CONSISTENT * noise => Vec::new(),
         Some(m) if stop == FixStop::MeshTooCoarse => vec![m.describe(noise)],
-        _ if state.misfit > CONSISTENT * noise => {
-            remains::describe(&final_sys, &fl.data, d_opts, noise, &findings, &unexplained)
-        }
-        _ => Vec::new(),
+        _ => remains::describe(&final_sys, &fl.data, d_opts, noise, &findings, &unexplained),
     };
     let stop_reason =
         remains::stop_reason(stop, &rejected_all, &equally_good, diagnosis_error.as_deref(), state.misfit, noise);
