@@ -475,6 +475,12 @@ fn report_sections(
     let c = &model.correlation;
     let measured = data.set;
     let mut first = summary(case, data, source, c, &doc.misfit, &doc.gains);
+    if let Some(noise) = doc.misfit.noise {
+        let consequence = "a missing effect fitted to what the mesh decides stands for the mesh (refine it)";
+        if let Some(b) = report::mesh_text(doc.mesh.as_ref(), noise, consequence) {
+            first.push(b);
+        }
+    }
     // the loop so far, when the case was written by an earlier step
     if let Some(fall) = report::loop_story::fall_figure(&case.history, false, out)? {
         first.push(fall);

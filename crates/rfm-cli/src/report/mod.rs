@@ -153,6 +153,23 @@ pub(crate) fn gain_reports(gains: &[rfm_update::output_error::Gain]) -> Vec<Gain
 }
 
 /// A gain in one form for every output: `5:uy: x40.26 (+32.1 dB) at -37.0 deg`.
+/// The mesh check in a report's words, when the mesh decides part of what
+/// the model leaves ([`rfm_update::diagnose::MeshCheck::visible`]): the
+/// same sentence in every report, `consequence` saying what it means where
+/// it is read.
+pub(crate) fn mesh_text(
+    mesh: Option<&rfm_update::diagnose::MeshCheck>,
+    noise: f64,
+    consequence: &str,
+) -> Option<Block> {
+    let m = mesh.filter(|m| m.visible(noise))?;
+    let mut text = m.describe(noise);
+    if let Some(first) = text.get_mut(..1) {
+        first.make_ascii_uppercase();
+    }
+    Some(Block::Text(format!("{text}: {consequence}.")))
+}
+
 pub(crate) fn gain_text(g: &GainReport) -> String {
     format!(
         "{}: x{} ({:+.1} dB) at {:+.1} deg",

@@ -113,6 +113,8 @@ fn a_mesh_too_coarse_for_the_band_stops_the_loop_with_nothing_added() {
     assert!(stdout.contains("what the model leaves is its mesh's"), "{stdout}");
     assert!(stdout.contains("the mesh: with every element cut in 2"), "{stdout}");
     assert!(!stdout.contains("step 1: added"), "{stdout}");
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert_eq!(html.matches("he mesh: with every element cut in 2").count(), 1, "said once in the fix report");
 
     let run = rfm(&["diagnose", case, "--json"]);
     assert!(run.status.success(), "{}", text(&run.stderr));
@@ -127,4 +129,8 @@ fn a_mesh_too_coarse_for_the_band_stops_the_loop_with_nothing_added() {
     assert_eq!(doc["mesh"]["refined_misfit"].as_f64(), Some(refined), "{}", doc["mesh"]);
     assert_eq!(doc["misfit"]["misfit"].as_f64(), Some(misfit), "{}", doc["misfit"]);
     assert!(text(&rfm(&["compare", case]).stdout).contains("note: the mesh: with every element cut in 2"));
+    let compared = dir.path().join("compared");
+    assert!(rfm(&["compare", case, "--out", compared.to_str().unwrap()]).status.success());
+    let html = std::fs::read_to_string(compared.join("report.html")).unwrap();
+    assert!(html.contains("The mesh: with every element cut in 2"), "the compare report says it too");
 }
