@@ -1059,7 +1059,7 @@ pub fn prepare(
         }
     }
     // a mesh too coarse for the band is a model error that no effect is
-    let mesh = diagnose::mesh_check(&current.model, &fl.data, d_opts.lines, d_opts.gains, d_opts.weights.as_deref())?;
+    let mesh = diagnose::mesh_check(&current.model, &fl.data, d_opts.lines, d_opts.gains, d_opts.weights.as_deref());
     Ok(Prepared {
         noise,
         nominal_misfit: nominal.misfit,
@@ -1182,7 +1182,7 @@ pub fn fix(
         // the same rule after every step: what is left, a finer mesh may explain
         if !steps.is_empty() {
             mesh =
-                diagnose::mesh_check(&current.model, &fl.data, d_opts.lines, d_opts.gains, d_opts.weights.as_deref())?;
+                diagnose::mesh_check(&current.model, &fl.data, d_opts.lines, d_opts.gains, d_opts.weights.as_deref());
             if mesh.as_ref().is_some_and(|m| m.explains(noise, CONSISTENT)) {
                 last_diagnosis = None;
                 break FixStop::MeshTooCoarse;

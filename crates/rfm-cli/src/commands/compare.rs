@@ -336,7 +336,7 @@ impl CompareRun {
             rfm_update::quantities::MISFIT_LINES,
             gains.0,
             weights.as_deref(),
-        )?;
+        );
         let comparison =
             comparison::compare_modes(&system, &measured, &compared.model.gains, MIN_MAC).map_err(|e| e.to_string());
         let model = ModelFrfs {

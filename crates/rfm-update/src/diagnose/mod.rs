@@ -680,8 +680,21 @@ impl MeshCheck {
 /// The model against itself with a finer mesh ([`MeshCheck`]), over the
 /// `lines` most informative lines of `measured`, with `gains` and
 /// `weights` as the diagnosis fits them; `None` for a model without beams
-/// or above [`MESH_CHECK_DOFS`].
+/// or above [`MESH_CHECK_DOFS`]. The check only advises: where the model
+/// or its refinement cannot be evaluated it is `None` too, and the
+/// commands go on without it (the model's own failure is theirs to
+/// report, where they evaluate it).
 pub fn mesh_check(
+    model: &fe_model::Model,
+    measured: &FrfSet,
+    lines: usize,
+    gains: Gains,
+    weights: Option<&[f64]>,
+) -> Option<MeshCheck> {
+    mesh_check_or_err(model, measured, lines, gains, weights).ok().flatten()
+}
+
+fn mesh_check_or_err(
     model: &fe_model::Model,
     measured: &FrfSet,
     lines: usize,

@@ -66,7 +66,7 @@ fn a_mesh_too_coarse_for_the_band_is_said_and_no_effect_stands_for_it() {
     // the frame as meshed, measured: the mesh is not what is left
     let own = measured(&nominal, &nominal);
     let d = &FixOptions::default().diagnose;
-    let m = mesh_check(&nominal.model, &own, d.lines, d.gains, None).unwrap().unwrap();
+    let m = mesh_check(&nominal.model, &own, d.lines, d.gains, None).unwrap();
     let noise = rfm_update::diagnose::estimate_noise_against(&DampedSystem::new(nominal.model.clone()).unwrap(), &own)
         .unwrap()
         .unwrap();
