@@ -537,7 +537,12 @@ fn print_outcome(o: &FixOutcome, done: usize) -> Result<()> {
     } else if o.significant_remains
         && let Some(r) = o.remaining.first()
     {
-        outln!("\nstill significant in the last diagnosis: {} (dBIC {})", r.description, table::dbic(r.delta_bic));
+        let why = if o.stop == FixStop::MeshTooCoarse {
+            "; not added: what it fits, the model meshed finer explains without a parameter"
+        } else {
+            ""
+        };
+        outln!("\nstill significant in the last diagnosis: {} (dBIC {}){why}", r.description, table::dbic(r.delta_bic));
     }
     Ok(())
 }
