@@ -34,7 +34,20 @@ class _Result:
         return self.to_dict()
 
 
-class Comparison(_Result):
+class _MeshChecked(_Result):
+    """A result that carries the mesh check (compare, diagnose, fix)."""
+
+    @property
+    def mesh(self) -> dict[str, Any] | None:
+        """The model against itself with every element cut in two, at the
+        lines the misfit is read on (``change``, ``misfit``,
+        ``refined_misfit``, ``parts``), or None for a model without beams
+        or above 10,000 DOFs: a ``refined_misfit`` well below ``misfit``
+        says the mesh, not missing physics, decides part of the misfit."""
+        return self._doc.get("mesh")
+
+
+class Comparison(_MeshChecked):
     """The model against the measured FRFs (``rfm compare``)."""
 
     def __init__(self, inner: _rfm.Comparison) -> None:
@@ -61,15 +74,6 @@ class Comparison(_Result):
     def misfit(self) -> float:
         """The complex-log misfit over every channel and line."""
         return float(self._doc["correlation"]["total"]["log_misfit"])
-
-    @property
-    def mesh(self) -> dict[str, Any] | None:
-        """The model against itself with every element cut in two, at the
-        lines the misfit is read on (``change``, ``misfit``,
-        ``refined_misfit``, ``parts``), or None for a model without beams
-        or above 10,000 DOFs: a ``refined_misfit`` well below ``misfit``
-        says the mesh, not missing physics, decides part of the misfit."""
-        return self._doc.get("mesh")
 
     @cached_property
     def mac(self) -> tuple[list[list[float]], list[float], list[float]] | None:
@@ -127,7 +131,7 @@ class Candidate:
         )
 
 
-class Diagnosis(_Result):
+class Diagnosis(_MeshChecked):
     """Every candidate effect fitted and ranked (``rfm diagnose``)."""
 
     def __init__(self, inner: _rfm.DiagnosisResult) -> None:
@@ -159,15 +163,6 @@ class Diagnosis(_Result):
     def nominal_misfit(self) -> float:
         """The misfit of the case's model as it is."""
         return float(self._doc["nominal_misfit"])
-
-    @property
-    def mesh(self) -> dict[str, Any] | None:
-        """The model against itself with every element cut in two, at the
-        lines the misfit is read on (``change``, ``misfit``,
-        ``refined_misfit``, ``parts``), or None for a model without beams
-        or above 10,000 DOFs: a ``refined_misfit`` well below ``misfit``
-        says the mesh, not missing physics, decides part of the misfit."""
-        return self._doc.get("mesh")
 
     def _rank(self, rank: int | None) -> int:
         if rank is not None:
@@ -287,7 +282,7 @@ class Step:
     raw: dict[str, Any] = field(repr=False, compare=False)
 
 
-class FixResult(_Result):
+class FixResult(_MeshChecked):
     """The loop closed (``rfm fix``)."""
 
     def __init__(self, inner: _rfm.FixResult) -> None:
@@ -325,15 +320,6 @@ class FixResult(_Result):
     def nominal_misfit(self) -> float:
         """The misfit of the case's model before the loop."""
         return float(self._doc["nominal_misfit"])
-
-    @property
-    def mesh(self) -> dict[str, Any] | None:
-        """The model against itself with every element cut in two, at the
-        lines the misfit is read on (``change``, ``misfit``,
-        ``refined_misfit``, ``parts``), or None for a model without beams
-        or above 10,000 DOFs: a ``refined_misfit`` well below ``misfit``
-        says the mesh, not missing physics, decides part of the misfit."""
-        return self._doc.get("mesh")
 
     @property
     def final_misfit(self) -> float:
