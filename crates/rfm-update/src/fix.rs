@@ -1141,28 +1141,8 @@ pub fn fix(
     let mut declared = p.declared;
     let mut current = p.case;
     let mut state = p.state;
-    // when the same model meshed finer explains the data, nothing is added
+    // the last mesh check: prepare's, then one before every step after it
     let mut mesh = p.mesh;
-    if let Some(m) = mesh.as_ref().filter(|m| m.explains(noise, CONSISTENT)) {
-        let stop = FixStop::MeshTooCoarse;
-        return Ok(FixOutcome {
-            noise,
-            nominal_misfit: nominal,
-            findings,
-            corrected_misfit: corrected,
-            declared,
-            effects: Vec::new(),
-            steps: Vec::new(),
-            stop,
-            stop_reason: remains::stop_reason(stop, &[], &[], None, state.misfit, noise),
-            remains: if state.misfit > CONSISTENT * noise { vec![m.describe(noise)] } else { Vec::new() },
-            equally_good: Vec::new(),
-            significant_remains: true,
-            remaining: Vec::new(),
-            diagnosis_error: None,
-            mesh,
-        });
-    }
 
     // the case every effect is added to: corrected, its own parameters updated
     let mut base = current.clone();
@@ -1179,14 +1159,15 @@ pub fn fix(
     // steps made again on data corrected after them
     let mut redone = 0;
     let stop = loop {
-        // the same rule after every step: what is left, a finer mesh may explain
+        // what is left, the same model meshed finer may explain: then
+        // nothing is added for it, before the first step or after any
         if !steps.is_empty() {
             mesh =
                 diagnose::mesh_check(&current.model, &fl.data, d_opts.lines, d_opts.gains, d_opts.weights.as_deref());
-            if mesh.as_ref().is_some_and(|m| m.explains(noise, CONSISTENT)) {
-                last_diagnosis = None;
-                break FixStop::MeshTooCoarse;
-            }
+        }
+        if mesh.as_ref().is_some_and(|m| m.explains(noise, CONSISTENT)) {
+            last_diagnosis = None;
+            break FixStop::MeshTooCoarse;
         }
         let d = match fl.diagnosed(&current, &extra_hz, steps.len(), &mut progress) {
             Ok(d) => d,

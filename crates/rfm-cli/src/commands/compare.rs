@@ -24,7 +24,7 @@ use crate::exit::Exit;
 use crate::output::Outputs;
 use crate::report::html::{Block, Report, Section};
 use crate::report::modes::{MIN_MAC, ModesJson, mode_table_rows, rows};
-use crate::report::{self, Data, ModelFrfs, ReportOptions, plot, sig, signed};
+use crate::report::{self, Data, MeshReading, ModelFrfs, ReportOptions, plot, sig, signed};
 use crate::table::{self, Table};
 use rfm_update::diagnose::MeshCheck;
 
@@ -219,13 +219,10 @@ pub fn compare(args: &CompareArgs<'_>) -> Result<Exit> {
         outln!("{}", serde_json::to_string_pretty(&doc)?);
     } else {
         print_tables(&run.case, &run.data(), &run.source, &run.model.correlation, &run.misfit)?;
-        if let (Some(m), Some(noise)) = (&run.mesh, run.misfit.noise)
-            && m.visible(noise)
+        if let Some(line) =
+            run.misfit.noise.and_then(|noise| report::mesh_sentence(run.mesh.as_ref(), noise, MeshReading::Compared))
         {
-            outln!(
-                "\nnote: {}; a missing effect fitted to what the mesh decides stands for the mesh (refine it)",
-                m.describe(noise)
-            );
+            outln!("\nnote: {line}");
         }
         print_gains(&doc.gains)?;
         match &run.comparison {
@@ -475,11 +472,10 @@ fn report_sections(
     let c = &model.correlation;
     let measured = data.set;
     let mut first = summary(case, data, source, c, &doc.misfit, &doc.gains);
-    if let Some(noise) = doc.misfit.noise {
-        let consequence = "a missing effect fitted to what the mesh decides stands for the mesh (refine it)";
-        if let Some(b) = report::mesh_text(doc.mesh.as_ref(), noise, consequence) {
-            first.push(b);
-        }
+    if let Some(b) =
+        doc.misfit.noise.and_then(|noise| report::mesh_text(doc.mesh.as_ref(), noise, MeshReading::Compared))
+    {
+        first.push(b);
     }
     // the loop so far, when the case was written by an earlier step
     if let Some(fall) = report::loop_story::fall_figure(&case.history, false, out)? {

@@ -109,8 +109,10 @@ pub fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
     } else {
         print_checks(&prepared)?;
         print_diagnosis(&d, args.top, prepared.declared.is_some())?;
-        if let Some(line) = mesh_note(&prepared) {
-            outln!("\n{line}");
+        if let Some(line) =
+            crate::report::mesh_sentence(prepared.mesh.as_ref(), prepared.noise, crate::report::MeshReading::Ranked)
+        {
+            outln!("\nnote: {line}");
         }
     }
     if let Some(mut output) = report_output.take() {
@@ -166,21 +168,6 @@ pub fn run_diagnosis(
 ) -> Result<(Prepared, Diagnosis)> {
     let opts = FixOptions { diagnose: study.diagnose_options(data)?, data: data_file, ..FixOptions::default() };
     Ok(diagnose_prepared(study.case(), data, &opts, progress, stage)?)
-}
-
-/// The mesh's share of what the model leaves, when the mesh moves the
-/// FRFs by more than the noise: a note that what the ranking proposes may
-/// stand for the mesh, or, when the model meshed finer explains the data
-/// alone, that no effect should be added before the mesh is refined.
-pub(crate) fn mesh_note(prepared: &Prepared) -> Option<String> {
-    let m = prepared.mesh.as_ref().filter(|m| m.visible(prepared.noise))?;
-    let consequence = if m.explains(prepared.noise, rfm_update::fix::CONSISTENT) {
-        "the same model meshed finer explains the data to their noise: refine the mesh before adding any effect \
-         (what the ranking proposes stands for the mesh)"
-    } else {
-        "effects found may stand in part for the mesh (refine it)"
-    };
-    Some(format!("note: {}; {consequence}", m.describe(prepared.noise)))
 }
 
 /// What `rfm diagnose --json` prints: the notes on reading the data, the

@@ -474,15 +474,10 @@ fn print_outcome(o: &FixOutcome, done: usize) -> Result<()> {
         quantities::SIGNIFICANT_DBIC
     );
     // (when the mesh stopped the loop above the noise, it is in what remains)
-    if let Some(m) = o.mesh.as_ref().filter(|m| m.visible(o.noise))
+    if let Some(line) = crate::report::mesh_sentence(o.mesh.as_ref(), o.noise, crate::report::mesh_reading(o))
         && (o.stop != FixStop::MeshTooCoarse || o.explained())
     {
-        let consequence = if o.stop == FixStop::MeshTooCoarse {
-            "what is left is the mesh's (refine it)"
-        } else {
-            "effects found may stand in part for the mesh (refine it)"
-        };
-        outln!("\nnote: {}: {consequence}", m.describe(o.noise));
+        outln!("\nnote: {line}");
     }
     outln!("\nstopped: {}", o.stop_reason);
     let last = o.final_misfit();

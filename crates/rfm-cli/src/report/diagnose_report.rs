@@ -123,14 +123,7 @@ pub(crate) fn write(
                  the candidates."
             .into(),
     }));
-    let consequence = if prepared.mesh.as_ref().is_some_and(|m| m.explains(prepared.noise, rfm_update::fix::CONSISTENT))
-    {
-        "the same model meshed finer explains the data to their noise: refine the mesh before adding any effect \
-         (what the ranking proposes stands for the mesh)"
-    } else {
-        "effects found may stand in part for the mesh (refine it)"
-    };
-    if let Some(b) = super::mesh_text(prepared.mesh.as_ref(), prepared.noise, consequence) {
+    if let Some(b) = super::mesh_text(prepared.mesh.as_ref(), prepared.noise, super::MeshReading::Ranked) {
         summary.push(b);
     }
     // the leading candidates where they act, numbered by their rank

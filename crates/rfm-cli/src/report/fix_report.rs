@@ -281,14 +281,11 @@ pub(crate) fn write(
         format!("The final misfit is {times} times the noise: something the model lacks remains.")
     }));
     fall.push(Block::Facts(vec![("stopped".into(), outcome.stop_reason.clone())]));
-    let consequence = if outcome.stop == rfm_update::fix::FixStop::MeshTooCoarse {
-        "what is left is the mesh's, and no effect is added for it (refine the mesh)"
-    } else {
-        "effects found may stand in part for the mesh (refine it)"
-    };
     // (said once: above the noise, it is among what remains)
     let in_remains = outcome.remains.iter().any(|r| r.starts_with("the mesh:"));
-    if let Some(b) = super::mesh_text(outcome.mesh.as_ref(), outcome.noise, consequence).filter(|_| !in_remains) {
+    if let Some(b) =
+        super::mesh_text(outcome.mesh.as_ref(), outcome.noise, super::mesh_reading(outcome)).filter(|_| !in_remains)
+    {
         fall.push(b);
     }
     if !outcome.remains.is_empty() {

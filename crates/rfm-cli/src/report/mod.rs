@@ -152,24 +152,62 @@ pub(crate) fn gain_reports(gains: &[rfm_update::output_error::Gain]) -> Vec<Gain
         .collect()
 }
 
-/// A gain in one form for every output: `5:uy: x40.26 (+32.1 dB) at -37.0 deg`.
-/// The mesh check in a report's words, when the mesh decides part of what
-/// the model leaves ([`rfm_update::diagnose::MeshCheck::visible`]): the
-/// same sentence in every report, `consequence` saying what it means where
-/// it is read.
+/// Where a mesh check is read, which decides what it means there.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum MeshReading {
+    /// Beside a comparison, before any effect is fitted.
+    Compared,
+    /// Beside a ranking of candidate effects.
+    Ranked,
+    /// After the loop, which the mesh stopped (`true`) or not.
+    Looped { stopped: bool },
+}
+
+/// The mesh check in one sentence, the same in the terminal and every
+/// report, when the mesh decides part of what the model leaves
+/// ([`rfm_update::diagnose::MeshCheck::visible`]): what it moves, and
+/// what that means where it is read.
+pub(crate) fn mesh_sentence(
+    mesh: Option<&rfm_update::diagnose::MeshCheck>,
+    noise: f64,
+    reading: MeshReading,
+) -> Option<String> {
+    let m = mesh.filter(|m| m.visible(noise))?;
+    let consequence = match reading {
+        MeshReading::Compared => "a missing effect fitted to what the mesh decides stands for the mesh (refine it)",
+        MeshReading::Ranked if m.explains(noise, rfm_update::fix::CONSISTENT) => {
+            "the same model meshed finer explains the data to their noise: refine the mesh before adding any \
+             effect (what the ranking proposes stands for the mesh)"
+        }
+        MeshReading::Looped { stopped: true } => {
+            "what is left is the mesh's, and no effect is added for it (refine the mesh)"
+        }
+        MeshReading::Ranked | MeshReading::Looped { stopped: false } => {
+            "effects found may stand in part for the mesh (refine it)"
+        }
+    };
+    Some(format!("{}: {consequence}", m.describe(noise)))
+}
+
+/// How the loop's outcome reads its last mesh check.
+pub(crate) fn mesh_reading(outcome: &rfm_update::fix::FixOutcome) -> MeshReading {
+    MeshReading::Looped { stopped: outcome.stop == rfm_update::fix::FixStop::MeshTooCoarse }
+}
+
+/// [`mesh_sentence`] as a report's paragraph.
 pub(crate) fn mesh_text(
     mesh: Option<&rfm_update::diagnose::MeshCheck>,
     noise: f64,
-    consequence: &str,
+    reading: MeshReading,
 ) -> Option<Block> {
-    let m = mesh.filter(|m| m.visible(noise))?;
-    let mut text = m.describe(noise);
+    let mut text = mesh_sentence(mesh, noise, reading)?;
     if let Some(first) = text.get_mut(..1) {
         first.make_ascii_uppercase();
     }
-    Some(Block::Text(format!("{text}: {consequence}.")))
+    Some(Block::Text(format!("{text}.")))
 }
 
+/// A gain in one form for every output: `5:uy: x40.26 (+32.1 dB) at -37.0 deg`.
 pub(crate) fn gain_text(g: &GainReport) -> String {
     format!(
         "{}: x{} ({:+.1} dB) at {:+.1} deg",

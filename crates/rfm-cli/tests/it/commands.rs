@@ -219,14 +219,7 @@ pyuff.UFF(again).write_sets(sets, mode='overwrite')
 #[test]
 fn a_case_without_data_is_simulated_and_compared_only_with_a_file() {
     let dir = tempfile::tempdir().unwrap();
-    let tutorial = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases/tutorial/l-frame.toml");
-    let tutorial = std::fs::read_to_string(tutorial).unwrap();
-    let body: String = tutorial
-        .lines()
-        .take_while(|l| !l.starts_with("# What `cargo xtask reproduce"))
-        .filter(|l| !l.starts_with("data ="))
-        .map(|l| format!("{l}\n"))
-        .collect();
+    let body = crate::fixtures::tutorial_text(|l| (!l.starts_with("data =")).then(|| l.to_string()));
     let case = dir.path().join("apart.toml");
     std::fs::write(&case, &body).unwrap();
     let (case, csv) = (case.to_str().unwrap(), dir.path().join("apart.csv"));

@@ -19,6 +19,17 @@ pub(crate) fn case(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases").join(format!("{name}.toml"))
 }
 
+/// The tutorial's case text (`cases/tutorial/l-frame.toml`) without its
+/// `[check]` tables, each line passed through `edit` (`None` drops it), for
+/// a case written beside the test's own data.
+pub(crate) fn tutorial_text(edit: impl Fn(&str) -> Option<String>) -> String {
+    let text = std::fs::read_to_string(case("tutorial/l-frame")).unwrap();
+    text.lines()
+        .take_while(|l| !l.starts_with("# What `cargo xtask reproduce"))
+        .filter_map(|l| edit(l).map(|l| format!("{l}\n")))
+        .collect()
+}
+
 /// A command's output as text.
 pub(crate) fn text(b: &[u8]) -> String {
     String::from_utf8_lossy(b).into_owned()

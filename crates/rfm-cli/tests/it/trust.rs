@@ -92,16 +92,13 @@ fn a_mesh_too_coarse_for_the_band_stops_the_loop_with_nothing_added() {
     let args = ["simulate", truth.to_str().unwrap(), "--noise", "0.01", "--seed", "3", "--out", data.to_str().unwrap()];
     let run = rfm(&args);
     assert!(run.status.success(), "{}", text(&run.stderr));
-    let tutorial = std::fs::read_to_string(root.join("cases/tutorial/l-frame.toml")).unwrap();
-    let nominal: String = tutorial
-        .lines()
-        .take_while(|l| !l.starts_with("# What `cargo xtask reproduce"))
-        .map(|l| match l {
-            _ if l.starts_with("data =") => "data = \"finer.csv\"\n".to_string(),
-            _ if l.starts_with("frequencies =") => "frequencies = { from = 2.0, to = 3000.0, step = 2.0 }\n".into(),
-            _ => format!("{l}\n"),
+    let nominal = crate::fixtures::tutorial_text(|l| {
+        Some(match l {
+            _ if l.starts_with("data =") => "data = \"finer.csv\"".to_string(),
+            _ if l.starts_with("frequencies =") => "frequencies = { from = 2.0, to = 3000.0, step = 2.0 }".into(),
+            _ => l.to_string(),
         })
-        .collect();
+    });
     let case = dir.path().join("coarse.toml");
     std::fs::write(&case, nominal).unwrap();
     let case = case.to_str().unwrap();

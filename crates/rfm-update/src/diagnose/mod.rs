@@ -701,8 +701,11 @@ fn mesh_check_or_err(
     gains: Gains,
     weights: Option<&[f64]>,
 ) -> Result<Option<MeshCheck>, UpdateError> {
+    if model.beams().is_empty() {
+        return Ok(None);
+    }
     let sys = DampedSystem::new(model.clone())?;
-    if model.beams().is_empty() || sys.n() > MESH_CHECK_DOFS {
+    if sys.n() > MESH_CHECK_DOFS {
         return Ok(None);
     }
     let refined = DampedSystem::new(model.refined(MESH_CHECK_PARTS)?)?;
