@@ -108,6 +108,9 @@ enum Command {
         /// Folder for step-0.toml (the case's own parameters updated), step-1.toml, ..., results.json, report.html and figures.
         #[arg(long)]
         out: PathBuf,
+        /// Measured FRF file to use instead of the case's data or truth (every step's case then reads it).
+        #[arg(long, value_name = "FILE")]
+        measured: Option<PathBuf>,
         /// Most effects to add (counting those of a resumed run).
         #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u64).range(1..=20))]
         steps: u64,
@@ -140,6 +143,9 @@ enum Command {
         /// Folder for results (results.json, updated.toml, report.html, SVG figures and CSV tables).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Measured FRF file to use instead of the case's data or truth (updated.toml then reads it).
+        #[arg(long, value_name = "FILE")]
+        measured: Option<PathBuf>,
         /// Replace the --out folder even when another command's results are in it.
         #[arg(long)]
         replace: bool,
@@ -252,23 +258,29 @@ fn run(cli: Cli) -> rfm_cli::Result<Exit> {
             replace,
             report_options: ReportOptions { frequency_scale: frequency_axis, ..Default::default() },
         }),
-        Command::Fix { case, out, steps, resume, replace, json, frequency_axis } => rfm_cli::fix(&rfm_cli::FixArgs {
-            case: &case,
-            out: &out,
-            steps: steps as usize,
-            json,
-            replace,
-            resume,
-            report: ReportOptions { frequency_scale: frequency_axis, ..Default::default() },
-        }),
+        Command::Fix { case, out, measured, steps, resume, replace, json, frequency_axis } => {
+            rfm_cli::fix(&rfm_cli::FixArgs {
+                case: &case,
+                out: &out,
+                measured: measured.as_deref(),
+                steps: steps as usize,
+                json,
+                replace,
+                resume,
+                report: ReportOptions { frequency_scale: frequency_axis, ..Default::default() },
+            })
+        }
         Command::Inspect { file, json } => rfm_cli::inspect(&file, json),
-        Command::Update { case, out, replace, json, method, lines, iterations, frequency_axis } => rfm_cli::update(
-            &case,
-            out.as_deref(),
-            replace,
-            json,
-            &rfm_cli::UpdateOverrides { method, lines, max_iterations: iterations },
-            &ReportOptions { frequency_scale: frequency_axis, ..Default::default() },
-        ),
+        Command::Update { case, out, measured, replace, json, method, lines, iterations, frequency_axis } => {
+            rfm_cli::update(
+                &case,
+                measured.as_deref(),
+                out.as_deref(),
+                replace,
+                json,
+                &rfm_cli::UpdateOverrides { method, lines, max_iterations: iterations },
+                &ReportOptions { frequency_scale: frequency_axis, ..Default::default() },
+            )
+        }
     }
 }

@@ -43,6 +43,32 @@ impl CaseFile {
         let geometry = self.measurement.as_ref().and_then(|m| m.geometry.clone());
         Ok(CaseEditor { path: self.path.clone(), data, geometry, doc })
     }
+
+    /// This case reading its measured FRFs from `data` instead of its own
+    /// data file or `[truth]` (the `--measured` of `rfm update` and `rfm
+    /// fix`): `[measurement] data` names it (relative to the case's folder
+    /// when it can, as every case derived from this one then writes it),
+    /// and the `[truth]` and `[check]`, which describe other data, are
+    /// left out. The channels, lines, gains and corrections the case
+    /// declares stay. The case keeps its path, for messages and for the
+    /// other paths it names.
+    pub fn with_data(&self, data: &Path) -> Result<CaseFile, CaseError> {
+        let absolute = std::path::absolute(data).map_err(|e| CaseError {
+            file: self.path.clone(),
+            location: None,
+            message: format!("cannot resolve the measured data's path {}: {e}", data.display()),
+            snippet: None,
+        })?;
+        let mut editor = self.editor()?;
+        editor.use_data(&absolute);
+        let text = editor.text_at(&self.path)?;
+        let mut case = CaseFile::parse(&self.path, &text)?;
+        // named as given in messages, not by the way up from the case's folder
+        if let Some(m) = case.measurement.as_mut() {
+            m.data = Some(absolute);
+        }
+        Ok(case)
+    }
 }
 
 impl CaseEditor {
@@ -456,6 +482,26 @@ mod tests {
         let got = back.measurement.unwrap().data.unwrap();
         assert_eq!(resolved(&got), resolved(&dir.join("study/data/measured.csv")));
         assert!(same.contains("# the user's comment"), "comments stay");
+    }
+
+    /// The case with other data names them relative to its folder, keeps
+    /// its channels and comments, and drops the truth that described its
+    /// own.
+    #[test]
+    fn a_case_reads_other_data_as_its_own() {
+        let dir = std::env::temp_dir().join(format!("rfm-with-data-{}", std::process::id()));
+        let c = case(&dir.join("study"));
+        let other = c.with_data(&dir.join("lab/run-2.uff")).unwrap();
+        let m = other.measurement.as_ref().unwrap();
+        assert_eq!(resolved(m.data.as_ref().unwrap()), resolved(&dir.join("lab/run-2.uff")));
+        assert_eq!(m.responses, c.measurement.as_ref().unwrap().responses);
+        // (the old file's comment on its line goes with it)
+        assert!(other.source.contains("data = \"../lab/run-2.uff\"\n"), "{}", other.source);
+        assert!(other.source.contains("# the user's comment"), "comments stay");
+        assert!(other.truth.is_none() && other.check.is_none());
+        // a step derived from it reads the same file
+        let step = other.editor().unwrap().text_at(&dir.join("study/out/step-1.toml")).unwrap();
+        assert!(step.contains("data = \"../../lab/run-2.uff\""), "{step}");
     }
 
     /// A correction of a channel corrected before is composed into the

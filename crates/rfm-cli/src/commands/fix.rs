@@ -33,6 +33,8 @@ pub struct FixArgs<'a> {
     pub case: &'a Path,
     /// The output folder.
     pub out: &'a Path,
+    /// Measured data to use instead of the case's (`--measured`).
+    pub measured: Option<&'a Path>,
     /// Most effects to add.
     pub steps: usize,
     /// Print JSON instead of tables.
@@ -80,7 +82,11 @@ struct Start {
 
 fn start(args: &FixArgs<'_>, case_text: &str) -> Result<Start> {
     if !args.resume {
-        return Ok(Start { study: super::load_study(args.case)?, done: 0, carried: Vec::new() });
+        return Ok(Start {
+            study: super::load_study_measured(args.case, args.measured)?,
+            done: 0,
+            carried: Vec::new(),
+        });
     }
     let path = args.out.join(PROGRESS_FILE);
     let text = std::fs::read_to_string(&path).map_err(|e| {
@@ -131,7 +137,29 @@ fn start(args: &FixArgs<'_>, case_text: &str) -> Result<Start> {
             Err(e) => return Err(format!("{}: {e}", args.out.join(name).display()).into()),
         }
     }
-    Ok(Start { study: super::load_study(&args.out.join(last))?, done, carried })
+    let study = super::load_study(&args.out.join(last))?;
+    // the steps read the data the run started with; other data given now
+    // would go on from fits made to those
+    if let Some(given) = args.measured {
+        let read = study.case().measurement.as_ref().and_then(|m| m.data.as_deref());
+        let same = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
+            (Ok(a), Ok(b)) => a == b,
+            _ => false,
+        };
+        if !read.is_some_and(|r| same(r, given)) {
+            return Err(Failure::new(
+                Exit::Usage,
+                format!(
+                    "--measured {}: the steps in {} were fitted to {}; resume with those data, or run without \
+                     --resume to start again",
+                    given.display(),
+                    args.out.display(),
+                    read.map_or("the case's truth".into(), |r| r.display().to_string())
+                ),
+            ));
+        }
+    }
+    Ok(Start { study, done, carried })
 }
 
 /// Whether the study's data are synthesised from its case's `[truth]`:

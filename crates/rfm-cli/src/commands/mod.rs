@@ -37,6 +37,17 @@ pub(crate) fn load_study(path: &Path) -> Result<rfm_update::Study> {
     study_of(load_case(path)?)
 }
 
+/// [`load_study`], reading the measured FRFs from `measured` when given
+/// (`--measured`) instead of the case's own data or `[truth]`; the cases
+/// the command writes then name that file ([`CaseFile::with_data`]).
+pub(crate) fn load_study_measured(path: &Path, measured: Option<&Path>) -> Result<rfm_update::Study> {
+    let case = load_case(path)?;
+    match measured {
+        Some(file) => study_of(case.with_data(file)?),
+        None => study_of(case),
+    }
+}
+
 /// [`load_study`] of a loaded case.
 pub(crate) fn study_of(case: CaseFile) -> Result<rfm_update::Study> {
     let spec = case.measurement.clone();

@@ -31,13 +31,14 @@ pub struct Overrides {
 /// with `--out` writes them.
 pub fn update(
     case: &Path,
+    measured: Option<&Path>,
     out: Option<&Path>,
     replace: bool,
     json: bool,
     over: &Overrides,
     report: &crate::report::ReportOptions,
 ) -> Result<Exit> {
-    let mut study = super::load_study(case)?;
+    let mut study = super::load_study_measured(case, measured)?;
     let mut output = out
         .map(|dir| Outputs::folder(dir, &study.case().inputs(), &UPDATE_OUTPUTS)?.of_command("update", replace))
         .transpose()?;

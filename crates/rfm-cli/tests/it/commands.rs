@@ -12,6 +12,10 @@ fn case(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases").join(format!("{name}.toml"))
 }
 
+fn read(p: &Path) -> String {
+    std::fs::read_to_string(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
+
 fn text(b: &[u8]) -> String {
     String::from_utf8_lossy(b).into_owned()
 }
@@ -233,6 +237,50 @@ fn a_case_without_data_is_simulated_and_compared_only_with_a_file() {
     assert!(err.contains(&format!("apart.toml:{line}:")) && err.contains("no `data` file"), "{err}");
     let out = rfm(&["compare", case, "--measured", csv.to_str().unwrap(), "--json"]);
     assert!(out.status.success(), "{}", text(&out.stderr));
+    // `fix` and `update` read a file given as well, and the cases they
+    // write name it: the truth's data (the tutorial's joint) in a folder
+    // of their own
+    let truth = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases/tutorial/l-frame-truth.toml");
+    let lab = dir.path().join("lab");
+    std::fs::create_dir(&lab).unwrap();
+    let data = lab.join("run-2.uff");
+    let out = rfm(&[
+        "simulate",
+        truth.to_str().unwrap(),
+        "--truth",
+        "--noise",
+        "0.01",
+        "--seed",
+        "9",
+        "--out",
+        data.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let fixed = dir.path().join("fixed");
+    let out = rfm(&["fix", case, "--measured", data.to_str().unwrap(), "--out", fixed.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(text(&out.stdout).contains("joint"), "{}", text(&out.stdout));
+    let step = fixed.join("step-1.toml");
+    assert!(read(&step).contains("data = \"../lab/run-2.uff\""), "{}", read(&step));
+    assert!(!fixed.join("measured.csv").exists(), "data given as a file are not written again");
+    let updated = dir.path().join("updated");
+    let out = rfm(&["update", step.to_str().unwrap(), "--out", updated.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(read(&updated.join("updated.toml")).contains("data = \"../lab/run-2.uff\""));
+    // and `update --measured` with other data reads those: the nominal's
+    // own simulated data are far from the joint's, so the fit leaves more
+    let again = dir.path().join("again");
+    let out = rfm(&[
+        "update",
+        step.to_str().unwrap(),
+        "--measured",
+        csv.to_str().unwrap(),
+        "--out",
+        again.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(read(&again.join("updated.toml")).contains("data = \"../apart.csv\""));
 }
 
 /// `simulate --out x.uff` writes UFF dataset 58 (ASCII, or 58b with

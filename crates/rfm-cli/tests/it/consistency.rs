@@ -256,6 +256,19 @@ fn an_interrupted_fix_keeps_its_finished_steps_and_resumes_from_them() {
     let e = text(&output.stderr);
     assert!(e.contains("the 1 finished step(s) are in") && e.contains("--resume"), "{e}");
     assert!(out.join("fix-progress.json").exists() && !out.join("report.html").exists());
+    // the steps were fitted to the case's data: others given now are refused
+    let other = crate::fixtures::case("tutorial/lab-frame").with_file_name("lab-frame-measured.csv");
+    let refused = rfm(&[
+        "fix",
+        case.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--resume",
+        "--measured",
+        other.to_str().unwrap(),
+    ]);
+    assert_eq!(refused.status.code(), Some(2), "{}", text(&refused.stderr));
+    assert!(text(&refused.stderr).contains("were fitted to"), "{}", text(&refused.stderr));
     let resumed = rfm(&["fix", case.to_str().unwrap(), "--out", out.to_str().unwrap(), "--resume"]);
     assert!(resumed.status.success(), "{}", text(&resumed.stderr));
     assert!(text(&resumed.stdout).contains("resuming after step 1"), "{}", text(&resumed.stdout));
