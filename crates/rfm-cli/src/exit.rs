@@ -41,8 +41,9 @@ pub enum Exit {
     Busy,
     /// An update stopped where no step lowers the misfit, above the noise.
     Stalled,
-    /// An update's restarts confirm its minimum, but the residual stays
-    /// above the noise: the model cannot represent the data.
+    /// The misfit stays above the noise where nothing more can be done: an
+    /// update's restarts confirm its minimum, or `rfm fix` finds no effect
+    /// with evidence of its own (or one only a finer mesh explains).
     ModelInadequate,
     /// An update stopped above the noise and its restarts disagree.
     LocalMinimum,
@@ -71,7 +72,7 @@ impl Exit {
         (Exit::Stalled, "stalled: no step lowers the misfit, which stays above the noise (best iterate written)"),
         (
             Exit::ModelInadequate,
-            "model inadequate: restarts confirm the minimum but the misfit stays above the noise (results written)",
+            "model inadequate: the misfit stays above the noise and nothing the tool can add explains it (update: restarts confirm the minimum; fix: no effect has its own evidence, or only a finer mesh would; results written)",
         ),
         (Exit::LocalMinimum, "local minimum: above the noise, and restarts disagree (best fit written)"),
         (Exit::WorseThanStart, "worse than the start: the update raised the misfit (results written, marked so)"),

@@ -35,7 +35,10 @@
 //!   own, by more than the noise allows, and the channel then fits like the
 //!   others (within three times the median channel's misfit). The other
 //!   axis at the node is a *misdirected* sensor; two channels that each fit
-//!   the other's DOF so are *swapped*.
+//!   the other's DOF so are *swapped*. Where several DOFs fit alike (within
+//!   what the larger of the noise and the fit's own misfit allows: the
+//!   axial DOFs of a member that moves as one body), the other axis at the
+//!   node is taken first and the rest are named with the finding.
 //! - **Calibration**: the channel's mean log-magnitude offset from its
 //!   reference's gain exceeds 5 % and five of its standard errors (counted
 //!   over the lines that are independent, from the residual's correlation
@@ -372,8 +375,6 @@ struct ChannelFit {
     centre: Option<C64>,
     /// The channel's own best log-gain.
     gain: Option<C64>,
-    /// The best other DOF and sign, with the cost there.
-    best_other: Option<(DofRef, bool, f64)>,
     /// Every other DOF compared, with its better sign and the cost there.
     others: Vec<(DofRef, bool, f64)>,
 }
@@ -387,6 +388,38 @@ impl ChannelFit {
     /// The better sign and the cost against another DOF, when compared.
     fn at(&self, d: DofRef) -> Option<(bool, f64)> {
         self.others.iter().find(|o| o.0 == d).map(|o| (o.1, o.2))
+    }
+
+    /// The other DOF (with its sign and cost) the channel is taken to have
+    /// measured, and the others that fit it alike, best first.
+    ///
+    /// The DOFs that fit alike are those whose cost exceeds the best one's
+    /// by less than 25 values' worth of the larger of the noise and the
+    /// best fit's own misfit: the data do not tell them apart (the axial
+    /// DOFs along a member that moves as one body, or DOFs that a model
+    /// error spoils alike). Among them, a DOF that another channel of the
+    /// reference measures is not taken (that would be a swap, found
+    /// apart, or a duplicate), and the other axis at the channel's own node
+    /// comes first: a sensor turned on its mount is likelier than one both
+    /// moved and turned. Else the best of them is taken.
+    fn taken_for(
+        &self,
+        s2: f64,
+        measured_elsewhere: impl Fn(DofRef) -> bool,
+    ) -> Option<((DofRef, bool, f64), Vec<DofRef>)> {
+        let best = self.others.iter().map(|o| o.2).min_by(f64::total_cmp)?;
+        let weight = self.own.weight();
+        let margin = 25.0 * s2.max(if weight > 0.0 { best / weight } else { 0.0 });
+        let mut alike: Vec<(DofRef, bool, f64)> =
+            self.others.iter().copied().filter(|o| o.2 <= best + margin && !measured_elsewhere(o.0)).collect();
+        alike.sort_by(|a, b| a.2.total_cmp(&b.2));
+        let node = self.channel.response.node;
+        let pick = alike.iter().position(|o| o.0.node == node).unwrap_or(0);
+        if alike.is_empty() {
+            return None;
+        }
+        let taken = alike.remove(pick);
+        Some((taken, alike.into_iter().map(|o| o.0).collect()))
     }
 }
 
@@ -455,8 +488,7 @@ pub fn check_channels(sys: &DampedSystem, measured: &FrfSet, opts: &CheckOptions
                     Some(if minus < plus { (d, true, minus) } else { (d, false, plus) })
                 })
                 .collect();
-            let best_other = others.iter().copied().min_by(|a, b| a.2.total_cmp(&b.2));
-            ChannelFit { channel: ch, own, centre: centres[c], gain: own_gains[c], best_other, others }
+            ChannelFit { channel: ch, own, centre: centres[c], gain: own_gains[c], others }
         })
         .collect();
     Ok(judge(&fits, opts))
@@ -602,9 +634,8 @@ fn judge(fits: &[ChannelFit], opts: &CheckOptions) -> Vec<Finding> {
         // many channels spoilt alike can fit a neighbour's DOF better by
         // chance (the table frame's loose corner: 31:uy "at 30:uy")
         let stands_out = rms(f.own_cost(), f.own.weight()) > OUTLIER * typical;
-        if let Some((d, neg, cost)) = f.best_other
+        if let Some(((d, neg, cost), alike)) = f.taken_for(s2, measured_elsewhere)
             && stands_out
-            && !measured_elsewhere(d)
             && better(f, cost)
             && (!inverted || cost * 2.0 < minus)
         {
@@ -615,13 +646,21 @@ fn judge(fits: &[ChannelFit], opts: &CheckOptions) -> Vec<Finding> {
                 (FindingKind::WrongNode, format!("measured at {d} instead"))
             };
             let inv = if neg { ", inverted" } else { "" };
+            let alike = match alike.len() {
+                0 => String::new(),
+                _ => format!(
+                    "; {} fit{} it about as well (the data do not tell them apart)",
+                    alike.iter().map(ToString::to_string).collect::<Vec<_>>().join(", "),
+                    if alike.len() == 1 { "s" } else { "" }
+                ),
+            };
             findings.push(Finding {
                 kind,
                 channels: vec![f.channel.to_string()],
                 summary: format!("channel {} looks {what}{inv}", f.channel),
                 evidence: format!(
                     "its misfit is {:.3} against {} and {:.3} against {d}{inv} (RMS of ln per value; the median \
-                     channel's is {typical:.3})",
+                     channel's is {typical:.3}){alike}",
                     rms(f.own_cost(), weight),
                     f.channel.response,
                     rms(cost, weight),
