@@ -422,7 +422,9 @@ fn print_diagnosis(d: &Diagnosis, top: usize, after_step0: bool) -> Result<()> {
         outln!("");
     }
     let mut t = Table::new(&["rank", "effect", "explained", "dBIC", "significant", "", "fitted values"]);
-    for (i, r) in d.ranking.iter().enumerate().take(top) {
+    let shown = d.shown(top);
+    for row in &shown {
+        let (i, r) = (row.rank - 1, &d.ranking[row.rank - 1]);
         let values = r
             .parameters
             .iter()
@@ -443,6 +445,12 @@ fn print_diagnosis(d: &Diagnosis, top: usize, after_step0: bool) -> Result<()> {
             (None, false) => "screened only".into(),
             (None, true) => String::new(),
         };
+        let alike = crate::report::alike_text(&row.alike);
+        let note = match (note.is_empty(), alike.is_empty()) {
+            (_, true) => note,
+            (true, false) => alike,
+            (false, false) => format!("{alike}; {note}"),
+        };
         t.row(vec![
             format!("{}", i + 1),
             r.description.clone(),
@@ -457,11 +465,16 @@ fn print_diagnosis(d: &Diagnosis, top: usize, after_step0: bool) -> Result<()> {
     outln!(
         "\n(explained: the share of the nominal model's squared misfit the effect removes; dBIC: the change of the \
          Bayesian information criterion, comparable only within one diagnosis; significant: dBIC below {}, very \
-         strong evidence; {} candidates tried, {} of them replaced by a variant{})",
+         strong evidence; {} candidates tried, {} of them replaced by a variant{}{})",
         quantities::SIGNIFICANT_DBIC,
         d.tried,
         d.superseded,
-        deferred_text(d)
+        deferred_text(d),
+        if shown.iter().any(|r| !r.alike.is_empty()) {
+            format!("; {}", crate::report::ALIKE_LEGEND)
+        } else {
+            String::new()
+        }
     );
     for line in unfitted_lines(d) {
         outln!("{line}");

@@ -163,6 +163,8 @@ pub(crate) fn write(
             quantities::SIGNIFICANT_DBIC
         ));
     let mut csv = Table::new(&t.header.iter().map(String::as_str).collect::<Vec<_>>());
+    // the table folds the variants alike into their best row; the CSV holds every rank
+    let shown = d.shown(RANKED_ROWS);
     for (i, r) in d.ranking.iter().enumerate() {
         let values = r
             .parameters
@@ -195,17 +197,20 @@ pub(crate) fn write(
             (values, Tone::Plain),
         ];
         csv.row(row.iter().map(|(c, _)| c.clone()).collect());
-        if i < RANKED_ROWS {
+        if let Some(s) = shown.iter().find(|s| s.rank == i + 1) {
+            let mut row = row;
+            let alike = super::alike_text(&s.alike);
+            if !alike.is_empty() {
+                row[1].0 = format!("{} ({alike})", row[1].0);
+            }
             t.row_toned(row);
         }
     }
     out.write("ranking.csv", csv.to_csv().as_bytes())?;
+    let folded: usize = shown.iter().map(|s| s.alike.len()).sum();
     t.caption = t.caption.map(|c| {
-        format!(
-            "{c} The first {} of {} rows; every row is in ranking.csv.",
-            RANKED_ROWS.min(d.ranking.len()),
-            d.ranking.len()
-        )
+        let alike = if folded > 0 { format!(" ({}: {folded} folded)", super::ALIKE_LEGEND) } else { String::new() };
+        format!("{c} The first {} rows of {} ranks{alike}; every rank is in ranking.csv.", shown.len(), d.ranking.len())
     });
     ranking.push(Block::Table(t));
     report.sections.push(ranking);

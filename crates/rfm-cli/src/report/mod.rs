@@ -208,6 +208,32 @@ pub(crate) fn mesh_text(
 }
 
 /// A gain in one form for every output: `5:uy: x40.26 (+32.1 dB) at -37.0 deg`.
+/// The ranks folded into a row of the ranking
+/// ([`rfm_update::diagnose::ShownRank::alike`]), as its note says them:
+/// "ranks 3-5, 8 alike"; empty when none.
+pub(crate) fn alike_text(alike: &[usize]) -> String {
+    let mut parts: Vec<String> = Vec::new();
+    let mut i = 0;
+    while i < alike.len() {
+        let mut j = i;
+        while j + 1 < alike.len() && alike[j + 1] == alike[j] + 1 {
+            j += 1;
+        }
+        parts.push(if j == i { alike[i].to_string() } else { format!("{}-{}", alike[i], alike[j]) });
+        i = j + 1;
+    }
+    match alike.len() {
+        0 => String::new(),
+        1 => format!("rank {} alike", parts[0]),
+        _ => format!("ranks {} alike", parts.join(", ")),
+    }
+}
+
+/// What "alike" in the ranking's notes means, for its legend.
+pub(crate) const ALIKE_LEGEND: &str = "ranks alike: the row's effect at its place, with the same form and \
+     parameters, fitted from other starting values (a resonator's tuning) to a dBIC within 10 of its own: the data \
+     do not tell them apart";
+
 pub(crate) fn gain_text(g: &GainReport) -> String {
     format!(
         "{}: x{} ({:+.1} dB) at {:+.1} deg",
@@ -885,6 +911,14 @@ mod tests {
     use super::*;
     use fe_model::{Dof, DofRef};
     use frf::FrfKind;
+
+    /// Runs of ranks are written as ranges, the rest one by one.
+    #[test]
+    fn ranks_alike_are_said_as_ranges() {
+        assert_eq!(alike_text(&[]), "");
+        assert_eq!(alike_text(&[3]), "rank 3 alike");
+        assert_eq!(alike_text(&[3, 4, 5, 8, 10, 11]), "ranks 3-5, 8, 10-11 alike");
+    }
 
     /// A folder and the `..` after it cancel; leading `..`, a root and the
     /// file name stay.

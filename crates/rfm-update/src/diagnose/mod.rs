@@ -107,6 +107,7 @@ use self::lines::LineSet;
 pub use self::lines::informative_lines;
 use self::search::Pool;
 use crate::error::UpdateError;
+use crate::quantities::SIGNIFICANT_DBIC;
 
 /// Relative noise level of measured FRFs (RMS of the relative error per
 /// complex value), from the roughness of `ln M` over adjacent lines; see the
@@ -518,6 +519,65 @@ impl Diagnosis {
     pub fn consistent(&self) -> bool {
         !self.ranking.iter().any(|r| r.fully_fitted && r.significant)
     }
+
+    /// The first `top` rows of the ranking as the terminal and the reports
+    /// show them (see [`shown_ranking`]).
+    pub fn shown(&self, top: usize) -> Vec<ShownRank> {
+        shown_ranking(&self.ranking, self.recommended, top)
+    }
+}
+
+/// A row of the ranking as it is shown: the candidate of rank `rank`
+/// (1-based), and the ranks below it folded into its row.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ShownRank {
+    /// Its rank in [`Diagnosis::ranking`] (1-based).
+    pub rank: usize,
+    /// The ranks folded into it: variants it does not differ from.
+    pub alike: Vec<usize>,
+}
+
+/// The first `top` rows of `ranking` as they are shown. A candidate that
+/// is the same effect as one shown above it (the same kind at the same
+/// nodes and elements, in the same directions, with the same damping form
+/// and the same parameters), as plausible and as fully fitted, whose dBIC
+/// is within the significance threshold's magnitude ([`SIGNIFICANT_DBIC`])
+/// of that one's, is folded into its row: it differs only in the values
+/// its fit started from (a resonator at one node offered at several
+/// tunings), and the data do not tell the two apart. Variants that differ
+/// in form (viscous or not, bending or all stiffness, one direction or
+/// two) keep rows of their own: which form the data prefer is what the
+/// ranking shows. The `recommended` rank is always a row of its own.
+/// Ranks keep their numbers, so that any of them can be applied.
+pub fn shown_ranking(ranking: &[Ranked], recommended: Option<usize>, top: usize) -> Vec<ShownRank> {
+    let mut rows: Vec<ShownRank> = Vec::new();
+    for (i, r) in ranking.iter().enumerate() {
+        let rank = i + 1;
+        let names = |x: &Ranked| x.parameters.iter().map(|p| p.name.clone()).chain(x.held.clone()).collect::<Vec<_>>();
+        let same = |o: &Ranked| {
+            o.kind == r.kind
+                && o.nodes == r.nodes
+                && o.elements == r.elements
+                && o.dof == r.dof
+                && o.damping == r.damping
+                && names(o) == names(r)
+                && o.plausible == r.plausible
+                && o.fully_fitted == r.fully_fitted
+                && (o.delta_bic - r.delta_bic).abs() <= SIGNIFICANT_DBIC.abs()
+        };
+        if recommended != Some(rank)
+            && let Some(row) = rows.iter_mut().find(|row| same(&ranking[row.rank - 1]))
+        {
+            row.alike.push(rank);
+            continue;
+        }
+        if rows.len() == top {
+            // a later rank may still fold into a row shown
+            continue;
+        }
+        rows.push(ShownRank { rank, alike: Vec::new() });
+    }
+    rows
 }
 
 /// The misfit the diagnosis, `rfm fix` and the case history speak of: the
@@ -996,6 +1056,64 @@ mod tests {
     use frf::{Channel, NoiseModel, synthesize};
 
     use super::*;
+
+    fn ranked(kind: EffectKind, nodes: &[u32], delta_bic: f64, plausible: bool) -> Ranked {
+        Ranked {
+            kind,
+            gains: Vec::new(),
+            description: format!("{kind:?} at {nodes:?}"),
+            nodes: nodes.to_vec(),
+            elements: Vec::new(),
+            dof: Vec::new(),
+            damping: None,
+            explained: 0.9,
+            misfit: 0.02,
+            lines: 200,
+            delta_bic,
+            significant: delta_bic < SIGNIFICANT_DBIC,
+            plausible,
+            implausible_reason: (!plausible).then(|| "too heavy".to_string()),
+            parameters: Vec::new(),
+            held: Vec::new(),
+            fully_fitted: true,
+            candidate: 0,
+        }
+    }
+
+    /// Fits of one effect at one place whose dBIC differ by no more than
+    /// the significance threshold fold into the best one's row (the
+    /// lap-joint tutorial's resonators at node 9 from several tunings);
+    /// another place, kind or damping form, an implausible twin, a larger
+    /// difference or the recommended rank keep rows of their own, and
+    /// `top` counts rows.
+    #[test]
+    fn variants_the_data_do_not_tell_apart_share_a_row() {
+        use EffectKind::{LumpedMass, Resonator};
+        let ranking = vec![
+            ranked(EffectKind::FlexibleJoint, &[9], -12_000_000.0, true),
+            ranked(Resonator, &[9], -1643.0, true),
+            ranked(Resonator, &[9], -1640.0, true),
+            ranked(Resonator, &[9], -1636.0, true),
+            ranked(Resonator, &[8], -1635.0, true),
+            Ranked { damping: Some("non-viscous"), ..ranked(Resonator, &[9], -1635.0, true) },
+            ranked(Resonator, &[9], -1633.0, false),
+            ranked(Resonator, &[9], -1634.0, true),
+            ranked(Resonator, &[9], -1600.0, true),
+            ranked(LumpedMass, &[9], -634.0, true),
+            ranked(LumpedMass, &[9], -630.0, true),
+        ];
+        let rows = |recommended, top| -> Vec<(usize, Vec<usize>)> {
+            shown_ranking(&ranking, recommended, top).into_iter().map(|r| (r.rank, r.alike)).collect()
+        };
+        assert_eq!(
+            rows(Some(1), 10),
+            vec![(1, vec![]), (2, vec![3, 4, 8]), (5, vec![]), (6, vec![]), (7, vec![]), (9, vec![]), (10, vec![11])]
+        );
+        // the recommended rank is shown even where it would fold
+        assert_eq!(rows(Some(3), 10)[1..3], [(2, vec![4, 8]), (3, vec![])]);
+        // top counts the rows shown; later ranks still fold into them
+        assert_eq!(rows(None, 2), vec![(1, vec![]), (2, vec![3, 4, 8])]);
+    }
 
     /// Fits made to fail at each stage are counted with their stage and
     /// reason, and every other candidate stays ranked: screenings that fail
