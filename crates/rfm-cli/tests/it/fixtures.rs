@@ -2,12 +2,37 @@
 //! them (the report checks and the browser check), so that the slow ones
 //! (`rfm fix` diagnoses the tutorial up to three times) run once.
 //!
-//! They are written under cargo's target temporary folder, replacing what
-//! an earlier run left there.
+//! They are written under cargo's target temporary folder, in a folder of
+//! the test process's own ([`reports_dir`]).
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::OnceLock;
+use std::time::Duration;
+
+/// The folder of this process's reports, `reports/run-PID` under cargo's
+/// target temporary folder, made empty at the first call. nextest runs
+/// every test in a process of its own, several at once: a folder per
+/// process keeps two of them from writing (and removing) one report at
+/// the same time; each writes the reports its own tests read. Folders an
+/// hour old or more (earlier runs) are removed.
+pub(crate) fn reports_dir() -> &'static Path {
+    static D: OnceLock<PathBuf> = OnceLock::new();
+    D.get_or_init(|| {
+        let root = Path::new(env!("CARGO_TARGET_TMPDIR")).join("reports");
+        for e in std::fs::read_dir(&root).into_iter().flatten().flatten() {
+            let age = e.metadata().and_then(|m| m.modified()).ok().and_then(|t| t.elapsed().ok());
+            if age.is_some_and(|a| a > Duration::from_secs(3600)) {
+                let path = e.path();
+                let _ = if path.is_dir() { std::fs::remove_dir_all(&path) } else { std::fs::remove_file(&path) };
+            }
+        }
+        let dir = root.join(format!("run-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).expect("the reports folder");
+        dir
+    })
+}
 
 /// Runs `rfm` with `args`.
 pub(crate) fn rfm(args: &[&str]) -> Output {
@@ -51,10 +76,7 @@ fn write(name: &str, command: &str, case_name: &str, extra: &[&str]) -> Written 
 /// Runs `rfm <command> <case> --out DIR [extra...]` into a fresh folder
 /// named `name` and returns it.
 fn write_case(name: &str, command: &str, case: &Path, extra: &[&str]) -> Written {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("reports").join(name);
-    // an earlier run's report, if any, is replaced whole
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(dir.parent().expect("a parent")).expect("the reports folder");
+    let dir = reports_dir().join(name);
     let mut args = vec![command, case.to_str().expect("a UTF-8 path"), "--out", dir.to_str().expect("a UTF-8 path")];
     args.extend_from_slice(extra);
     let output = rfm(&args);
@@ -88,8 +110,7 @@ pub(crate) fn tutorial_update() -> &'static Written {
         let case = std::fs::read_to_string(tutorial.join("l-frame.toml"))
             .expect("the tutorial case")
             .replace("data = \"l-frame-measured.csv\"", &format!("data = {:?}", data.display().to_string()));
-        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("reports");
-        std::fs::create_dir_all(&dir).expect("the reports folder");
+        let dir = reports_dir();
         let guess = dir.join("l-frame-guess.toml");
         std::fs::write(&guess, format!("{case}\n{block}")).expect("the guess");
         write_case("tutorial-update", "update", &guess, &[])
@@ -102,8 +123,7 @@ pub(crate) fn tutorial_update() -> &'static Written {
 fn tutorial_applied() -> &'static PathBuf {
     static P: OnceLock<PathBuf> = OnceLock::new();
     P.get_or_init(|| {
-        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("reports");
-        std::fs::create_dir_all(&dir).expect("the reports folder");
+        let dir = reports_dir();
         let applied = dir.join("l-frame-applied.toml");
         let _ = std::fs::remove_file(&applied);
         let case = case("tutorial/l-frame");
@@ -143,8 +163,7 @@ pub(crate) fn lap_fix() -> &'static Written {
 pub(crate) fn lap_update() -> &'static Written {
     static W: OnceLock<Written> = OnceLock::new();
     W.get_or_init(|| {
-        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("reports");
-        std::fs::create_dir_all(&dir).expect("the reports folder");
+        let dir = reports_dir();
         let applied = dir.join("lap-with-joint.toml");
         let _ = std::fs::remove_file(&applied);
         let case = case("tutorial/lap-joint");
@@ -158,8 +177,7 @@ pub(crate) fn lap_update() -> &'static Written {
 pub(crate) fn tutorial_diagnose_report() -> &'static Written {
     static W: OnceLock<Written> = OnceLock::new();
     W.get_or_init(|| {
-        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("reports").join("tutorial-diagnose");
-        let _ = std::fs::remove_dir_all(&dir);
+        let dir = reports_dir().join("tutorial-diagnose");
         let case = case("tutorial/l-frame");
         let output = rfm(&["diagnose", case.to_str().unwrap(), "--report", dir.to_str().unwrap()]);
         Written { dir, output }
