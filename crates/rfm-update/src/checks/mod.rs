@@ -641,7 +641,7 @@ fn judge(fits: &[ChannelFit], opts: &CheckOptions) -> Vec<Finding> {
         {
             let same_node = d.node == f.channel.response.node;
             let (kind, what) = if same_node {
-                (FindingKind::MisdirectedChannel, format!("measured {d} instead (the other axis at its node)"))
+                (FindingKind::MisdirectedChannel, format!("measured along {d} instead (the other axis at its node)"))
             } else {
                 (FindingKind::WrongNode, format!("measured at {d} instead"))
             };
