@@ -12,9 +12,15 @@ from pathlib import Path
 import rfm
 from conftest import ROOT, TUTORIAL
 
+# A process started with SIGINT ignored (a background job of a shell
+# without job control, nohup) keeps it ignored, and Python then installs no
+# KeyboardInterrupt handler: the child and the test install Python's own,
+# as an interactive session has it.
 CHILD = r"""
-import sys, time
+import signal, sys, time
 import rfm
+
+signal.signal(signal.SIGINT, signal.default_int_handler)
 
 case = rfm.load_case(sys.argv[1])
 def progress(message):
@@ -114,12 +120,15 @@ def test_interrupt_main_stops_an_update() -> None:
             _thread.interrupt_main()
             time.sleep(0.5)
 
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     try:
         rfm.update(case, progress=progress, check=False)
     except KeyboardInterrupt:
         pass
     else:
         raise AssertionError("not interrupted")
+    finally:
+        signal.signal(signal.SIGINT, previous)
     assert calls == [calls[0]] and calls[0].startswith("iteration 0"), calls
 
 
