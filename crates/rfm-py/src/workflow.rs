@@ -78,6 +78,21 @@ fn stage(case: &CaseFile, measured: Measured) -> Result<Staged> {
     Ok(Staged { path, case, _dir: Some(dir) })
 }
 
+/// The case reading `measured` instead of its own data or `[truth]`, as
+/// the `--measured` of `rfm update` and `rfm fix` makes it: a file as it
+/// is; FRFs in memory from a file written for them (in model DOFs, read
+/// without the case's map), whose folder is kept, since the cases a
+/// result gives or saves read it.
+fn reading(case: &CaseFile, measured: Option<Measured>) -> Result<CaseFile> {
+    let Some(measured) = measured else { return Ok(case.clone()) };
+    let staged = stage(case, measured)?;
+    let Some(dir) = staged._dir else { return Ok(case.with_data(&staged.path)?) };
+    let _ = dir.keep();
+    // (FRFs per volt are staged as rfm's CSV, which names model DOFs and
+    // which no map reads either)
+    Ok(case.with_model_dof_data(&staged.path)?)
+}
+
 fn report_options(frequency_axis: &str) -> Result<ReportOptions> {
     let frequency_scale = match frequency_axis {
         "auto" => FrequencyScale::Auto,
@@ -271,10 +286,11 @@ pub(crate) struct UpdateResult {
 
 /// `rfm update`: the case's parameters updated.
 #[pyfunction]
-#[pyo3(signature = (case, method=None, lines=None, iterations=None, progress=None))]
+#[pyo3(signature = (case, measured=None, method=None, lines=None, iterations=None, progress=None))]
 pub(crate) fn update(
     py: Python<'_>,
     case: &Case,
+    measured: Option<Measured>,
     method: Option<String>,
     lines: Option<usize>,
     iterations: Option<usize>,
@@ -282,7 +298,7 @@ pub(crate) fn update(
 ) -> PyResult<UpdateResult> {
     let file = &case.file;
     run(py, progress, move |p| {
-        let mut study = Study::from_case(file.clone())?;
+        let mut study = Study::from_case(reading(file, measured)?)?;
         let setup = UpdateSetup::new(&mut study, &UpdateOverrides { method, lines, max_iterations: iterations })?;
         let mut outcome = setup.run(&study, |r| {
             p.say(&format!(
@@ -349,14 +365,20 @@ fn fix_line(p: &FixProgress<'_>) -> String {
 
 /// `rfm fix`: diagnose, add the recommended effect, update, and again.
 #[pyfunction]
-#[pyo3(signature = (case, steps=3, progress=None))]
-pub(crate) fn fix(py: Python<'_>, case: &Case, steps: usize, progress: Option<Py<PyAny>>) -> PyResult<FixResult> {
+#[pyo3(signature = (case, measured=None, steps=3, progress=None))]
+pub(crate) fn fix(
+    py: Python<'_>,
+    case: &Case,
+    measured: Option<Measured>,
+    steps: usize,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<FixResult> {
     if !(1..=20).contains(&steps) {
         return Err(Error::argument(format!("steps {steps}: from 1 to 20")).into_pyerr(py));
     }
     let file = &case.file;
     run(py, progress, move |p| {
-        let study = Study::from_case(file.clone())?;
+        let study = Study::from_case(reading(file, measured)?)?;
         p.checkpoint();
         let (dir, data) = data_file(&study)?;
         let opts = rfm_cli::fix_options(&study, steps, data)?;

@@ -50,6 +50,31 @@ def test_measured_data_given_as_frfdata_are_read_as_a_file(rfm_bin, tutorial, tm
     assert_same(in_memory, from_file)
 
 
+def test_update_and_fix_read_measured_data_given_as_the_cli_takes_them(rfm_bin, tutorial, tmp_path) -> None:
+    # the truth's FRFs with 1 % noise, as a file and in memory
+    data = rfm.load_case(TUTORIAL.with_name("l-frame-truth.toml")).simulate(truth=True, noise=0.01, seed=6)
+    data.write_uff(tmp_path / "run.uff", binary=True)
+    fixed = rfm.fix(tutorial, measured=tmp_path / "run.uff", steps=1)
+    cli = json.loads(
+        run_cli(rfm_bin, "fix", TUTORIAL, "--measured", tmp_path / "run.uff", "--steps", "1", "--json",
+                "--out", tmp_path / "cli").stdout
+    )
+    assert_same(fixed.to_dict(), cli)
+    assert "joint at node 13" in fixed.steps[0].effect.description
+    fixed.save(tmp_path / "py")
+    step = (tmp_path / "py" / "step-1.toml").read_text()
+    assert step == (tmp_path / "cli" / "step-1.toml").read_text() and 'data = "../run.uff"' in step
+    # in memory: the same loop, its cases reading a file written for the data
+    in_memory = rfm.fix(tutorial, measured=data, steps=1)
+    assert abs(in_memory.final_misfit - fixed.final_misfit) <= 1e-9 * fixed.final_misfit
+    np.testing.assert_array_equal(in_memory.case.measured().h, data.h)
+    # update of the fixed case against the same data, from the file and from memory
+    one = rfm.update(fixed.case, measured=tmp_path / "run.uff", check=False)
+    two = rfm.update(fixed.case, measured=data, check=False)
+    for a, b in zip(one.parameters, two.parameters):
+        assert a.name == b.name and abs(a.value - b.value) <= 1e-9 * abs(a.value)
+
+
 def test_diagnose_names_the_clis_leader_with_its_dbic(rfm_bin, diagnosis) -> None:
     cli = json.loads(run_cli(rfm_bin, "diagnose", TUTORIAL, "--json").stdout)
     assert_same(diagnosis.to_dict(), cli)

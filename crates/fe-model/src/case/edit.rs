@@ -53,6 +53,18 @@ impl CaseFile {
     /// declares stay. The case keeps its path, for messages and for the
     /// other paths it names.
     pub fn with_data(&self, data: &Path) -> Result<CaseFile, CaseError> {
+        self.reading(data, false)
+    }
+
+    /// As [`Self::with_data`], for data whose channels name the model's
+    /// DOFs already (a file written from FRFs held in memory): the
+    /// `[measurement]` map and pairing, which translate a test's own points
+    /// and directions, are left out, here and in every case derived.
+    pub fn with_model_dof_data(&self, data: &Path) -> Result<CaseFile, CaseError> {
+        self.reading(data, true)
+    }
+
+    fn reading(&self, data: &Path, model_dofs: bool) -> Result<CaseFile, CaseError> {
         let absolute = std::path::absolute(data).map_err(|e| CaseError {
             file: self.path.clone(),
             location: None,
@@ -61,6 +73,12 @@ impl CaseFile {
         })?;
         let mut editor = self.editor()?;
         editor.use_data(&absolute);
+        if model_dofs && let Some(m) = editor.doc.get_mut("measurement").and_then(Item::as_table_like_mut) {
+            for key in ["map", "pair", "tolerance", "axes", "geometry"] {
+                m.remove(key);
+            }
+            editor.geometry = None;
+        }
         let text = editor.text_at(&self.path)?;
         let mut case = CaseFile::parse(&self.path, &text)?;
         // named as given in messages, not by the way up from the case's folder
@@ -502,6 +520,22 @@ mod tests {
         // a step derived from it reads the same file
         let step = other.editor().unwrap().text_at(&dir.join("study/out/step-1.toml")).unwrap();
         assert!(step.contains("data = \"../../lab/run-2.uff\""), "{step}");
+    }
+
+    /// Data in model DOFs drop the map that translates a test's points.
+    #[test]
+    fn data_in_model_dofs_are_read_without_the_map() {
+        let dir = std::env::temp_dir().join(format!("rfm-model-dofs-{}", std::process::id()));
+        let text = format!("{CASE}\n[[measurement.map]]\ntest = \"101:+Y\"\nmodel = \"2:ux\"\n");
+        let c = CaseFile::parse(&dir.join("study/case.toml"), &text).unwrap();
+        assert_eq!(c.measurement.as_ref().unwrap().map.len(), 1);
+        let kept = c.with_data(&dir.join("lab/run.uff")).unwrap();
+        assert_eq!(kept.measurement.as_ref().unwrap().map.len(), 1, "a test's file keeps the map");
+        let own = c.with_model_dof_data(&dir.join("lab/run.uff")).unwrap();
+        assert!(own.measurement.as_ref().unwrap().map.is_empty());
+        assert!(!own.source.contains("measurement.map"), "{}", own.source);
+        let step = own.editor().unwrap().text_at(&dir.join("study/out/step-1.toml")).unwrap();
+        assert!(!step.contains("measurement.map") && step.contains("data = \"../../lab/run.uff\""), "{step}");
     }
 
     /// A correction of a channel corrected before is composed into the

@@ -153,23 +153,32 @@ def update(
     iterations: int | None = None,
     progress: Progress = None,
     check: bool = True,
+    *,
+    measured: Measured = None,
 ) -> UpdateResult:
     """Updates the case's ``[update]`` parameters, as ``rfm update``:
     ``method`` ``"rfm"`` or ``"output-error"`` (default: the case's),
-    ``lines`` to fit that many measured lines, ``iterations`` a limit.
-    Unless ``check=False``, an update that does not converge raises
+    ``lines`` to fit that many measured lines, ``iterations`` a limit;
+    ``measured`` (a file or an :class:`FrfData`) instead of the case's
+    data, as ``--measured``: the updated case then reads them. Unless
+    ``check=False``, an update that does not converge raises
     :class:`NotConverged` carrying the result."""
     result = _with_reporter(
-        "update", progress, lambda r: UpdateResult(_rfm.update(case, method, lines, iterations, r))
+        "update",
+        progress,
+        lambda r: UpdateResult(_rfm.update(case, _measured(measured), method, lines, iterations, r)),
     )
     return _checked(result, check, "update")
 
 
-def fix(case: Case, steps: int = 3, progress: Progress = None, check: bool = True) -> FixResult:
+def fix(
+    case: Case, steps: int = 3, progress: Progress = None, check: bool = True, *, measured: Measured = None
+) -> FixResult:
     """Closes the loop, as ``rfm fix``: diagnose, add the recommended effect,
     update, and again until nothing significant remains (at most ``steps``
-    effects). Unless ``check=False``, a loop that ends without the data
-    explained down to their noise raises :class:`NotConverged` carrying the
-    result."""
-    result = _with_reporter("fix", progress, lambda r: FixResult(_rfm.fix(case, steps, r)))
+    effects); ``measured`` (a file or an :class:`FrfData`) instead of the
+    case's data, as ``--measured``: every step's case then reads them.
+    Unless ``check=False``, a loop that ends without the data explained
+    down to their noise raises :class:`NotConverged` carrying the result."""
+    result = _with_reporter("fix", progress, lambda r: FixResult(_rfm.fix(case, _measured(measured), steps, r)))
     return _checked(result, check, "fix")
