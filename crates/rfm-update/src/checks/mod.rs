@@ -35,7 +35,9 @@
 //!   own, by more than the noise allows, and the channel then fits like the
 //!   others (within three times the median channel's misfit). The other
 //!   axis at the node is a *misdirected* sensor; two channels that each fit
-//!   the other's DOF so are *swapped*. Where several DOFs fit alike (within
+//!   the other's DOF so are *swapped* (four times better together, or,
+//!   against a model far from the data, from twice what two typical
+//!   channels leave to no more than it). Where several DOFs fit alike (within
 //!   what the larger of the noise and the fit's own misfit allows: the
 //!   axial DOFs of a member that moves as one body), the other axis at the
 //!   node is taken first and the rest are named with the finding.
@@ -540,9 +542,15 @@ fn judge(fits: &[ChannelFit], opts: &CheckOptions) -> Vec<Finding> {
                 continue;
             };
             // exchanged, the two together fit far better, each better than
-            // before, by more than the noise allows
+            // before, by more than the noise allows. Far better is four
+            // times, or, against a model far from the data (a missing
+            // joint leaves every channel at a hundred times the noise, and
+            // no exchange brings two channels below the others), from
+            // twice the cost of two typical channels to no more than it
             let own = fa.own_cost() + fb.own_cost();
-            if !((ca + cb) * FALL < own && ca < fa.own_cost() && cb < fb.own_cost() && (own - ca - cb) > 25.0 * s2) {
+            let typical_pair = (fa.own.weight() + fb.own.weight()) * typical * typical;
+            let far_better = (ca + cb) * FALL < own || (own > 2.0 * typical_pair && ca + cb <= typical_pair);
+            if !(far_better && ca < fa.own_cost() && cb < fb.own_cost() && (own - ca - cb) > 25.0 * s2) {
                 continue;
             }
             let before = fa.own_cost() + fb.own_cost();

@@ -291,3 +291,36 @@ fn corrections_written_into_the_case_undo_the_set_up_errors_when_read() {
     }
     assert!(study.notes().iter().any(|n| n.contains("sign inverted")), "{:?}", study.notes());
 }
+
+/// Two channels exchanged at the front end (the tutorial's 9:ux and
+/// 13:ux), against a model that lacks the truth's corner joint and leaves
+/// the median channel at about 140 times the noise: exchanged, the two
+/// fit like the other channels, not four times better than before (no
+/// exchange fits below what the model error leaves), and the swap is
+/// found, on its own, with the inverted channel beside it.
+#[test]
+fn a_swap_is_found_beside_a_large_model_error() {
+    let case = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases/tutorial/l-frame-truth.toml");
+    let study = rfm_update::Study::load(&case).unwrap();
+    let truth = study.truth().expect("the case's truth");
+    let channels = study.measured().channels().to_vec();
+    let mut data = synthesize(truth, &channels, study.measured().frequencies_hz()).unwrap();
+    let at =
+        |node: u32, dof: fe_model::Dof| channels.iter().position(|c| c.response == DofRef::new(node, dof)).unwrap();
+    let (a, b, c) = (at(9, fe_model::Dof::Ux), at(13, fe_model::Dof::Ux), at(17, fe_model::Dof::Uy));
+    let (ha, hb) = (data.channel(a).to_vec(), data.channel(b).to_vec());
+    data.channel_mut(a).copy_from_slice(&hb);
+    data.channel_mut(b).copy_from_slice(&ha);
+    data.channel_mut(c).iter_mut().for_each(|v| *v = -*v);
+    let data = noisy(data, 31);
+    let found = check_channels(study.system(), &data, &opts()).unwrap();
+    let kinds: Vec<_> = found.iter().map(|f| (f.kind, f.channels.clone())).collect();
+    assert_eq!(found.len(), 2, "{kinds:?}");
+    let swap = found.iter().find(|f| f.kind == FindingKind::SwappedChannels).expect("the swap found");
+    for ch in [channels[a], channels[b]] {
+        assert!(swap.channels.contains(&ch.to_string()), "{kinds:?}");
+    }
+    assert!(found.iter().any(|f| f.kind == FindingKind::InvertedPolarity && f.channels == [channels[c].to_string()]));
+    // the model error is as large as said: the median channel far above the noise
+    assert!(swap.misfit_after > 50.0 * NOISE, "{}", swap.misfit_after);
+}
