@@ -34,7 +34,7 @@ pub(crate) fn load_case(path: &Path) -> Result<CaseFile> {
 /// what the file holds, so that a wrong file is seen as such at once
 /// rather than one symptom at a time.
 pub(crate) fn load_study(path: &Path) -> Result<rfm_update::Study> {
-    study_of(load_case(path)?)
+    load_study_measured(path, None)
 }
 
 /// [`load_study`], reading the measured FRFs from `measured` when given
