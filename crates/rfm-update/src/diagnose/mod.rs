@@ -67,7 +67,14 @@
 //! alone (a smaller second moment of area). A twin stays in the ranking
 //! only when it beats its original by very strong evidence (`dBIC` lower
 //! by 10); where the data cannot tell the two apart the plain change
-//! stands.
+//! stands. Last, each of the three leaders with a damping group of its own
+//! (a support, joint, damping window or resonator) is fitted fully in its
+//! other damping form from its own fit (a non-viscous form starting from a
+//! kernel that relaxes ten times faster than the highest line, which damps
+//! as the viscous one does): the non-viscous form's screening fit can stop
+//! in a local minimum of its relaxation parameter, and a leader holding an
+//! undetermined spring has no other form in the pool at all. The
+//! information criterion ranks the two forms as any two candidates.
 //!
 //! A fitted parameter whose relative standard deviation exceeds one (its
 //! value could as well be e times larger), or a spring that ran to its

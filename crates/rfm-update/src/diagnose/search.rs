@@ -593,6 +593,48 @@ impl<'a> Pool<'a> {
         self.add(new)
     }
 
+    /// The other damping form ([`candidates::other_form`]) of each of the
+    /// best `leaders` full fits that has one, with its starting values:
+    /// the leader's fitted values, and a new relaxation parameter where
+    /// the form starts it. A form the pool holds already is fitted from
+    /// there too when only its screening fit was made (it may have stopped
+    /// in a local minimum of its relaxation parameter); one fitted fully
+    /// already is left as it is. Returns the indices to fit and their starts.
+    pub(crate) fn other_forms(
+        &mut self,
+        opts: &CandidateOptions,
+        leaders: usize,
+    ) -> (Vec<usize>, Vec<Option<Vec<f64>>>) {
+        let (mut which, mut starts) = (Vec::new(), Vec::new());
+        let mut new: Vec<(Candidate, Vec<f64>)> = Vec::new();
+        for i in self.by_full_fit().into_iter().take(leaders) {
+            let leader = &self.candidates[i];
+            let Some(c) = candidates::other_form(self.model, leader, opts.band_hz) else { continue };
+            let fit = self.full[i].as_ref().expect("fully fitted");
+            let own = c.start_values();
+            let start: Vec<f64> = (0..c.parameters.len())
+                .map(|p| leader.parameters.iter().position(|n| *n == c.parameters[p]).map_or(own[p], |q| fit.values[q]))
+                .collect();
+            match self.candidates.iter().position(|o| o.description == c.description) {
+                Some(j)
+                    if self.full[j].is_none()
+                        && !which.contains(&j)
+                        && self.candidates[j].parameters == c.parameters =>
+                {
+                    which.push(j);
+                    starts.push(Some(start));
+                }
+                Some(_) => {}
+                None if new.iter().any(|(o, _)| o.description == c.description) => {}
+                None => new.push((c, start)),
+            }
+        }
+        let (made, made_starts): (Vec<Candidate>, Vec<Vec<f64>>) = new.into_iter().unzip();
+        which.extend(self.add(made));
+        starts.extend(made_starts.into_iter().map(Some));
+        (which, starts)
+    }
+
     /// For every full fit with parameters the data do not determine, the
     /// variant that holds them (see [`Candidate::holding`]) is fitted fully
     /// from the determined values and supersedes the fuller one, once its
@@ -781,6 +823,12 @@ pub(crate) fn search(
     }
     pool.hold_undetermined(full, &coarse, (opts.iterations, opts.screen_iterations))?;
     trace(&format!("held what the data do not determine: {}", pool.clock.since_last()));
+    // the other damping form of the leaders, started where they ended
+    let (forms, starts) = pool.other_forms(copts, REFINED_LEADERS);
+    if !forms.is_empty() {
+        pool.full_fit(full, &coarse, (opts.iterations, opts.screen_iterations), &forms, Some(starts))?;
+        trace(&format!("fitted {} leaders in their other damping form: {}", forms.len(), pool.clock.since_last()));
+    }
     Ok(())
 }
 

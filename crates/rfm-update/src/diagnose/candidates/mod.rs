@@ -38,6 +38,7 @@
 mod edit;
 mod generate;
 mod imported;
+mod other_form;
 mod per_direction;
 
 use fe_model::{Dof, ElementId, Model, ModelError, NodeId, Parameter, PartIndex};
@@ -46,6 +47,7 @@ pub(crate) use edit::Edit;
 pub use generate::generate;
 pub(crate) use generate::refine;
 pub(crate) use generate::twins::twins;
+pub(crate) use other_form::other_form;
 pub(crate) use per_direction::per_direction_variant;
 
 /// The kind of a candidate effect.
