@@ -4,6 +4,7 @@ mod apply_every;
 mod bending_loss;
 mod calibration;
 mod coherence_noise;
+mod damping_form;
 mod fast_vs_naive;
 mod held_out;
 mod hidden_effects;
