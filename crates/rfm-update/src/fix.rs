@@ -221,6 +221,16 @@ impl FixStep {
         self.corrected_misfit.unwrap_or(self.misfit_updated)
     }
 
+    /// The step updated again on data a late check corrected: its case
+    /// `editor` holds, at `misfit`, with the update's `outcome`.
+    fn corrected(&mut self, editor: CaseEditor, misfit: f64, outcome: crate::study::UpdateOutcome) {
+        self.corrected_misfit = Some(misfit);
+        self.case = editor;
+        self.status = step_status(&outcome);
+        self.parameters = outcome.parameters;
+        self.uncertainty = outcome.uncertainty;
+    }
+
     fn of(a: Added, delta_bic: f64, alternatives: Vec<LookAhead>, replaced: Option<String>) -> FixStep {
         FixStep {
             misfit_added: a.effect.misfit,
@@ -1414,17 +1424,7 @@ pub fn fix(
                     fl.modes_hz.push(f);
                 }
             }
-            // far from the data, a correction must earn its place (see
-            // LATE_CHECKS_BELOW)
-            let near = state.misfit <= LATE_CHECKS_BELOW * noise;
-            let late: Vec<Finding> = checks::check_channels(&sys, &fl.data, &check_options(opts, noise))?
-                .into_iter()
-                .filter(|f| !f.corrections.is_empty())
-                .map(|mut f| {
-                    f.found_after_step = steps.len();
-                    f
-                })
-                .collect();
+            let late = late_findings(&sys, &fl.data, opts, noise, steps.len())?;
             // the case names a channel moved earlier by its own response
             let written = as_the_case_names(&late, &findings);
             let corrected_update = |fl: &Loop<'_>| -> Result<_, UpdateError> {
@@ -1436,7 +1436,7 @@ pub fn fix(
             // a correction whose update fails is not made (the step stands)
             if let Some((data, new_base, (editor, case_after, stats, outcome))) =
                 (!late.is_empty()).then(|| corrected_update(&fl).ok()).flatten()
-                && (near || share(state.misfit, stats.misfit, noise).is_some_and(|s| s >= SHARE))
+                && correction_kept(state.misfit, stats.misfit, noise)
             {
                 progress(FixProgress::Checked { findings: &late });
                 fl.data = data;
@@ -1462,12 +1462,7 @@ pub fn fix(
                 }
                 current = case_after;
                 state = State { misfit: stats.misfit, k: outcome.parameters.len() };
-                let s = steps.last_mut().expect("a step was kept");
-                s.corrected_misfit = Some(stats.misfit);
-                s.case = editor;
-                s.status = step_status(&outcome);
-                s.parameters = outcome.parameters;
-                s.uncertainty = outcome.uncertainty;
+                steps.last_mut().expect("a step was kept").corrected(editor, stats.misfit, outcome);
                 findings.extend(late);
             }
         }
@@ -1559,34 +1554,21 @@ pub fn fix(
     // misfit); a correction is kept as one after a step is, and a check
     // that fails leaves the loop's answer as it is
     if opts.check_data && mended && state.misfit > CONSISTENT * noise && !steps.is_empty() {
-        let late: Vec<Finding> = damping::DampedSystem::new(current.model.clone())
+        let late = damping::DampedSystem::new(current.model.clone())
             .ok()
-            .and_then(|sys| checks::check_channels(&sys, &fl.data, &check_options(opts, noise)).ok())
-            .unwrap_or_default()
-            .into_iter()
-            .filter(|f| !f.corrections.is_empty())
-            .map(|mut f| {
-                f.found_after_step = steps.len();
-                f
-            })
-            .collect();
+            .and_then(|sys| late_findings(&sys, &fl.data, opts, noise, steps.len()).ok())
+            .unwrap_or_default();
         let written = as_the_case_names(&late, &findings);
-        let near = state.misfit <= LATE_CHECKS_BELOW * noise;
         if !late.is_empty()
             && let Ok((data, (editor, case_after, stats, outcome))) =
                 update_corrected(&fl, &current, (&late, &written), (steps.len(), true), noise)
-            && (near || share(state.misfit, stats.misfit, noise).is_some_and(|s| s >= SHARE))
+            && correction_kept(state.misfit, stats.misfit, noise)
         {
             progress(FixProgress::Checked { findings: &late });
             fl.data = data;
             current = case_after;
             state = State { misfit: stats.misfit, k: outcome.parameters.len() };
-            let s = steps.last_mut().expect("a step was made");
-            s.corrected_misfit = Some(stats.misfit);
-            s.case = editor;
-            s.status = step_status(&outcome);
-            s.parameters = outcome.parameters;
-            s.uncertainty = outcome.uncertainty;
+            steps.last_mut().expect("a step was made").corrected(editor, stats.misfit, outcome);
             findings.extend(late);
             last_diagnosis = None;
         }
@@ -1644,6 +1626,34 @@ pub fn fix(
         diagnosis_error,
         mesh,
     })
+}
+
+/// The channel findings against `sys` that come with a correction, as
+/// found after `step` steps.
+fn late_findings(
+    sys: &damping::DampedSystem,
+    data: &FrfSet,
+    opts: &FixOptions,
+    noise: f64,
+    step: usize,
+) -> Result<Vec<Finding>, UpdateError> {
+    let found = checks::check_channels(sys, data, &check_options(opts, noise))?;
+    Ok(found
+        .into_iter()
+        .filter(|f| !f.corrections.is_empty())
+        .map(|mut f| {
+            f.found_after_step = step;
+            f
+        })
+        .collect())
+}
+
+/// Whether a late correction is kept: near the data (within
+/// [`LATE_CHECKS_BELOW`] times the noise) when its update succeeds, and
+/// farther only when it explains [`SHARE`] of what the model left above
+/// the noise (`before` and `after`: the misfits without and with it).
+fn correction_kept(before: f64, after: f64, noise: f64) -> bool {
+    before <= LATE_CHECKS_BELOW * noise || share(before, after, noise).is_some_and(|s| s >= SHARE)
 }
 
 /// The model of `current` updated again on the loop's data with the

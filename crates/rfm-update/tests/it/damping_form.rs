@@ -20,7 +20,7 @@ use fe_model::CaseFile;
 use rfm_update::Study;
 use rfm_update::checks::FindingKind;
 use rfm_update::diagnose::{DiagnoseOptions, Diagnosis, Ranked, diagnose};
-use rfm_update::fix::{FixOptions, fix};
+use rfm_update::fix::{FixOptions, FixOutcome, fix};
 
 const FRAME: &str = include_str!("cases/portal-frame.toml");
 
@@ -87,6 +87,22 @@ fn diagnosis(clamp: &Clamp) -> Diagnosis {
     d
 }
 
+/// `rfm fix`'s loop on the nominal case with the truth's data, one channel
+/// scaled (see [`nominal_case`]), with the options `rfm fix` uses.
+fn fixed(clamp: &Clamp, wrong: (&str, f64)) -> FixOutcome {
+    let tmp = tempfile::tempdir().unwrap();
+    let case = nominal_case(clamp, Some(wrong), tmp.path());
+    let study = Study::from_case(case.clone()).unwrap();
+    let out = fix(&case, study.measured(), &FixOptions::default(), |_| {}).unwrap();
+    println!(
+        "findings {:?}; effects {:?}; {:.2} x the noise",
+        out.findings.iter().map(|f| &f.summary).collect::<Vec<_>>(),
+        out.effects.iter().map(|e| &e.description).collect::<Vec<_>>(),
+        out.final_misfit() / out.noise
+    );
+    out
+}
+
 /// The best ranked support at node 27 in the damping form `form`.
 fn support<'a>(d: &'a Diagnosis, form: &str) -> (usize, &'a Ranked) {
     d.ranking
@@ -140,16 +156,8 @@ fn a_viscous_clamp_keeps_its_viscous_form() {
 
 #[test]
 fn the_loop_adds_the_relaxing_clamp_alone_beside_an_inverted_channel() {
-    let tmp = tempfile::tempdir().unwrap();
-    let case = nominal_case(&RELAXING, Some(("19:ux", -1.0)), tmp.path());
-    let study = Study::from_case(case.clone()).unwrap();
-    let out = fix(&case, study.measured(), &FixOptions::default(), |_| {}).unwrap();
+    let out = fixed(&RELAXING, ("19:ux", -1.0));
     let effects: Vec<&str> = out.effects.iter().map(|e| e.description.as_str()).collect();
-    println!(
-        "findings {:?}; effects {effects:?}; {:.2} x the noise",
-        out.findings.iter().map(|f| &f.summary).collect::<Vec<_>>(),
-        out.final_misfit() / out.noise
-    );
     assert_eq!(out.findings.len(), 1);
     assert_eq!(out.findings[0].kind, FindingKind::InvertedPolarity);
     assert_eq!(out.findings[0].channels, ["H(19:ux,12:uy)"]);
@@ -168,16 +176,8 @@ fn the_loop_adds_the_relaxing_clamp_alone_beside_an_inverted_channel() {
 #[test]
 fn a_low_sensor_is_found_once_the_revisions_mend_the_model() {
     let truth = Clamp { motor: Some(0.25), noise: 0.02, ..RELAXING };
-    let tmp = tempfile::tempdir().unwrap();
-    let case = nominal_case(&truth, Some(("9:ux", 0.8)), tmp.path());
-    let study = Study::from_case(case.clone()).unwrap();
-    let out = fix(&case, study.measured(), &FixOptions::default(), |_| {}).unwrap();
+    let out = fixed(&truth, ("9:ux", 0.8));
     let effects: Vec<&str> = out.effects.iter().map(|e| e.description.as_str()).collect();
-    println!(
-        "findings {:?}; effects {effects:?}; {:.2} x the noise",
-        out.findings.iter().map(|f| &f.summary).collect::<Vec<_>>(),
-        out.final_misfit() / out.noise
-    );
     assert_eq!(out.findings.len(), 1);
     assert_eq!(out.findings[0].kind, FindingKind::Calibration);
     assert_eq!(out.findings[0].channels, ["H(9:ux,12:uy)"]);

@@ -306,6 +306,23 @@ impl Candidate {
         })
     }
 
+    /// A variant of this candidate at the same place: `edit` (its
+    /// description) with `fitted`, on the same nodes and part, over the same
+    /// band. `None` when the edit does not apply.
+    pub(crate) fn variant(&self, model: &Model, edit: Edit, fitted: Vec<Fitted>) -> Option<Candidate> {
+        let head = Head {
+            kind: self.kind,
+            description: edit.describe(self.kind),
+            nodes: self.nodes.clone(),
+            elements: self.elements.clone(),
+            dofs: self.dofs.clone(),
+            part_nodes: self.part_nodes.clone(),
+        };
+        let mut c = Candidate::new(model, head, edit, fitted)?;
+        c.band_rad = self.band_rad;
+        Some(c)
+    }
+
     /// The whole nominal model with this effect inserted at its starting values.
     pub fn model(&self, nominal: &Model) -> Result<Model, ModelError> {
         let mut m = nominal.clone();

@@ -23,7 +23,7 @@
 use fe_model::Model;
 
 use super::edit::Edit;
-use super::{Candidate, Fitted, Head, Role};
+use super::{Candidate, Fitted, Role};
 
 /// A non-viscous form starts with its kernel relaxing this many times
 /// faster than the highest line (rad/s): viscous over the band.
@@ -76,16 +76,7 @@ pub(crate) fn other_form(model: &Model, leader: &Candidate, band_hz: (f64, f64))
         group.mu = Some(FAST * w_max);
         fitted.extend(mus);
     }
-    let head = Head {
-        kind: leader.kind,
-        description: edit.describe(leader.kind),
-        nodes: leader.nodes.clone(),
-        elements: leader.elements.clone(),
-        dofs: leader.dofs.clone(),
-        part_nodes: leader.part_nodes.clone(),
-    };
-    let mut c = Candidate::new(model, head, edit, fitted)?;
-    c.band_rad = leader.band_rad;
+    let mut c = leader.variant(model, edit, fitted)?;
     c.held = leader.held.clone();
     Some(c)
 }

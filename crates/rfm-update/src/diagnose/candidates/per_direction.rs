@@ -14,7 +14,7 @@
 use fe_model::Model;
 
 use super::edit::{Edit, direction_name};
-use super::{Candidate, Fitted, Head, Role};
+use super::{Candidate, Fitted, Role};
 
 /// The per-direction variant of `leader`, when it is a support or joint
 /// (not already per direction) with springs in two or more DOFs, started
@@ -71,15 +71,5 @@ pub(crate) fn per_direction_variant(model: &Model, leader: &Candidate, values: &
             fitted.push(Fitted { name, role, bounds, plausible });
         }
     }
-    let head = Head {
-        kind: leader.kind,
-        description: edit.describe(leader.kind),
-        nodes: leader.nodes.clone(),
-        elements: leader.elements.clone(),
-        dofs: leader.dofs.clone(),
-        part_nodes: leader.part_nodes.clone(),
-    };
-    let mut c = Candidate::new(model, head, edit, fitted)?;
-    c.band_rad = leader.band_rad;
-    Some(c)
+    leader.variant(model, edit, fitted)
 }
