@@ -187,8 +187,9 @@ const FIX_SECONDS: f64 = 30.0;
 /// The loop of `rfm fix` end to end (`fix_point`): 3 steps on each
 /// workload, with its wall and CPU time and the load average the machine
 /// ran it at. Returns the bounds missed: over [`FIX_SECONDS`], or a wrong
-/// answer (a hidden effect not found, or a final misfit above 1.5 times
-/// the noise), which fails however fast it came.
+/// answer (a hidden effect not found, an effect added that is none of
+/// them, or a final misfit above 1.5 times the noise), which fails however
+/// fast it came.
 fn fix_times() -> Result<Vec<String>, String> {
     let exe = release_example("fix_point")?;
     println!("\nthe loop of rfm fix, 3 steps, on test-resolution data (bound {FIX_SECONDS} s of wall time):");
@@ -217,7 +218,8 @@ fn fix_times() -> Result<Vec<String>, String> {
         );
         if !right {
             missed.push(format!(
-                "fix {model}: the loop ended with [{}] at {:.2} times the noise, where it should find [{}] within 1.5",
+                "fix {model}: the loop ended with [{}] at {:.2} times the noise, where it should find [{}] and nothing \
+                 else within 1.5",
                 effects.join("; "),
                 p.num("misfit_over_noise"),
                 p.json["hidden"].as_array().map_or(String::new(), |a| a

@@ -26,10 +26,11 @@
 //! `--steps` steps) and one JSON line is printed: sizes, wall and CPU time
 //! of the loop, the load average before and after, the effects the loop
 //! ended with, whether each hidden effect is among them (right kind at its
-//! place: the beam's one node either side, the tower's at its node), the
-//! final misfit over the injected noise, whether that answer is right
-//! (every hidden effect found and the misfit within 1.5 times the noise:
-//! a fast wrong answer is a failure of the bench) and the stop. `--write
+//! place: the beam's one node either side, the tower's at its node), how
+//! many effects it ended with that are none of them, the final misfit over
+//! the injected noise, whether that answer is right (every hidden effect
+//! found, nothing else, and the misfit within 1.5 times the noise: a fast
+//! wrong answer is a failure of the bench) and the stop. `--write
 //! DIR` also writes the nominal case, its data and the truth, to run `rfm
 //! fix DIR/nominal.toml` on them; `--verbose` prints the loop's progress
 //! with times to stderr.
@@ -299,7 +300,10 @@ fn main() {
     };
     let found: Vec<bool> = w.hidden.iter().map(|h| outcome.effects.iter().any(|e| is(e, h))).collect();
     let ratio = outcome.final_misfit() / NOISE;
-    let right = found.iter().all(|&f| f) && ratio <= rfm_update::fix::CONSISTENT;
+    // an effect that is none of the hidden ones: the loop added what the
+    // data did not hold
+    let spurious = outcome.effects.iter().filter(|e| !w.hidden.iter().any(|h| is(e, h))).count();
+    let right = found.iter().all(|&f| f) && spurious == 0 && ratio <= rfm_update::fix::CONSISTENT;
     let quoted =
         |v: Vec<String>| v.iter().map(|s| format!("\"{}\"", s.replace('"', "'"))).collect::<Vec<_>>().join(",");
     if verbose {
@@ -313,7 +317,7 @@ fn main() {
     println!(
         "{{\"label\":\"{}\",\"dofs\":{},\"channels\":{},\"freqs\":{},\"steps\":{},\"seconds\":{seconds:e},\
          \"cpu_seconds\":{cpu},\"load_before\":\"{load_before}\",\"load_after\":\"{}\",\"effects\":[{}],\
-         \"hidden\":[{}],\"found\":[{}],\"misfit_over_noise\":{ratio:e},\"right\":{right},\"stop\":\"{:?}\",\
+         \"hidden\":[{}],\"found\":[{}],\"spurious\":{spurious},\"misfit_over_noise\":{ratio:e},\"right\":{right},\"stop\":\"{:?}\",\
          \"peak_kib\":{}}}",
         w.label,
         DampedSystem::new(case.model.clone()).expect("assembles").n(),

@@ -47,7 +47,8 @@
 //!    revised with the others in place (its other forms, a kind that stands
 //!    in for it, or nothing; `fix/revise.rs`), and effects added early are
 //!    left out and replaced (`fix/swap.rs`): each replacement is a step kept
-//!    by the same rule.
+//!    by the same rule, and an effect is taken out when, added to the model
+//!    without it, the rule would no longer keep it.
 //!
 //! The loop stops when no step passes the rule: with the data explained to
 //! their noise ([`FixStop::NothingSignificant`]), or with something the
@@ -181,10 +182,14 @@ pub struct FixStep {
     /// it (left out, the others kept, and these added instead; see [`fix`]),
     /// when it did: their descriptions joined by " and ".
     pub replaced: Option<String>,
-    /// The effect was taken out again, not added: with the others revised
-    /// it no longer paid for its parameters (`fix/revise.rs`); `misfit_added`
+    /// The effect was taken out again, not added: with the others revised,
+    /// added to the model without it, it would no longer be kept by the
+    /// rule it was added by (`fix/revise.rs`); `misfit_added`
     /// and `misfit_updated` are both the misfit without it, updated.
     pub removed: bool,
+    /// Why the effect was taken out (with `removed`): the test of the rule
+    /// it was added by that it fails against the model without it.
+    pub removed_because: Option<String>,
     /// The misfit after the data found wrong once this step was kept were
     /// corrected and every parameter updated again (see [`FixOutcome::findings`],
     /// `found_after_step`); `case`, `parameters` and `status` are then that
@@ -244,6 +249,7 @@ impl FixStep {
             alternatives,
             replaced,
             removed: false,
+            removed_because: None,
             corrected_misfit: None,
             refit: None,
             case: a.editor,
@@ -1501,6 +1507,7 @@ pub fn fix(
                     // nothing was added: the misfit without it is the updated one
                     s.misfit_added = s.misfit_updated;
                     s.removed = true;
+                    s.removed_because = r.why;
                     steps.push(s);
                 } else {
                     effects[r.index] = r.added.effect.clone();

@@ -409,7 +409,10 @@ fn progress_lines_after(p: &FixProgress<'_>, done: usize) -> Vec<String> {
             effects.join(", ")
         )],
         // the step was announced by `Updated`; this one is for keeping it
-        FixProgress::StepDone { .. } => Vec::new(),
+        FixProgress::StepDone { done: step, .. } => match &step.removed_because {
+            Some(why) => vec![format!("  taken out: {why}")],
+            None => Vec::new(),
+        },
     }
 }
 

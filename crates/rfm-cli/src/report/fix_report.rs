@@ -328,14 +328,25 @@ pub(crate) fn write(
         let mut facts = vec![
             ("explained".into(), format!("{} of the squared misfit before it", super::percent(e.explained))),
             ("dBIC in the diagnosis".into(), format!("{} (against the other candidates)", table::dbic(e.delta_bic))),
-            (
-                "dBIC of the step".into(),
-                format!(
-                    "{} (the model after the step against the model before, both updated; significant below {})",
-                    table::dbic(s.delta_bic),
-                    quantities::SIGNIFICANT_DBIC
-                ),
-            ),
+            if s.removed {
+                (
+                    "dBIC of the step".into(),
+                    format!(
+                        "{} (the model without the effect against the model with it, both updated: an effect stays \
+                         only while it would be added to the model without it)",
+                        table::dbic(s.delta_bic)
+                    ),
+                )
+            } else {
+                (
+                    "dBIC of the step".into(),
+                    format!(
+                        "{} (the model after the step against the model before, both updated; significant below {})",
+                        table::dbic(s.delta_bic),
+                        quantities::SIGNIFICANT_DBIC
+                    ),
+                )
+            },
             ("misfit with it".into(), format!("{} ({} x noise)", table::misfit(s.misfit_added), times(s.misfit_added))),
             (
                 "after the update".into(),
@@ -347,6 +358,9 @@ pub(crate) fn write(
                 ),
             ),
         ];
+        if let Some(why) = &s.removed_because {
+            facts.push(("why taken out".into(), why.clone()));
+        }
         if let Some(m) = s.corrected_misfit {
             facts.push((
                 "after the data found wrong since were corrected".into(),

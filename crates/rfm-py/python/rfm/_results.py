@@ -274,6 +274,8 @@ class Step:
 
     effect: Candidate
     removed: bool
+    #: why the effect was taken out (with ``removed``)
+    removed_because: str | None
     misfit_added: float
     misfit_updated: float
     status: str
@@ -296,6 +298,7 @@ class FixResult(_MeshChecked):
             Step(
                 effect=Candidate._of(0, s["effect"]),
                 removed=bool(s.get("removed", False)),
+                removed_because=s.get("removed_because"),
                 misfit_added=float(s["misfit_added"]),
                 misfit_updated=float(s["misfit_updated"]),
                 status=_status_name(s["status"]),

@@ -15,11 +15,16 @@
 //! replaced by each of the few best other candidates of the diagnosis it
 //! came from that act at its place (any kind: a mass change of two
 //! elements is a lumped mass's neighbour), the others kept, and everything
-//! updated jointly. A replacement (or the effect's removal) is kept by the
-//! loop's one rule (`fix/judge.rs`): the evidence for the model with it over
-//! the model before, every parameter counted, plausible values and an
-//! update that reached a stationary point; the next effect is then revised
-//! with it in place.
+//! updated jointly. A replacement is kept by the loop's one rule
+//! (`fix/judge.rs`): the evidence for the model with it over the model
+//! before, every parameter counted, plausible values and an update that
+//! reached a stationary point; the next effect is then revised with it in
+//! place. The same rule read backwards takes an effect out: it stays only
+//! while, added to the model without it, it would be kept (significant on
+//! its own and explaining [`super::SHARE`] of what that model leaves above
+//! the noise). When it would not, the model without it is the one its
+//! replacements must beat by that rule, as any new effect must: the data
+//! no longer call for it, so what takes its place is an addition.
 
 use fe_model::{CaseEditor, CaseFile};
 
@@ -45,6 +50,9 @@ pub(super) struct Replacement {
     pub replaced: String,
     /// Its evidence over the model before it.
     pub delta_bic: f64,
+    /// Why the effect it replaced was not needed, when it was not (see
+    /// `unneeded`).
+    pub why: Option<String>,
 }
 
 /// Kinds that stand in for one another: a joint and a short stiffness
@@ -219,6 +227,39 @@ fn refs(a: &[(Diagnosis, usize)]) -> Vec<(&Diagnosis, usize)> {
     a.iter().map(|(d, r)| (d, *r)).collect()
 }
 
+/// Why the effect taken out of the model `state` to leave `without` (its
+/// update, `a`, whose evidence over `state` is `delta_bic`) is not needed:
+/// the rule it was added by, read backwards. It is needed when, added to
+/// the model without it, it would be kept: significant on its own, its
+/// parameters counted, and explaining [`super::SHARE`] of what that model
+/// leaves above the noise. An effect kept only because taking it out was
+/// not strongly preferred is one the evidence never singled out (the fix
+/// bench's beam: a lumped mass of 21 mg ± 240 % at the tip, left from
+/// before the joint's place was mended, then replaced by a mass change of
+/// 0.05 % over eight elements that explained 37 % of what the model
+/// without either left above the noise). `None` when it is needed, or when
+/// the model without it cannot be judged (an update short of a stationary
+/// point, or implausible values).
+fn unneeded(fl: &Loop<'_>, state: State, a: &Added, without: &[(&Diagnosis, usize)], delta_bic: f64) -> Option<String> {
+    if !super::judge::stationary(&a.outcome) || super::judge::implausible_after(without, &a.outcome).is_some() {
+        return None;
+    }
+    let significance = fl.evidence.significance;
+    let own = -delta_bic;
+    if !(own < significance) {
+        return Some(format!(
+            "added to the model without it, its dBIC would be {}, not below {significance}",
+            crate::quantities::dbic_text(own)
+        ));
+    }
+    let noise = fl.evidence.noise;
+    let floor = if a.stats.misfit > noise { fl.floor(&a.case) } else { noise };
+    super::small_share(a.stats.misfit, state.misfit, noise, floor).map(|why| match why.strip_prefix("it ") {
+        Some(rest) => format!("added to the model without it, it would {}", rest.replacen("explains", "explain", 1)),
+        None => format!("without it, {}", why.replacen("the model before it", "the model", 1)),
+    })
+}
+
 /// Revises the effects `applied` (diagnosis and rank of each, in the order
 /// added to `nominal`), which leave the model `before` in the case
 /// `current`; see the module docs. Returns the replacements kept, in order
@@ -267,17 +308,33 @@ pub(super) fn revise(
         };
         // taken out: an effect added to make up for a wrong form of
         // another may not be needed once that is mended (trial 25: a stiff
-        // in-line joint beside the corner joint)
+        // in-line joint beside the corner joint). It stays only while it
+        // passes, against the model without it, the rule it was added by
+        // (`unneeded`); when it does not, the model without it is the base
+        // every replacement is judged against.
+        let mut base: Option<State> = None;
+        let mut why: Option<String> = None;
         if let Ok((case, editor)) = &without_built
             && let Ok((editor, case, stats, outcome)) = fl.update_case(case, editor.clone(), step, false)
             && stats.misfit.is_finite()
         {
             let a = Added { effect: own.clone(), rank: applied[index].1, editor, case, stats, outcome };
             let v = fl.judge(state, &a, &without);
-            if v.rejected.is_none() {
+            if let Some(reason) = unneeded(fl, state, &a, &without, v.delta_bic) {
+                why = Some(reason);
+                base = Some(State { misfit: a.stats.misfit, k: a.outcome.parameters.len() });
                 best = Some((v.delta_bic, None, a));
             }
         }
+        // the floor of the model without the effect, read once (see
+        // `small_share`)
+        let base_floor = base.map(|b| {
+            let noise = fl.evidence.noise;
+            match (&best, b.misfit > noise) {
+                (Some((_, _, a)), true) => fl.floor(&a.case),
+                _ => noise,
+            }
+        });
         // an effect alone: the diagnosis it came from is that of the model
         // without it (its other form is the revision it may need)
         let d = if without.is_empty() {
@@ -310,7 +367,21 @@ pub(super) fn revise(
                     a.effect.description = retitled(&own, &a.effect);
                     a.effect.misfit = state.misfit;
                 }
-                let v = fl.judge(state, &a, &tried);
+                // judged against the model before the revision, or, when the
+                // effect it replaces is not needed, as an addition to the
+                // model without it: a replacement of what the data no longer
+                // call for is a new effect and needs its own evidence
+                let v = match (base, base_floor) {
+                    (Some(b), Some(floor)) => {
+                        let mut v = fl.judge(b, &a, &tried);
+                        if v.rejected.is_none() {
+                            v.rejected = super::small_share(b.misfit, a.stats.misfit, fl.evidence.noise, floor);
+                        }
+                        v.delta_bic = fl.judge(state, &a, &tried).delta_bic;
+                        v
+                    }
+                    _ => fl.judge(state, &a, &tried),
+                };
                 if v.rejected.is_none() && best.as_ref().is_none_or(|(b, ..)| v.delta_bic < *b) {
                     best = Some((v.delta_bic, Some(other), a));
                 }
@@ -323,7 +394,14 @@ pub(super) fn revise(
         warm = added.case.model.clone();
         state = State { misfit: added.stats.misfit, k: added.outcome.parameters.len() };
         pass_changed = true;
-        kept.push(Replacement { index, removed: other.is_none(), added, replaced: own.description.clone(), delta_bic });
+        kept.push(Replacement {
+            index,
+            removed: other.is_none(),
+            added,
+            replaced: own.description.clone(),
+            delta_bic,
+            why,
+        });
         match (other, d) {
             (Some(other), Ok((d, _))) => {
                 applied[index] = (d, other);
