@@ -48,7 +48,7 @@
 //!    in for it, or nothing; `fix/revise.rs`), and effects added early are
 //!    left out and replaced (`fix/swap.rs`): each replacement is a step kept
 //!    by the same rule, and an effect is taken out when, added to the model
-//!    without it, the rule would no longer keep it.
+//!    without it, it would no longer be significant.
 //!
 //! The loop stops when no step passes the rule: with the data explained to
 //! their noise ([`FixStop::NothingSignificant`]), or with something the
@@ -183,12 +183,12 @@ pub struct FixStep {
     /// when it did: their descriptions joined by " and ".
     pub replaced: Option<String>,
     /// The effect was taken out again, not added: with the others revised,
-    /// added to the model without it, it would no longer be kept by the
-    /// rule it was added by (`fix/revise.rs`); `misfit_added`
+    /// added to the model without it, it would no longer be significant
+    /// (`fix/revise.rs`); `misfit_added`
     /// and `misfit_updated` are both the misfit without it, updated.
     pub removed: bool,
-    /// Why the effect was taken out (with `removed`): the test of the rule
-    /// it was added by that it fails against the model without it.
+    /// Why the effect was taken out (with `removed`): its evidence added to
+    /// the model without it.
     pub removed_because: Option<String>,
     /// The misfit after the data found wrong once this step was kept were
     /// corrected and every parameter updated again (see [`FixOutcome::findings`],

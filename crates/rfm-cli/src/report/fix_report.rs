@@ -333,7 +333,7 @@ pub(crate) fn write(
                     "dBIC of the step".into(),
                     format!(
                         "{} (the model without the effect against the model with it, both updated: an effect stays \
-                         only while it would be added to the model without it)",
+                         only while it would be significant added to the model without it)",
                         table::dbic(s.delta_bic)
                     ),
                 )

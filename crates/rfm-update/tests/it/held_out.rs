@@ -297,7 +297,9 @@ fn the_loop_keeps_its_steps_when_the_last_diagnosis_fails() {
 /// way the loop goes (alone or as a pair), both effects are found, and
 /// every step it keeps passes the rule on its own: a dBIC below the
 /// diagnosis's significance against the model before it, so that no
-/// partner rides along with a strong effect.
+/// partner rides along with a strong effect; an effect the revisions take
+/// out is one that, added back, would not be significant (its removal's
+/// dBIC above minus the significance).
 #[test]
 fn two_effects_that_mislead_one_at_a_time_are_both_found() {
     let trial = trial_of(12, 16, 76);
@@ -310,8 +312,16 @@ fn two_effects_that_mislead_one_at_a_time_are_both_found() {
             s.delta_bic,
             s.misfit_updated / NOISE
         );
-        if s.replaced.is_none() {
-            let significance = DiagnoseOptions::default().significance;
+        let significance = DiagnoseOptions::default().significance;
+        if s.removed {
+            assert!(s.removed_because.is_some(), "{} taken out without a reason", s.effect.description);
+            assert!(
+                -s.delta_bic >= significance,
+                "{} taken out though its own dBIC is {:.3e}",
+                s.effect.description,
+                -s.delta_bic
+            );
+        } else if s.replaced.is_none() {
             assert!(s.delta_bic < significance, "{} kept with dBIC {:.3e}", s.effect.description, s.delta_bic);
         }
     }
