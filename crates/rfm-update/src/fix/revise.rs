@@ -385,7 +385,15 @@ pub(super) fn revise(
                         if v.rejected.is_none() {
                             v.rejected = super::small_share(b.misfit, a.stats.misfit, fl.evidence.noise, floor);
                         }
-                        v.delta_bic = fl.judge(state, &a, &tried).delta_bic;
+                        // its evidence over the model before the revision,
+                        // as every step reports it
+                        v.delta_bic = diagnose::delta_bic(
+                            state.misfit,
+                            state.k,
+                            &a.stats,
+                            a.outcome.parameters.len(),
+                            fl.evidence.noise,
+                        );
                         v
                     }
                     _ => fl.judge(state, &a, &tried),
