@@ -669,9 +669,14 @@ impl Loop<'_> {
     /// residual's, trial 68 of the lab study). The loop's reading stays the one the evidence, the stop
     /// and whether the model before is already within the noise are judged
     /// against: there a higher noise is the cautious one, as a lower one is
-    /// here (see `small_share`).
-    fn floor(&self, current: &CaseFile) -> f64 {
+    /// here (see `small_share`). The residual's reading costs a synthesis at
+    /// every line: it is made only for a model whose misfit, `misfit`, is
+    /// above the loop's noise (within it, `small_share` keeps nothing).
+    fn floor(&self, misfit: f64, current: &CaseFile) -> f64 {
         let noise = self.evidence.noise;
+        if !(misfit > noise) {
+            return noise;
+        }
         let read = damping::DampedSystem::new(current.model.clone()).ok().and_then(|sys| {
             diagnose::residual_roughness(&sys, &self.data, self.opts.diagnose.weights.as_deref()).ok().flatten()
         });
@@ -1208,9 +1213,7 @@ pub fn fix(
         }
         let step = steps.len() + 1;
         let last = step >= opts.max_steps;
-        // the residual's reading costs a synthesis at every line; the share
-        // is read only for a model above the loop's noise (`small_share`)
-        let floor = if state.misfit > noise { fl.floor(&current) } else { noise };
+        let floor = fl.floor(state.misfit, &current);
         let mut moves: Vec<Move> = Vec::new();
         let mut singles: Vec<(usize, Added)> = Vec::new();
         let mut tried: Vec<LookAhead> = Vec::new();

@@ -328,25 +328,22 @@ pub(crate) fn write(
         let mut facts = vec![
             ("explained".into(), format!("{} of the squared misfit before it", super::percent(e.explained))),
             ("dBIC in the diagnosis".into(), format!("{} (against the other candidates)", table::dbic(e.delta_bic))),
-            if s.removed {
-                (
-                    "dBIC of the step".into(),
+            (
+                "dBIC of the step".into(),
+                if s.removed {
                     format!(
                         "{} (the model without the effect against the model with it, both updated: an effect stays \
                          only while it would be significant added to the model without it)",
                         table::dbic(s.delta_bic)
-                    ),
-                )
-            } else {
-                (
-                    "dBIC of the step".into(),
+                    )
+                } else {
                     format!(
                         "{} (the model after the step against the model before, both updated; significant below {})",
                         table::dbic(s.delta_bic),
                         quantities::SIGNIFICANT_DBIC
-                    ),
-                )
-            },
+                    )
+                },
+            ),
             ("misfit with it".into(), format!("{} ({} x noise)", table::misfit(s.misfit_added), times(s.misfit_added))),
             (
                 "after the update".into(),

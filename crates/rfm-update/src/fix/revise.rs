@@ -236,9 +236,8 @@ fn refs(a: &[(Diagnosis, usize)]) -> Vec<(&Diagnosis, usize)> {
 /// bench's beam: a lumped mass of 21 mg ± 240 % at the tip, left from
 /// before the joint's place was mended, whose removal the evidence
 /// preferred by 3.5, then replaced by a mass change of 0.05 % over eight
-/// elements). The share of the excess an
-/// addition must explain ([`super::SHARE`]) is not asked of an effect
-/// already in: against a model that still lacks another effect, or data
+/// elements). The share of the excess an addition must explain
+/// ([`super::SHARE`]) is not asked of an effect already in: against a model that still lacks another effect, or data
 /// that hold an error not yet found, a right effect or a fair stand-in for
 /// one explains only part of what is left (the damping-form test's clamp
 /// with a motor beside it and a sensor 20 % low, at 38 times the noise: a
@@ -310,8 +309,8 @@ pub(super) fn revise(
         // in-line joint beside the corner joint). It stays only while it
         // would be significant added to the model without it (`unneeded`);
         // when it would not, the model without it is the base every
-        // replacement is judged against.
-        let mut base: Option<State> = None;
+        // replacement is judged against (with its floor, see `small_share`)
+        let mut base: Option<(State, f64)> = None;
         let mut why: Option<String> = None;
         if let Ok((case, editor)) = &without_built
             && let Ok((editor, case, stats, outcome)) = fl.update_case(case, editor.clone(), step, false)
@@ -321,19 +320,11 @@ pub(super) fn revise(
             let v = fl.judge(state, &a, &without);
             if let Some(reason) = unneeded(&a, &without, v.delta_bic, fl.evidence.significance) {
                 why = Some(reason);
-                base = Some(State { misfit: a.stats.misfit, k: a.outcome.parameters.len() });
+                let floor = fl.floor(a.stats.misfit, &a.case);
+                base = Some((State { misfit: a.stats.misfit, k: a.outcome.parameters.len() }, floor));
                 best = Some((v.delta_bic, None, a));
             }
         }
-        // the floor of the model without the effect, read once (see
-        // `small_share`)
-        let base_floor = base.map(|b| {
-            let noise = fl.evidence.noise;
-            match (&best, b.misfit > noise) {
-                (Some((_, _, a)), true) => fl.floor(&a.case),
-                _ => noise,
-            }
-        });
         // an effect alone: the diagnosis it came from is that of the model
         // without it (its other form is the revision it may need); an
         // effect not needed: the diagnosis of the model without it,
@@ -379,8 +370,8 @@ pub(super) fn revise(
                 // effect it replaces is not needed, as an addition to the
                 // model without it: a replacement of what the data no longer
                 // call for is a new effect and needs its own evidence
-                let v = match (base, base_floor) {
-                    (Some(b), Some(floor)) => {
+                let v = match base {
+                    Some((b, floor)) => {
                         let mut v = fl.judge(b, &a, &tried);
                         if v.rejected.is_none() {
                             v.rejected = super::small_share(b.misfit, a.stats.misfit, fl.evidence.noise, floor);
@@ -396,7 +387,7 @@ pub(super) fn revise(
                         );
                         v
                     }
-                    _ => fl.judge(state, &a, &tried),
+                    None => fl.judge(state, &a, &tried),
                 };
                 if v.rejected.is_none() && best.as_ref().is_none_or(|(b, ..)| v.delta_bic < *b) {
                     best = Some((v.delta_bic, Some(other), a));
