@@ -6,7 +6,9 @@
 //! tests with `RFM_STUDY=full`: the held-out study of the loop (12 trials
 //! per family, 8 pairs, 20 null trials), the hidden-effect diagnosis (13
 //! trials per kind, 20 null trials) and the lab study (4 trials per family
-//! of `tests/it/lab.rs`: 72), with their counts asserted. Only the tests
+//! of `tests/it/lab.rs`: 72), with their counts asserted, and writes every
+//! effect of every diagnosis of the cases into a case file (`cargo test`
+//! writes a sample of each kind of edit). Only the tests
 //! whose size `RFM_STUDY` sets run here: the other tests of those modules
 //! are the same either way, and CI, which runs this after `cargo test`,
 //! ran them there (they took about four minutes of this task before). It
@@ -22,7 +24,8 @@
 /// The studies: the tests of rfm-update's integration tests whose size
 /// `RFM_STUDY=full` sets (`crate::study_size` and `crate::full_study` in
 /// `crates/rfm-update/tests/it/main.rs`), matched exactly.
-const STUDIES: [&str; 5] = [
+const STUDIES: [&str; 6] = [
+    "apply_every::every_ranked_effect_applies_to_the_tutorial_the_papers_cases_and_samples",
     "held_out::the_loop_finds_and_fixes_held_out_effects",
     "held_out::null_trials_find_nothing_significant",
     "hidden_effects::diagnosis_names_hidden_effects_and_updating_recovers_them",
@@ -56,7 +59,7 @@ mod tests {
     #[test]
     fn the_studies_are_the_tests_sized_by_rfm_study() {
         let dir = crate::root().join("crates/rfm-update/tests/it");
-        for module in ["held_out", "hidden_effects", "lab_study"] {
+        for module in ["apply_every", "held_out", "hidden_effects", "lab_study"] {
             let text = std::fs::read_to_string(dir.join(format!("{module}.rs"))).expect("the study's module");
             // each test function, and whether its body reads the size
             let mut tests = Vec::new();
