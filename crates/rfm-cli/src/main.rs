@@ -78,7 +78,7 @@ enum Command {
         /// Print machine-readable JSON instead of tables.
         #[arg(long)]
         json: bool,
-        /// Write the case with the effect of this rank added (needs --out).
+        /// Write the case with the effect of this rank added (needs --out; with --measured, the new case reads that file).
         #[arg(long)]
         apply: Option<usize>,
         /// New case file for --apply.

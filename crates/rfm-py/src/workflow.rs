@@ -82,15 +82,17 @@ fn stage(case: &CaseFile, measured: Measured) -> Result<Staged> {
 /// the `--measured` of `rfm update` and `rfm fix` makes it: a file as it
 /// is; FRFs in memory from a file written for them (in model DOFs, read
 /// without the case's map), whose folder is kept, since the cases a
-/// result gives or saves read it.
-fn reading(case: &CaseFile, measured: Option<Measured>) -> Result<CaseFile> {
-    let Some(measured) = measured else { return Ok(case.clone()) };
+/// result gives read it, and whose path is returned too: a result's
+/// `save` copies that file into its folder, so that the cases saved read
+/// the copy, not a temporary file.
+fn reading(case: &CaseFile, measured: Option<Measured>) -> Result<(CaseFile, Option<PathBuf>)> {
+    let Some(measured) = measured else { return Ok((case.clone(), None)) };
     let staged = stage(case, measured)?;
-    let Some(dir) = staged._dir else { return Ok(case.with_data(&staged.path)?) };
+    let Some(dir) = staged._dir else { return Ok((case.with_data(&staged.path)?, None)) };
     let _ = dir.keep();
     // (FRFs per volt are staged as rfm's CSV, which names model DOFs and
     // which no map reads either)
-    Ok(case.with_model_dof_data(&staged.path)?)
+    Ok((case.with_model_dof_data(&staged.path)?, Some(staged.path)))
 }
 
 fn report_options(frequency_axis: &str) -> Result<ReportOptions> {
@@ -210,7 +212,10 @@ pub(crate) struct DiagnosisResult {
     notes: Vec<String>,
     /// The measured file given, as `--measured`.
     measured: Option<PathBuf>,
-    _staged: Option<tempfile::TempDir>,
+    /// Whether that file was written for FRFs given in memory (its folder
+    /// is kept for the cases `apply` gives; `save` copies it beside the
+    /// case it writes).
+    carried: bool,
 }
 
 /// `rfm diagnose`: every candidate effect fitted and ranked.
@@ -231,7 +236,8 @@ pub(crate) fn diagnose(
         let path = staged.as_ref().map(|s| s.path.clone());
         let (data, notes, _masked) = rfm_cli::diagnosis_data(&mut study, path.as_deref())?;
         let (prepared, diagnosis) = rfm_cli::run_diagnosis(&study, &data, None, &mut |_| {}, |stage| p.say(stage))?;
-        Ok(DiagnosisResult { study, prepared, diagnosis, notes, measured: path, _staged: staged.and_then(|s| s._dir) })
+        let carried = staged.and_then(|s| s._dir).map(tempfile::TempDir::keep).is_some();
+        Ok(DiagnosisResult { study, prepared, diagnosis, notes, measured: path, carried })
     })
 }
 
@@ -252,8 +258,9 @@ impl DiagnosisResult {
     /// the data file written beside it, if any.
     fn save(&self, py: Python<'_>, path: PathBuf, rank: usize) -> PyResult<Option<PathBuf>> {
         let (study, d, measured) = (&self.study, &self.diagnosis, self.measured.as_deref());
+        let carried = measured.filter(|_| self.carried);
         let base = &self.prepared.case;
-        run(py, None, |_| Ok(rfm_cli::write_applied(study, base, d, rank, measured, &path)?))
+        run(py, None, |_| Ok(rfm_cli::write_applied(study, base, d, rank, (measured, carried), &path)?))
     }
 }
 
@@ -282,6 +289,8 @@ pub(crate) struct UpdateResult {
     study: Study,
     outcome: UpdateOutcome,
     step: fe_model::HistoryEntry,
+    /// The file written for FRFs given in memory (see [`reading`]).
+    carried: Option<PathBuf>,
 }
 
 /// `rfm update`: the case's parameters updated.
@@ -298,7 +307,8 @@ pub(crate) fn update(
 ) -> PyResult<UpdateResult> {
     let file = &case.file;
     run(py, progress, move |p| {
-        let mut study = Study::from_case(reading(file, measured)?)?;
+        let (case, carried) = reading(file, measured)?;
+        let mut study = Study::from_case(case)?;
         let setup = UpdateSetup::new(&mut study, &UpdateOverrides { method, lines, max_iterations: iterations })?;
         let mut outcome = setup.run(&study, |r| {
             p.say(&format!(
@@ -308,7 +318,7 @@ pub(crate) fn update(
         })?;
         p.checkpoint();
         let step = rfm_cli::finish_update(&study, &mut outcome)?;
-        Ok(UpdateResult { study, outcome, step })
+        Ok(UpdateResult { study, outcome, step, carried })
     })
 }
 
@@ -326,7 +336,8 @@ impl UpdateResult {
         let opts = raise(py, report_options(frequency_axis))?;
         let (study, outcome, step) = (&self.study, &self.outcome, &self.step);
         let case = study.case().path.clone();
-        run(py, None, |_| Ok(rfm_cli::save_update(study, outcome, step, &case, &folder, &opts)?.to_vec()))
+        let into = (folder.as_path(), self.carried.as_deref());
+        run(py, None, |_| Ok(rfm_cli::save_update(study, outcome, step, &case, into, &opts)?.to_vec()))
     }
 
     /// The updated case (`updated.toml`), in memory.
@@ -356,6 +367,8 @@ pub(crate) struct FixResult {
     steps: usize,
     /// The data the steps' cases read when the case synthesises them.
     _data: tempfile::TempDir,
+    /// The file written for FRFs given in memory (see [`reading`]).
+    carried: Option<PathBuf>,
 }
 
 /// What the loop did, as `rfm fix` prints it.
@@ -378,12 +391,13 @@ pub(crate) fn fix(
     }
     let file = &case.file;
     run(py, progress, move |p| {
-        let study = Study::from_case(reading(file, measured)?)?;
+        let (case, carried) = reading(file, measured)?;
+        let study = Study::from_case(case)?;
         p.checkpoint();
         let (dir, data) = data_file(&study)?;
         let opts = rfm_cli::fix_options(&study, steps, data)?;
         let outcome = run_fix(study.case(), study.measured(), &opts, |e| p.say(&fix_line(&e)))?;
-        Ok(FixResult { study, outcome, steps, _data: dir })
+        Ok(FixResult { study, outcome, steps, _data: dir, carried })
     })
 }
 
@@ -399,7 +413,8 @@ impl FixResult {
     fn save(&self, py: Python<'_>, folder: PathBuf, frequency_axis: &str) -> PyResult<Vec<PathBuf>> {
         let opts = raise(py, report_options(frequency_axis))?;
         let (study, outcome, steps) = (&self.study, &self.outcome, self.steps);
-        run(py, None, |_| Ok(rfm_cli::save_fix(study, outcome, steps, &folder, &opts)?))
+        let into = (folder.as_path(), self.carried.as_deref());
+        run(py, None, |_| Ok(rfm_cli::save_fix(study, outcome, steps, into, &opts)?))
     }
 
     /// The case after each step, in memory.

@@ -75,6 +75,32 @@ def test_update_and_fix_read_measured_data_given_as_the_cli_takes_them(rfm_bin, 
         assert a.name == b.name and abs(a.value - b.value) <= 1e-9 * abs(a.value)
 
 
+def test_saved_results_of_frfs_given_in_memory_carry_a_copy_of_them(tutorial, tmp_path) -> None:
+    # the truth's FRFs with 1 % noise, in memory only: the folders saved must
+    # not name the temporary file written for them
+    import shutil
+
+    data = rfm.load_case(TUTORIAL.with_name("l-frame-truth.toml")).simulate(truth=True, noise=0.01, seed=6)
+    fixed = rfm.fix(tutorial, measured=data, steps=1)
+    fixed.save(tmp_path / "fix")
+    updated = rfm.update(rfm.load_case(GUESS), measured=data, check=False)
+    updated.save(tmp_path / "update")
+    diagnosis = rfm.diagnose(tutorial, measured=data)
+    beside = diagnosis.save(tmp_path / "applied" / "joint.toml", diagnosis.recommended.rank)
+    assert beside == tmp_path / "applied" / "joint-measured.uff" and beside.is_file()
+    # moved elsewhere, each saved case reads its own copy: the same FRFs
+    moved = tmp_path / "moved"
+    shutil.copytree(tmp_path / "fix", moved / "fix")
+    shutil.copytree(tmp_path / "update", moved / "update")
+    shutil.copytree(tmp_path / "applied", moved / "applied")
+    for case, name in (("fix/step-1.toml", "measured.uff"), ("update/updated.toml", "measured.uff"),
+                       ("applied/joint.toml", "joint-measured.uff")):
+        assert f'data = "{name}"' in (moved / case).read_text(), case
+        np.testing.assert_array_equal(rfm.load_case(moved / case).measured().h, data.h)
+    # the fixed case as saved is the fixed case in memory: the same model
+    np.testing.assert_array_equal(rfm.load_case(moved / "fix/step-1.toml").simulate().h, fixed.case.simulate().h)
+
+
 def test_diagnose_names_the_clis_leader_with_its_dbic(rfm_bin, diagnosis) -> None:
     cli = json.loads(run_cli(rfm_bin, "diagnose", TUTORIAL, "--json").stdout)
     assert_same(diagnosis.to_dict(), cli)

@@ -61,7 +61,7 @@ pub fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
         .map(|dir| Outputs::folder(dir, &inputs, &["report.html"])?.of_command("diagnose", args.replace))
         .transpose()?;
     let mut outputs = match (args.apply, args.out) {
-        (Some(_), Some(out)) => Some(apply_outputs(&study, args.measured, out)?),
+        (Some(_), Some(out)) => Some(apply_outputs(&study, args.measured, None, out)?),
         _ => None,
     };
     let read = read_data(&mut study, args.measured)?;
@@ -82,7 +82,7 @@ pub fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
     let bar = if args.json { ProgressBar::hidden() } else { ProgressBar::new_spinner() };
     bar.enable_steady_tick(std::time::Duration::from_millis(120));
     let start = std::time::Instant::now();
-    let data_file = outputs.as_ref().and_then(|(_, data)| data.as_ref().map(|(_, path)| path.clone()));
+    let data_file = outputs.as_ref().and_then(|(_, data)| data.as_ref().map(|o| o.path.clone()));
     let (prepared, d) = run_diagnosis(
         &study,
         measured,
@@ -140,7 +140,7 @@ pub fn diagnose(args: &DiagnoseArgs<'_>) -> Result<Exit> {
     if let Some(rank) = args.apply {
         let out = args.out.ok_or("--apply needs --out FILE for the new case file")?;
         let outputs = outputs.take().ok_or("--apply needs --out FILE for the new case file")?;
-        let data = write_apply(&study, &prepared.case, &d, rank, out, outputs)?;
+        let data = write_apply(&prepared.case, &d, rank, (out, args.measured), outputs)?;
         if !args.json {
             if let Some(path) = data {
                 outln!("\nwrote {} with the data synthesised from the case's [truth]", path.display());
@@ -240,8 +240,14 @@ fn read_data(study: &mut Study, measured: Option<&Path>) -> Result<DiagnosisData
 
 /// The outputs of `--apply` into `out`, opened before the diagnosis: the
 /// case, and where the study's data come from its `[truth]` (and not from
-/// `measured`), the data beside it.
-fn apply_outputs(study: &Study, measured: Option<&Path>, out: &Path) -> Result<(Outputs, Option<(Outputs, PathBuf)>)> {
+/// `measured`), the data beside it; a copy of `carried` instead where given
+/// (see [`write_applied`]).
+fn apply_outputs(
+    study: &Study,
+    measured: Option<&Path>,
+    carried: Option<&Path>,
+    out: &Path,
+) -> Result<(Outputs, Option<DataOutput>)> {
     let mut inputs = study.case().inputs();
     inputs.extend(measured.map(Path::to_path_buf));
     let output = Outputs::file(out, &inputs)?;
@@ -252,13 +258,32 @@ fn apply_outputs(study: &Study, measured: Option<&Path>, out: &Path) -> Result<(
     let synthesised = measured.is_none()
         && study.case().measurement.as_ref().is_some_and(|m| m.data.is_none())
         && study.case().truth.is_some();
-    let data = if synthesised {
-        let path = data_beside(out);
-        Some((Outputs::file(&path, &inputs)?, path))
+    let data = if let Some(file) = carried {
+        // a file that lives no longer than the run (FRFs given in memory to
+        // the Python package): a copy of it beside the new case
+        let bytes = std::fs::read(file)
+            .map_err(|e| Failure::input(format!("{}: cannot read the data to copy ({e})", file.display())))?;
+        let ext = file.extension().map_or("csv".into(), |e| e.to_string_lossy().into_owned());
+        let path = data_beside(out, &ext);
+        Some(DataOutput { output: Outputs::file(&path, &inputs)?, path, bytes, carried: true })
+    } else if synthesised {
+        let path = data_beside(out, "csv");
+        let bytes = frf::io::csv::to_csv_string(study.measured()).into_bytes();
+        Some(DataOutput { output: Outputs::file(&path, &inputs)?, path, bytes, carried: false })
     } else {
         None
     };
     Ok((output, data))
+}
+
+/// The data file written beside a new case: where, what, and whether it
+/// is a copy of a file carried (else the data synthesised from the case's
+/// `[truth]`).
+struct DataOutput {
+    output: Outputs,
+    path: PathBuf,
+    bytes: Vec<u8>,
+    carried: bool,
 }
 
 /// Writes the case `base` (the study's case as the diagnosis saw it:
@@ -266,17 +291,22 @@ fn apply_outputs(study: &Study, measured: Option<&Path>, out: &Path) -> Result<(
 /// as `out`, and the synthesised data beside it when it needs them;
 /// returns their path.
 fn write_apply(
-    study: &Study,
     base: &CaseFile,
     d: &Diagnosis,
     rank: usize,
-    out: &Path,
-    (mut output, data_output): (Outputs, Option<(Outputs, PathBuf)>),
+    (out, measured): (&Path, Option<&Path>),
+    (mut output, data_output): (Outputs, Option<DataOutput>),
 ) -> Result<Option<PathBuf>> {
-    let data = data_output.as_ref().map(|(_, path)| path.clone());
-    let editor = d.apply_with_data(base, rank, data.as_deref())?;
-    if let Some((mut data, _)) = data_output {
-        data.write_file(frf::io::csv::to_csv_string(study.measured()).as_bytes())?;
+    let data = data_output.as_ref().map(|o| o.path.clone());
+    let mut editor = d.apply_with_data(base, rank, data.as_deref())?;
+    // the new case reads the data the diagnosis read, as the cases `rfm
+    // update` and `rfm fix` write with `--measured` do: the file given, or
+    // the copy of one carried
+    if let Some(path) = data_output.as_ref().filter(|o| o.carried).map(|o| o.path.as_path()).or(measured) {
+        editor.use_data(path);
+    }
+    if let Some(DataOutput { output: mut data, bytes, .. }) = data_output {
+        data.write_file(&bytes)?;
         data.commit()?;
     }
     let text = editor.text_at(out)?;
@@ -290,23 +320,27 @@ fn write_apply(
 /// is `None`, else from that file; `base` the case it was made of, see
 /// [`run_diagnosis`]): the case with the effect of rank `rank` added, and
 /// when the study's data come from its `[truth]`, those data beside it
-/// (`CASE-measured.csv`, whose path is returned), each file all or nothing.
+/// (`CASE-measured.csv`, whose path is returned), each file all or nothing;
+/// the new case reads `measured` where given. `carried`: a data file the new case must not name, because it lives no
+/// longer than the caller (FRFs given in memory to the Python package,
+/// written to a temporary file): it is copied beside the new case
+/// (`CASE-measured.uff` or `.csv`, as its extension), which reads the copy.
 pub fn write_applied(
     study: &Study,
     base: &CaseFile,
     d: &Diagnosis,
     rank: usize,
-    measured: Option<&Path>,
+    (measured, carried): (Option<&Path>, Option<&Path>),
     out: &Path,
 ) -> Result<Option<PathBuf>> {
-    let outputs = apply_outputs(study, measured, out)?;
-    write_apply(study, base, d, rank, out, outputs)
+    let outputs = apply_outputs(study, measured, carried, out)?;
+    write_apply(base, d, rank, (out, measured), outputs)
 }
 
-/// `NEW-measured.csv` beside the new case `NEW.toml`.
-fn data_beside(case: &Path) -> PathBuf {
+/// `NEW-measured.EXT` beside the new case `NEW.toml`.
+fn data_beside(case: &Path, ext: &str) -> PathBuf {
     let stem = case.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "case".into());
-    case.with_file_name(format!("{stem}-measured.csv"))
+    case.with_file_name(format!("{stem}-measured.{ext}"))
 }
 
 /// Candidates whose fits failed listed in the text after the ranking; the

@@ -166,16 +166,24 @@ fn synthesises(study: &Study) -> bool {
     study.case().measurement.as_ref().and_then(|m| m.data.as_ref()).is_none()
 }
 
-/// Opens the outputs of `rfm fix` in `dir` for `steps` steps at most,
-/// protecting `inputs`; a folder another command wrote is refused unless
-/// `replace`.
-fn fix_outputs(inputs: &[PathBuf], synthesised: bool, steps: usize, dir: &Path, replace: bool) -> Result<Outputs> {
+/// Opens the outputs of `rfm fix` in `dir` for `steps` steps at most, and
+/// the files `more`, protecting `inputs`; a folder another command wrote is
+/// refused unless `replace`.
+fn fix_outputs(
+    inputs: &[PathBuf],
+    synthesised: bool,
+    steps: usize,
+    dir: &Path,
+    replace: bool,
+    more: &[&str],
+) -> Result<Outputs> {
     // step 0 and one more than the steps: the loop may end by replacing an early effect
     let mut names: Vec<String> = (0..=steps + 1).map(step_file).collect();
     names.extend(["results.json", "report.html"].map(String::from));
     if synthesised {
         names.push(DATA_FILE.into());
     }
+    names.extend(more.iter().map(|n| n.to_string()));
     let known: Vec<&str> = names.iter().map(String::as_str).collect();
     Ok(Outputs::folder(dir, inputs, &known)?.of_command("fix", replace)?)
 }
@@ -205,7 +213,7 @@ pub fn fix(args: &FixArgs<'_>) -> Result<Exit> {
     // of the folder, staged again below rather than replaced: the case's own
     // inputs are the ones to protect
     let inputs: Vec<PathBuf> = super::load_case(args.case)?.inputs();
-    let mut output = fix_outputs(&inputs, synthesised, args.steps, args.out, args.replace || args.resume)?;
+    let mut output = fix_outputs(&inputs, synthesised, args.steps, args.out, args.replace || args.resume, &[])?;
     for (name, bytes) in &carried {
         output.write(name, bytes)?;
     }
@@ -268,7 +276,7 @@ pub fn fix(args: &FixArgs<'_>) -> Result<Exit> {
         steps: done,
         history: if resumed { study.case().history.clone() } else { Vec::new() },
     };
-    write_fix(&study, &outcome, &resumed, &args.report, &mut output)?;
+    write_fix(&study, &outcome, &resumed, &args.report, &mut output, None)?;
     // a finished run leaves nothing to resume
     output.forget(PROGRESS_FILE)?;
     let written = output.commit()?;
@@ -437,10 +445,16 @@ fn write_fix(
     resumed: &Resumed,
     report: &crate::report::ReportOptions,
     output: &mut Outputs,
+    carried: Option<(&str, &[u8])>,
 ) -> Result<()> {
     let synthesised = synthesises(study);
-    let data_file = synthesised.then(|| output.path(DATA_FILE));
-    if synthesised {
+    let data_file = match carried {
+        Some((name, _)) => Some(output.path(name)),
+        None => synthesised.then(|| output.path(DATA_FILE)),
+    };
+    if let Some((name, bytes)) = carried {
+        output.write(name, bytes)?;
+    } else if synthesised {
         output.write(DATA_FILE, frf::io::csv::to_csv_string(study.measured()).as_bytes())?;
     }
     let declared = outcome.declared.iter().filter(|_| !resumed.earlier);
@@ -462,17 +476,35 @@ fn write_fix(
 /// `step-1.toml`, ...), `results.json`, `report.html` and the figures, and
 /// the data synthesised from the case's `[truth]` (`measured.csv`) where
 /// the steps read them; returns the files. A folder another command wrote
-/// is refused, as `rfm fix` without `--replace` refuses it.
+/// is refused, as `rfm fix` without `--replace` refuses it. `carried`: the
+/// study's data file when the cases must not name it, because it lives no
+/// longer than the caller (FRFs given in memory to the Python package,
+/// written to a temporary file): it is copied into the folder
+/// (`measured.uff` or `measured.csv`, as its extension) and the cases read
+/// the copy.
 pub fn save_fix(
     study: &Study,
     outcome: &FixOutcome,
     steps: usize,
-    dir: &Path,
+    (dir, carried): (&Path, Option<&Path>),
     report: &crate::report::ReportOptions,
 ) -> Result<Vec<PathBuf>> {
-    let mut output = fix_outputs(&study.case().inputs(), synthesises(study), steps, dir, false)?;
-    write_fix(study, outcome, &Resumed { earlier: false, steps: 0, history: Vec::new() }, report, &mut output)?;
+    let carried = carried.map(carried_data).transpose()?;
+    let names: Vec<&str> = carried.iter().map(|(name, _)| name.as_str()).collect();
+    let mut output = fix_outputs(&study.case().inputs(), synthesises(study), steps, dir, false, &names)?;
+    let resumed = Resumed { earlier: false, steps: 0, history: Vec::new() };
+    let carried = carried.as_ref().map(|(name, bytes)| (name.as_str(), bytes.as_slice()));
+    write_fix(study, outcome, &resumed, report, &mut output, carried)?;
     Ok(output.commit()?)
+}
+
+/// The name a copy of the data file `file` takes in an output folder
+/// (`measured.` and its extension), and its bytes.
+pub(crate) fn carried_data(file: &Path) -> Result<(String, Vec<u8>)> {
+    let bytes = std::fs::read(file)
+        .map_err(|e| Failure::input(format!("{}: cannot read the data to copy ({e})", file.display())))?;
+    let ext = file.extension().map_or("csv".into(), |e| e.to_string_lossy().into_owned());
+    Ok((format!("measured.{ext}"), bytes))
 }
 
 fn print_outcome(o: &FixOutcome, done: usize) -> Result<()> {

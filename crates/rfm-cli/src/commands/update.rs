@@ -106,7 +106,7 @@ pub fn update(
         }
     }
     if let Some(output) = output.take() {
-        let [path, updated, report] = write_update(&study, &outcome, &step, &misfits, output, case, report)?;
+        let [path, updated, report] = write_update(&study, &outcome, &step, &misfits, output, case, report, None)?;
         if !json {
             outln!("\nwrote {} and {}", path.display(), updated.display());
             outln!("wrote {} (figures beside it)", report.display());
@@ -244,6 +244,7 @@ fn json_of(outcome: &UpdateOutcome, misfits: &[MisfitReport; 2]) -> Result<Strin
 
 /// Writes the outputs of `rfm update --out` and commits them; returns the
 /// paths of `results.json`, `updated.toml` and `report.html`.
+#[allow(clippy::too_many_arguments)]
 fn write_update(
     study: &Study,
     outcome: &UpdateOutcome,
@@ -252,9 +253,14 @@ fn write_update(
     mut output: Outputs,
     case: &Path,
     report: &crate::report::ReportOptions,
+    carried: Option<(&str, &[u8])>,
 ) -> Result<[PathBuf; 3]> {
     let path = output.write("results.json", json_of(outcome, misfits)?.as_bytes())?;
-    let updated = write_updated_model(study, outcome, step, &mut output)?;
+    let data = match carried {
+        Some((name, bytes)) => Some(output.write(name, bytes)?),
+        None => None,
+    };
+    let updated = write_updated_model(study, outcome, step, &mut output, data.as_deref())?;
     let report = crate::report::update_report::write(
         study,
         outcome,
@@ -273,16 +279,25 @@ fn write_update(
 /// `results.json`, `updated.toml`, `report.html` and the figures. `case`
 /// is the case file's path as the report names it. A folder another
 /// command wrote is refused, as `rfm update` without `--replace` refuses it.
+/// `carried`: the study's data file when `updated.toml` must not name it,
+/// because it lives no longer than the caller (FRFs given in memory to the
+/// Python package, written to a temporary file): it is copied into the
+/// folder (`measured.uff` or `measured.csv`, as its extension) and the
+/// updated case reads the copy.
 pub fn save_update(
     study: &Study,
     outcome: &UpdateOutcome,
     step: &fe_model::HistoryEntry,
     case: &Path,
-    dir: &Path,
+    (dir, carried): (&Path, Option<&Path>),
     report: &crate::report::ReportOptions,
 ) -> Result<[PathBuf; 3]> {
-    let output = Outputs::folder(dir, &study.case().inputs(), &UPDATE_OUTPUTS)?.of_command("update", false)?;
-    write_update(study, outcome, step, &misfits(study, outcome)?, output, case, report)
+    let carried = carried.map(super::fix::carried_data).transpose()?;
+    let mut known: Vec<&str> = UPDATE_OUTPUTS.to_vec();
+    known.extend(carried.iter().map(|(name, _)| name.as_str()));
+    let output = Outputs::folder(dir, &study.case().inputs(), &known)?.of_command("update", false)?;
+    let carried = carried.as_ref().map(|(name, bytes)| (name.as_str(), bytes.as_slice()));
+    write_update(study, outcome, step, &misfits(study, outcome)?, output, case, report, carried)
 }
 
 /// What `--json` prints and `results.json` holds: the library's outcome
@@ -314,8 +329,12 @@ fn write_updated_model(
     outcome: &UpdateOutcome,
     step: &fe_model::HistoryEntry,
     output: &mut Outputs,
+    data: Option<&Path>,
 ) -> Result<std::path::PathBuf> {
-    let editor = updated_case(study, outcome, step)?;
+    let mut editor = updated_case(study, outcome, step)?;
+    if let Some(data) = data {
+        editor.use_data(data);
+    }
     let text = editor.text_at(&output.path("updated.toml"))?;
     Ok(output.write("updated.toml", text.as_bytes())?)
 }

@@ -42,6 +42,28 @@ fn tutorial_diagnosis_names_the_joint_and_updating_cuts_the_misfit_tenfold() {
     assert!(dir.path().join("up/updated.toml").exists());
 }
 
+/// `--apply` with `--measured FILE`: the new case reads FILE, the data its
+/// effect was fitted to and its history's misfits are of, as the cases
+/// `rfm update` and `rfm fix` write with `--measured` do (it named the
+/// case's own data before).
+#[test]
+fn a_case_applied_from_other_data_reads_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = dir.path().join("run-2.csv");
+    std::fs::copy(tutorial().with_file_name("l-frame-measured.csv"), &run).unwrap();
+    let new_case = dir.path().join("cases").join("with-joint.toml");
+    std::fs::create_dir_all(new_case.parent().unwrap()).unwrap();
+    let (case, run_s, new_s) = (tutorial(), run.to_str().unwrap(), new_case.to_str().unwrap());
+    let out = rfm(&["diagnose", case.to_str().unwrap(), "--measured", run_s, "--apply", "1", "--out", new_s]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = std::fs::read_to_string(&new_case).unwrap();
+    assert!(text.contains("data = \"../run-2.csv\""), "{text}");
+    // and nothing is written beside it
+    assert_eq!(std::fs::read_dir(new_case.parent().unwrap()).unwrap().count(), 1);
+    let out = rfm(&["compare", new_s, "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+}
+
 #[test]
 fn apply_without_out_fails_with_a_message() {
     let out = rfm(&["diagnose", tutorial().to_str().unwrap(), "--apply", "1"]);

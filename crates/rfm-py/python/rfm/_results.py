@@ -182,7 +182,9 @@ class Diagnosis(_MeshChecked):
     def save(self, path: str | os.PathLike[str], rank: int | None = None) -> Path | None:
         """Writes what ``rfm diagnose --apply RANK --out PATH`` writes: the
         case with the effect added (and beside it, when the case synthesises
-        its data from a ``[truth]``, those data, whose path is returned)."""
+        its data from a ``[truth]``, those data, whose path is returned; when
+        the data were given as an ``FrfData``, a copy of the file written for
+        them, ``PATH-measured.uff`` or ``.csv``, which the case reads)."""
         return self._inner.save(Path(path), self._rank(rank))
 
     def __repr__(self) -> str:
@@ -260,7 +262,10 @@ class UpdateResult(_Result):
 
     def save(self, folder: str | os.PathLike[str], frequency_axis: str = "auto") -> list[Path]:
         """Writes what ``rfm update --out FOLDER`` writes (``results.json``,
-        ``updated.toml``, ``report.html``, the figures), all or nothing."""
+        ``updated.toml``, ``report.html``, the figures), all or nothing; when
+        the data were given as an ``FrfData``, a copy of the file written for
+        them too (``measured.uff`` or ``measured.csv``), which
+        ``updated.toml`` reads."""
         return list(self._inner.save(Path(folder), frequency_axis))
 
     def __repr__(self) -> str:
@@ -348,7 +353,9 @@ class FixResult(_MeshChecked):
     def save(self, folder: str | os.PathLike[str], frequency_axis: str = "auto") -> list[Path]:
         """Writes what ``rfm fix --out FOLDER`` writes (``step-1.toml`` ..,
         ``results.json``, ``report.html``, the figures, and ``measured.csv``
-        where the case synthesises its data), all or nothing."""
+        where the case synthesises its data), all or nothing; when the data
+        were given as an ``FrfData``, a copy of the file written for them
+        (``measured.uff`` or ``measured.csv``), which the steps' cases read."""
         return list(self._inner.save(Path(folder), frequency_axis))
 
     def __repr__(self) -> str:
