@@ -365,8 +365,6 @@ pub(crate) struct FixResult {
     study: Study,
     outcome: FixOutcome,
     steps: usize,
-    /// The data the steps' cases read when the case synthesises them.
-    _data: tempfile::TempDir,
     /// The file written for FRFs given in memory (see [`reading`]).
     carried: Option<PathBuf>,
 }
@@ -396,8 +394,15 @@ pub(crate) fn fix(
         p.checkpoint();
         let (dir, data) = data_file(&study)?;
         let opts = rfm_cli::fix_options(&study, steps, data)?;
+        // the steps' cases read the data synthesised from the case's
+        // `[truth]` from that file, and outlive the result (`FixResult.case`
+        // kept, the result dropped): it is kept, as `Diagnosis.apply` keeps
+        // its own, and left for the system to clean
+        if opts.data.is_some() {
+            let _ = dir.keep();
+        }
         let outcome = run_fix(study.case(), study.measured(), &opts, |e| p.say(&fix_line(&e)))?;
-        Ok(FixResult { study, outcome, steps, _data: dir, carried })
+        Ok(FixResult { study, outcome, steps, carried })
     })
 }
 

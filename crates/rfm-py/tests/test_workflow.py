@@ -101,6 +101,21 @@ def test_saved_results_of_frfs_given_in_memory_carry_a_copy_of_them(tutorial, tm
     np.testing.assert_array_equal(rfm.load_case(moved / "fix/step-1.toml").simulate().h, fixed.case.simulate().h)
 
 
+def test_the_cases_a_fix_gives_outlive_it() -> None:
+    # a case whose data are synthesised from its [truth]: the steps' cases
+    # read them from a file written for the loop, which must outlive the result
+    import gc
+
+    case = rfm.load_case(TUTORIAL.with_name("l-frame-truth.toml"))
+    fixed = rfm.fix(case, steps=1)
+    expected = fixed.case.measured().h
+    cases = [fixed.case] + [s.case for s in fixed.steps]
+    del fixed
+    gc.collect()
+    for c in cases:
+        np.testing.assert_array_equal(c.measured().h, expected)
+
+
 def test_diagnose_names_the_clis_leader_with_its_dbic(rfm_bin, diagnosis) -> None:
     cli = json.loads(run_cli(rfm_bin, "diagnose", TUTORIAL, "--json").stdout)
     assert_same(diagnosis.to_dict(), cli)
