@@ -271,7 +271,13 @@ impl DiagnosisResult {
             && case.measurement.as_ref().is_some_and(|m| m.data.is_none())
             && case.truth.is_some();
         let data = synthesised.then(|| data_file(&self.study)).transpose()?;
-        let editor = self.diagnosis.apply_with_data(case, rank, data.as_ref().map(|d| d.1.as_path()))?;
+        let mut editor = self.diagnosis.apply_with_data(case, rank, data.as_ref().map(|d| d.1.as_path()))?;
+        // the data the diagnosis read, as `save` writes the case (the case's
+        // own data file would be read without its map when the FRFs were
+        // given in memory)
+        if let Some(measured) = &self.measured {
+            editor.use_data(measured);
+        }
         let applied = case_at(&editor, &beside(case, &format!("effect-{rank}")))?;
         // the case reads the data: their folder is left for the system to clean
         if let Some((dir, _)) = data {

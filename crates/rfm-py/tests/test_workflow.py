@@ -88,6 +88,8 @@ def test_saved_results_of_frfs_given_in_memory_carry_a_copy_of_them(tutorial, tm
     diagnosis = rfm.diagnose(tutorial, measured=data)
     beside = diagnosis.save(tmp_path / "applied" / "joint.toml", diagnosis.recommended.rank)
     assert beside == tmp_path / "applied" / "joint-measured.uff" and beside.is_file()
+    # the case applied in memory reads the same data
+    np.testing.assert_array_equal(diagnosis.apply().measured().h, data.h)
     # moved elsewhere, each saved case reads its own copy: the same FRFs
     moved = tmp_path / "moved"
     shutil.copytree(tmp_path / "fix", moved / "fix")

@@ -321,10 +321,11 @@ fn write_apply(
 /// [`run_diagnosis`]): the case with the effect of rank `rank` added, and
 /// when the study's data come from its `[truth]`, those data beside it
 /// (`CASE-measured.csv`, whose path is returned), each file all or nothing;
-/// the new case reads `measured` where given. `carried`: a data file the new case must not name, because it lives no
-/// longer than the caller (FRFs given in memory to the Python package,
-/// written to a temporary file): it is copied beside the new case
-/// (`CASE-measured.uff` or `.csv`, as its extension), which reads the copy.
+/// the new case reads `measured` where given. `carried`: a data file the
+/// new case must not name, because it lives no longer than the caller
+/// (FRFs given in memory to the Python package, written to a temporary
+/// file): it is copied beside the new case (`CASE-measured.uff` or `.csv`,
+/// as its extension), which reads the copy.
 pub fn write_applied(
     study: &Study,
     base: &CaseFile,
