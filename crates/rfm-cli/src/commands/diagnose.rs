@@ -261,9 +261,7 @@ fn apply_outputs(
     let data = if let Some(file) = carried {
         // a file that lives no longer than the run (FRFs given in memory to
         // the Python package): a copy of it beside the new case
-        let bytes = std::fs::read(file)
-            .map_err(|e| Failure::input(format!("{}: cannot read the data to copy ({e})", file.display())))?;
-        let ext = file.extension().map_or("csv".into(), |e| e.to_string_lossy().into_owned());
+        let (ext, bytes) = super::carried_file(file)?;
         let path = data_beside(out, &ext);
         Some(DataOutput { output: Outputs::file(&path, &inputs)?, path, bytes, carried: true })
     } else if synthesised {

@@ -447,16 +447,11 @@ fn write_fix(
     output: &mut Outputs,
     carried: Option<(&str, &[u8])>,
 ) -> Result<()> {
-    let synthesised = synthesises(study);
-    let data_file = match carried {
-        Some((name, _)) => Some(output.path(name)),
-        None => synthesised.then(|| output.path(DATA_FILE)),
-    };
-    if let Some((name, bytes)) = carried {
-        output.write(name, bytes)?;
-    } else if synthesised {
-        output.write(DATA_FILE, frf::io::csv::to_csv_string(study.measured()).as_bytes())?;
-    }
+    // the data the steps' cases read from the folder: a copy of a file
+    // carried, or those synthesised from the case's `[truth]`
+    let csv = (carried.is_none() && synthesises(study)).then(|| frf::io::csv::to_csv_string(study.measured()));
+    let data = carried.or(csv.as_deref().map(|c| (DATA_FILE, c.as_bytes())));
+    let data_file = data.map(|(name, bytes)| output.write(name, bytes)).transpose()?;
     let declared = outcome.declared.iter().filter(|_| !resumed.earlier);
     let cases = declared
         .map(|d| (0, &d.case))
@@ -501,9 +496,7 @@ pub fn save_fix(
 /// The name a copy of the data file `file` takes in an output folder
 /// (`measured.` and its extension), and its bytes.
 pub(crate) fn carried_data(file: &Path) -> Result<(String, Vec<u8>)> {
-    let bytes = std::fs::read(file)
-        .map_err(|e| Failure::input(format!("{}: cannot read the data to copy ({e})", file.display())))?;
-    let ext = file.extension().map_or("csv".into(), |e| e.to_string_lossy().into_owned());
+    let (ext, bytes) = super::carried_file(file)?;
     Ok((format!("measured.{ext}"), bytes))
 }
 

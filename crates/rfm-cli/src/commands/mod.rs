@@ -25,6 +25,16 @@ pub use update::{
 /// A command's result: its exit code, or why it failed (see [`Failure`]).
 pub type Result<T> = std::result::Result<T, Failure>;
 
+/// A data file to copy into an output (FRFs given in memory to the Python
+/// package, written to a temporary file that the cases written must not
+/// name): its extension (`csv` when it has none) and its bytes.
+pub(crate) fn carried_file(file: &Path) -> Result<(String, Vec<u8>)> {
+    let bytes = std::fs::read(file)
+        .map_err(|e| Failure::input(format!("{}: cannot read the data to copy ({e})", file.display())))?;
+    let ext = file.extension().map_or("csv".into(), |e| e.to_string_lossy().into_owned());
+    Ok((ext, bytes))
+}
+
 pub(crate) fn load_case(path: &Path) -> Result<CaseFile> {
     Ok(CaseFile::load(path)?)
 }

@@ -237,8 +237,9 @@ fn refs(a: &[(Diagnosis, usize)]) -> Vec<(&Diagnosis, usize)> {
 /// before the joint's place was mended, whose removal the evidence
 /// preferred by 3.5, then replaced by a mass change of 0.05 % over eight
 /// elements). The share of the excess an addition must explain
-/// ([`super::SHARE`]) is not asked of an effect already in: against a model that still lacks another effect, or data
-/// that hold an error not yet found, a right effect or a fair stand-in for
+/// ([`super::SHARE`]) is not asked of an effect already in: against a
+/// model that still lacks another effect, or data that hold an error not
+/// yet found, a right effect or a fair stand-in for
 /// one explains only part of what is left (the damping-form test's clamp
 /// with a motor beside it and a sensor 20 % low, at 38 times the noise: a
 /// stiffness change standing in for the motor explained 28 %, and taken
