@@ -157,6 +157,10 @@ pub(crate) struct Pool<'a> {
     /// Gather the refinement's sets of equations with the screening's
     /// data (see [`search`]); off only where a test compares the two paths.
     pub(crate) anticipate: bool,
+    /// The place (nodes, elements) the search is confined to, when it is:
+    /// only the candidates near it (see [`Candidate::near`]) are made,
+    /// around it the refinement too (see [`super::diagnose_near`]).
+    pub(crate) place: Option<(Vec<u32>, Vec<u32>)>,
     /// Makes the fits of the candidates it picks fail at a stage: the
     /// failures a real search meets (a singular low-rank and whole-model
     /// system at a line, a misfit that is not finite) hang on floating-point
@@ -186,6 +190,7 @@ impl<'a> Pool<'a> {
             gathered: Mutex::new(None),
             clock: Clock::default(),
             anticipate: true,
+            place: None,
             #[cfg(test)]
             forced_failure: None,
         }
@@ -198,6 +203,15 @@ impl<'a> Pool<'a> {
             std::mem::take(&mut self.locals),
             self.gathered.get_mut().unwrap_or_else(PoisonError::into_inner).take(),
         ));
+    }
+
+    /// `new` without the candidates away from the search's place, when it
+    /// has one.
+    pub(crate) fn at_place(&self, new: Vec<Candidate>) -> Vec<Candidate> {
+        match &self.place {
+            Some((nodes, elements)) => new.into_iter().filter(|c| c.near(self.model, nodes, elements)).collect(),
+            None => new,
+        }
     }
 
     /// Adds candidates; returns their indices.
@@ -531,7 +545,7 @@ impl<'a> Pool<'a> {
     pub(crate) fn refine(&mut self, opts: &CandidateOptions, leaders: usize) -> Vec<usize> {
         let order = self.by_full_fit();
         let best: Vec<&Candidate> = order.iter().take(leaders).map(|&i| &self.candidates[i]).collect();
-        let new = candidates::refine(self.model, opts, &best, &self.descriptions());
+        let new = self.at_place(candidates::refine(self.model, opts, &best, &self.descriptions()));
         self.add(new)
     }
 
@@ -712,7 +726,7 @@ pub(crate) fn search(
     let weights = opts.weights.as_deref();
     let coarse = LineSet::with_model(measured, opts.screen_lines, opts.gains, nominal, weights)?;
     let t = Instant::now();
-    let generated = candidates::generate(pool.model, copts);
+    let generated = pool.at_place(candidates::generate(pool.model, copts));
     let generation = t.elapsed().as_secs_f64();
     let all = pool.add(generated);
     trace(&format!("generated {} candidates ({generation:.2} s): {}", all.len(), pool.clock.since_last()));
@@ -766,7 +780,7 @@ pub(crate) fn search(
         let around: Vec<&Candidate> = leaders.iter().map(|&i| &pool.candidates[i]).collect();
         let tried = pool.descriptions();
         let nominal = pool.nominal;
-        candidates::refine(pool.model, copts, &around, &tried)
+        pool.at_place(candidates::refine(pool.model, copts, &around, &tried))
             .par_iter()
             .filter_map(|c| LocalCandidate::new(nominal, c).map(|l| l.form))
             .collect()
