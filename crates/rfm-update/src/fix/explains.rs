@@ -81,21 +81,49 @@ impl Unexplained {
         )
     }
 
-    /// What remains, in the user's terms.
-    pub(super) fn remains(&self) -> String {
+    /// What remains, in the user's terms, where the final model leaves
+    /// `now` times the noise at the lines within [`AROUND`] of `hz` (`None`
+    /// when that could not be read).
+    pub(super) fn remains(&self, now: Option<f64>) -> String {
+        let now = now.map_or_else(String::new, |x| format!(" {x:.1} times the noise in the final model;"));
         if !self.of_mode {
             return format!(
-                "a misfit spread over the band around {:.1} Hz ({:.1} times the noise), which no candidate explains: \
-                 the best resonator ({}) leaves it",
-                self.hz, self.ratio, self.effect
+                "a misfit spread over the band around {:.1} Hz ({:.0} % either side:{now} a broad residual of {:.1} \
+                 times the noise when a resonator was tried), which no candidate explains: the best resonator ({}) \
+                 left it",
+                self.hz,
+                100.0 * AROUND,
+                self.ratio,
+                self.effect
             );
         }
         format!(
-            "the data's mode at {:.1} Hz, which no candidate explains: a resonator tuned to it ({}) leaves its lines \
-             at {:.1} times the noise (a part driven otherwise than by one node's translation: a fin or plate driven \
-             by its root's rotation, a part spanning several nodes?)",
-            self.hz, self.effect, self.ratio
+            "the data's mode at {:.1} Hz, which no candidate explains (its lines within {:.0} %:{now} a resonator \
+             tuned to it, {}, left them at {:.1} times the noise): a part driven otherwise than by one node's \
+             translation, a fin or plate driven by its root's rotation, a part spanning several nodes?",
+            self.hz,
+            100.0 * AROUND,
+            self.effect,
+            self.ratio
         )
+    }
+
+    /// Whether a later step explained what the resonator left: the final
+    /// model `sys` leaves the lines within [`AROUND`] of `hz` within
+    /// [`UNEXPLAINED`] times the noise. Returns that and the level read
+    /// (over the noise; `None` when it could not be read, and then it is
+    /// not explained).
+    pub(super) fn explained_by(
+        &self,
+        sys: &damping::DampedSystem,
+        data: &FrfSet,
+        opts: &DiagnoseOptions,
+        noise: f64,
+    ) -> (bool, Option<f64>) {
+        match misfit_around(sys, data, opts, self.hz) {
+            Ok(Some(level)) => (level <= UNEXPLAINED * noise, Some(level / noise)),
+            _ => (false, None),
+        }
     }
 }
 
@@ -290,5 +318,22 @@ mod tests {
         assert!((own_scaled / own - 1.0).abs() < 0.05, "{own_scaled} with the gain fitted, {own} without one");
         // fewer than two lines: nothing to read
         assert_eq!(misfit_around(&truth, &data, &opts, 1e4).unwrap(), None);
+
+        // what a resonator left when tried is said at the end only while the
+        // final model still leaves it: not for the truth, for the nominal
+        // model at its level now
+        for of_mode in [true, false] {
+            let left = Unexplained { hz, of_mode, ratio: 44.6, effect: "resonator at node 21".into() };
+            let said = |sys: &DampedSystem| {
+                super::super::remains::describe(sys, &data, &opts, 0.01, &[], std::slice::from_ref(&left))
+                    .into_iter()
+                    .filter(|s| s.contains("which no candidate explains"))
+                    .collect::<Vec<String>>()
+            };
+            assert!(said(&truth).is_empty(), "{:?}", said(&truth));
+            let now = format!("{:.1} times the noise in the final model", lacking / 0.01);
+            let lacking_said = said(&nominal);
+            assert!(lacking_said.len() == 1 && lacking_said[0].contains(&now), "{lacking_said:?}, {now}");
+        }
     }
 }
