@@ -32,7 +32,8 @@ pub enum Exit {
     /// numbers (a singular dynamic stiffness at a line, a NaN misfit).
     Numerics,
     /// An update reached its iteration limit; its outputs hold the best
-    /// iterate.
+    /// iterate. For `rfm fix`: the steps asked for were done, or the
+    /// diagnosis after the last failed, with more than the noise left.
     NotConverged,
     /// The outputs could not be written (a full disk, no permission, an
     /// output that would replace an input); none of them were.
@@ -66,7 +67,10 @@ impl Exit {
         (Exit::Usage, "wrong command line"),
         (Exit::InvalidInput, "invalid input: a case file or measured file is malformed or inconsistent"),
         (Exit::Numerics, "failed numerics: the model cannot be evaluated, or the fit gave non-finite numbers"),
-        (Exit::NotConverged, "not converged: the update reached its iteration limit (best iterate written)"),
+        (
+            Exit::NotConverged,
+            "not converged: an update reached its iteration limit (best iterate written), or rfm fix did the steps asked for, or could not diagnose the model after the last, with more than the noise left (its steps written)",
+        ),
         (Exit::Output, "outputs not written: cannot write, or an output would replace an input"),
         (Exit::Busy, "busy: another rfm run is writing into the same output"),
         (Exit::Stalled, "stalled: no step lowers the misfit, which stays above the noise (best iterate written)"),

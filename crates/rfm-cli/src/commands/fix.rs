@@ -427,7 +427,9 @@ fn progress_lines_after(p: &FixProgress<'_>, done: usize) -> Vec<String> {
 /// The exit code of `rfm fix`: success only when the loop ended with the
 /// data explained down to their noise; a model that stays above it with
 /// nothing the evidence singles out (or several effects it cannot tell
-/// apart) is inadequate.
+/// apart) is inadequate; one that stays above it when the steps asked for
+/// are done, or when the model after the last could not be diagnosed, is
+/// not converged (the meaning of its code says both).
 pub fn fix_exit(outcome: &FixOutcome) -> Exit {
     match outcome.stop {
         _ if outcome.explained() => Exit::Success,

@@ -820,11 +820,12 @@ pub fn diagnose_with(
 /// As [`diagnose`], with only the candidates near a place (`nodes`,
 /// `elements`; see [`Candidate::near`]): what fits best there, which is
 /// all the revision of an effect asks (`fix/revise.rs`). The search keeps
-/// its stages, confined to the place: its full fits and its refinement
-/// go to the best candidates there instead of the best anywhere, which
-/// a model still lacking the effect leads with (on the fix bench's beam,
-/// four fifths of the refinement's 800 to 1,050 fits went to windows
-/// away from the effect revised).
+/// its stages, confined to the place, but for the per-direction variants
+/// of its leaders: its full fits and its refinement go to the best
+/// candidates there instead of the best anywhere, which a model still
+/// lacking the effect leads with (on the fix bench's beam, four fifths of
+/// the refinement's 800 to 1,050 fits went to windows away from the
+/// effect revised).
 pub(crate) fn diagnose_near(
     model: &fe_model::Model,
     measured: &FrfSet,

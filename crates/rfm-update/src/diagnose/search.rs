@@ -824,7 +824,12 @@ pub(crate) fn search(
     // direction: fitted fully from its leader's fit, beside the refined
     // candidates rather than competing with them for a full fit (it
     // screens as well as its leader and would crowd out the windows)
-    let variants = pool.per_direction(REFINED_LEADERS);
+    // (not in a search confined to a place: there the leaders are all at
+    // the place, and their per-direction variants offered a revision a
+    // replacement the whole search never ranks: a portal frame's clamp
+    // replaced by a per-direction joint beside it while its motor was
+    // still missing, after which the motor was never found)
+    let variants = if pool.place.is_some() { Vec::new() } else { pool.per_direction(REFINED_LEADERS) };
     if !variants.is_empty() {
         pool.full_fit(full, &coarse, (opts.iterations, opts.screen_iterations), &variants, None)?;
         trace(&format!(
