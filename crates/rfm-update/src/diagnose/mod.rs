@@ -817,24 +817,6 @@ pub fn diagnose_with(
     diagnose_in(model, measured, opts, &mut progress, |_| {})
 }
 
-/// As [`diagnose`], with only the candidates near a place (`nodes`,
-/// `elements`; see [`Candidate::near`]): what fits best there, which is
-/// all the revision of an effect asks (`fix/revise.rs`). The search keeps
-/// its stages, confined to the place, but for the per-direction variants
-/// of its leaders: its full fits and its refinement go to the best
-/// candidates there instead of the best anywhere, which a model still
-/// lacking the effect leads with (on the fix bench's beam, four fifths of
-/// the refinement's 800 to 1,050 fits went to windows away from the
-/// effect revised).
-pub(crate) fn diagnose_near(
-    model: &fe_model::Model,
-    measured: &FrfSet,
-    opts: &DiagnoseOptions,
-    (nodes, elements): (&[u32], &[u32]),
-) -> Result<Diagnosis, UpdateError> {
-    diagnose_in(model, measured, opts, &mut |_| {}, |pool| pool.place = Some((nodes.to_vec(), elements.to_vec())))
-}
-
 /// As [`diagnose_with`], with `prepare` given the pool before the search
 /// (where the tests make chosen fits fail).
 fn diagnose_in(
@@ -1260,40 +1242,6 @@ mod determinism_tests {
                 assert_eq!(a.delta_bic.to_bits(), b.delta_bic.to_bits(), "{}", a.description);
                 let values = |r: &Ranked| r.parameters.iter().map(|p| p.value.to_bits()).collect::<Vec<_>>();
                 assert_eq!(values(a), values(b), "{}", a.description);
-            }
-        }
-    }
-
-    /// A search confined to a place makes only the candidates near it,
-    /// and at the hidden stiffness loss's element it leads with the
-    /// change the whole search leads with, at the same evidence (the same
-    /// fit on the same lines, to the round-off of a factorisation ordered
-    /// with other cliques); elsewhere it has no such candidate, and it tries
-    /// fewer than the whole search.
-    #[test]
-    fn a_search_confined_to_a_place_finds_there_what_the_whole_search_finds() {
-        let (nominal, data) = small_frame(2, 2, 3);
-        let opts = DiagnoseOptions::default();
-        let whole = diagnose(&nominal, &data, &opts).unwrap();
-        let leader = whole.leader().expect("a leader").clone();
-        assert_eq!((leader.kind, leader.elements.as_slice()), (EffectKind::StiffnessChange, &[14][..]), "{leader:?}");
-        let place = |e: u32| {
-            let b = &nominal.beams()[nominal.beam_index(fe_model::ElementId(e)).unwrap()];
-            (b.nodes.map(|n| n.0).to_vec(), vec![e])
-        };
-        for (e, holds_it) in [(14, true), (1, false)] {
-            let (nodes, elements) = place(e);
-            let d = diagnose_near(&nominal, &data, &opts, (&nodes, &elements)).unwrap();
-            assert!(d.tried < whole.tried, "element {e}: {} tried, {} by the whole search", d.tried, whole.tried);
-            for c in &d.candidates {
-                assert!(c.near(&nominal, &nodes, &elements), "element {e}: {} is away from it", c.description);
-            }
-            let found = d.ranking.iter().find(|r| r.description == leader.description);
-            assert_eq!(found.is_some(), holds_it, "element {e}");
-            if holds_it {
-                let first = d.leader().expect("a leader");
-                assert_eq!(first.description, leader.description);
-                assert!((first.delta_bic - leader.delta_bic).abs() <= 1e-6 * leader.delta_bic.abs(), "{first:?}");
             }
         }
     }

@@ -157,10 +157,6 @@ pub(crate) struct Pool<'a> {
     /// Gather the refinement's sets of equations with the screening's
     /// data (see [`search`]); off only where a test compares the two paths.
     pub(crate) anticipate: bool,
-    /// The place (nodes, elements) the search is confined to, when it is:
-    /// only the candidates near it (see [`Candidate::near`]) are made,
-    /// around it the refinement too (see [`super::diagnose_near`]).
-    pub(crate) place: Option<(Vec<u32>, Vec<u32>)>,
     /// Makes the fits of the candidates it picks fail at a stage: the
     /// failures a real search meets (a singular low-rank and whole-model
     /// system at a line, a misfit that is not finite) hang on floating-point
@@ -190,7 +186,6 @@ impl<'a> Pool<'a> {
             gathered: Mutex::new(None),
             clock: Clock::default(),
             anticipate: true,
-            place: None,
             #[cfg(test)]
             forced_failure: None,
         }
@@ -203,15 +198,6 @@ impl<'a> Pool<'a> {
             std::mem::take(&mut self.locals),
             self.gathered.get_mut().unwrap_or_else(PoisonError::into_inner).take(),
         ));
-    }
-
-    /// `new` without the candidates away from the search's place, when it
-    /// has one.
-    pub(crate) fn at_place(&self, new: Vec<Candidate>) -> Vec<Candidate> {
-        match &self.place {
-            Some((nodes, elements)) => new.into_iter().filter(|c| c.near(self.model, nodes, elements)).collect(),
-            None => new,
-        }
     }
 
     /// Adds candidates; returns their indices.
@@ -545,7 +531,7 @@ impl<'a> Pool<'a> {
     pub(crate) fn refine(&mut self, opts: &CandidateOptions, leaders: usize) -> Vec<usize> {
         let order = self.by_full_fit();
         let best: Vec<&Candidate> = order.iter().take(leaders).map(|&i| &self.candidates[i]).collect();
-        let new = self.at_place(candidates::refine(self.model, opts, &best, &self.descriptions()));
+        let new = candidates::refine(self.model, opts, &best, &self.descriptions());
         self.add(new)
     }
 
@@ -726,7 +712,7 @@ pub(crate) fn search(
     let weights = opts.weights.as_deref();
     let coarse = LineSet::with_model(measured, opts.screen_lines, opts.gains, nominal, weights)?;
     let t = Instant::now();
-    let generated = pool.at_place(candidates::generate(pool.model, copts));
+    let generated = candidates::generate(pool.model, copts);
     let generation = t.elapsed().as_secs_f64();
     let all = pool.add(generated);
     trace(&format!("generated {} candidates ({generation:.2} s): {}", all.len(), pool.clock.since_last()));
@@ -780,7 +766,7 @@ pub(crate) fn search(
         let around: Vec<&Candidate> = leaders.iter().map(|&i| &pool.candidates[i]).collect();
         let tried = pool.descriptions();
         let nominal = pool.nominal;
-        pool.at_place(candidates::refine(pool.model, copts, &around, &tried))
+        candidates::refine(pool.model, copts, &around, &tried)
             .par_iter()
             .filter_map(|c| LocalCandidate::new(nominal, c).map(|l| l.form))
             .collect()
@@ -824,12 +810,7 @@ pub(crate) fn search(
     // direction: fitted fully from its leader's fit, beside the refined
     // candidates rather than competing with them for a full fit (it
     // screens as well as its leader and would crowd out the windows)
-    // (not in a search confined to a place: there the leaders are all at
-    // the place, and their per-direction variants offered a revision a
-    // replacement the whole search never ranks: a portal frame's clamp
-    // replaced by a per-direction joint beside it while its motor was
-    // still missing, after which the motor was never found)
-    let variants = if pool.place.is_some() { Vec::new() } else { pool.per_direction(REFINED_LEADERS) };
+    let variants = pool.per_direction(REFINED_LEADERS);
     if !variants.is_empty() {
         pool.full_fit(full, &coarse, (opts.iterations, opts.screen_iterations), &variants, None)?;
         trace(&format!(

@@ -334,17 +334,14 @@ pub(super) fn revise(
         // their update would: on the fix bench's beam, the model without a
         // tip mass of 21 mg, updated, leaves nothing significant, and a mass
         // change of 0.05 % over eight elements diagnosed at the values
-        // before was kept). Only its place is searched: the replacements
-        // are candidates there
-        let place = (own.nodes.as_slice(), own.elements.as_slice());
+        // before was kept)
         let d = match (&best, base) {
             _ if without.is_empty() => Ok((applied[index].0.clone(), nominal.clone())),
             (Some((_, _, a)), Some(_)) => {
-                diagnose::diagnose_near(&a.case.model, &fl.data, &fl.opts.diagnose, place).map(|d| (d, a.case.clone()))
+                diagnose::diagnose(&a.case.model, &fl.data, &fl.opts.diagnose).map(|d| (d, a.case.clone()))
             }
-            _ => without_built.and_then(|(case, _)| {
-                diagnose::diagnose_near(&case.model, &fl.data, &fl.opts.diagnose, place).map(|d| (d, case))
-            }),
+            _ => without_built
+                .and_then(|(case, _)| diagnose::diagnose(&case.model, &fl.data, &fl.opts.diagnose).map(|d| (d, case))),
         };
         if let Ok((d, without_case)) = &d {
             for other in neighbours(d, &own, &without_case.model) {
