@@ -103,6 +103,9 @@ mod local;
 mod search;
 mod suspects;
 
+/// The half-width of a band of broad residual (see [`broad_bands`]), relative to its middle.
+pub(crate) use suspects::HALF_WIDTH as BAND_HALF_WIDTH;
+
 use damping::DampedSystem;
 use fe_model::case::Gains;
 use frf::FrfSet;

@@ -28,7 +28,7 @@ use crate::error::UpdateError;
 /// lightly damped peak or of an antiresonance are outvoted, narrow against
 /// the band a heavily damped resonator spreads over (on trials 22 and 23,
 /// the residual exceeds ten times the noise over 100 to 150 Hz).
-const HALF_WIDTH: f64 = 0.1;
+pub(crate) const HALF_WIDTH: f64 = 0.1;
 
 /// Lines within this relative distance of a peak of the model or of the
 /// data are the mode's own: a residual there is a shifted or mis-damped
