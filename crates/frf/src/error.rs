@@ -137,6 +137,14 @@ pub enum MismatchError {
         /// Number of FRF values (channels x lines).
         frfs: usize,
     },
+    /// Per-line weights that do not match the FRF values one to one.
+    #[error("{values} line weights given for {frfs} FRF values")]
+    WeightsLength {
+        /// Number of weights given.
+        values: usize,
+        /// Number of FRF values (channels x lines).
+        frfs: usize,
+    },
     /// A line asked for that the data does not have.
     #[error("the data has no line at {freq_hz} Hz (nearest lines must match to 1e-6)")]
     NoLine {

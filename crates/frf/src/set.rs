@@ -68,6 +68,10 @@ pub struct FrfSet {
     data: Vec<C64>,
     /// Optional coherence per channel and line, same layout.
     coherence: Option<Vec<f64>>,
+    /// Optional weights from an additive noise floor per channel and line,
+    /// same layout, and per channel the spread of the weighted noise
+    /// ([`crate::noise::floor_weights`]).
+    floor_weights: Option<(Vec<f64>, Vec<f64>)>,
 }
 
 impl FrfSet {
@@ -82,7 +86,7 @@ impl FrfSet {
             return Err(MismatchError::RepeatedChannel { channel: *c }.into());
         }
         let data = vec![C64::new(0.0, 0.0); frequencies_hz.len() * channels.len()];
-        Ok(FrfSet { frequencies_hz, channels, kind, data, coherence: None })
+        Ok(FrfSet { frequencies_hz, channels, kind, data, coherence: None, floor_weights: None })
     }
 
     /// Frequency lines (Hz).
@@ -154,6 +158,31 @@ impl FrfSet {
         Ok(())
     }
 
+    /// The weight of each line of channel `c` for an additive noise floor
+    /// ([`crate::noise::floor_weights`]), when one was attached.
+    pub fn floor_weights(&self, c: usize) -> Option<&[f64]> {
+        let nf = self.n_freq();
+        self.floor_weights.as_ref().map(|(w, _)| &w[c * nf..(c + 1) * nf])
+    }
+
+    /// The spread of channel `c`'s weighted noise
+    /// ([`crate::noise::ChannelFloor::spread`]), when floor weights were
+    /// attached.
+    pub fn floor_spread(&self, c: usize) -> Option<f64> {
+        self.floor_weights.as_ref().map(|(_, s)| s[c])
+    }
+
+    /// Attaches noise-floor weights (channel-major, same layout as the
+    /// data) and each channel's spread of the weighted noise, carried by
+    /// the sets selected from this one.
+    pub fn set_floor_weights(&mut self, values: Vec<f64>, spread: Vec<f64>) -> Result<(), FrfError> {
+        if values.len() != self.data.len() || spread.len() != self.channels.len() {
+            return Err(MismatchError::WeightsLength { values: values.len(), frfs: self.data.len() }.into());
+        }
+        self.floor_weights = Some((values, spread));
+        Ok(())
+    }
+
     /// The same FRFs converted to receptance (dividing by `j w` or `-w^2`).
     pub fn to_receptance(&self) -> FrfSet {
         self.converted(FrfKind::Receptance)
@@ -203,11 +232,12 @@ impl FrfSet {
                 out.set(c, j, self.get(c, k));
             }
         }
-        if let Some(coh) = &self.coherence {
-            let nf = self.n_freq();
-            let v = (0..self.channels.len()).flat_map(|c| idx.iter().map(move |&k| coh[c * nf + k])).collect();
-            out.coherence = Some(v);
-        }
+        let nf = self.n_freq();
+        let pick = |per_line: &Vec<f64>| -> Vec<f64> {
+            (0..self.channels.len()).flat_map(|c| idx.iter().map(move |&k| per_line[c * nf + k])).collect()
+        };
+        out.coherence = self.coherence.as_ref().map(pick);
+        out.floor_weights = self.floor_weights.as_ref().map(|(w, s)| (pick(w), s.clone()));
         Ok(out)
     }
 
@@ -216,11 +246,19 @@ impl FrfSet {
         let nf = self.n_freq();
         let channels = idx.iter().map(|&c| self.channels[c]).collect();
         let data = idx.iter().flat_map(|&c| self.channel(c).iter().copied()).collect();
-        let coherence = self
-            .coherence
-            .as_ref()
-            .map(|coh| idx.iter().flat_map(|&c| coh[c * nf..(c + 1) * nf].iter().copied()).collect());
-        FrfSet { frequencies_hz: self.frequencies_hz.clone(), channels, kind: self.kind, data, coherence }
+        let pick = |per_line: &Vec<f64>| -> Vec<f64> {
+            idx.iter().flat_map(|&c| per_line[c * nf..(c + 1) * nf].iter().copied()).collect()
+        };
+        let coherence = self.coherence.as_ref().map(pick);
+        let floor_weights = self.floor_weights.as_ref().map(|(w, s)| (pick(w), idx.iter().map(|&c| s[c]).collect()));
+        FrfSet {
+            frequencies_hz: self.frequencies_hz.clone(),
+            channels,
+            kind: self.kind,
+            data,
+            coherence,
+            floor_weights,
+        }
     }
 
     /// Gives the channels other names (one per channel, in order;

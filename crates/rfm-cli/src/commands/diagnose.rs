@@ -436,7 +436,8 @@ fn print_diagnosis(d: &Diagnosis, top: usize, after_step0: bool) -> Result<()> {
     );
     if d.weighted {
         outln!(
-            "(both, and every fit, weigh the lines as the update does: by the measured coherence and any band weights)"
+            "(both, and every fit, weigh the lines as the update does: by the measured coherence, or the weights of the \
+             lines at a noise floor, and any band weights)"
         );
     }
     if !d.singular_hz.is_empty() {

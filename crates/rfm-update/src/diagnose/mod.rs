@@ -151,7 +151,26 @@ pub fn estimate_noise_weighted(measured: &FrfSet, weights: Option<&[f64]>) -> Op
             }
         }
     }
-    level_of(d2)
+    level_of(d2).map(|l| l * floor_spread(measured, weights))
+}
+
+/// What raises a noise level read as a median of weighted values to the
+/// RMS a fit's weighted residual leaves, when the weights are those of a
+/// noise floor the data carry ([`frf::noise::ChannelFloor::spread`]; its
+/// lines near the floor stay noisier than the others): the RMS of the
+/// channels' spreads; 1 for data weighted by their coherence, or not
+/// weighted.
+fn floor_spread(measured: &FrfSet, weights: Option<&[f64]>) -> f64 {
+    let n = measured.channels().len();
+    if weights.is_none() || n == 0 || (0..n).any(|c| measured.coherence(c).is_some()) {
+        return 1.0;
+    }
+    let squares: Vec<f64> = (0..n).filter_map(|c| measured.floor_spread(c)).map(|s| s * s).collect();
+    if squares.is_empty() {
+        1.0
+    } else {
+        (squares.iter().sum::<f64>() / n as f64 + (n - squares.len()) as f64 / n as f64).sqrt()
+    }
 }
 
 /// The noise level from squared second differences `|e(k+1) - 2 e(k) +
@@ -291,7 +310,7 @@ fn residual_level(measured: &FrfSet, weights: Option<&[f64]>, model: &FrfSet, ce
             }
         }
     }
-    level_of(d2)
+    level_of(d2).map(|l| l * floor_spread(measured, weights))
 }
 
 /// [`estimate_noise_against_weighted`] with the model's receptances given

@@ -150,9 +150,10 @@ impl Study {
         let mut pairing = Vec::new();
         let measured = match (&spec.data, &case.truth, &truth) {
             (Some(path), _, _) => {
-                let read = read_measured_for(&system, path, Some(spec))?;
+                let mut read = read_measured_for(&system, path, Some(spec))?;
                 masked = read.masked.clone();
                 notes = read.notes.iter().map(|n| format!("{}: {n}", path.display())).collect();
+                notes.extend(weights::attach_floor_weights(&mut read.set).map(|n| format!("{}: {n}", path.display())));
                 measured_kind = read.set.kind();
                 per_volt = read.per_volt_references();
                 pairing = PairingReport::of(&read.pairing);
@@ -174,6 +175,7 @@ impl Study {
             (None, Some(spec_t), Some(truth)) => {
                 let mut set = frf::synthesize(truth, &channels, &grid)?;
                 NoiseModel { relative: spec_t.noise, floor: spec_t.floor, seed: spec_t.seed }.apply(&mut set);
+                notes.extend(weights::attach_floor_weights(&mut set));
                 set
             }
             _ => {
@@ -213,7 +215,8 @@ impl Study {
     /// caller holds (the loop of [`crate::fix`] keeps one data set while the
     /// model grows). The channels must be those of the case's measurement.
     /// The case's truth, if any, is not built: the data are given.
-    pub fn with_measured(case: CaseFile, measured: FrfSet) -> Result<Self, UpdateError> {
+    pub fn with_measured(case: CaseFile, mut measured: FrfSet) -> Result<Self, UpdateError> {
+        let notes = weights::attach_floor_weights(&mut measured).into_iter().collect();
         let system = DampedSystem::new(case.model.clone())?;
         let parameters = case.update.as_ref().map(|u| u.parameters.clone()).unwrap_or_default();
         // the data's per-volt references are not known here: the caller that
@@ -227,7 +230,7 @@ impl Study {
             parameters,
             update_frequencies_hz: Vec::new(),
             masked: Vec::new(),
-            notes: Vec::new(),
+            notes,
             measured_kind: FrfKind::Receptance,
             gains,
             gains_reason,

@@ -1,5 +1,7 @@
 //! The residual weights of a study's fits: band weights from `[update]`
-//! times the measured coherence's.
+//! times the measured coherence's, or, for data without coherence, the
+//! weights of the lines at an additive noise floor
+//! ([`frf::noise::floor_weights`], attached when the data are read).
 
 use fe_model::CaseFile;
 use frf::FrfSet;
@@ -19,7 +21,8 @@ impl Study {
     /// `[update]` band weights times the coherence weight
     /// `sqrt(g / (1 - g))`, the inverse of an FRF estimate's relative
     /// standard deviation up to a constant (capped at coherence 0.999 and
-    /// scaled to 1 there); channel-major, `None` when all are 1. Used by the
+    /// scaled to 1 there), or for data without coherence the noise floor's
+    /// weights the data carry; channel-major, `None` when all are 1. Used by the
     /// output-error fit, the gain fits and the comparison.
     pub fn line_weights(&self, measured: &FrfSet) -> Result<Option<Vec<f64>>, UpdateError> {
         line_weights_for(&self.case, measured)
@@ -39,14 +42,38 @@ impl Study {
 
 /// The residual weights of a case's measured data `measured` (see
 /// [`Study::line_weights`]): band weights times the coherence weight,
-/// whenever the data carry coherence unless `[update] coherence = false`.
+/// whenever the data carry coherence unless `[update] coherence = false`,
+/// or else the weights of the lines at a noise floor the data carry.
 pub fn line_weights_for(case: &CaseFile, measured: &FrfSet) -> Result<Option<Vec<f64>>, UpdateError> {
-    let coherence = coherence_weights(case, measured)?;
-    Ok(match (band_weights(case, measured), coherence) {
+    let noise = noise_weights(case, measured)?;
+    Ok(match (band_weights(case, measured), noise) {
         (None, None) => None,
         (Some(w), None) | (None, Some(w)) => Some(w),
-        (Some(band), Some(coherence)) => Some(band.iter().zip(&coherence).map(|(b, c)| b * c).collect()),
+        (Some(band), Some(noise)) => Some(band.iter().zip(&noise).map(|(b, c)| b * c).collect()),
     })
+}
+
+/// The weights of the data's noise: the coherence's where the data carry
+/// coherence ([`coherence_weights`]), else those of the lines at a noise
+/// floor that the data carry ([`frf::noise::floor_weights`]); channel-major,
+/// a channel without either weighted 1.
+fn noise_weights(case: &CaseFile, measured: &FrfSet) -> Result<Option<Vec<f64>>, UpdateError> {
+    if let Some(w) = coherence_weights(case, measured)? {
+        return Ok(Some(w));
+    }
+    let has = (0..measured.channels().len()).any(|c| measured.coherence(c).is_some());
+    let floors = (0..measured.channels().len()).any(|c| measured.floor_weights(c).is_some());
+    if has || !floors {
+        return Ok(None);
+    }
+    let nf = measured.n_freq();
+    let mut w = vec![1.0; nf * measured.channels().len()];
+    for (c, chunk) in w.chunks_mut(nf.max(1)).enumerate().take(measured.channels().len()) {
+        if let Some(floor) = measured.floor_weights(c) {
+            chunk.copy_from_slice(floor);
+        }
+    }
+    Ok(Some(w))
 }
 
 /// The `[update]` band weights at the lines of `measured`, channel-major;
@@ -98,7 +125,9 @@ fn coherence_weights(case: &CaseFile, measured: &FrfSet) -> Result<Option<Vec<f6
 /// of `measured`, the case's data) is compared with: the noise weighted as
 /// the residual is. The coherence weight is the inverse of an FRF
 /// estimate's relative standard deviation up to a constant, so the
-/// coherence-weighted values have one noise level throughout, estimated
+/// weighted values have one noise level throughout (a noise floor's
+/// weights leave the lines near it noisier, and the level read is raised
+/// by their spread: `diagnose::estimate_noise_weighted`), estimated
 /// from their roughness over every measured line, and from that of their
 /// residual against the model `sys` where that is lower (on lines coarse
 /// against the peaks the data's own roughness is mostly the dynamics;
@@ -110,8 +139,8 @@ pub fn residual_noise_for(
     measured: &FrfSet,
     fitted: &FrfSet,
 ) -> Result<Option<f64>, UpdateError> {
-    let coherence = coherence_weights(case, measured)?;
-    let Some(level) = crate::diagnose::estimate_noise_against_weighted(sys, measured, coherence.as_deref())? else {
+    let noise = noise_weights(case, measured)?;
+    let Some(level) = crate::diagnose::estimate_noise_against_weighted(sys, measured, noise.as_deref())? else {
         return Ok(None);
     };
     let Some(band) = band_weights(case, fitted) else { return Ok(Some(level)) };
@@ -124,4 +153,31 @@ pub fn residual_noise_for(
         .filter(|&((_, &w), m)| w > 0.0 && m.norm() > 0.0 && m.norm().is_finite())
         .fold((0.0, 0usize), |(sum, n), ((b, _), _)| (sum + b * b, n + 1));
     Ok((n > 0).then(|| level * (sum / n as f64).sqrt()))
+}
+
+/// Finds the lines at an additive noise floor of data without coherence
+/// ([`frf::noise::floor_weights`]) and attaches their weights to `set`
+/// (carried by every set selected from it); returns the note that says
+/// so, `None` when the data carry coherence or weights already, or have no
+/// such lines. Call it on the data as measured (their kind as read).
+pub(crate) fn attach_floor_weights(set: &mut FrfSet) -> Option<String> {
+    let n = set.channels().len();
+    if (0..n).any(|c| set.coherence(c).is_some() || set.floor_weights(c).is_some()) {
+        return None;
+    }
+    let found = frf::noise::floor_weights(set)?;
+    set.set_floor_weights(found.weights.clone(), found.spreads()).expect("one weight per value");
+    let per: Vec<String> = found
+        .channels
+        .iter()
+        .zip(set.channels())
+        .filter_map(|(f, ch)| f.map(|f| format!("{ch} {} lines (floor {:.3e})", f.lines, f.floor)))
+        .collect();
+    let lines: usize = found.channels.iter().flatten().map(|f| f.lines).sum();
+    Some(format!(
+        "{lines} lines of {} channels read at an additive noise floor (their relative noise over 5 % and 5 times \
+         the channel's cleanest) are weighted down: {}",
+        per.len(),
+        per.join(", ")
+    ))
 }

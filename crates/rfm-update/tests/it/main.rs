@@ -13,6 +13,7 @@ mod lab;
 mod lab_study;
 mod mesh;
 mod noise_estimate;
+mod noise_floor;
 mod numerics;
 mod output_error;
 mod paper_cases;
