@@ -105,7 +105,7 @@ pub struct ChannelFloor {
     /// at the lines weighted down.
     pub floor: f64,
     /// The RMS of the weighted relative noise over its median, on the
-    /// lines below the resonances (at least 1): what turns a noise level
+    /// lines outside the resonances (at least 1): what turns a noise level
     /// read as a median into the RMS a fit's residual leaves.
     pub spread: f64,
 }
@@ -233,11 +233,15 @@ fn channel_floor(h: &[C64], w: &mut [f64]) -> Option<ChannelFloor> {
         return None;
     }
     let floor = median(&mut at_floor)? / MEDIAN_OF_MODULUS;
-    // the weighted noise's RMS over its median below the resonances: a
-    // noise level read as a median of the weighted values' roughness,
-    // times this, is the RMS a fit's weighted residual leaves
-    let mut weighted: Vec<f64> =
-        (0..n).filter(|&k| h[k].norm() < level).map(|k| w[k] * local[k]).filter(|s| s.is_finite()).collect();
+    // the weighted noise's RMS over its median outside the resonances
+    // (whose reading is their curvature, not their noise): a noise level
+    // read as a median of the weighted values' roughness, times this, is
+    // the RMS a fit's weighted residual leaves
+    let mut weighted: Vec<f64> = (0..n)
+        .filter(|&k| h[k].norm() < level && !resonant[k])
+        .map(|k| w[k] * local[k])
+        .filter(|s| s.is_finite())
+        .collect();
     let rms = (weighted.iter().map(|s| s * s).sum::<f64>() / weighted.len().max(1) as f64).sqrt();
     let spread = median(&mut weighted).filter(|&m| m > 0.0).map_or(1.0, |m| (rms / m).max(1.0));
     Some(ChannelFloor { lines, typical, threshold, floor, spread })
