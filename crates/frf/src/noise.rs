@@ -143,7 +143,9 @@ const MEDIAN_OF_MODULUS: f64 = 0.832_554_611_157_697_7;
 /// channel's cleanest lines (the tenth of its lines where it is lowest:
 /// the relative part, even where a floor dominates most lines), when a
 /// fiftieth of the channel's lines, and at least 5, are (fewer are the
-/// reading's scatter beside sharp features). Its
+/// reading's scatter beside sharp features) and their noise is flat (its
+/// level does not follow `|H|` across them, as relative noise and the
+/// curvature of modes unresolved by the lines do). Its
 /// weight is `(t / q)^2`, so that its weighted noise `t^2 / q` falls from
 /// the threshold's at the threshold to the cleanest lines' where the
 /// floor is 5 times the threshold and below beyond: the lines at the floor
@@ -217,18 +219,19 @@ fn channel_floor(h: &[C64], w: &mut [f64]) -> Option<ChannelFloor> {
             }
         }
     }
-    let mut at_floor = Vec::new();
+    let (mut at_floor, mut at_floor_lines) = (Vec::new(), Vec::new());
     for k in 0..n {
         if h[k].norm() < level && !resonant[k] && local[k] > threshold {
             w[k] = (threshold / local[k]).powi(2);
             at_floor.push(rough[k]);
+            at_floor_lines.push(k);
         }
     }
     // a floor covers a share of the band: a few lines alone are the
     // reading's scatter beside sharp features (1 % relative noise on the
     // tutorial's frame, 1 Hz lines: 1 to 6 of 599 per channel)
     let lines = at_floor.len();
-    if lines < (n / 50).max(5) {
+    if lines < (n / 50).max(5) || !flat(&at_floor_lines, h, &rough) {
         w.fill(1.0);
         return None;
     }
@@ -245,6 +248,29 @@ fn channel_floor(h: &[C64], w: &mut [f64]) -> Option<ChannelFloor> {
     let rms = (weighted.iter().map(|s| s * s).sum::<f64>() / weighted.len().max(1) as f64).sqrt();
     let spread = median(&mut weighted).filter(|&m| m > 0.0).map_or(1.0, |m| (rms / m).max(1.0));
     Some(ChannelFloor { lines, typical, threshold, floor, spread })
+}
+
+/// Whether the noise read at `lines` is a floor: a level that does not
+/// follow `|H|` (the least-squares slope of `ln` of the local level over
+/// `ln |H|` below one half). Relative noise and the curvature of an FRF on
+/// lines coarse against its modes both grow with `|H|` (slope near 1):
+/// 1 % relative noise on a frame of dense modes read 5 times over on such
+/// lines, and taken for a floor its weights raised the loop's noise to
+/// 1.4 %.
+fn flat(lines: &[usize], h: &[C64], rough: &[f64]) -> bool {
+    let points: Vec<(f64, f64)> = lines
+        .iter()
+        .map(|&k| (h[k].norm().ln(), rough[k].ln()))
+        .filter(|(x, y)| x.is_finite() && y.is_finite())
+        .collect();
+    let m = points.len() as f64;
+    if m < 2.0 {
+        return false;
+    }
+    let (mx, my) = (points.iter().map(|p| p.0).sum::<f64>() / m, points.iter().map(|p| p.1).sum::<f64>() / m);
+    let sxx: f64 = points.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    let sxy: f64 = points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    sxx > 0.0 && sxy / sxx < 0.5
 }
 
 #[cfg(test)]
