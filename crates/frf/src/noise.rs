@@ -193,7 +193,7 @@ fn channel_floor(h: &[C64], w: &mut [f64]) -> Option<ChannelFloor> {
         })
         .collect();
     // the tenth of the lines where |H| is highest hold the resonances,
-    // whose second difference is large where the lines do not resolve them
+    // whose difference is large where the lines do not resolve them
     let mut moduli: Vec<f64> = h.iter().map(|v| v.norm()).collect();
     moduli.sort_by(f64::total_cmp);
     let level = moduli[n - 1 - n / 10];
@@ -219,23 +219,20 @@ fn channel_floor(h: &[C64], w: &mut [f64]) -> Option<ChannelFloor> {
             }
         }
     }
-    let (mut at_floor, mut at_floor_lines) = (Vec::new(), Vec::new());
-    for k in 0..n {
-        if h[k].norm() < level && !resonant[k] && local[k] > threshold {
-            w[k] = (threshold / local[k]).powi(2);
-            at_floor.push(rough[k]);
-            at_floor_lines.push(k);
-        }
+    let at_floor: Vec<usize> =
+        (0..n).filter(|&k| h[k].norm() < level && !resonant[k] && local[k] > threshold).collect();
+    for &k in &at_floor {
+        w[k] = (threshold / local[k]).powi(2);
     }
     // a floor covers a share of the band: a few lines alone are the
     // reading's scatter beside sharp features (1 % relative noise on the
     // tutorial's frame, 1 Hz lines: 1 to 6 of 599 per channel)
     let lines = at_floor.len();
-    if lines < (n / 50).max(5) || !flat(&at_floor_lines, h, &rough) {
+    if lines < (n / 50).max(5) || !flat(&at_floor, h, &rough) {
         w.fill(1.0);
         return None;
     }
-    let floor = median(&mut at_floor)? / MEDIAN_OF_MODULUS;
+    let floor = median(&mut at_floor.iter().map(|&k| rough[k]).collect::<Vec<_>>())? / MEDIAN_OF_MODULUS;
     // the weighted noise's RMS over its median outside the resonances
     // (whose reading is their curvature, not their noise): a noise level
     // read as a median of the weighted values' roughness, times this, is

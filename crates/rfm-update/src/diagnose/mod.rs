@@ -165,12 +165,11 @@ fn floor_spread(measured: &FrfSet, weights: Option<&[f64]>) -> f64 {
     if weights.is_none() || n == 0 || (0..n).any(|c| measured.coherence(c).is_some()) {
         return 1.0;
     }
-    let squares: Vec<f64> = (0..n).filter_map(|c| measured.floor_spread(c)).map(|s| s * s).collect();
-    if squares.is_empty() {
-        1.0
-    } else {
-        (squares.iter().sum::<f64>() / n as f64 + (n - squares.len()) as f64 / n as f64).sqrt()
-    }
+    // attached to every channel or none
+    (0..n)
+        .map(|c| measured.floor_spread(c))
+        .collect::<Option<Vec<f64>>>()
+        .map_or(1.0, |spreads| (spreads.iter().map(|s| s * s).sum::<f64>() / n as f64).sqrt())
 }
 
 /// The noise level from squared second differences `|e(k+1) - 2 e(k) +

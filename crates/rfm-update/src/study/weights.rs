@@ -55,25 +55,15 @@ pub fn line_weights_for(case: &CaseFile, measured: &FrfSet) -> Result<Option<Vec
 
 /// The weights of the data's noise: the coherence's where the data carry
 /// coherence ([`coherence_weights`]), else those of the lines at a noise
-/// floor that the data carry ([`frf::noise::floor_weights`]); channel-major,
-/// a channel without either weighted 1.
+/// floor that the data carry ([`frf::noise::floor_weights`], attached to
+/// every channel or none); channel-major.
 fn noise_weights(case: &CaseFile, measured: &FrfSet) -> Result<Option<Vec<f64>>, UpdateError> {
-    if let Some(w) = coherence_weights(case, measured)? {
-        return Ok(Some(w));
+    let coherence = coherence_weights(case, measured)?;
+    let n = measured.channels().len();
+    if coherence.is_some() || (0..n).any(|c| measured.coherence(c).is_some()) {
+        return Ok(coherence);
     }
-    let has = (0..measured.channels().len()).any(|c| measured.coherence(c).is_some());
-    let floors = (0..measured.channels().len()).any(|c| measured.floor_weights(c).is_some());
-    if has || !floors {
-        return Ok(None);
-    }
-    let nf = measured.n_freq();
-    let mut w = vec![1.0; nf * measured.channels().len()];
-    for (c, chunk) in w.chunks_mut(nf.max(1)).enumerate().take(measured.channels().len()) {
-        if let Some(floor) = measured.floor_weights(c) {
-            chunk.copy_from_slice(floor);
-        }
-    }
-    Ok(Some(w))
+    Ok((0..n).map(|c| measured.floor_weights(c)).collect::<Option<Vec<_>>>().map(|w| w.concat()))
 }
 
 /// The `[update]` band weights at the lines of `measured`, channel-major;

@@ -5,9 +5,8 @@
 
 use std::path::Path;
 
-use damping::DampedSystem;
 use fe_model::CaseFile;
-use frf::{Channel, NoiseModel};
+use frf::NoiseModel;
 use rfm_update::Study;
 use rfm_update::status::Status;
 
@@ -83,15 +82,12 @@ fn study(stiffer: f64, more: &str, coherent: bool) -> Study {
 /// shaker's interaction leave it).
 fn measured(case: &CaseFile, coherent: bool, bias: f64, seed: u64) -> frf::FrfSet {
     let spec = case.measurement.as_ref().unwrap();
-    let channels: Vec<Channel> =
-        spec.references.iter().flat_map(|&r| spec.responses.iter().map(move |&m| Channel::new(m, r))).collect();
-    let truth = DampedSystem::new(case.truth.as_ref().unwrap().model.clone()).unwrap();
-    let clean = frf::synthesize(&truth, &channels, &spec.frequencies_hz).unwrap();
+    let clean = crate::truth_receptances(case);
     let mut unit = clean.clone();
     NoiseModel::relative(1.0, seed).apply(&mut unit);
     let mut measured = clean.clone();
     let mut coh = Vec::new();
-    for c in 0..channels.len() {
+    for c in 0..clean.channels().len() {
         for (k, &f) in spec.frequencies_hz.iter().enumerate() {
             let h = clean.get(c, k);
             let level = if coherent { relative_noise(coherence(f)) } else { NOISE_AT_099 };

@@ -39,3 +39,13 @@ pub(crate) fn full_study() -> bool {
 pub(crate) fn study_size(var: &str, reduced: usize, full: usize) -> usize {
     std::env::var(var).ok().and_then(|v| v.parse().ok()).unwrap_or(if full_study() { full } else { reduced })
 }
+
+/// The receptances of a case's truth (its `[truth.set]` applied) on the
+/// case's measured channels and lines, without noise.
+pub(crate) fn truth_receptances(case: &fe_model::CaseFile) -> frf::FrfSet {
+    let spec = case.measurement.as_ref().expect("a [measurement]");
+    let channels: Vec<frf::Channel> =
+        spec.references.iter().flat_map(|&r| spec.responses.iter().map(move |&m| frf::Channel::new(m, r))).collect();
+    let truth = damping::DampedSystem::new(case.truth.as_ref().expect("a [truth]").model.clone()).unwrap();
+    frf::synthesize(&truth, &channels, &spec.frequencies_hz).unwrap()
+}

@@ -11,9 +11,7 @@
 
 use std::path::Path;
 
-use damping::DampedSystem;
 use fe_model::CaseFile;
-use frf::Channel;
 use num_complex::Complex64 as C64;
 use rfm_update::Study;
 use rfm_update::status::Status;
@@ -98,14 +96,10 @@ fn case() -> CaseFile {
 /// The truth's receptances plus complex Gaussian noise of RMS `floor`
 /// times each channel's peak modulus, of seed `seed`.
 fn measured(case: &CaseFile, floor: f64, seed: u64) -> frf::FrfSet {
-    let spec = case.measurement.as_ref().unwrap();
-    let channels: Vec<Channel> =
-        spec.references.iter().flat_map(|&r| spec.responses.iter().map(move |&m| Channel::new(m, r))).collect();
-    let truth = DampedSystem::new(case.truth.as_ref().unwrap().model.clone()).unwrap();
-    let clean = frf::synthesize(&truth, &channels, &spec.frequencies_hz).unwrap();
+    let clean = crate::truth_receptances(case);
     let mut rng = Normal(seed * 7919);
     let mut measured = clean.clone();
-    for c in 0..channels.len() {
+    for c in 0..clean.channels().len() {
         let peak = clean.channel(c).iter().map(|h| h.norm()).fold(0.0, f64::max);
         for k in 0..clean.n_freq() {
             measured.set(c, k, clean.get(c, k) + floor * peak * rng.complex());
@@ -183,13 +177,9 @@ fn the_lines_at_a_noise_floor_are_weighed_down_and_the_update_finds_the_truth() 
 #[test]
 fn relative_noise_has_no_floor_weights() {
     let case = case();
-    let spec = case.measurement.as_ref().unwrap();
-    let channels: Vec<Channel> =
-        spec.references.iter().flat_map(|&r| spec.responses.iter().map(move |&m| Channel::new(m, r))).collect();
-    let truth = DampedSystem::new(case.truth.as_ref().unwrap().model.clone()).unwrap();
-    let mut data = frf::synthesize(&truth, &channels, &spec.frequencies_hz).unwrap();
+    let mut data = crate::truth_receptances(&case);
     frf::NoiseModel::relative(0.01, 5).apply(&mut data);
     let study = Study::with_measured(case, data).unwrap();
-    assert!((0..channels.len()).all(|c| study.measured().floor_weights(c).is_none()));
+    assert!((0..study.measured().channels().len()).all(|c| study.measured().floor_weights(c).is_none()));
     assert!(study.weights(study.measured()).unwrap().is_none());
 }
