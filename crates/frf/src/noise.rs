@@ -97,7 +97,9 @@ pub struct ChannelFloor {
     /// Lines weighted down.
     pub lines: usize,
     /// The relative noise of the channel's cleanest lines (the tenth of
-    /// its lines where it is lowest).
+    /// its lines where it is lowest, among those whose noise stands above
+    /// the floor outside the resonances); 0 where fewer than a tenth of
+    /// the lines are such.
     pub typical: f64,
     /// The relative noise above which a line is weighted down.
     pub threshold: f64,
@@ -140,13 +142,20 @@ const MEDIAN_OF_MODULUS: f64 = 0.832_554_611_157_697_7;
 /// weighted down when `|H|` is below that of the tenth of the channel's
 /// lines where it is highest (which hold its resonances) and its relative
 /// noise `q` exceeds the threshold `t`, both 5 % and 5 times that of the
-/// channel's cleanest lines (the tenth of its lines where it is lowest:
-/// the relative part, even where a floor dominates most lines), when a
+/// channel's cleanest lines (the tenth of its lines where it is lowest,
+/// among those outside the resonances whose noise stands 3 times above
+/// that of the quarter of the lines where `|H|` is lowest: the relative
+/// part, even where a floor dominates most lines; none is read where
+/// fewer than a tenth of the lines are such), when a
 /// fiftieth of the channel's lines, and at least 5, are (fewer are the
 /// reading's scatter beside sharp features) and their noise is flat (its
 /// level does not follow `|H|` across them, as relative noise and the
-/// curvature of modes unresolved by the lines do). Its
-/// weight is `(t / q)^2`, so that its weighted noise `t^2 / q` falls from
+/// curvature of modes unresolved by the lines do). A line's weight is
+/// `(t / q)^2`, its relative noise `q` read as the floor's level over
+/// `|H|` on every line, where that level puts at most half as many lines
+/// again above the threshold as were found at it (a floor the local
+/// reading's scatter would leave partly unweighted), else as the local
+/// reading on the lines found; so that its weighted noise `t^2 / q` falls from
 /// the threshold's at the threshold to the cleanest lines' where the
 /// floor is 5 times the threshold and below beyond: the lines at the floor
 /// neither dominate the fit nor raise its misfit above the noise of the
@@ -182,43 +191,57 @@ fn channel_floor(h: &[C64], w: &mut [f64]) -> Option<ChannelFloor> {
         .map(|k| k.clamp(2, n - 3))
         .map(|k| (h[k - 2] - 4.0 * h[k - 1] + 6.0 * h[k] - 4.0 * h[k + 1] + h[k + 2]).norm() / 70f64.sqrt())
         .collect();
-    // the local noise level over the line's own modulus: the floor is
-    // flat, so its level is read over five lines and a sharp line of one
-    // does not count
-    let local: Vec<f64> = (0..n)
+    // the local noise level: the floor is flat, so its level is read over
+    // five lines and a sharp line of one does not count
+    let smooth: Vec<f64> = (0..n)
         .map(|k| {
             let (lo, hi) = (k.saturating_sub(2), (k + 3).min(n));
-            let level = median(&mut rough[lo..hi].to_vec()).expect("a window of lines");
-            if h[k].norm() > 0.0 { level / h[k].norm() } else { f64::INFINITY }
+            let mut window = [0.0; 5];
+            window[..hi - lo].copy_from_slice(&rough[lo..hi]);
+            median(&mut window[..hi - lo]).expect("a window of lines")
         })
         .collect();
+    // over the line's own modulus
+    let local: Vec<f64> =
+        (0..n).map(|k| if h[k].norm() > 0.0 { smooth[k] / h[k].norm() } else { f64::INFINITY }).collect();
     // the tenth of the lines where |H| is highest hold the resonances,
     // whose difference is large where the lines do not resolve them
-    let mut moduli: Vec<f64> = h.iter().map(|v| v.norm()).collect();
-    moduli.sort_by(f64::total_cmp);
-    let level = moduli[n - 1 - n / 10];
-    // the relative noise of the channel's cleanest lines (the tenth of
-    // the lines where it is lowest): what the relative part is, even where
-    // a floor dominates most lines
-    let mut sorted = local.clone();
-    sorted.sort_by(f64::total_cmp);
-    let typical = sorted[n / 10];
-    let threshold = (5.0 * typical).max(0.05);
+    let mut by_modulus: Vec<usize> = (0..n).collect();
+    by_modulus.sort_by(|&a, &b| h[a].norm().total_cmp(&h[b].norm()));
+    let level = h[by_modulus[n - 1 - n / 10]].norm();
     // and a resonance that stands out of its neighbourhood (its peak over
-    // 3 times the median modulus of the 21 lines around it; noise at a
-    // floor does so once in 500 lines) is left as it is, with 3 lines
-    // either side, wherever its modulus ranks
+    // 3 times the median modulus of the 21 lines around it, and 10 times
+    // the roughness of the quarter of the lines where |H| is lowest: noise
+    // at a floor stands out so once in 500 lines, and 6 such peaks of a
+    // strip's floor kept their 42 lines at weight 1) is not read at the
+    // floor, with 3 lines either side, wherever its modulus ranks
+    let lowest = median(&mut by_modulus[..n / 4].iter().map(|&k| rough[k]).collect::<Vec<_>>()).expect("lines");
     let mut resonant = vec![false; n];
     for k in 1..n - 1 {
         let m = h[k].norm();
         if m >= h[k - 1].norm() && m >= h[k + 1].norm() {
             let (lo, hi) = (k.saturating_sub(10), (k + 11).min(n));
             let around = median(&mut h[lo..hi].iter().map(|v| v.norm()).collect::<Vec<_>>()).expect("lines");
-            if m > 3.0 * around {
+            if m > 3.0 * around && m > 10.0 * lowest {
                 resonant[k.saturating_sub(3)..(k + 4).min(n)].fill(true);
             }
         }
     }
+    // the relative noise of the channel's cleanest lines (the tenth of
+    // the lines where it is lowest), read where the noise stands above the
+    // floor (three times the roughness of the quarter of the lines where
+    // |H| is lowest) outside the resonances, whose roughness is their
+    // curvature: the relative part of the noise, even where a floor
+    // dominates most lines. Where fewer than a tenth of the lines are
+    // such, the floor and the resonances are all there is (a floor at
+    // 3e-3 of a strip's peak covers 85 to 96 % of its lines, and the
+    // cleanest tenth read 0.3 to 0.5 there, so that only the lines 40
+    // times noisier than their value were weighted down), and no relative
+    // part is read.
+    let mut above: Vec<f64> = (0..n).filter(|&k| !resonant[k] && smooth[k] > 3.0 * lowest).map(|k| local[k]).collect();
+    above.sort_by(f64::total_cmp);
+    let typical = if above.len() >= n / 10 { above[above.len() / 10] } else { 0.0 };
+    let threshold = (5.0 * typical).max(0.05);
     let at_floor: Vec<usize> =
         (0..n).filter(|&k| h[k].norm() < level && !resonant[k] && local[k] > threshold).collect();
     for &k in &at_floor {
@@ -232,7 +255,28 @@ fn channel_floor(h: &[C64], w: &mut [f64]) -> Option<ChannelFloor> {
         w.fill(1.0);
         return None;
     }
-    let floor = median(&mut at_floor.iter().map(|&k| rough[k]).collect::<Vec<_>>())? / MEDIAN_OF_MODULUS;
+    // the median of the floor's lines' roughness, on the local reading's scale
+    let at_level = median(&mut at_floor.iter().map(|&k| rough[k]).collect::<Vec<_>>())?;
+    // the floor's level over |H| is a line's relative noise, read without
+    // the local reading's scatter (lines a scattered reading left at
+    // weight 1 at a floor at 3e-3 of a strip's peak, and the lines beside
+    // its resonances, ran its moduli to 7 times the truth), where that
+    // level puts about the lines found at it above the threshold (at most
+    // half as many again: the curvature of modes unresolved by the lines,
+    // taken for a floor on 2 channels of 40 of a frame at 1 % relative
+    // noise, has a level that puts three times as many there); elsewhere
+    // the local reading stays
+    let by_level = |k: usize| at_level / h[k].norm();
+    let placed = (0..n).filter(|&k| by_level(k) > threshold).count();
+    let lines = if 2 * placed <= 3 * lines {
+        for (k, w) in w.iter_mut().enumerate() {
+            let q = by_level(k);
+            *w = if q > threshold { (threshold / q).powi(2) } else { 1.0 };
+        }
+        placed
+    } else {
+        lines
+    };
     // the weighted noise's RMS over its median outside the resonances
     // (whose reading is their curvature, not their noise): a noise level
     // read as a median of the weighted values' roughness, times this, is
@@ -244,7 +288,7 @@ fn channel_floor(h: &[C64], w: &mut [f64]) -> Option<ChannelFloor> {
         .collect();
     let rms = (weighted.iter().map(|s| s * s).sum::<f64>() / weighted.len().max(1) as f64).sqrt();
     let spread = median(&mut weighted).filter(|&m| m > 0.0).map_or(1.0, |m| (rms / m).max(1.0));
-    Some(ChannelFloor { lines, typical, threshold, floor, spread })
+    Some(ChannelFloor { lines, typical, threshold, floor: at_level / MEDIAN_OF_MODULUS, spread })
 }
 
 /// Whether the noise read at `lines` is a floor: a level that does not
@@ -355,6 +399,36 @@ mod tests {
                 }
             }
             assert!(ch.lines >= 10, "{} lines weighted", ch.lines);
+        }
+    }
+
+    /// A floor over most of the band (the two modes' peaks alone stand
+    /// above it): every line whose FRF is below it is weighted down,
+    /// those beside the resonances and those whose local reading scatters
+    /// low among them (a floor at 3e-3 of a strip's peak left such lines at
+    /// weight 1, and its moduli ran to 7 times the truth), and the
+    /// resonances' tops are not.
+    #[test]
+    fn a_floor_over_most_of_the_band_weighs_down_every_line_below_it() {
+        for seed in 1..=3 {
+            let clean = two_modes();
+            let mut s = clean.clone();
+            let floor = 1.0;
+            NoiseModel { relative: 0.0, floor, seed }.apply(&mut s);
+            let rms = (clean.channel(0).iter().map(|v| v.norm_sqr()).sum::<f64>() / clean.n_freq() as f64).sqrt();
+            let sigma = floor * rms;
+            let below = clean.channel(0).iter().filter(|h| h.norm() < sigma).count();
+            assert!(below * 10 > 8 * clean.n_freq(), "{below} of {} lines below the floor", clean.n_freq());
+            let found = floor_weights(&s).expect("a floor");
+            for (k, (&w, h)) in found.weights.iter().zip(clean.channel(0)).enumerate() {
+                let snr = h.norm() / sigma;
+                if snr < 1.0 {
+                    assert!(w < 0.25, "seed {seed}, line {k}: SNR {snr:.2}, weight {w:.3}");
+                }
+                if snr > 200.0 {
+                    assert_eq!(w, 1.0, "seed {seed}, line {k}: SNR {snr:.0}");
+                }
+            }
         }
     }
 

@@ -137,11 +137,11 @@ fn fit(data: frf::FrfSet) -> Fit {
 
 /// A floor at 1e-6 and 1e-5 of each channel's peak (two seeds each): the
 /// lines at it are found and weighed down, the moduli come within 0.5 %
-/// (3 % at 1e-5) of the truth and within 3 of their standard deviations
+/// (1 % at 1e-5; seen: up to 0.54 %) of the truth and within 3 of their standard deviations
 /// (and every other parameter the data determine within 3), and the
-/// misfit stays within 2 times the noise (seen: 1.26 to 1.79, so that 3 of
-/// the 4 still end "model inadequate" beyond the verdict's 1.5: the level
-/// read beside the floor's lines is low, a known shortfall).
+/// update converges within the verdict's 1.5 times the noise (seen: 0.84
+/// to 1.39; before the floor's level was read over `|H|` on every line,
+/// 1.26 to 1.79, 3 of the 4 "model inadequate").
 /// The same data fitted with every line weighted alike (floor weights of
 /// 1 attached beforehand, which the study then keeps) end "model
 /// inadequate" at over 5 times the noise (seen: 7.6 to 22), the
@@ -151,9 +151,10 @@ fn fit(data: frf::FrfSet) -> Fit {
 fn the_lines_at_a_noise_floor_are_weighed_down_and_the_update_finds_the_truth() {
     for (floor, seed) in [(1e-6, 1), (1e-6, 2), (1e-5, 1), (1e-5, 2)] {
         // the moduli's error, as the floor's lines carry less
-        let bound = if floor < 5e-6 { 0.005 } else { 0.03 };
+        let bound = if floor < 5e-6 { 0.005 } else { 0.01 };
         let data = measured(&case(), floor, seed);
         let f = fit(data.clone());
+        println!("{floor}/{seed}: {:?}, {:.2} x noise ({:?})", f.z, f.ratio, f.status);
         assert!(f.notes.iter().any(|n| n.contains("noise floor")), "{floor}/{seed}: notes {:?}", f.notes);
         for (name, z, err) in &f.z {
             assert!(z.abs() <= 3.0, "{floor}/{seed}: {name} {z:.2} standard deviations off");
@@ -162,7 +163,8 @@ fn the_lines_at_a_noise_floor_are_weighed_down_and_the_update_finds_the_truth() 
             }
         }
         assert!(f.z.iter().filter(|(n, ..)| n.ends_with(".E")).count() == 2, "{floor}/{seed}: {:?}", f.z);
-        assert!(f.ratio < 2.0, "{floor}/{seed}: {:.2} times the noise ({:?})", f.ratio, f.status);
+        assert!(f.ratio <= 1.5, "{floor}/{seed}: {:.2} times the noise ({:?})", f.ratio, f.status);
+        assert_eq!(f.status, Status::Converged, "{floor}/{seed}");
         let mut alike = data;
         let n = alike.channels().len();
         alike.set_floor_weights(vec![1.0; n * alike.n_freq()], vec![1.0; n]).unwrap();
@@ -182,4 +184,30 @@ fn relative_noise_has_no_floor_weights() {
     let study = Study::with_measured(case, data).unwrap();
     assert!((0..study.measured().channels().len()).all(|c| study.measured().floor_weights(c).is_none()));
     assert!(study.weights(study.measured()).unwrap().is_none());
+}
+
+/// A floor at 3e-3 of each channel's peak, as a generator that adds noise
+/// at a fraction of the peak makes it: the strip's receptance falls below
+/// it on 85 to 96 % of the lines, and only the first resonances stand out.
+/// Before the floor's level was read over `|H|` on every line (the lines
+/// beside the resonances, and those a scattered local reading left at
+/// weight 1, kept the noise's logarithm in the fit), the update ran the
+/// moduli to 7.2 and 0.16 times the truth (seed 1), 12 and 9 standard
+/// deviations off. The moduli now come within 1 %
+/// of the truth and within 3 of their standard deviations. The misfit is
+/// not asserted: the noise level read beside so many weighted lines is
+/// low (seen: the fit leaves 3.8 times it, "model inadequate"), a known
+/// shortfall the docs name.
+#[test]
+fn a_floor_over_most_lines_leaves_the_moduli_to_the_resonances() {
+    for seed in [1, 2] {
+        let f = fit(measured(&case(), 3e-3, seed));
+        assert!(f.notes.iter().any(|n| n.contains("noise floor")), "{seed}: notes {:?}", f.notes);
+        let moduli: Vec<&(String, f64, f64)> = f.z.iter().filter(|(n, ..)| n.ends_with(".E")).collect();
+        println!("seed {seed}: {moduli:?}, {:.2} x noise ({:?})", f.ratio, f.status);
+        assert_eq!(moduli.len(), 2, "{seed}: {:?}", f.z);
+        for (name, z, err) in moduli {
+            assert!(z.abs() <= 3.0 && *err < 0.01, "{seed}: {name} {z:.2} sd and {:.2} % off", 100.0 * err);
+        }
+    }
 }
