@@ -196,7 +196,7 @@ fn relative_noise_has_no_floor_weights() {
 /// deviations off. The moduli now come within 1 %
 /// of the truth and within 3 of their standard deviations. The misfit is
 /// not asserted: the noise level read beside so many weighted lines is
-/// low (seen: the fit leaves 3.8 times it, "model inadequate"), a known
+/// low (seen: the fit leaves 2.9 and 3.7 times it, "model inadequate"), a known
 /// shortfall the docs name.
 #[test]
 fn a_floor_over_most_lines_leaves_the_moduli_to_the_resonances() {
