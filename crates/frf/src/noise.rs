@@ -82,13 +82,29 @@ pub struct FloorWeights {
     /// Per channel: the lines weighted down and the floor estimated from
     /// them (`None` where no line is).
     pub channels: Vec<Option<ChannelFloor>>,
-}
-
-impl FloorWeights {
-    /// Each channel's [`ChannelFloor::spread`], 1 where it has no floor.
-    pub fn spreads(&self) -> Vec<f64> {
-        self.channels.iter().map(|c| c.map_or(1.0, |c| c.spread)).collect()
-    }
+    /// Per channel and line, channel-major: the RMS relative noise of the
+    /// value as the floor's reading tells it, `sqrt(r^2 + (F / |H|)^2)`
+    /// for its relative part `r` ([`ChannelFloor::relative`]) and its
+    /// floor `F` ([`ChannelFloor::floor`]), where the floor covers over
+    /// half the lines of every channel and its level holds over them;
+    /// infinite on a value of 0. Over so many lines at a floor the
+    /// weighted noise of a line runs from the threshold's beside the
+    /// resonances to a hundredth of it, and a single level read from the
+    /// lines' roughness as a median is the noise of none of them (on a
+    /// strip at a floor of 3e-3 of its peak, 0.0041 where the truth's
+    /// weighted residual left 0.037). NaN on every value elsewhere: the
+    /// data's roughness tells their noise, raised by the spread of their
+    /// weighted noise ([`ChannelFloor::spread`]). A floor that some
+    /// channels' highest lines alone reach is not always found on them
+    /// (the strip's first channel at a floor of 1e-5 of its peak, its
+    /// highest lines at a relative noise of 0.1 where one level read over
+    /// every line put 0.026), and the level of a channel's quietest lines,
+    /// which reads such a floor, reads the curvature of a frame's coarse
+    /// lines as a noise of 0.3 where 0.01 was injected: the reading of
+    /// some channels only is not mixed with one level for the others. The
+    /// same in every kind: a conversion scales the value and its noise
+    /// alike.
+    pub noise: Vec<f64>,
 }
 
 /// A channel's noise floor as [`floor_weights`] reads it.
@@ -103,6 +119,10 @@ pub struct ChannelFloor {
     pub typical: f64,
     /// The relative noise above which a line is weighted down.
     pub threshold: f64,
+    /// The RMS of the relative part of the noise, read from `typical` (of
+    /// which it is [`TENTH_OF_MEDIAN_OF_FIVE`] times as much for relative
+    /// noise alone); 0 where `typical` is.
+    pub relative: f64,
     /// The floor's level (in the data's units): the RMS noise of one value
     /// at the lines weighted down.
     pub floor: f64,
@@ -110,6 +130,13 @@ pub struct ChannelFloor {
     /// lines outside the resonances (at least 1): what turns a noise level
     /// read as a median into the RMS a fit's residual leaves.
     pub spread: f64,
+}
+
+impl FloorWeights {
+    /// Each channel's [`ChannelFloor::spread`], 1 where it has no floor.
+    pub fn spreads(&self) -> Vec<f64> {
+        self.channels.iter().map(|c| c.map_or(1.0, |c| c.spread)).collect()
+    }
 }
 
 /// Median of `v` (sorted in place); `None` when empty.
@@ -125,6 +152,15 @@ fn median(v: &mut [f64]) -> Option<f64> {
 /// The median of `|z|` for `z` complex Gaussian of unit mean square,
 /// `sqrt(ln 2)`: turns a median of moduli into an RMS level.
 const MEDIAN_OF_MODULUS: f64 = 0.832_554_611_157_697_7;
+
+/// The tenth percentile of the median of five moduli of complex Gaussian
+/// numbers of unit mean square: `sqrt(-ln(1 - p))` for the `p` at which
+/// the third of five order statistics of the uniform distribution has
+/// probability 0.1 (`10 p^3 (1 - p)^2 + 5 p^4 (1 - p) + p^5 = 0.1`, `p =
+/// 0.246636`). Relative noise alone of RMS `r` reads as a local noise
+/// (the median of five lines' fourth differences over `|H|`) whose tenth
+/// percentile is this times `r`.
+pub const TENTH_OF_MEDIAN_OF_FIVE: f64 = 0.532_172_312_257_883;
 
 /// Finds, per channel, the lines at an additive noise floor and weighs
 /// them down; `None` when no line of any channel is.
@@ -162,27 +198,55 @@ const MEDIAN_OF_MODULUS: f64 = 0.832_554_611_157_697_7;
 /// others (a weight of `t / q`, proportional to `|H|` there as a fit of
 /// `H` itself would weigh them, left every such line at the threshold's
 /// noise, and a model that explained the data read 3 to 4 times the
-/// noise). Data with relative noise only, or
-/// none, have no such lines, and are fitted as before.
+/// noise). A value whose modulus is below 4 times the floor's RMS is
+/// the floor's more than the response's, and weighs 0
+/// ([`floor_weight`]). Data with relative noise only, or
+/// none, have no such lines, and are fitted as before. The floor's
+/// relative noise at each value ([`FloorWeights::relative`]) tells what
+/// noise the weighted values carry, line by line.
 ///
 /// Run it on the data as measured (the floor is flat in the measured
 /// quantity, not in a converted one); the weights are the same for every
 /// kind. Channels of fewer than 11 lines are left at weight 1.
 pub fn floor_weights(set: &FrfSet) -> Option<FloorWeights> {
     let nf = set.n_freq();
-    let mut weights = vec![1.0; nf * set.channels().len()];
-    let mut channels = Vec::with_capacity(set.channels().len());
-    for (c, w) in weights.chunks_mut(nf.max(1)).enumerate().take(set.channels().len()) {
-        channels.push(channel_floor(set.channel(c), w));
+    let read = |cut: bool| {
+        let mut weights = vec![1.0; nf * set.channels().len()];
+        let mut channels = Vec::with_capacity(set.channels().len());
+        let mut readings = Vec::with_capacity(set.channels().len());
+        for (c, w) in weights.chunks_mut(nf.max(1)).enumerate().take(set.channels().len()) {
+            let (found, read) = channel_floor(set.channel(c), w, cut);
+            channels.push(found);
+            readings.push(read);
+        }
+        (weights, channels, readings)
+    };
+    let (mut weights, mut channels, mut readings) = read(true);
+    if readings.iter().any(Option::is_none) {
+        // the noise of some channels only: the data's roughness reads it
+        // over all of them, and no value is left out beside the others
+        (weights, channels, _) = read(false);
+        readings.fill(None);
     }
-    channels.iter().any(Option::is_some).then_some(FloorWeights { weights, channels })
+    let noise = readings
+        .iter()
+        .enumerate()
+        .flat_map(|(c, r)| {
+            set.channel(c).iter().map(move |h| r.map_or(f64::NAN, |(floor, relative)| relative.hypot(floor / h.norm())))
+        })
+        .collect();
+    channels.iter().any(Option::is_some).then_some(FloorWeights { weights, channels, noise })
 }
 
-/// [`floor_weights`] for one channel's values `h`, writing `w`.
-fn channel_floor(h: &[C64], w: &mut [f64]) -> Option<ChannelFloor> {
+/// [`floor_weights`] for one channel's values `h`, writing `w`; and the
+/// channel's noise as (floor, relative part) (see [`FloorWeights::noise`])
+/// where a floor is found over more than half the lines and its level
+/// holds over them; values indistinct from the floor weigh 0 there when
+/// `cut` ([`floor_weight`]).
+fn channel_floor(h: &[C64], w: &mut [f64], cut: bool) -> (Option<ChannelFloor>, Option<(f64, f64)>) {
     let n = h.len();
     if n < 11 || h.iter().any(|v| !(v.re.is_finite() && v.im.is_finite())) {
-        return None;
+        return (None, None);
     }
     // the fourth difference: a dip to an antiresonance, smooth in the
     // complex plane over a few lines, leaves it near zero where a second
@@ -244,19 +308,47 @@ fn channel_floor(h: &[C64], w: &mut [f64]) -> Option<ChannelFloor> {
     let threshold = (5.0 * typical).max(0.05);
     let at_floor: Vec<usize> =
         (0..n).filter(|&k| h[k].norm() < level && !resonant[k] && local[k] > threshold).collect();
+    let cut = cut && 2 * at_floor.len() > n;
     for &k in &at_floor {
-        w[k] = (threshold / local[k]).powi(2);
+        w[k] = floor_weight(local[k], threshold, cut);
     }
+    // the floor's level itself: the lines found at it were chosen where
+    // their reading stood above the threshold, which reads it high where
+    // the floor covers few lines (a floor at 3e-3 of the RMS of two modes
+    // beside 0.5 % relative noise: 1.2 and 1.37 times the floor injected);
+    // the quarter of the lines whose neighbourhood (the median modulus of
+    // the 11 lines around) is quietest reads it low where the floor covers
+    // most lines, as their moduli are then the floor's noise, and the
+    // quietest the smallest (0.85 to 0.94 times on a strip at 3e-3 of its
+    // peak, where the lines found read 0.92 to 1.01). Where the quiet
+    // lines read lower, the floor is the geometric mean of the two
+    // readings (0.89 to 0.97 times on the strip, 0.96 to 1.10 on the two
+    // modes); where they read higher, they are not at the floor
+    let around: Vec<f64> = (0..n)
+        .map(|k| {
+            let (lo, hi) = (k.saturating_sub(5), (k + 6).min(n));
+            let mut window = [0.0; 11];
+            for (w, v) in window.iter_mut().zip(&h[lo..hi]) {
+                *w = v.norm();
+            }
+            median(&mut window[..hi - lo]).expect("a window of lines")
+        })
+        .collect();
+    let mut by_around: Vec<usize> = (0..n).collect();
+    by_around.sort_by(|&a, &b| around[a].total_cmp(&around[b]));
+    let quiet = median(&mut by_around[..n / 4].iter().map(|&k| rough[k]).collect::<Vec<_>>()).expect("lines");
+    let relative = typical / TENTH_OF_MEDIAN_OF_FIVE;
     // a floor covers a share of the band: a few lines alone are the
     // reading's scatter beside sharp features (1 % relative noise on the
     // tutorial's frame, 1 Hz lines: 1 to 6 of 599 per channel)
     let lines = at_floor.len();
     if lines < (n / 50).max(5) || !flat(&at_floor, h, &rough) {
         w.fill(1.0);
-        return None;
+        return (None, None);
     }
     // the median of the floor's lines' roughness, on the local reading's scale
-    let at_level = median(&mut at_floor.iter().map(|&k| rough[k]).collect::<Vec<_>>())?;
+    let at_level = median(&mut at_floor.iter().map(|&k| rough[k]).collect::<Vec<_>>()).expect("lines at the floor");
+
     // the floor's level over |H| is a line's relative noise, read without
     // the local reading's scatter (lines a scattered reading left at
     // weight 1 at a floor at 3e-3 of a strip's peak, and the lines beside
@@ -268,28 +360,68 @@ fn channel_floor(h: &[C64], w: &mut [f64]) -> Option<ChannelFloor> {
     // the local reading stays
     let by_level = |k: usize| at_level / h[k].norm();
     let placed = (0..n).filter(|&k| by_level(k) > threshold).count();
-    let lines = if 2 * placed <= 3 * lines {
+    let (lines, level_holds) = if 2 * placed <= 3 * lines {
+        let cut = cut && 2 * placed > n;
         for (k, w) in w.iter_mut().enumerate() {
-            let q = by_level(k);
-            *w = if q > threshold { (threshold / q).powi(2) } else { 1.0 };
+            *w = floor_weight(by_level(k), threshold, cut);
         }
-        placed
+        (placed, true)
     } else {
-        lines
+        (lines, false)
     };
+    let floor = (at_level * quiet.min(at_level)).sqrt() / MEDIAN_OF_MODULUS;
     // the weighted noise's RMS over its median outside the resonances
     // (whose reading is their curvature, not their noise): a noise level
     // read as a median of the weighted values' roughness, times this, is
     // the RMS a fit's weighted residual leaves
     let mut weighted: Vec<f64> = (0..n)
-        .filter(|&k| h[k].norm() < level && !resonant[k])
+        .filter(|&k| h[k].norm() < level && !resonant[k] && w[k] > 0.0)
         .map(|k| w[k] * local[k])
         .filter(|s| s.is_finite())
         .collect();
     let rms = (weighted.iter().map(|s| s * s).sum::<f64>() / weighted.len().max(1) as f64).sqrt();
     let spread = median(&mut weighted).filter(|&m| m > 0.0).map_or(1.0, |m| (rms / m).max(1.0));
-    Some(ChannelFloor { lines, typical, threshold, floor: at_level / MEDIAN_OF_MODULUS, spread })
+    // the noise of each value where the floor covers over half the lines
+    // and its level holds over them: there a median over the lines is the
+    // noise of none of them (see `FloorWeights::noise`)
+    let reading = (level_holds && 2 * lines > n).then_some((floor, relative));
+    (Some(ChannelFloor { lines, typical, threshold, relative, floor, spread }), reading)
 }
+
+/// The weight of a line whose relative noise (on the median's scale, as
+/// [`floor_weights`] reads it) is `q`, against the channel's threshold `t`:
+/// 1 up to the threshold, `(t / q)^2` above it, and, where the floor
+/// covers over half the channel's lines and the noise of every channel is
+/// read from its floor (`cut`), 0 where the value is
+/// not clearly above the floor (its modulus below 4 times the floor's RMS,
+/// or `q` above twice the threshold where that is higher). There the value is mostly the
+/// floor's noise, which tells only that the response lies below it: its
+/// logarithm is the noise's, not the response's plus a small error, and a
+/// model whose response lies far below the floor leaves a residual of the
+/// order of `ln` of their ratio, not of `q` (on a strip whose receptance
+/// falls below a floor at 3e-3 of its peak on most lines, such lines,
+/// weighted `(t / q)^2` with `|M|` 2 to 3 times the floor by chance, were
+/// the largest weighted residuals of the truth, 0.1 to 0.18 where `t^2 /
+/// q` put 0.01, and held its misfit at 3.5 times the weighted noise).
+/// Elsewhere their weights stay `(t / q)^2`: the noise there is read
+/// from the roughness of the lines (see [`FloorWeights::noise`]), which
+/// lines left out beside those that weigh would read lower than a fit's
+/// residual leaves (the strip at a floor of 1e-5 of its peak: 1.5 times
+/// the noise where its update converged at 1.19 with every line weighted).
+fn floor_weight(q: f64, t: f64, cut: bool) -> f64 {
+    if cut && q > (MEDIAN_OF_MODULUS / INDISTINCT).max(2.0 * t) {
+        0.0
+    } else if q > t {
+        (t / q).powi(2)
+    } else {
+        1.0
+    }
+}
+
+/// A value below this many times the floor's RMS is not told from the
+/// floor ([`floor_weight`]): pure noise of that RMS exceeds it once in
+/// `e^16` (about 9 million) values.
+const INDISTINCT: f64 = 4.0;
 
 /// Whether the noise read at `lines` is a floor: a level that does not
 /// follow `|H|` (the least-squares slope of `ln` of the local level over
@@ -420,10 +552,14 @@ mod tests {
             let below = clean.channel(0).iter().filter(|h| h.norm() < sigma).count();
             assert!(below * 10 > 8 * clean.n_freq(), "{below} of {} lines below the floor", clean.n_freq());
             let found = floor_weights(&s).expect("a floor");
-            for (k, (&w, h)) in found.weights.iter().zip(clean.channel(0)).enumerate() {
+            for (k, ((&w, h), m)) in found.weights.iter().zip(clean.channel(0)).zip(s.channel(0)).enumerate() {
                 let snr = h.norm() / sigma;
                 if snr < 1.0 {
                     assert!(w < 0.25, "seed {seed}, line {k}: SNR {snr:.2}, weight {w:.3}");
+                }
+                // a value the floor's noise could make alone tells nothing of ln H
+                if m.norm() < 2.0 * sigma {
+                    assert_eq!(w, 0.0, "seed {seed}, line {k}: |M| {:.2} times the floor", m.norm() / sigma);
                 }
                 if snr > 200.0 {
                     assert_eq!(w, 1.0, "seed {seed}, line {k}: SNR {snr:.0}");
@@ -439,11 +575,55 @@ mod tests {
         let mut s = two_modes();
         NoiseModel { relative: 0.0, floor: 0.01, seed: 4 }.apply(&mut s);
         let found = floor_weights(&s).unwrap();
-        s.set_floor_weights(found.weights.clone(), found.spreads()).unwrap();
+        s.set_floor_weights(found.weights.clone(), found.noise.clone(), found.spreads()).unwrap();
         let picked = s.to_receptance().converted(FrfKind::Accelerance).select_lines(&[3, 400, 500]).unwrap();
         let w = picked.select_channels(&[0]).floor_weights(0).unwrap().to_vec();
         assert_eq!(w, [found.weights[3], found.weights[400], found.weights[500]]);
-        assert!(s.set_floor_weights(vec![1.0; 3], found.spreads()).is_err());
+        assert!(s.set_floor_weights(vec![1.0; 3], found.noise.clone(), found.spreads()).is_err());
         assert_eq!(picked.floor_spread(0), Some(found.spreads()[0]));
+        let q = picked.select_channels(&[0]).floor_noise(0).unwrap().to_vec();
+        assert_eq!(q, [found.noise[3], found.noise[400], found.noise[500]]);
+    }
+
+    /// The noise each value carries, as the floor's reading tells it where
+    /// the floor covers over half the lines, is the noise the
+    /// values carry: over the lines that weigh, the RMS of the weighted
+    /// relative errors injected (0.5 % relative beside a floor at 3 % and
+    /// 30 % of the channel's RMS) is within 0.8 and 1.25 times that of the
+    /// weighted noise read (seen: 0.98 to 1.17), and a relative part, where
+    /// one is read, is read at its level.
+    #[test]
+    fn the_noise_read_for_each_value_is_the_noise_it_carries() {
+        for (floor, seed) in [(0.03, 9), (0.03, 10), (0.3, 9), (0.3, 10)] {
+            let clean = two_modes();
+            let mut s = clean.clone();
+            NoiseModel { relative: 0.005, floor, seed }.apply(&mut s);
+            let found = floor_weights(&s).expect("a floor");
+            let ch = found.channels[0].expect("on the channel");
+            let (mut injected, mut read, mut n) = (0.0, 0.0, 0);
+            assert!(2 * ch.lines > clean.n_freq(), "the floor covers {} lines", ch.lines);
+            for (k, ((&w, h), m)) in found.weights.iter().zip(clean.channel(0)).zip(s.channel(0)).enumerate() {
+                let q = found.noise[k];
+                assert!((q - ch.relative.hypot(ch.floor / m.norm())).abs() <= 1e-12 * q, "line {k}");
+                if w > 0.0 {
+                    injected += (w * (m / h).ln()).norm_sqr();
+                    read += (w * q).powi(2);
+                    n += 1;
+                }
+            }
+            let ratio = (injected / read).sqrt();
+            let rms = (clean.channel(0).iter().map(|v| v.norm_sqr()).sum::<f64>() / clean.n_freq() as f64).sqrt();
+            println!(
+                "floor {floor}, seed {seed}: relative {:.5}, floor read {:.3}, {n} lines weigh, injected / read {ratio:.3}",
+                ch.relative,
+                ch.floor / (floor * rms)
+            );
+            assert!((0.8..1.25).contains(&ratio), "floor {floor}, seed {seed}: injected / read {ratio:.3}");
+            assert!(
+                ch.relative == 0.0 || (ch.relative / 0.005 - 1.0).abs() < 0.3,
+                "floor {floor}, seed {seed}: relative {:.5}",
+                ch.relative
+            );
+        }
     }
 }

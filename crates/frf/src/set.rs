@@ -58,6 +58,38 @@ impl fmt::Display for FrfKind {
     }
 }
 
+/// What a set carries of a noise floor found in its data
+/// ([`crate::noise::floor_weights`]): per channel and line, channel-major,
+/// the weights and the relative noise of each value, and per channel the
+/// spread of the weighted noise.
+#[derive(Clone, Debug, PartialEq)]
+struct FloorNoise {
+    weights: Vec<f64>,
+    noise: Vec<f64>,
+    spread: Vec<f64>,
+}
+
+impl FloorNoise {
+    /// The values at lines `idx` of every channel (of `nf` lines), and the
+    /// channels `channels` (all when `None`).
+    fn pick(&self, nf: usize, idx: Option<&[usize]>, channels: &[usize]) -> FloorNoise {
+        let per_value = |v: &Vec<f64>| -> Vec<f64> {
+            channels
+                .iter()
+                .flat_map(|&c| match idx {
+                    Some(idx) => idx.iter().map(|&k| v[c * nf + k]).collect::<Vec<_>>(),
+                    None => v[c * nf..(c + 1) * nf].to_vec(),
+                })
+                .collect()
+        };
+        FloorNoise {
+            weights: per_value(&self.weights),
+            noise: per_value(&self.noise),
+            spread: channels.iter().map(|&c| self.spread[c]).collect(),
+        }
+    }
+}
+
 /// A set of FRFs over common frequency lines.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FrfSet {
@@ -69,9 +101,9 @@ pub struct FrfSet {
     /// Optional coherence per channel and line, same layout.
     coherence: Option<Vec<f64>>,
     /// Optional weights from an additive noise floor per channel and line,
-    /// same layout, and per channel the spread of the weighted noise
-    /// ([`crate::noise::floor_weights`]).
-    floor_weights: Option<(Vec<f64>, Vec<f64>)>,
+    /// and the relative noise of each value that the floor's reading
+    /// tells, both in the same layout ([`crate::noise::floor_weights`]).
+    floor_weights: Option<FloorNoise>,
 }
 
 impl FrfSet {
@@ -162,24 +194,42 @@ impl FrfSet {
     /// ([`crate::noise::floor_weights`]), when one was attached.
     pub fn floor_weights(&self, c: usize) -> Option<&[f64]> {
         let nf = self.n_freq();
-        self.floor_weights.as_ref().map(|(w, _)| &w[c * nf..(c + 1) * nf])
+        self.floor_weights.as_ref().map(|f| &f.weights[c * nf..(c + 1) * nf])
+    }
+
+    /// The RMS relative noise of each line of channel `c` as the reading
+    /// of a noise floor tells it ([`crate::noise::FloorWeights::noise`]:
+    /// NaN on a channel without a floor), when floor weights were attached.
+    pub fn floor_noise(&self, c: usize) -> Option<&[f64]> {
+        let nf = self.n_freq();
+        self.floor_weights.as_ref().map(|f| &f.noise[c * nf..(c + 1) * nf])
     }
 
     /// The spread of channel `c`'s weighted noise
     /// ([`crate::noise::ChannelFloor::spread`]), when floor weights were
     /// attached.
     pub fn floor_spread(&self, c: usize) -> Option<f64> {
-        self.floor_weights.as_ref().map(|(_, s)| s[c])
+        self.floor_weights.as_ref().map(|f| f.spread[c])
     }
 
-    /// Attaches noise-floor weights (channel-major, same layout as the
-    /// data) and each channel's spread of the weighted noise, carried by
-    /// the sets selected from this one.
-    pub fn set_floor_weights(&mut self, values: Vec<f64>, spread: Vec<f64>) -> Result<(), FrfError> {
-        if values.len() != self.data.len() || spread.len() != self.channels.len() {
-            return Err(MismatchError::WeightsLength { values: values.len(), frfs: self.data.len() }.into());
+    /// The relative noise of every value (channel-major, as
+    /// [`FrfSet::floor_noise`] per channel), when floor weights were attached.
+    pub fn floor_noise_values(&self) -> Option<&[f64]> {
+        self.floor_weights.as_ref().map(|f| &f.noise[..])
+    }
+
+    /// Attaches noise-floor weights and the relative noise of each value
+    /// (both channel-major, same layout as the data; NaN on a channel
+    /// whose noise the floor's reading does not tell), and each channel's
+    /// spread of the weighted noise, carried by the sets selected from
+    /// this one.
+    pub fn set_floor_weights(&mut self, values: Vec<f64>, noise: Vec<f64>, spread: Vec<f64>) -> Result<(), FrfError> {
+        if values.len() != self.data.len() || noise.len() != self.data.len() || spread.len() != self.channels.len() {
+            let values =
+                [values.len(), noise.len()].into_iter().find(|&n| n != self.data.len()).unwrap_or(spread.len());
+            return Err(MismatchError::WeightsLength { values, frfs: self.data.len() }.into());
         }
-        self.floor_weights = Some((values, spread));
+        self.floor_weights = Some(FloorNoise { weights: values, noise, spread });
         Ok(())
     }
 
@@ -237,7 +287,8 @@ impl FrfSet {
             (0..self.channels.len()).flat_map(|c| idx.iter().map(move |&k| per_line[c * nf + k])).collect()
         };
         out.coherence = self.coherence.as_ref().map(pick);
-        out.floor_weights = self.floor_weights.as_ref().map(|(w, s)| (pick(w), s.clone()));
+        let all: Vec<usize> = (0..self.channels.len()).collect();
+        out.floor_weights = self.floor_weights.as_ref().map(|f| f.pick(nf, Some(idx), &all));
         Ok(out)
     }
 
@@ -250,7 +301,7 @@ impl FrfSet {
             idx.iter().flat_map(|&c| per_line[c * nf..(c + 1) * nf].iter().copied()).collect()
         };
         let coherence = self.coherence.as_ref().map(pick);
-        let floor_weights = self.floor_weights.as_ref().map(|(w, s)| (pick(w), idx.iter().map(|&c| s[c]).collect()));
+        let floor_weights = self.floor_weights.as_ref().map(|f| f.pick(nf, None, idx));
         FrfSet {
             frequencies_hz: self.frequencies_hz.clone(),
             channels,

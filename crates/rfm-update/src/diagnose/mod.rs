@@ -133,9 +133,19 @@ pub fn estimate_noise(measured: &FrfSet) -> Option<f64> {
 /// noise level of a residual weighted the same way, which is what a
 /// weighted fit's residual must be compared with.
 pub fn estimate_noise_weighted(measured: &FrfSet, weights: Option<&[f64]>) -> Option<f64> {
+    estimate_noise_weighted_on(measured, weights, None)
+}
+
+/// [`estimate_noise_weighted`] for a misfit read on the lines `read_on`
+/// (Hz, lines of `measured`; by default the misfit's, see [`with_floor`]).
+fn estimate_noise_weighted_on(measured: &FrfSet, weights: Option<&[f64]>, read_on: Option<&[f64]>) -> Option<f64> {
     let nf = measured.n_freq();
+    let known = floor_noise(measured, weights);
     let mut d2 = Vec::new();
     for c in 0..measured.channels().len() {
+        if read_at_floor(known, c, nf) {
+            continue;
+        }
         let h = measured.channel(c);
         for k in 1..h.len().saturating_sub(1) {
             if h[k - 1].norm() == 0.0 || h[k].norm() == 0.0 || h[k + 1].norm() == 0.0 {
@@ -151,7 +161,23 @@ pub fn estimate_noise_weighted(measured: &FrfSet, weights: Option<&[f64]>) -> Op
             }
         }
     }
-    level_of(d2).map(|l| l * floor_spread(measured, weights))
+    with_floor(measured, weights, known, level_of(d2), read_on)
+}
+
+/// The relative noise of each value of `measured` as the reading of its
+/// noise floor tells it (channel-major, [`FrfSet::floor_noise_values`];
+/// NaN on a channel without a floor), when the values are weighted by the
+/// floor's weights: `weights` given and no coherence (whose weights are
+/// the inverse of the noise, so that the weighted values have one level
+/// throughout).
+fn floor_noise<'a>(measured: &'a FrfSet, weights: Option<&[f64]>) -> Option<&'a [f64]> {
+    let n = measured.channels().len();
+    if weights.is_none() || (0..n).any(|c| measured.coherence(c).is_some()) {
+        return None;
+    }
+    // every channel's, or none: where the reading tells the noise of some
+    // channels only, a level read over all of them is the surer
+    measured.floor_noise_values().filter(|q| !q.iter().any(|q| q.is_nan()))
 }
 
 /// What raises a noise level read as a median of weighted values to the
@@ -170,6 +196,65 @@ fn floor_spread(measured: &FrfSet, weights: Option<&[f64]>) -> f64 {
         .map(|c| measured.floor_spread(c))
         .collect::<Option<Vec<f64>>>()
         .map_or(1.0, |spreads| (spreads.iter().map(|s| s * s).sum::<f64>() / n as f64).sqrt())
+}
+
+/// Whether channel `c`'s noise is the floor reading's (`known`, over `nf`
+/// lines per channel), not its roughness's.
+fn read_at_floor(known: Option<&[f64]>, c: usize, nf: usize) -> bool {
+    known.is_some_and(|q| q.get(c * nf).is_some_and(|q| !q.is_nan()))
+}
+
+/// The noise level of values weighted by `weights`: `level`, read from the
+/// roughness of the values as a median, times the RMS of the channels'
+/// floor spreads ([`floor_spread`]); or, where the data carry a noise floor
+/// whose reading tells the noise of every value (`known`, see
+/// [`frf::noise::FloorWeights::noise`]), the RMS of `w q` for the noise `q`
+/// of each value of weight `w` above 0 on the lines where the misfit is
+/// read (`read_on`, by default the [`informative_lines`] of
+/// [`crate::quantities::MISFIT_LINES`]): the noise a weighted residual
+/// leaves there. A floor's noise differs from line to line as the inverse
+/// of the modulus, and a weight of `(t / q)^2` leaves the weighted noise
+/// `t^2 / q` of a line near the floor as high as the threshold `t` where
+/// cleaner lines carry far less: over so many lines at a floor, a single
+/// level read from the lines' roughness as a median is the noise of none
+/// of them (on a strip whose receptance lies below a floor at 3e-3 of its
+/// peak on most lines, the median read 0.0041 where the truth's weighted
+/// residual left 0.037), and the lines beside the resonances, which read
+/// it, hold mostly the dynamics.
+fn with_floor(
+    measured: &FrfSet,
+    weights: Option<&[f64]>,
+    known: Option<&[f64]>,
+    level: Option<f64>,
+    read_on: Option<&[f64]>,
+) -> Option<f64> {
+    let Some(known) = known else { return level.map(|l| l * floor_spread(measured, weights)) };
+    let weights = weights.expect("a floor's noise is read for weighted values");
+    let nf = measured.n_freq();
+    let nc = measured.channels().len();
+    let misfit_lines;
+    let read_on = match read_on {
+        Some(lines) => lines,
+        None => {
+            misfit_lines = informative_lines(measured, crate::quantities::MISFIT_LINES);
+            &misfit_lines[..]
+        }
+    };
+    let lines: Vec<usize> = read_on.iter().filter_map(|&f| measured.line_of(f)).collect();
+    let (mut sum, mut n) = (0.0, 0usize);
+    for i in (0..nc).flat_map(|c| lines.iter().map(move |&k| c * nf + k)) {
+        let (w, q, m) = (weights[i], known[i], measured.values()[i]);
+        if !(w > 0.0 && m.norm() > 0.0) {
+            continue;
+        }
+        if !q.is_finite() {
+            continue;
+        }
+        let s = w * q;
+        sum += s * s;
+        n += 1;
+    }
+    (n > 0).then(|| (sum / n as f64).sqrt())
 }
 
 /// The noise level from squared second differences `|e(k+1) - 2 e(k) +
@@ -215,10 +300,24 @@ pub fn estimate_noise_against_weighted(
     measured: &FrfSet,
     weights: Option<&[f64]>,
 ) -> Result<Option<f64>, UpdateError> {
+    estimate_noise_against_on(sys, measured, weights, None)
+}
+
+/// [`estimate_noise_against_weighted`] for a misfit read on the lines
+/// `read_on` (Hz, lines of `measured`), where that is not the misfit's
+/// ([`crate::quantities::misfit`]): for data at a noise floor, the noise of
+/// each value differs from line to line, and a fit's residual on its own
+/// lines is compared with the noise there.
+pub fn estimate_noise_against_on(
+    sys: &DampedSystem,
+    measured: &FrfSet,
+    weights: Option<&[f64]>,
+    read_on: Option<&[f64]>,
+) -> Result<Option<f64>, UpdateError> {
     let freqs = noise_lines(measured);
     // a triplet with a line where the model is singular is left out
     let (model, _) = frf::synthesize_regular(sys, measured.channels(), &freqs)?;
-    Ok(noise_against(measured, weights, &model))
+    Ok(noise_against(measured, weights, &model, read_on))
 }
 
 /// The lines of the triplets that [`estimate_noise_against`] reads (none
@@ -280,18 +379,28 @@ pub fn residual_roughness(
     let freqs: Vec<f64> = idx.iter().map(|&k| lines[k]).collect();
     // a triplet with a line where the model is singular is left out
     let (model, _) = frf::synthesize_regular(sys, measured.channels(), &freqs)?;
-    Ok(residual_level(measured, weights, &model, &centres))
+    Ok(residual_level(measured, weights, &model, &centres, None))
 }
 
 /// The level of the residual's second differences at the triplets centred
 /// on `centres`, the model's receptances given at their lines (a triplet
 /// with a line the model lacks is left out).
-fn residual_level(measured: &FrfSet, weights: Option<&[f64]>, model: &FrfSet, centres: &[usize]) -> Option<f64> {
+fn residual_level(
+    measured: &FrfSet,
+    weights: Option<&[f64]>,
+    model: &FrfSet,
+    centres: &[usize],
+    read_on: Option<&[f64]>,
+) -> Option<f64> {
     let nf = measured.n_freq();
     let lines = measured.frequencies_hz();
     let model = model.converted(measured.kind());
+    let known = floor_noise(measured, weights);
     let mut d2 = Vec::new();
     for c in 0..measured.channels().len() {
+        if read_at_floor(known, c, nf) {
+            continue;
+        }
         for &k in centres {
             let w = weights.map_or(1.0, |w| w[c * nf + k]);
             if w == 0.0 {
@@ -309,13 +418,13 @@ fn residual_level(measured: &FrfSet, weights: Option<&[f64]>, model: &FrfSet, ce
             }
         }
     }
-    level_of(d2).map(|l| l * floor_spread(measured, weights))
+    with_floor(measured, weights, known, level_of(d2), read_on)
 }
 
 /// [`estimate_noise_against_weighted`] with the model's receptances given
 /// at (at least) the lines of [`noise_lines`].
-fn noise_against(measured: &FrfSet, weights: Option<&[f64]>, model: &FrfSet) -> Option<f64> {
-    let own = estimate_noise_weighted(measured, weights);
+fn noise_against(measured: &FrfSet, weights: Option<&[f64]>, model: &FrfSet, read_on: Option<&[f64]>) -> Option<f64> {
+    let own = estimate_noise_weighted_on(measured, weights, read_on);
     let nf = measured.n_freq();
     if nf < 3 {
         return own;
@@ -323,7 +432,7 @@ fn noise_against(measured: &FrfSet, weights: Option<&[f64]>, model: &FrfSet) -> 
     let (centres, _) = noise_triplets(nf);
     // the residual's level, read on fewer lines, only where it is clearly
     // lower: where both agree, the data's own (on every line) is the surer
-    match (own, residual_level(measured, weights, model, &centres)) {
+    match (own, residual_level(measured, weights, model, &centres, read_on)) {
         (Some(a), Some(b)) if b < CLEARLY_LOWER * a => Some(b),
         (a, b) => a.or(b),
     }
@@ -897,7 +1006,7 @@ fn diagnose_in(
         at_lines = frf::synthesize_regular(&nominal, measured.channels(), &read_of(measured))?.0;
     }
     let lines = measured.frequencies_hz();
-    let noise = noise_against(measured, weights, &at_lines)
+    let noise = noise_against(measured, weights, &at_lines, None)
         .ok_or_else(|| UpdateError::Data("too few usable measured values to estimate the noise level".into()))?;
     // a noise floor for noise-free data keeps the criterion finite
     let s2 = (noise * noise / 2.0).max(1e-20);

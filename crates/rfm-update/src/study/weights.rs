@@ -115,9 +115,9 @@ fn coherence_weights(case: &CaseFile, measured: &FrfSet) -> Result<Option<Vec<f6
 /// of `measured`, the case's data) is compared with: the noise weighted as
 /// the residual is. The coherence weight is the inverse of an FRF
 /// estimate's relative standard deviation up to a constant, so the
-/// weighted values have one noise level throughout (a noise floor's
-/// weights leave the lines near it noisier, and the level read is raised
-/// by their spread: `diagnose::estimate_noise_weighted`), estimated
+/// weighted values have one noise level throughout (the noise of data at
+/// a floor differs from line to line, and is read on the fitted lines from
+/// the floor: [`crate::diagnose::estimate_noise_against_on`]), estimated
 /// from their roughness over every measured line, and from that of their
 /// residual against the model `sys` where that is lower (on lines coarse
 /// against the peaks the data's own roughness is mostly the dynamics;
@@ -130,7 +130,8 @@ pub fn residual_noise_for(
     fitted: &FrfSet,
 ) -> Result<Option<f64>, UpdateError> {
     let noise = noise_weights(case, measured)?;
-    let Some(level) = crate::diagnose::estimate_noise_against_weighted(sys, measured, noise.as_deref())? else {
+    let on = Some(fitted.frequencies_hz());
+    let Some(level) = crate::diagnose::estimate_noise_against_on(sys, measured, noise.as_deref(), on)? else {
         return Ok(None);
     };
     let Some(band) = band_weights(case, fitted) else { return Ok(Some(level)) };
@@ -156,7 +157,7 @@ pub(crate) fn attach_floor_weights(set: &mut FrfSet) -> Option<String> {
         return None;
     }
     let found = frf::noise::floor_weights(set)?;
-    set.set_floor_weights(found.weights.clone(), found.spreads()).expect("one weight per value");
+    set.set_floor_weights(found.weights.clone(), found.noise.clone(), found.spreads()).expect("one weight per value");
     let per: Vec<String> = found
         .channels
         .iter()

@@ -139,9 +139,11 @@ fn fit(data: frf::FrfSet) -> Fit {
 /// lines at it are found and weighed down, the moduli come within 0.5 %
 /// (1 % at 1e-5; seen: up to 0.54 %) of the truth and within 3 of their standard deviations
 /// (and every other parameter the data determine within 3), and the
-/// update converges within the verdict's 1.5 times the noise (seen: 0.84
-/// to 1.39; before the floor's level was read over `|H|` on every line,
-/// 1.26 to 1.79, 3 of the 4 "model inadequate").
+/// update converges within the verdict's 1.5 times the noise (seen: 0.99
+/// to 1.13, against the noise read for each value on the fitted lines;
+/// 0.84 to 1.39 against one level read as a median over the lines, and
+/// 1.26 to 1.79 before the floor's level was read over `|H|` on every
+/// line, 3 of the 4 "model inadequate").
 /// The same data fitted with every line weighted alike (floor weights of
 /// 1 attached beforehand, which the study then keeps) end "model
 /// inadequate" at over 5 times the noise (seen: 7.6 to 22), the
@@ -167,7 +169,9 @@ fn the_lines_at_a_noise_floor_are_weighed_down_and_the_update_finds_the_truth() 
         assert_eq!(f.status, Status::Converged, "{floor}/{seed}");
         let mut alike = data;
         let n = alike.channels().len();
-        alike.set_floor_weights(vec![1.0; n * alike.n_freq()], vec![1.0; n]).unwrap();
+        alike
+            .set_floor_weights(vec![1.0; n * alike.n_freq()], vec![f64::NAN; n * alike.n_freq()], vec![1.0; n])
+            .unwrap();
         let g = fit(alike);
         assert!(g.ratio > 5.0, "{floor}/{seed}: weighted alike, {:.2} times the noise", g.ratio);
         assert_ne!(g.status, Status::Converged);
@@ -186,6 +190,79 @@ fn relative_noise_has_no_floor_weights() {
     assert!(study.weights(study.measured()).unwrap().is_none());
 }
 
+/// The noise level read from data at a floor over most lines of every
+/// channel (and no coherence) is the noise they carry: the truth's
+/// weighted misfit over the diagnosis's lines reads within 0.75 and 1.33
+/// times it, read against the truth or against the nominal model, from a
+/// floor at 3e-3 of each channel's peak to one at 3e-2 (the first
+/// resonances alone stand above it). Before the noise of each value was
+/// read from the floor, a single level read as a median over lines whose
+/// weighted noise ranges from the threshold's down to a hundredth of it
+/// put the truth at 6 times the noise at 3e-3 (seen: 0.0257 against
+/// 0.0041), "model inadequate" for the right model.
+#[test]
+fn the_truth_reads_at_the_noise_read_from_data_at_a_floor() {
+    for (floor, seed) in [(3e-3, 1), (3e-3, 2), (3e-2, 1), (3e-2, 2)] {
+        let case = case();
+        let data = measured(&case, floor, seed);
+        let truth = damping::DampedSystem::new(case.truth.as_ref().unwrap().model.clone()).unwrap();
+        let study = Study::with_measured(case, data).unwrap();
+        let weights = study.line_weights(study.measured()).unwrap();
+        let (m, w) = (study.measured(), weights.as_deref());
+        let misfit = rfm_update::quantities::misfit(&truth, m, study.gains(), w).unwrap();
+        let noise = rfm_update::quantities::noise(&truth, m, w).unwrap().unwrap();
+        let against_nominal = rfm_update::quantities::noise(study.system(), m, w).unwrap().unwrap();
+        println!(
+            "{floor}/{seed}: the truth's misfit {misfit:.4}, noise {noise:.4} ({:.2} x; {against_nominal:.4} read against the nominal)",
+            misfit / noise
+        );
+        assert!(w.is_some(), "{floor}/{seed}: no floor found");
+        for n in [noise, against_nominal] {
+            assert!(
+                (0.75..=1.0 / 0.75).contains(&(misfit / n)),
+                "{floor}/{seed}: the truth at {:.2} x the noise {n:.4}",
+                misfit / n
+            );
+        }
+    }
+}
+
+/// `rfm fix` on a floor over most lines: the case's own four parameters
+/// are updated (step 0), found within 1 % of the truth, nothing is added,
+/// and the loop ends at the noise (seen: 1.07 and 1.18 times it). Before
+/// the noise of each value was read from the floor, the same loop ended
+/// "model inadequate" at 6.3 times a noise level read low.
+#[test]
+fn the_loop_on_a_floor_over_most_lines_ends_at_the_noise_with_nothing_added() {
+    use rfm_update::fix::{CONSISTENT, FixOptions, FixStop, fix};
+    for seed in [1, 2] {
+        let study = Study::with_measured(case(), measured(&case(), 3e-3, seed)).unwrap();
+        let opts = FixOptions {
+            max_steps: 2,
+            diagnose: study.diagnose_options(study.measured()).unwrap(),
+            ..FixOptions::default()
+        };
+        let outcome = fix(study.case(), study.measured(), &opts, |_| {}).unwrap();
+        let d = outcome.declared.as_ref().expect("step 0");
+        let ratio = outcome.final_misfit() / outcome.noise;
+        println!("seed {seed}: {:.4} x the noise {:.4}, {:?}", ratio, outcome.noise, outcome.stop);
+        for p in &d.parameters {
+            // the moduli as the update's test holds them; the damping, read
+            // on the resonances alone, within 5 % (seen: up to 1.8 %)
+            let bound = if p.name.ends_with(".E") { 0.01 } else { 0.05 };
+            let err = (p.updated / truth_of(&p.name) - 1.0).abs();
+            assert!(err < bound, "{seed}: {} {:.2} % off", p.name, 100.0 * err);
+        }
+        assert!(
+            outcome.effects.is_empty(),
+            "{seed}: added {:?}",
+            outcome.effects.iter().map(|e| &e.description).collect::<Vec<_>>()
+        );
+        assert!(ratio <= CONSISTENT, "{seed}: final misfit {ratio:.2} x the noise");
+        assert_eq!(outcome.stop, FixStop::NothingSignificant, "{seed}");
+    }
+}
+
 /// A floor at 3e-3 of each channel's peak, as a generator that adds noise
 /// at a fraction of the peak makes it: the strip's receptance falls below
 /// it on 85 to 96 % of the lines, and only the first resonances stand out.
@@ -195,9 +272,11 @@ fn relative_noise_has_no_floor_weights() {
 /// moduli to 7.2 and 0.16 times the truth (seed 1), 12 and 9 standard
 /// deviations off. The moduli now come within 1 %
 /// of the truth and within 3 of their standard deviations. The misfit is
-/// not asserted: the noise level read beside so many weighted lines is
-/// low (seen: the fit leaves 2.9 and 3.7 times it, "model inadequate"), a known
-/// shortfall the docs name.
+/// not asserted: on the update's 60 lines few values weigh above 0 (the
+/// rest lie at the floor), and one of them 2.3 times its noise moves it
+/// (seen: the fit leaves 0.99 and 1.56 times the noise on its lines, the
+/// truth 1.36 and 1.45; against a single level read as a median over
+/// the lines, 2.9 and 3.7).
 #[test]
 fn a_floor_over_most_lines_leaves_the_moduli_to_the_resonances() {
     for seed in [1, 2] {
