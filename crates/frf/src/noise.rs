@@ -198,12 +198,12 @@ pub const TENTH_OF_MEDIAN_OF_FIVE: f64 = 0.532_172_312_257_883;
 /// others (a weight of `t / q`, proportional to `|H|` there as a fit of
 /// `H` itself would weigh them, left every such line at the threshold's
 /// noise, and a model that explained the data read 3 to 4 times the
-/// noise). A value whose modulus is below 4 times the floor's RMS is
-/// the floor's more than the response's, and weighs 0
-/// ([`floor_weight`]). Data with relative noise only, or
-/// none, have no such lines, and are fitted as before. The floor's
-/// relative noise at each value ([`FloorWeights::relative`]) tells what
-/// noise the weighted values carry, line by line.
+/// noise). Where the floor covers over half the lines of every channel,
+/// a value whose modulus is below 4 times the floor's RMS is the floor's
+/// more than the response's and weighs 0, and the noise of each value
+/// ([`FloorWeights::noise`]) tells what noise the weighted values carry,
+/// line by line. Data with relative noise only, or none, have no such
+/// lines, and are fitted as before.
 ///
 /// Run it on the data as measured (the floor is flat in the measured
 /// quantity, not in a converted one); the weights are the same for every
